@@ -1,0 +1,33 @@
+// Exact 64-bit event counters (ours: the thesis counted triangle tests on the CPU side).
+// GLSL 4.50 has no 64-bit atomics, so every counter is a pair of uints (low, high) with a
+// carry: atomicAdd returns the old low word, and an addition that wraps it adds 1 to the high
+// word. Each work group first sums its invocations' counts in shared memory, so there is one
+// global atomic per work group and counter. The host clears the buffer every frame.
+layout(std430, binding = 8) coherent buffer CounterBuffer { uint counters[]; };
+
+shared uint groupCount[COUNTER_SLOTS_PER_KERNEL];
+
+void countersBegin()
+{
+    if (gl_LocalInvocationIndex < uint(COUNTER_SLOTS_PER_KERNEL))
+        groupCount[gl_LocalInvocationIndex] = 0u;
+    barrier();
+}
+
+void countAdd(int local, uint n)
+{
+    if (n > 0u) atomicAdd(groupCount[local], n);
+}
+
+// local: the kernel's own counter 0..COUNTER_SLOTS_PER_KERNEL-1; slot: the global counter.
+void countersEnd(int local, int slot)
+{
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        uint n = groupCount[local];
+        if (n > 0u) {
+            uint old = atomicAdd(counters[2 * slot], n);
+            if (old > 0xFFFFFFFFu - n) atomicAdd(counters[2 * slot + 1], 1u);
+        }
+    }
+}

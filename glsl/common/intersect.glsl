@@ -1,0 +1,19 @@
+// Ray/triangle intersection, Algorithm 1 of Müller 2015 (ch. 2.1, after Purcell et al.):
+// the Möller–Trumbore test. No determinant epsilon, as in the thesis: a ray parallel to the
+// triangle gives det = 0, 1/det = inf and comparisons that fail, i.e. no hit.
+// Returns true for a hit with t > 0 and the barycentric (u, v).
+bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
+                       out float t, out float u, out float v)
+{
+    vec3 edge1 = v1 - v0;
+    vec3 edge2 = v2 - v0;
+    vec3 pvec = cross(rd, edge2);
+    float det = dot(edge1, pvec);
+    float invDet = 1.0 / det;
+    vec3 tvec = r0 - v0;
+    u = invDet * dot(tvec, pvec);
+    vec3 qvec = cross(tvec, edge1);
+    v = invDet * dot(rd, qvec);
+    t = invDet * dot(edge2, qvec);
+    return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
+}

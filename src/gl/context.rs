@@ -1,0 +1,297 @@
+//! Headless OpenGL 4.5 core context through glutin's EGL device platform.
+//!
+//! `Device::query_devices()` enumerates the EGL devices (Mesa's llvmpipe "software" device on a
+//! machine without a GPU, the NVIDIA device on an NVIDIA machine); a display is created on the
+//! chosen device, a config with an empty surface type is chosen (the default template asks for
+//! window surfaces and then finds nothing), and a 4.5 core context is made current without a
+//! surface. All rendering happens in our own textures and framebuffers.
+
+use std::ffi::{c_void, CString};
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use glow::HasContext;
+use glutin::api::egl::{context::PossiblyCurrentContext, device::Device, display::Display};
+use glutin::config::{ConfigSurfaceTypes, ConfigTemplateBuilder};
+use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
+use glutin::prelude::*;
+
+/// Facts about the GL implementation, printed by `info` and stored in the statistics.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GlInfo {
+    pub vendor: String,
+    pub renderer: String,
+    pub version: String,
+    pub glsl_version: String,
+    pub egl_device: usize,
+    pub egl_device_name: String,
+    pub max_ssbo_block_size: i64,
+    pub max_texture_size: i32,
+    pub max_3d_texture_size: i32,
+    pub max_compute_work_group_count: [i32; 3],
+    pub max_compute_work_group_invocations: i32,
+    pub max_compute_shared_memory_size: i32,
+    pub max_vertex_shader_storage_blocks: i32,
+    pub max_compute_shader_storage_blocks: i32,
+    pub max_image_units: i32,
+    pub max_array_texture_layers: i32,
+    pub timer_query_bits: i32,
+}
+
+/// A current GL context. Dropping it releases the context.
+pub struct GlContext {
+    pub gl: Arc<Gl>,
+    pub info: GlInfo,
+    _context: PossiblyCurrentContext,
+    _display: Display,
+}
+
+impl GlContext {
+    /// Open a headless GL 4.5 core context. `device`: the index of the EGL device to use; `None`
+    /// picks the first device that gives a 4.5 core context.
+    pub fn headless(device: Option<usize>) -> Result<GlContext> {
+        let devices: Vec<Device> = Device::query_devices()
+            .map_err(|e| {
+                anyhow!(
+                    "no EGL device platform available ({e}); install Mesa's EGL \
+                     (Debian: libegl1 libegl-mesa0 libgl1-mesa-dri) or the NVIDIA driver"
+                )
+            })?
+            .collect();
+        if devices.is_empty() {
+            bail!("EGL reports no devices; install libegl-mesa0 (llvmpipe) or a GPU driver");
+        }
+        let describe = |i: usize, d: &Device| {
+            format!(
+                "device {i} ({})",
+                d.name().or(d.vendor()).unwrap_or("unnamed EGL device")
+            )
+        };
+        let candidates: Vec<usize> = match device {
+            Some(i) if i < devices.len() => vec![i],
+            Some(i) => bail!(
+                "--device {i}: there are only {} EGL devices: {}",
+                devices.len(),
+                devices
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| describe(i, d))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            None => (0..devices.len()).collect(),
+        };
+        let mut failures = Vec::new();
+        for i in candidates {
+            match Self::open(&devices[i], i) {
+                Ok(ctx) => return Ok(ctx),
+                Err(e) => failures.push(format!("{}: {e:#}", describe(i, &devices[i]))),
+            }
+        }
+        bail!(
+            "no EGL device gives an OpenGL 4.5 core context:\n  {}",
+            failures.join("\n  ")
+        )
+    }
+
+    fn open(device: &Device, index: usize) -> Result<GlContext> {
+        // SAFETY: no native display handle is passed; the device comes from query_devices.
+        let display = unsafe { Display::with_device(device, None) }
+            .map_err(|e| anyhow!("cannot create an EGL display: {e}"))?;
+        let template = ConfigTemplateBuilder::new()
+            .with_surface_type(ConfigSurfaceTypes::empty())
+            .build();
+        // SAFETY: the template is valid for this display.
+        let config = unsafe { display.find_configs(template) }
+            .map_err(|e| anyhow!("no EGL config: {e}"))?
+            .next()
+            .ok_or_else(|| anyhow!("no surfaceless EGL config"))?;
+        let attributes = ContextAttributesBuilder::new()
+            .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
+            .with_profile(GlProfile::Core)
+            .build(None);
+        // SAFETY: the config belongs to this display.
+        let context = unsafe { display.create_context(&config, &attributes) }
+            .map_err(|e| anyhow!("cannot create a GL 4.5 core context: {e}"))?;
+        let context = context
+            .make_current_surfaceless()
+            .map_err(|e| anyhow!("cannot make the context current without a surface: {e}"))?;
+        // SAFETY: the context is current on this thread; symbols come from its display.
+        let load = |name: &str| {
+            let name = CString::new(name).expect("GL symbol names have no NUL");
+            display.get_proc_address(&name)
+        };
+        // SAFETY: the context is current; the loader returns this display's GL entry points.
+        let gl = unsafe { Gl::load(load) }?;
+        let version = gl.version();
+        if (version.major, version.minor) < (4, 5) || version.is_embedded {
+            bail!(
+                "the context is OpenGL {}.{}{}, 4.5 core is needed",
+                version.major,
+                version.minor,
+                if version.is_embedded { " ES" } else { "" }
+            );
+        }
+        let info = query_info(&gl, index, device.name().or(device.vendor()).unwrap_or(""));
+        Ok(GlContext {
+            gl: Arc::new(gl),
+            info,
+            _context: context,
+            _display: display,
+        })
+    }
+}
+
+fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
+    // SAFETY: plain queries on a current context.
+    unsafe {
+        let int = |p: u32| gl.get_parameter_i32(p);
+        let indexed = |p: u32, i: u32| gl.get_parameter_indexed_i32(p, i);
+        let mut timer_bits = 0i32;
+        (gl.get_query_iv)(glow::TIME_ELAPSED, QUERY_COUNTER_BITS, &mut timer_bits);
+        GlInfo {
+            vendor: gl.get_parameter_string(glow::VENDOR),
+            renderer: gl.get_parameter_string(glow::RENDERER),
+            version: gl.get_parameter_string(glow::VERSION),
+            glsl_version: gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION),
+            egl_device: device,
+            egl_device_name: device_name.to_string(),
+            max_ssbo_block_size: gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE),
+            max_texture_size: int(glow::MAX_TEXTURE_SIZE),
+            max_3d_texture_size: int(glow::MAX_3D_TEXTURE_SIZE),
+            max_compute_work_group_count: [
+                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 0),
+                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 1),
+                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 2),
+            ],
+            max_compute_work_group_invocations: int(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS),
+            max_compute_shared_memory_size: int(glow::MAX_COMPUTE_SHARED_MEMORY_SIZE),
+            max_vertex_shader_storage_blocks: int(glow::MAX_VERTEX_SHADER_STORAGE_BLOCKS),
+            max_compute_shader_storage_blocks: int(glow::MAX_COMPUTE_SHADER_STORAGE_BLOCKS),
+            max_image_units: int(glow::MAX_IMAGE_UNITS),
+            max_array_texture_layers: int(glow::MAX_ARRAY_TEXTURE_LAYERS),
+            timer_query_bits: timer_bits,
+        }
+    }
+}
+
+const QUERY_COUNTER_BITS: u32 = 0x8864;
+
+type ClearBufferDataFn = unsafe extern "system" fn(u32, u32, u32, u32, *const c_void);
+type ClearTexImageFn = unsafe extern "system" fn(u32, i32, u32, u32, *const c_void);
+type GetQueryIvFn = unsafe extern "system" fn(u32, u32, *mut i32);
+type GetQueryObjectU64Fn = unsafe extern "system" fn(u32, u32, *mut u64);
+
+/// The GL functions: glow's, plus the few GL 4.4/4.5 entry points glow does not wrap
+/// (`glClearBufferData` — the thesis clears its grid lists with it every frame —,
+/// `glClearTexImage` and `glGetQueryiv`).
+pub struct Gl {
+    glow: glow::Context,
+    clear_buffer_data: ClearBufferDataFn,
+    clear_tex_image: ClearTexImageFn,
+    get_query_iv: GetQueryIvFn,
+    get_query_object_u64: GetQueryObjectU64Fn,
+}
+
+impl std::ops::Deref for Gl {
+    type Target = glow::Context;
+    fn deref(&self) -> &glow::Context {
+        &self.glow
+    }
+}
+
+impl Gl {
+    /// # Safety
+    /// A GL context must be current and `load` must return its entry points.
+    pub unsafe fn load(load: impl Fn(&str) -> *const c_void) -> Result<Gl> {
+        let get = |name: &str| {
+            let p = load(name);
+            if p.is_null() {
+                Err(anyhow!("the GL implementation lacks {name}"))
+            } else {
+                Ok(p)
+            }
+        };
+        let clear_buffer_data = get("glClearBufferData")?;
+        let clear_tex_image = get("glClearTexImage")?;
+        let get_query_iv = get("glGetQueryiv")?;
+        let get_query_object_u64 = get("glGetQueryObjectui64v")?;
+        Ok(Gl {
+            glow: glow::Context::from_loader_function(|n| load(n)),
+            // SAFETY: the pointers are the named GL entry points with these signatures.
+            clear_buffer_data: std::mem::transmute::<*const c_void, ClearBufferDataFn>(
+                clear_buffer_data,
+            ),
+            clear_tex_image: std::mem::transmute::<*const c_void, ClearTexImageFn>(
+                clear_tex_image,
+            ),
+            get_query_iv: std::mem::transmute::<*const c_void, GetQueryIvFn>(get_query_iv),
+            get_query_object_u64: std::mem::transmute::<*const c_void, GetQueryObjectU64Fn>(
+                get_query_object_u64,
+            ),
+        })
+    }
+
+    /// `glClearBufferData(target, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value)` on the
+    /// buffer bound to `target`: every 32-bit word of it becomes `value`.
+    pub fn clear_buffer_u32(&self, target: u32, value: u32) {
+        // SAFETY: value outlives the call; the format describes one u32.
+        unsafe {
+            (self.clear_buffer_data)(
+                target,
+                glow::R32UI,
+                glow::RED_INTEGER,
+                glow::UNSIGNED_INT,
+                &value as *const u32 as *const c_void,
+            )
+        }
+    }
+
+    /// The 64-bit result of a query (`GL_QUERY_RESULT`, waits for it): nanoseconds for
+    /// `GL_TIME_ELAPSED`. (A 32-bit result would wrap after 4.3 s, which a brute-force frame
+    /// on llvmpipe exceeds.)
+    pub fn query_result_u64(&self, query: glow::Query) -> u64 {
+        let mut v = 0u64;
+        // SAFETY: v outlives the call.
+        unsafe { (self.get_query_object_u64)(query.0.get(), glow::QUERY_RESULT, &mut v) };
+        v
+    }
+
+    /// `glClearTexImage` of level 0 with four floats (RGBA32F textures).
+    pub fn clear_tex_f32(&self, texture: glow::Texture, value: [f32; 4]) {
+        // SAFETY: value outlives the call.
+        unsafe {
+            (self.clear_tex_image)(
+                texture.0.get(),
+                0,
+                glow::RGBA,
+                glow::FLOAT,
+                value.as_ptr() as *const c_void,
+            )
+        }
+    }
+
+    /// `glClearTexImage` of level 0 with four unsigned integers (RGBA32UI / R32UI textures).
+    pub fn clear_tex_u32(&self, texture: glow::Texture, format: u32, value: [u32; 4]) {
+        // SAFETY: value outlives the call.
+        unsafe {
+            (self.clear_tex_image)(
+                texture.0.get(),
+                0,
+                format,
+                glow::UNSIGNED_INT,
+                value.as_ptr() as *const c_void,
+            )
+        }
+    }
+}
+
+/// Check `glGetError` after a step and name the step.
+pub fn check_error(gl: &Gl, what: &str) -> Result<()> {
+    // SAFETY: glGetError on a current context.
+    let err = unsafe { gl.get_error() };
+    if err != glow::NO_ERROR {
+        return Err(anyhow!("GL error 0x{err:04x} after {what}")).context("OpenGL call failed");
+    }
+    Ok(())
+}

@@ -1,0 +1,194 @@
+//! Typed helpers for the GL objects the tracers own: shader storage buffers, RGBA32F images,
+//! GPU timers.
+
+use std::collections::BTreeMap;
+
+use anyhow::{anyhow, bail, Result};
+use glow::HasContext;
+
+use super::context::Gl;
+
+/// A shader storage buffer of fixed size.
+pub struct Ssbo {
+    pub buffer: glow::Buffer,
+    pub bytes: usize,
+    pub name: &'static str,
+}
+
+impl Ssbo {
+    /// Allocate `bytes` (at least 16) of immutable storage, optionally filled with `data`,
+    /// after checking the size against `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`.
+    pub fn new(gl: &Gl, name: &'static str, bytes: usize, data: Option<&[u8]>, max_block: i64) -> Result<Ssbo> {
+        let bytes = bytes.max(16);
+        if bytes as i64 > max_block {
+            bail!(
+                "buffer `{name}` needs {bytes} bytes, more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {max_block} \
+                 of this GL implementation; use a smaller scene or image"
+            );
+        }
+        if bytes > i32::MAX as usize {
+            bail!("buffer `{name}` needs {bytes} bytes, more than a GL size can express");
+        }
+        // SAFETY: plain buffer creation on a current context; data is bytes long if given.
+        unsafe {
+            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer));
+            let padded;
+            let data = match data {
+                Some(d) if d.len() < bytes => {
+                    let mut v = d.to_vec();
+                    v.resize(bytes, 0);
+                    padded = v;
+                    Some(&padded[..])
+                }
+                d => d,
+            };
+            gl.buffer_storage(glow::SHADER_STORAGE_BUFFER, bytes as i32, data, glow::DYNAMIC_STORAGE_BIT);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+            Ok(Ssbo { buffer, bytes, name })
+        }
+    }
+
+    pub fn bind(&self, gl: &Gl, binding: u32) {
+        // SAFETY: binding an existing buffer.
+        unsafe { gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, binding, Some(self.buffer)) };
+    }
+
+    /// `glClearBufferData` with a 32-bit value.
+    pub fn clear_u32(&self, gl: &Gl, value: u32) {
+        // SAFETY: binding an existing buffer.
+        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer)) };
+        gl.clear_buffer_u32(glow::SHADER_STORAGE_BUFFER, value);
+        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None) };
+    }
+
+    pub fn read_u32(&self, gl: &Gl) -> Vec<u32> {
+        let mut bytes = vec![0u8; self.bytes];
+        // SAFETY: the slice is the buffer's size.
+        unsafe {
+            gl.memory_barrier(glow::BUFFER_UPDATE_BARRIER_BIT);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer));
+            gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+        }
+        bytemuck::pod_collect_to_vec(&bytes)
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own buffer.
+        unsafe { gl.delete_buffer(self.buffer) };
+    }
+}
+
+/// A 2D texture used as an image (RGBA32F or RGBA32UI).
+pub struct Image2d {
+    pub texture: glow::Texture,
+    pub width: u32,
+    pub height: u32,
+    pub format: u32,
+}
+
+impl Image2d {
+    pub fn new(gl: &Gl, width: u32, height: u32, format: u32) -> Result<Image2d> {
+        // SAFETY: texture creation on a current context.
+        unsafe {
+            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+            gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+            gl.bind_texture(glow::TEXTURE_2D, None);
+            Ok(Image2d { texture, width, height, format })
+        }
+    }
+
+    pub fn bind_image(&self, gl: &Gl, unit: u32) {
+        // SAFETY: binding an existing texture to an image unit.
+        unsafe {
+            gl.bind_image_texture(unit, Some(self.texture), 0, false, 0, glow::READ_WRITE, self.format)
+        };
+    }
+
+    pub fn clear(&self, gl: &Gl) {
+        match self.format {
+            glow::RGBA32UI => gl.clear_tex_u32(self.texture, glow::RGBA_INTEGER, [0; 4]),
+            _ => gl.clear_tex_f32(self.texture, [0.0; 4]),
+        }
+    }
+
+    /// Read back RGBA32F texels, row 0 = the bottom row (GL order).
+    pub fn read_f32(&self, gl: &Gl) -> Vec<[f32; 4]> {
+        let mut data = vec![[0f32; 4]; (self.width * self.height) as usize];
+        // SAFETY: the slice holds width·height RGBA floats.
+        unsafe {
+            gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT);
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            gl.get_tex_image(
+                glow::TEXTURE_2D,
+                0,
+                glow::RGBA,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
+            );
+            gl.bind_texture(glow::TEXTURE_2D, None);
+        }
+        data
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own texture.
+        unsafe { gl.delete_texture(self.texture) };
+    }
+}
+
+/// GPU time per kernel from GL timer queries: a `GL_TIMESTAMP` query (`glQueryCounter`)
+/// before and after every dispatch, differences summed per kernel name when the frame is
+/// resolved. (Timestamps rather than `GL_TIME_ELAPSED`, whose compute-dispatch results Mesa's
+/// llvmpipe does not fill in; both are GL timer queries.)
+#[derive(Default)]
+pub struct GpuTimers {
+    free: Vec<glow::Query>,
+    pending: Vec<(&'static str, glow::Query, glow::Query)>,
+}
+
+impl GpuTimers {
+    fn query(&mut self, gl: &Gl) -> glow::Query {
+        match self.free.pop() {
+            Some(q) => q,
+            // SAFETY: query creation on a current context.
+            None => unsafe { gl.create_query().expect("glGenQueries failed") },
+        }
+    }
+
+    /// Time the GL commands `f` issues under `name`.
+    pub fn time<R>(&mut self, gl: &Gl, name: &'static str, f: impl FnOnce() -> R) -> R {
+        let (a, b) = (self.query(gl), self.query(gl));
+        // SAFETY: timestamp queries on a current context.
+        unsafe { gl.query_counter(a, glow::TIMESTAMP) };
+        let r = f();
+        unsafe { gl.query_counter(b, glow::TIMESTAMP) };
+        self.pending.push((name, a, b));
+        r
+    }
+
+    /// Wait for all queries and return milliseconds per kernel name.
+    pub fn resolve(&mut self, gl: &Gl) -> BTreeMap<String, f64> {
+        let mut out = BTreeMap::new();
+        for (name, a, b) in std::mem::take(&mut self.pending) {
+            let ns = gl.query_result_u64(b).saturating_sub(gl.query_result_u64(a));
+            *out.entry(name.to_string()).or_insert(0.0) += ns as f64 / 1e6;
+            self.free.push(a);
+            self.free.push(b);
+        }
+        out
+    }
+
+    pub fn delete(&mut self, gl: &Gl) {
+        let pending = std::mem::take(&mut self.pending);
+        for q in self.free.drain(..).chain(pending.into_iter().flat_map(|p| [p.1, p.2])) {
+            // SAFETY: deleting our own queries.
+            unsafe { gl.delete_query(q) };
+        }
+    }
+}

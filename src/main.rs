@@ -1,0 +1,217 @@
+//! The `gpgpu-rt` command line.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use serde_json::json;
+
+use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::output;
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::base::BaseTracer;
+use gpgpu_rt::tracer::{RenderOptions, ShadowFlags};
+
+#[derive(Parser)]
+#[command(name = "gpgpu-rt", version, about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum TracerKind {
+    /// The thesis' base tracer: every ray against every triangle (ch. 3.1, 4.1).
+    Base,
+}
+
+#[derive(clap::Args)]
+struct GpuArgs {
+    /// EGL device index (default: the first that gives an OpenGL 4.5 core context).
+    #[arg(long)]
+    device: Option<usize>,
+    /// Load the GLSL kernels from this directory instead of the copies built into the binary.
+    #[arg(long, value_name = "DIR")]
+    glsl_dir: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to a PNG.
+    Render {
+        /// Scene file (TOML), e.g. scenes/teapot1.toml.
+        scene: PathBuf,
+        /// Output PNG.
+        #[arg(short, long, default_value = "out.png")]
+        output: PathBuf,
+        /// Image width (default: the scene's render.width).
+        #[arg(long)]
+        width: Option<u32>,
+        /// Image height (default: the scene's render.height).
+        #[arg(long)]
+        height: Option<u32>,
+        #[arg(long, value_enum, default_value = "base")]
+        tracer: TracerKind,
+        /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
+        #[arg(long)]
+        refl_depth: Option<u32>,
+        /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
+        #[arg(long, value_enum, default_value = "bits")]
+        shadow_flags: ShadowFlags,
+        /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling),
+        /// so that no dispatch runs long enough for a driver watchdog.
+        #[arg(long, default_value_t = 256, value_name = "N")]
+        tile: u32,
+        /// Write NumPy AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal) here.
+        #[arg(long, value_name = "DIR")]
+        aov_dir: Option<PathBuf>,
+        /// Write the statistics of the frame as JSON.
+        #[arg(long, value_name = "FILE.json")]
+        stats: Option<PathBuf>,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+    /// Write the scene's world-space triangles as f32 [T,3,3] in triangle-id order.
+    ExportTriangles {
+        scene: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
+    Info {
+        scene: Option<PathBuf>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn load_scene(path: &Path) -> Result<Scene> {
+    Ok(Scene::load(path)?)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Render {
+            scene,
+            output,
+            width,
+            height,
+            tracer,
+            refl_depth,
+            shadow_flags,
+            tile,
+            aov_dir,
+            stats,
+            gpu,
+        } => {
+            let scene = load_scene(&scene)?;
+            let shaders = ShaderSource::from_dir(gpu.glsl_dir)?;
+            let ctx = GlContext::headless(gpu.device)?;
+            let options = RenderOptions {
+                width: width.unwrap_or(scene.settings.width),
+                height: height.unwrap_or(scene.settings.height),
+                refl_depth: refl_depth.unwrap_or(scene.settings.refl_depth),
+                tile,
+                shadow_flags,
+                aovs: aov_dir.is_some(),
+            };
+            let (frame, name) = match tracer {
+                TracerKind::Base => {
+                    let mut t = BaseTracer::new(&ctx, &scene, &shaders, options.clone())?;
+                    (t.render(&scene.camera)?, "base")
+                }
+            };
+            output::write_png(&output, &frame)?;
+            if let (Some(dir), Some(aovs)) = (&aov_dir, &frame.aovs) {
+                output::write_aovs(dir, frame.width, frame.height, aovs)?;
+            }
+            let s = &frame.stats;
+            if let Some(path) = stats {
+                let doc = json!({
+                    "scene": scene.path,
+                    "renderer": ctx.info.renderer,
+                    "gl_version": ctx.info.version,
+                    "vendor": ctx.info.vendor,
+                    "tracer": name,
+                    "width": frame.width,
+                    "height": frame.height,
+                    "triangles": scene.triangle_count(),
+                    "lights": scene.lights.len(),
+                    "refl_depth": options.refl_depth,
+                    "shadow_flags": options.shadow_flags,
+                    "tile": options.tile,
+                    "triangle_tests": s.triangle_tests,
+                    "triangle_tests_total": s.total_triangle_tests(),
+                    "gpu_ms": s.gpu_ms,
+                    "gpu_ms_total": s.total_gpu_ms(),
+                    "wall_ms": s.wall_ms,
+                });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)? + "\n")
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            }
+            eprintln!(
+                "{}: {}x{}, {} triangles, {} lights, {} tracer on {}: {:.1} GPU ms, {} triangle tests -> {}",
+                scene.path.display(),
+                frame.width,
+                frame.height,
+                scene.triangle_count(),
+                scene.lights.len(),
+                name,
+                ctx.info.renderer,
+                s.total_gpu_ms(),
+                s.total_triangle_tests(),
+                output.display()
+            );
+            Ok(())
+        }
+        Command::ExportTriangles { scene, output } => {
+            let scene = load_scene(&scene)?;
+            let tris = scene.world_triangles();
+            output::write_npy(
+                &output,
+                &[tris.len() as u64, 3, 3],
+                tris.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())),
+            )
+        }
+        Command::Info { scene, json, gpu } => {
+            let scene = scene.as_deref().map(load_scene).transpose()?;
+            if gpu.glsl_dir.is_some() {
+                bail!("--glsl-dir has no effect on info");
+            }
+            let ctx = GlContext::headless(gpu.device)?;
+            let mut doc = serde_json::to_value(&ctx.info)?;
+            if let Some(s) = &scene {
+                doc["scene"] = json!(s.path);
+                doc["triangles"] = json!(s.triangle_count());
+                doc["lights"] = json!(s.lights.len());
+                doc["objects"] = json!(s.objects.len());
+                doc["materials"] = json!(s.materials.len());
+                doc["textures"] = json!(s.textures.len());
+            }
+            if json {
+                println!("{}", serde_json::to_string_pretty(&doc)?);
+            } else if let serde_json::Value::Object(m) = doc {
+                for (k, v) in m {
+                    println!("{k:36} {v}");
+                }
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,282 @@
+//! The CPU reference: the base tracer's camera, Algorithm 1, shadow feelers, reflections and
+//! shading (Müller 2015, ch. 3.1 and 4.1) in plain Rust, pixel by pixel, with the same f32
+//! arithmetic and the same pass structure as the kernels. It is the oracle of the tests: the
+//! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
+
+use glam::{Vec2, Vec3, Vec4};
+use rayon::prelude::*;
+
+use crate::scene::{Camera, Scene, WorldAttributes};
+use crate::tracer::Aovs;
+
+/// The scene prepared for tracing on the CPU.
+pub struct Reference {
+    triangles: Vec<[Vec3; 3]>,
+    attributes: WorldAttributes,
+    materials: Vec<Vec4>,
+    lights: Vec<(Vec3, Vec3)>,
+    layers: (u32, u32, Vec<image::RgbaImage>),
+    background: Vec3,
+    ambient: Vec3,
+    shadow_offset: f32,
+}
+
+/// What the reference computes for a frame: colour (row 0 = top), the AOVs and the test
+/// counts of the two intersection kernels.
+pub struct ReferenceFrame {
+    pub width: u32,
+    pub height: u32,
+    pub color: Vec<[f32; 4]>,
+    pub aovs: Aovs,
+    pub intersect1_tests: u64,
+    pub intersect2_tests: u64,
+}
+
+/// Algorithm 1 (Möller–Trumbore without a determinant epsilon), as `glsl/common/intersect.glsl`.
+#[inline]
+pub fn intersect_triangle(r0: Vec3, rd: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<(f32, f32, f32)> {
+    let edge1 = v1 - v0;
+    let edge2 = v2 - v0;
+    let pvec = rd.cross(edge2);
+    let det = edge1.dot(pvec);
+    let inv_det = 1.0 / det;
+    let tvec = r0 - v0;
+    let u = inv_det * tvec.dot(pvec);
+    let qvec = tvec.cross(edge1);
+    let v = inv_det * rd.dot(qvec);
+    let t = inv_det * edge2.dot(qvec);
+    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 {
+        Some((t, u, v))
+    } else {
+        None
+    }
+}
+
+/// GLSL's reflect(I, N).
+fn reflect(i: Vec3, n: Vec3) -> Vec3 {
+    i - 2.0 * n.dot(i) * n
+}
+
+impl Reference {
+    pub fn new(scene: &Scene) -> Reference {
+        Reference {
+            triangles: scene.world_triangles(),
+            attributes: scene.world_attributes(),
+            materials: scene
+                .materials
+                .iter()
+                .map(|m| Vec4::new(m.reflection, m.specular, m.shininess, m.texture.map(|t| t as f32).unwrap_or(-1.0)))
+                .collect(),
+            lights: scene.lights.iter().map(|l| (l.position, l.color)).collect(),
+            layers: scene.texture_layers(16384),
+            background: Vec3::from(scene.settings.background),
+            ambient: Vec3::from(scene.settings.ambient),
+            shadow_offset: scene.settings.shadow_offset,
+        }
+    }
+
+    /// Bilinear lookup with repeat wrapping, as GL_LINEAR / GL_REPEAT on RGBA8 at level 0.
+    fn sample(&self, layer: usize, uv: Vec2) -> Vec3 {
+        let (w, h, layers) = (&self.layers.0, &self.layers.1, &self.layers.2);
+        let img = &layers[layer.min(layers.len() - 1)];
+        let x = uv.x * *w as f32 - 0.5;
+        let y = uv.y * *h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |i: i64, j: i64| {
+            let i = i.rem_euclid(*w as i64) as u32;
+            let j = j.rem_euclid(*h as i64) as u32;
+            let p = img.get_pixel(i, j).0;
+            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0
+        };
+        let (i, j) = (x0 as i64, y0 as i64);
+        let top = texel(i, j).lerp(texel(i + 1, j), fx);
+        let bottom = texel(i, j + 1).lerp(texel(i + 1, j + 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// Closest hit skipping `last`; (t, id, u, v) and the number of tests.
+    fn closest(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<(f32, usize, f32, f32)>, u64) {
+        let mut best: Option<(f32, usize, f32, f32)> = None;
+        let mut tests = 0;
+        for (i, t) in self.triangles.iter().enumerate() {
+            if i as i32 == last {
+                continue;
+            }
+            tests += 1;
+            if let Some((tt, u, v)) = intersect_triangle(ro, rd, t[0], t[1], t[2]) {
+                if best.is_none_or(|b| tt < b.0) {
+                    best = Some((tt, i, u, v));
+                }
+            }
+        }
+        (best, tests)
+    }
+
+    /// The shadow feeler of Listing 15: (in shadow, tests).
+    fn shadowed(&self, p: Vec3, n: Vec3, last: usize, light: Vec3) -> (bool, u64) {
+        let to_light = light - p;
+        let dist = to_light.length();
+        let rd = to_light / dist;
+        if n.dot(rd) <= 0.0 {
+            return (true, 0);
+        }
+        let mut tests = 0;
+        for (i, t) in self.triangles.iter().enumerate() {
+            if i == last {
+                continue;
+            }
+            tests += 1;
+            if let Some((tt, _, _)) = intersect_triangle(p, rd, t[0], t[1], t[2]) {
+                if tt > self.shadow_offset && tt < dist {
+                    return (true, tests);
+                }
+            }
+        }
+        (false, tests)
+    }
+
+    /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.
+    fn pixel(&self, camera_pos: Vec3, primary: (Vec3, Vec3), refl_depth: u32) -> PixelResult {
+        let (mut ro, mut rd) = primary;
+        let mut ray_state = 1.0f32;
+        let mut last: i32 = -1;
+        let mut final_color = Vec4::ZERO;
+        let mut out = PixelResult {
+            hit_t: f32::INFINITY,
+            triangle_id: -1,
+            normal: Vec3::ZERO,
+            ..Default::default()
+        };
+        let a = &self.attributes;
+        for pass in 0..=refl_depth {
+            if ray_state <= 0.0 {
+                break;
+            }
+            let (hit, tests) = self.closest(ro, rd, last);
+            out.tests1 += tests;
+            let (temp, weight_in) = match hit {
+                None => {
+                    ray_state = 0.0;
+                    (self.background, 1.0)
+                }
+                Some((t, id, u, v)) => {
+                    let w = 1.0 - u - v;
+                    let k = 3 * id;
+                    let mut n = (w * a.normals[k] + u * a.normals[k + 1] + v * a.normals[k + 2]).normalize();
+                    if n.dot(rd) > 0.0 {
+                        n = -n;
+                    }
+                    let mat = self.materials[a.triangle_material[id] as usize];
+                    let color = if mat.w >= 0.0 {
+                        let uv = w * a.texcoords[k] + u * a.texcoords[k + 1] + v * a.texcoords[k + 2];
+                        self.sample(mat.w as usize, uv)
+                    } else {
+                        w * a.colors[k] + u * a.colors[k + 1] + v * a.colors[k + 2]
+                    };
+                    if pass == 0 {
+                        out.hit_t = t;
+                        out.triangle_id = id as i32;
+                        out.normal = n;
+                    }
+                    let p = ro + t * rd;
+                    let refl = mat.x;
+                    if refl > 0.0 {
+                        ray_state += 1.0;
+                        rd = reflect(rd, n);
+                    }
+                    // shadow feelers and shading at p
+                    let view = (camera_pos - p).normalize();
+                    let mut temp = self.ambient * color;
+                    for &(lp, lc) in &self.lights {
+                        let (shadow, tests) = self.shadowed(p, n, id, lp);
+                        out.tests2 += tests;
+                        if shadow {
+                            continue;
+                        }
+                        let l = (lp - p).normalize();
+                        let diffuse = n.dot(l).max(0.0);
+                        let r = reflect(-l, n);
+                        let specular = mat.y * r.dot(view).max(0.0).powf(mat.z);
+                        temp += lc * (diffuse * color + Vec3::splat(specular));
+                    }
+                    ro = p;
+                    last = id as i32;
+                    (temp, 1.0 - refl)
+                }
+            };
+            // Listing 16
+            let weight = final_color.w;
+            let rgb = weight * final_color.truncate() + (1.0 - weight) * temp;
+            final_color = rgb.extend(weight + (1.0 - weight) * weight_in);
+            if ray_state > 0.0 {
+                ray_state -= 1.0;
+            }
+        }
+        out.color = final_color.to_array();
+        out
+    }
+
+    /// Render a `width`×`height` frame with `refl_depth` reflection passes.
+    pub fn render(&self, camera: &Camera, width: u32, height: u32, refl_depth: u32) -> ReferenceFrame {
+        let cam = camera.rays(width, height);
+        let pixels: Vec<(PixelResult, (Vec3, Vec3))> = (0..height)
+            .into_par_iter()
+            .flat_map_iter(|row| {
+                // row 0 = top: GL row height-1-row
+                let y = height - 1 - row;
+                (0..width).map(move |x| (x, y))
+            })
+            .map(|(x, y)| {
+                let primary = cam.primary_ray(x, y);
+                (self.pixel(cam.cam_position, primary, refl_depth), primary)
+            })
+            .collect();
+        let mut frame = ReferenceFrame {
+            width,
+            height,
+            color: Vec::with_capacity(pixels.len()),
+            aovs: Aovs::default(),
+            intersect1_tests: 0,
+            intersect2_tests: 0,
+        };
+        for (p, (o, d)) in pixels {
+            frame.color.push(p.color);
+            frame.aovs.ray_origin.push(o.to_array());
+            frame.aovs.ray_direction.push(d.to_array());
+            frame.aovs.hit_t.push(p.hit_t);
+            frame.aovs.triangle_id.push(p.triangle_id);
+            frame.aovs.normal.push(p.normal.to_array());
+            frame.intersect1_tests += p.tests1;
+            frame.intersect2_tests += p.tests2;
+        }
+        frame
+    }
+}
+
+#[derive(Default)]
+struct PixelResult {
+    color: [f32; 4],
+    hit_t: f32,
+    triangle_id: i32,
+    normal: Vec3,
+    tests1: u64,
+    tests2: u64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn algorithm1_hits_inside_and_misses_outside() {
+        let (v0, v1, v2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let (t, u, v) = intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, v0, v1, v2).unwrap();
+        assert!((t - 1.0).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.25).abs() < 1e-6);
+        assert!(intersect_triangle(Vec3::new(0.75, 0.75, 1.0), -Vec3::Z, v0, v1, v2).is_none());
+        // behind the origin: t < 0 is no hit
+        assert!(intersect_triangle(Vec3::new(0.25, 0.25, -1.0), -Vec3::Z, v0, v1, v2).is_none());
+        // parallel: det = 0
+        assert!(intersect_triangle(Vec3::new(0.25, 0.25, 1.0), Vec3::X, v0, v1, v2).is_none());
+    }
+}

@@ -1,0 +1,375 @@
+//! Triangle meshes in object space: OBJ files (tobj, with MTL colours and textures), Newell's
+//! teapot tessellated from its Bézier patches, and the thesis' floor of quads.
+//!
+//! A mesh is a triangle soup, as the kernels read it (Müller 2015, Listing 12): the vertices of
+//! triangle k are entries 3k, 3k+1, 3k+2 of every per-vertex array.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+use super::SceneError;
+
+/// Per-vertex attributes of a triangle soup plus a local material index per triangle.
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub colors: Vec<Vec3>,
+    pub texcoords: Vec<Vec2>,
+    /// Index into the mesh's own material list ([`LoadedObj::materials`] for OBJ files, a
+    /// single material otherwise), one entry per triangle.
+    pub triangle_material: Vec<u32>,
+}
+
+impl Mesh {
+    pub fn triangle_count(&self) -> usize {
+        self.positions.len() / 3
+    }
+
+    fn push_triangle(&mut self, p: [Vec3; 3], n: [Vec3; 3], c: [Vec3; 3], t: [Vec2; 3], m: u32) {
+        self.positions.extend_from_slice(&p);
+        self.normals.extend_from_slice(&n);
+        self.colors.extend_from_slice(&c);
+        self.texcoords.extend_from_slice(&t);
+        self.triangle_material.push(m);
+    }
+
+    /// Axis-aligned bounds of the positions.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        )
+    }
+}
+
+/// A material found in an MTL file.
+#[derive(Debug, Clone)]
+pub struct ObjMaterial {
+    pub name: String,
+    pub diffuse: Option<Vec3>,
+    pub texture: Option<PathBuf>,
+    pub shininess: Option<f32>,
+}
+
+#[derive(Debug, Clone)]
+pub struct LoadedObj {
+    pub mesh: Mesh,
+    pub materials: Vec<ObjMaterial>,
+    /// true when the file gave per-vertex colours (`v x y z r g b`).
+    pub has_vertex_colors: bool,
+}
+
+/// Load an OBJ file (triangulated) with its MTL materials. Material index
+/// `materials.len()` in `triangle_material` means "no material".
+pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| {
+        if !path.exists() {
+            return SceneError::at(path, None, format!("cannot open OBJ file: {e}"));
+        }
+        let (line, what) = locate_obj_error(path);
+        SceneError::at(path, line, format!("malformed OBJ file ({e}){what}"))
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let materials: Vec<ObjMaterial> = match mtl {
+        Ok(ms) => ms
+            .into_iter()
+            .map(|m| ObjMaterial {
+                name: m.name.clone(),
+                diffuse: m.diffuse.map(Vec3::from),
+                texture: m.diffuse_texture.as_ref().map(|t| dir.join(t)),
+                shininess: m.shininess,
+            })
+            .collect(),
+        Err(tobj::LoadError::OpenFileFailed) => Vec::new(),
+        Err(e) => {
+            return Err(SceneError::at(path, None, format!("cannot load its MTL file: {e}")))
+        }
+    };
+    let none = materials.len() as u32;
+    let mut mesh = Mesh::default();
+    let mut has_vertex_colors = false;
+    for model in &models {
+        let m = &model.mesh;
+        let count = m.positions.len() / 3;
+        let pos = |i: usize| Vec3::new(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]);
+        // smooth normals (area weighted) when the file has none
+        let normals: Vec<Vec3> = if m.normals.len() == m.positions.len() {
+            (0..count)
+                .map(|i| Vec3::new(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]).normalize_or_zero())
+                .collect()
+        } else {
+            let mut acc = vec![Vec3::ZERO; count];
+            for f in m.indices.chunks_exact(3) {
+                let (a, b, c) = (f[0] as usize, f[1] as usize, f[2] as usize);
+                let n = (pos(b) - pos(a)).cross(pos(c) - pos(a));
+                acc[a] += n;
+                acc[b] += n;
+                acc[c] += n;
+            }
+            acc.into_iter().map(|n| n.normalize_or_zero()).collect()
+        };
+        let vcol = m.vertex_color.len() == m.positions.len();
+        has_vertex_colors |= vcol;
+        let mat = m.material_id.map(|i| i as u32).unwrap_or(none);
+        let diffuse = m
+            .material_id
+            .and_then(|i| materials.get(i))
+            .and_then(|mm| mm.diffuse)
+            .unwrap_or(Vec3::splat(0.8));
+        for f in m.indices.chunks_exact(3) {
+            let idx = [f[0] as usize, f[1] as usize, f[2] as usize];
+            let p = idx.map(pos);
+            // a face whose normals are all zero (degenerate) gets its geometric normal
+            let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            let n = idx.map(|i| if normals[i] == Vec3::ZERO { geo } else { normals[i] });
+            let c = idx.map(|i| {
+                if vcol {
+                    Vec3::new(m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2])
+                } else {
+                    diffuse
+                }
+            });
+            let t = idx.map(|i| {
+                if m.texcoords.len() >= 2 * count {
+                    Vec2::new(m.texcoords[2 * i], m.texcoords[2 * i + 1])
+                } else {
+                    Vec2::ZERO
+                }
+            });
+            mesh.push_triangle(p, n, c, t, mat);
+        }
+    }
+    if mesh.positions.is_empty() {
+        return Err(SceneError::at(path, None, "the OBJ file has no faces".into()));
+    }
+    Ok(LoadedObj {
+        mesh,
+        materials,
+        has_vertex_colors,
+    })
+}
+
+/// Find the first line tobj could not have parsed: numbers of `v`/`vn`/`vt` lines and the
+/// indices of `f` lines (tobj's errors do not carry a line number).
+fn locate_obj_error(path: &Path) -> (Option<usize>, String) {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return (None, String::new());
+    };
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    for (i, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        let Some(tag) = it.next() else { continue };
+        let rest: Vec<&str> = it.collect();
+        let floats_ok = |min: usize| rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok());
+        let bad = match tag {
+            "v" => {
+                nv += 1;
+                !floats_ok(3)
+            }
+            "vt" => {
+                nt += 1;
+                !floats_ok(1)
+            }
+            "vn" => {
+                nn += 1;
+                !floats_ok(3)
+            }
+            "f" => {
+                rest.len() < 3
+                    || rest.iter().any(|corner| {
+                        corner.split('/').enumerate().any(|(k, s)| {
+                            if s.is_empty() && k > 0 {
+                                return false;
+                            }
+                            let limit = [nv, nt, nn][k.min(2)];
+                            match s.parse::<i64>() {
+                                Ok(v) => v == 0 || v > limit || -v > limit,
+                                Err(_) => true,
+                            }
+                        })
+                    })
+            }
+            _ => false,
+        };
+        if bad {
+            return (Some(i + 1), format!(": `{}`", line.trim()));
+        }
+    }
+    (None, String::new())
+}
+
+/// Newell's teapot: 32 bicubic Bézier patches in the `.bpt` format (a line with the patch
+/// count, then per patch a line `3 3` and 16 control points `x y z`, z up), tessellated
+/// `n`×`n` quads per patch — 32·n·n·2 triangles, 6400 for the thesis' n = 10 (ch. 5.1).
+/// The result is y-up.
+pub fn teapot(path: &Path, n: u32) -> Result<Mesh, SceneError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::at(path, None, format!("cannot read teapot patches: {e}")))?;
+    let patches = parse_bpt(path, &text)?;
+    let mut mesh = Mesh::default();
+    let y_up = |p: Vec3| Vec3::new(p.x, p.z, -p.y);
+    let nf = n as f32;
+    for cp in &patches {
+        let grid: Vec<(Vec3, Vec3)> = (0..=n)
+            .flat_map(|i| (0..=n).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let (u, v) = (i as f32 / nf, j as f32 / nf);
+                let (p, normal) = bezier_point_normal(cp, u, v);
+                (y_up(p), y_up(normal))
+            })
+            .collect();
+        let at = |i: u32, j: u32| grid[(i * (n + 1) + j) as usize];
+        let uv = |i: u32, j: u32| Vec2::new(i as f32 / nf, j as f32 / nf);
+        for i in 0..n {
+            for j in 0..n {
+                let quad = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                for tri in [[0, 1, 2], [0, 2, 3]] {
+                    let c = tri.map(|k| quad[k]);
+                    let pts = c.map(|(a, b)| at(a, b));
+                    mesh.push_triangle(
+                        pts.map(|x| x.0),
+                        pts.map(|x| x.1),
+                        [Vec3::ONE; 3],
+                        c.map(|(a, b)| uv(a, b)),
+                        0,
+                    );
+                }
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+fn parse_bpt(path: &Path, text: &str) -> Result<Vec<[Vec3; 16]>, SceneError> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let err = |line: usize, msg: String| SceneError::at(path, Some(line + 1), msg);
+    let (l0, first) = lines.next().ok_or_else(|| SceneError::at(path, None, "empty patch file".into()))?;
+    let count: usize = first
+        .trim()
+        .parse()
+        .map_err(|_| err(l0, format!("expected the patch count, found `{}`", first.trim())))?;
+    let mut patches = Vec::with_capacity(count);
+    for _ in 0..count {
+        let (ln, deg) = lines
+            .next()
+            .ok_or_else(|| SceneError::at(path, None, format!("file ends before patch {} of {count}", patches.len() + 1)))?;
+        if deg.split_whitespace().collect::<Vec<_>>() != ["3", "3"] {
+            return Err(err(ln, format!("expected `3 3` (bicubic patch), found `{}`", deg.trim())));
+        }
+        let mut cp = [Vec3::ZERO; 16];
+        for p in cp.iter_mut() {
+            let (ln, l) = lines
+                .next()
+                .ok_or_else(|| SceneError::at(path, None, "file ends inside a patch".into()))?;
+            let v: Vec<f32> = l.split_whitespace().filter_map(|s| s.parse().ok()).collect();
+            if v.len() != 3 || l.split_whitespace().count() != 3 {
+                return Err(err(ln, format!("expected a control point `x y z`, found `{}`", l.trim())));
+            }
+            *p = Vec3::new(v[0], v[1], v[2]);
+        }
+        patches.push(cp);
+    }
+    Ok(patches)
+}
+
+fn bernstein(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t]
+}
+
+fn bernstein_d(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t]
+}
+
+/// Point and unit normal of a bicubic patch (control point (i, j) at index 4i + j).
+fn bezier_point_normal(cp: &[Vec3; 16], u: f32, v: f32) -> (Vec3, Vec3) {
+    let eval = |bu: [f32; 4], bv: [f32; 4]| {
+        let mut p = Vec3::ZERO;
+        for i in 0..4 {
+            for j in 0..4 {
+                p += bu[i] * bv[j] * cp[4 * i + j];
+            }
+        }
+        p
+    };
+    let p = eval(bernstein(u), bernstein(v));
+    let normal_at = |u: f32, v: f32| {
+        eval(bernstein_d(u), bernstein(v)).cross(eval(bernstein(u), bernstein_d(v)))
+    };
+    let mut n = normal_at(u, v);
+    if n.length() < 1e-6 {
+        // degenerate corner (the lid's and the bottom's poles): step inwards a little
+        let nudge = |t: f32| if t < 0.5 { t + 1e-3 } else { t - 1e-3 };
+        n = normal_at(nudge(u), nudge(v));
+    }
+    (p, n.normalize_or_zero())
+}
+
+/// The thesis' floor (ch. 5.1): `quads`×`quads` squares, two triangles each, in the xz plane
+/// (y = 0) with side `size`, centred at the origin, normal +y. `checker` colours alternate
+/// squares; texture coordinates run 0..quads.
+pub fn floor(size: f32, quads: u32, checker: [Vec3; 2]) -> Mesh {
+    let mut mesh = Mesh::default();
+    let step = size / quads as f32;
+    let half = size / 2.0;
+    for i in 0..quads {
+        for j in 0..quads {
+            let x0 = -half + i as f32 * step;
+            let z0 = -half + j as f32 * step;
+            let corner = |di: u32, dj: u32| {
+                Vec3::new(x0 + di as f32 * step, 0.0, z0 + dj as f32 * step)
+            };
+            let tc = |di: u32, dj: u32| Vec2::new((i + di) as f32, (j + dj) as f32);
+            let q = [(0, 0), (0, 1), (1, 1), (1, 0)];
+            let c = checker[((i + j) % 2) as usize];
+            for tri in [[0, 1, 2], [0, 2, 3]] {
+                let k = tri.map(|t| q[t]);
+                mesh.push_triangle(
+                    k.map(|(a, b)| corner(a, b)),
+                    [Vec3::Y; 3],
+                    [c; 3],
+                    k.map(|(a, b)| tc(a, b)),
+                    0,
+                );
+            }
+        }
+    }
+    mesh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn teapot_path() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/teapot.bpt")
+    }
+
+    #[test]
+    fn teapot_has_the_thesis_triangle_count() {
+        let m = teapot(&teapot_path(), 10).unwrap();
+        assert_eq!(m.triangle_count(), 6400);
+        assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-3));
+    }
+
+    #[test]
+    fn floor_has_the_thesis_triangle_count() {
+        assert_eq!(floor(4.0, 64, [Vec3::ONE; 2]).triangle_count(), 8192);
+    }
+
+    #[test]
+    fn bezier_corners_interpolate_control_points() {
+        let cp: [Vec3; 16] = std::array::from_fn(|k| Vec3::new((k / 4) as f32, (k % 4) as f32, ((k * 7) % 5) as f32));
+        assert!((bezier_point_normal(&cp, 0.0, 0.0).0 - cp[0]).length() < 1e-6);
+        assert!((bezier_point_normal(&cp, 1.0, 1.0).0 - cp[15]).length() < 1e-6);
+        assert!((bezier_point_normal(&cp, 1.0, 0.0).0 - cp[12]).length() < 1e-6);
+    }
+}

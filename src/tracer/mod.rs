@@ -1,0 +1,95 @@
+//! The tracer designs. Each module owns its kernels and GPU resources, like the thesis'
+//! RTScene and kernel classes (Müller 2015, Fig. 16–18).
+
+pub mod base;
+pub mod gpu_scene;
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// How the shadow flags of intersect2 are stored (Müller 2015, Listing 15 and ch. 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowFlags {
+    /// The thesis: one channel of an RGBA32F texture per light, so at most 4 lights.
+    Rgba,
+    /// The bitwise flags proposed in ch. 5: one bit per light in an RGBA32UI texture, so at
+    /// most 128 lights.
+    Bits,
+}
+
+impl ShadowFlags {
+    pub fn max_lights(self) -> usize {
+        match self {
+            ShadowFlags::Rgba => 4,
+            ShadowFlags::Bits => 128,
+        }
+    }
+}
+
+/// Options of one render.
+#[derive(Debug, Clone)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    /// REFL_DEPTH: reflection passes after the primary pass (Fig. 8).
+    pub refl_depth: u32,
+    /// Dispatches cover at most tile×tile pixels (0: the whole image in one dispatch).
+    pub tile: u32,
+    pub shadow_flags: ShadowFlags,
+    /// Read back the primary rays and first hits for the AOVs.
+    pub aovs: bool,
+}
+
+/// Global counter slots, shared with the kernels through `#define COUNTER_*`.
+pub const COUNTERS: &[&str] = &["intersect1", "intersect2"];
+
+/// Statistics of one frame.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct FrameStats {
+    /// Ray–triangle tests per kernel (exact 64-bit counts).
+    pub triangle_tests: BTreeMap<String, u64>,
+    /// GPU time per kernel in milliseconds (GL timer queries, summed over tiles and passes).
+    pub gpu_ms: BTreeMap<String, f64>,
+    /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
+    pub wall_ms: f64,
+}
+
+impl FrameStats {
+    pub fn total_gpu_ms(&self) -> f64 {
+        self.gpu_ms.values().sum()
+    }
+    pub fn total_triangle_tests(&self) -> u64 {
+        self.triangle_tests.values().sum()
+    }
+}
+
+/// Per-pixel outputs beside the colour, row 0 = the top image row.
+#[derive(Debug, Clone, Default)]
+pub struct Aovs {
+    pub ray_origin: Vec<[f32; 3]>,
+    pub ray_direction: Vec<[f32; 3]>,
+    pub hit_t: Vec<f32>,
+    pub triangle_id: Vec<i32>,
+    pub normal: Vec<[f32; 3]>,
+}
+
+/// A rendered frame: RGBA colour (rgb: colour, a: accumulated weight), row 0 = top.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub color: Vec<[f32; 4]>,
+    pub aovs: Option<Aovs>,
+    pub stats: FrameStats,
+}
+
+/// Flip GL row order (row 0 = bottom) to image order (row 0 = top).
+pub fn flip_rows<T: Clone>(data: &[T], width: u32, height: u32) -> Vec<T> {
+    let w = width as usize;
+    (0..height as usize)
+        .rev()
+        .flat_map(|r| data[r * w..(r + 1) * w].iter().cloned())
+        .collect()
+}
