@@ -8,7 +8,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
-#define COUNTER_SLOTS_PER_KERNEL 1
+#define COUNTER_SLOTS_PER_KERNEL 2
 #include "common/scene.glsl"
 #include "common/images.glsl"
 #include "common/intersect.glsl"
@@ -18,6 +18,28 @@ uniform vec4 backgroundColor;
 // 1 in the first pass (primary rays): the first hit is also stored for the AOVs.
 uniform int storePrimaryHit;
 layout(binding = 0) uniform sampler2DArray textures;
+
+// Listing 12's loop body: test triangle i (unless it is the one the ray starts on) and keep
+// the closest hit.
+void testTriangle(int i, int n, vec3 ro, vec3 rd, int lastTriID,
+                  inout float t_min, inout int triID, inout float hit_u, inout float hit_v,
+                  inout uint tests)
+{
+    if (i < n && i != lastTriID) {
+        // load the vertices of triangle #i
+        vec3 v0 = vertex[3 * i].xyz, v1 = vertex[3 * i + 1].xyz, v2 = vertex[3 * i + 2].xyz;
+        float t, u, v;
+        tests++;
+        // hit inside the triangle and closest so far? update the buffered results
+        if (intersectTriangle(ro, rd, v0, v1, v2, t, u, v) && t < t_min) {
+            t_min = t;
+            triID = i;
+            hit_u = u; hit_v = v;
+        }
+    }
+}
+
+uint truncated = 0u;
 
 // the number of triangle tests this invocation did
 uint trace(ivec2 storePos)
@@ -39,21 +61,22 @@ uint trace(ivec2 storePos)
     float hit_u = 0.0, hit_v = 0.0;
     uint tests = 0u;
 
-    // Listing 12: iteration over all triangles of the scene
+    // Listing 12: iteration over all triangles of the scene, TRIANGLES_PER_ITERATION at a
+    // time (see loopLimit in common/intersect.glsl)
     int n = triangleCount();
-    for (int i = 0; i < n; i++) {
-        if (i != lastTriID) {
-            vec3 v0 = vertex[3 * i].xyz, v1 = vertex[3 * i + 1].xyz, v2 = vertex[3 * i + 2].xyz;
-            float t, u, v;
-            tests++;
-            // hit inside the triangle and closest so far?
-            if (intersectTriangle(ro, rd, v0, v1, v2, t, u, v) && t < t_min) {
-                t_min = t;
-                triID = i;
-                hit_u = u; hit_v = v;
-            }
-        }
+    int i = 0;
+    for (; i < n; i += TRIANGLES_PER_ITERATION) {
+        testTriangle(i, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 1, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 2, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 3, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 4, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 5, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 6, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i + 7, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
     }
+    // a loop cut short by the implementation is counted, never hidden
+    if (i < n) truncated = 1u;
 
     if (storePrimaryHit != 0)
         imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
@@ -110,5 +133,7 @@ void main()
     ivec2 storePos = pixelPosition();
     uint tests = insideImage(storePos) ? trace(storePos) : 0u;
     countAdd(0, tests);
+    countAdd(1, truncated);
     countersEnd(0, COUNTER_INTERSECT1);
+    countersEnd(1, COUNTER_TRUNCATED_RAYS);
 }

@@ -9,13 +9,27 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
-#define COUNTER_SLOTS_PER_KERNEL 1
+#define COUNTER_SLOTS_PER_KERNEL 2
 #include "common/scene.glsl"
 #include "common/images.glsl"
 #include "common/intersect.glsl"
 #include "common/counters.glsl"
 
 uniform int lightSource;
+
+// Listing 15's loop body: does triangle i (not the hit triangle: no self-shadowing) block the
+// feeler between the 0.02 offset and the light?
+bool occludes(int i, int n, vec3 ro, vec3 rd, float lightDistance, int lastTriID, inout uint tests)
+{
+    if (i >= n || i == lastTriID) return false;
+    float t, u, v;
+    tests++;
+    return intersectTriangle(ro, rd, vertex[3 * i].xyz, vertex[3 * i + 1].xyz,
+                             vertex[3 * i + 2].xyz, t, u, v)
+        && t > SHADOW_OFFSET && t < lightDistance;
+}
+
+uint truncated = 0u;
 
 uint trace(ivec2 storePos)
 {
@@ -33,17 +47,20 @@ uint trace(ivec2 storePos)
     // light in the back half-space of the hit point: shadow without a test
     bool shadow = dot(n, rd) <= 0.0;
     int count = triangleCount();
-    for (int i = 0; (i < count) && (!shadow); i++) {
-        // no self-shadowing of the hit triangle
-        if (i != lastTriID) {
-            float t, u, v;
-            tests++;
-            if (intersectTriangle(ro, rd, vertex[3 * i].xyz, vertex[3 * i + 1].xyz,
-                                  vertex[3 * i + 2].xyz, t, u, v)
-                && t > SHADOW_OFFSET && t < lightDistance)
-                shadow = true;
-        }
+    int i = 0;
+    // any hit: the loop ends with the first occluder; TRIANGLES_PER_ITERATION at a time (see
+    // loopLimit in common/intersect.glsl)
+    for (; (i < count) && (!shadow); i += TRIANGLES_PER_ITERATION) {
+        shadow = shadow || occludes(i, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 1, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 2, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 3, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 4, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 5, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 6, count, ro, rd, lightDistance, lastTriID, tests);
+        shadow = shadow || occludes(i + 7, count, ro, rd, lightDistance, lastTriID, tests);
     }
+    if (!shadow && i < count) truncated = 1u;
 
     // set the shadow flag if needed
     if (shadow) {
@@ -71,5 +88,7 @@ void main()
     ivec2 storePos = pixelPosition();
     uint tests = insideImage(storePos) ? trace(storePos) : 0u;
     countAdd(0, tests);
+    countAdd(1, truncated);
     countersEnd(0, COUNTER_INTERSECT2);
+    countersEnd(1, COUNTER_TRUNCATED_RAYS);
 }

@@ -17,3 +17,10 @@ bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
     t = invDet * dot(edge2, qvec);
     return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
 }
+
+// loopLimit: Mesa's llvmpipe ends every loop of an invocation after 65535 iterations in total
+// (its guard against endless loops), which would silently cut a brute-force loop over the
+// 69451-triangle bunny short. The kernels therefore test TRIANGLES_PER_ITERATION triangles
+// per iteration (written out, not a loop), and count every ray whose loop still ended early
+// (the truncated_rays statistic; the host refuses such a frame).
+#define TRIANGLES_PER_ITERATION 8

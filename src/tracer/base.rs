@@ -10,7 +10,7 @@ use glam::Mat4;
 use glow::HasContext;
 
 use super::gpu_scene::{binding, GpuScene};
-use super::{flip_rows, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS};
+use super::{flip_rows, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS, TRIANGLE_TEST_COUNTERS};
 use crate::gl::resources::{GpuTimers, Image2d, Ssbo};
 use crate::gl::{check_error, compile_program, Defines, Gl, GlContext, ShaderSource};
 use crate::scene::{Camera, Scene};
@@ -105,6 +105,7 @@ pub struct BaseTracer {
     lights: usize,
     background: [f32; 3],
     ambient: [f32; 3],
+    renderer: String,
     /// Model matrix per object, applied by the transform pass every frame.
     pub models: Vec<Mat4>,
 }
@@ -165,6 +166,7 @@ impl BaseTracer {
             ambient: scene.settings.ambient,
             models: scene.objects.iter().map(|o| o.model).collect(),
             options,
+            renderer: ctx.info.renderer.clone(),
             gl,
         };
         check_error(&tracer.gl, "creating the base tracer")?;
@@ -294,7 +296,19 @@ impl BaseTracer {
         };
         for (i, name) in COUNTERS.iter().enumerate() {
             let v = raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32);
-            stats.triangle_tests.insert(name.to_string(), v);
+            if TRIANGLE_TEST_COUNTERS.contains(name) {
+                stats.triangle_tests.insert(name.to_string(), v);
+            } else if *name == "truncated_rays" {
+                stats.truncated_rays = v;
+            }
+        }
+        if stats.truncated_rays > 0 {
+            bail!(
+                "{} rays stopped before testing all {} triangles: this GL implementation ({}) ends                  long shader loops early (Mesa llvmpipe: 65535 iterations per invocation); the                  frame would be wrong",
+                stats.truncated_rays,
+                self.scene.triangles,
+                self.renderer
+            );
         }
         check_error(&gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
         stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -43,7 +43,10 @@ pub struct RenderOptions {
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
-pub const COUNTERS: &[&str] = &["intersect1", "intersect2"];
+pub const COUNTERS: &[&str] = &["intersect1", "intersect2", "truncated_rays"];
+
+/// The counters that count ray–triangle tests (the rest count events).
+pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
 /// Statistics of one frame.
 #[derive(Debug, Clone, Default, Serialize)]
@@ -52,6 +55,9 @@ pub struct FrameStats {
     pub triangle_tests: BTreeMap<String, u64>,
     /// GPU time per kernel in milliseconds (GL timer queries, summed over tiles and passes).
     pub gpu_ms: BTreeMap<String, f64>,
+    /// Rays whose loop the GL implementation ended early (llvmpipe's loop limit); a frame
+    /// with any is refused by the host.
+    pub truncated_rays: u64,
     /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
     pub wall_ms: f64,
 }

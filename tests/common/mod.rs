@@ -1,0 +1,116 @@
+//! Shared helpers of the integration tests: a headless context, rendering on the GPU and on
+//! the CPU reference, and pixel-by-pixel comparison with stated tolerances.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::reference::{Reference, ReferenceFrame};
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::base::BaseTracer;
+use gpgpu_rt::tracer::{Frame, RenderOptions, ShadowFlags};
+
+pub fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
+}
+
+pub fn load(name: &str) -> Scene {
+    Scene::load(&scene_path(name)).expect("shipped scene loads")
+}
+
+pub fn context() -> GlContext {
+    GlContext::headless(None).expect("a headless GL 4.5 context (Mesa llvmpipe or a GPU)")
+}
+
+pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
+    RenderOptions {
+        width: w,
+        height: h,
+        refl_depth,
+        tile: 256,
+        shadow_flags: ShadowFlags::Bits,
+        aovs: true,
+    }
+}
+
+pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
+    let mut t = BaseTracer::new(ctx, scene, &ShaderSource::default(), opts).expect("tracer");
+    t.render(&scene.camera).expect("frame")
+}
+
+pub fn render_cpu(scene: &Scene, opts: &RenderOptions) -> ReferenceFrame {
+    Reference::new(scene).render(&scene.camera, opts.width, opts.height, opts.refl_depth)
+}
+
+/// How a GPU frame differs from the CPU reference.
+#[derive(Debug)]
+pub struct Comparison {
+    pub pixels: usize,
+    /// pixels whose first-hit triangle id differs
+    pub id_mismatches: usize,
+    /// largest relative hit-distance difference over pixels with equal ids
+    pub max_t_rel: f32,
+    /// mean over pixels and channels of |gpu - cpu| colour
+    pub mean_color_diff: f32,
+    /// share of pixels with any channel off by more than 0.02
+    pub color_outliers: f32,
+    pub hits: usize,
+}
+
+pub fn compare(gpu: &Frame, cpu: &ReferenceFrame) -> Comparison {
+    let a = gpu.aovs.as_ref().expect("GPU AOVs");
+    let n = cpu.color.len();
+    assert_eq!(gpu.color.len(), n);
+    let mut c = Comparison {
+        pixels: n,
+        id_mismatches: 0,
+        max_t_rel: 0.0,
+        mean_color_diff: 0.0,
+        color_outliers: 0.0,
+        hits: 0,
+    };
+    let mut sum = 0.0f64;
+    let mut outliers = 0;
+    for i in 0..n {
+        let (gi, ci) = (a.triangle_id[i], cpu.aovs.triangle_id[i]);
+        if ci >= 0 {
+            c.hits += 1;
+        }
+        if gi != ci {
+            c.id_mismatches += 1;
+        } else if ci >= 0 {
+            let rel = (a.hit_t[i] - cpu.aovs.hit_t[i]).abs() / cpu.aovs.hit_t[i].max(1e-3);
+            c.max_t_rel = c.max_t_rel.max(rel);
+        } else {
+            assert!(a.hit_t[i].is_infinite() && a.hit_t[i] > 0.0, "miss must have hit_t = +inf");
+        }
+        let mut worst = 0.0f32;
+        for k in 0..3 {
+            let d = (gpu.color[i][k] - cpu.color[i][k]).abs();
+            sum += d as f64;
+            worst = worst.max(d);
+        }
+        if worst > 0.02 {
+            outliers += 1;
+        }
+    }
+    c.mean_color_diff = (sum / (3 * n) as f64) as f32;
+    c.color_outliers = outliers as f32 / n as f32;
+    c
+}
+
+/// The tolerances all GPU/CPU comparisons use: f32 on two implementations may flip a ray that
+/// grazes a shared triangle edge, so a few ids may differ (at most 0.5 % of the pixels); where
+/// the ids agree the hit distances agree to 1e-4 relative; colours differ by at most 0.005 on
+/// average and by more than 0.02 in at most 1 % of the pixels (the pixels whose ids or shadow
+/// decisions differ).
+pub fn assert_close(gpu: &Frame, cpu: &ReferenceFrame, what: &str) -> Comparison {
+    let c = compare(gpu, cpu);
+    eprintln!("{what}: {c:?}");
+    assert!(c.hits > 0, "{what}: the image shows no geometry");
+    assert!(c.id_mismatches as f32 <= 0.005 * c.pixels as f32, "{what}: triangle ids differ: {c:?}");
+    assert!(c.max_t_rel < 1e-4, "{what}: hit distances differ: {c:?}");
+    assert!(c.mean_color_diff < 0.005, "{what}: colours differ: {c:?}");
+    assert!(c.color_outliers < 0.01, "{what}: colours differ: {c:?}");
+    c
+}
