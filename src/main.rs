@@ -4,26 +4,19 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _, Result};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use serde_json::json;
 
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output;
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::{RenderOptions, ShadowFlags};
+use gpgpu_rt::tracer::{self, RenderOptions, ShadowFlags, TracerKind};
 
 #[derive(Parser)]
 #[command(name = "gpgpu-rt", version, about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum TracerKind {
-    /// The thesis' base tracer: every ray against every triangle (ch. 3.1, 4.1).
-    Base,
 }
 
 #[derive(clap::Args)]
@@ -131,12 +124,9 @@ fn run(cli: Cli) -> Result<()> {
                 shadow_flags,
                 aovs: aov_dir.is_some(),
             };
-            let (frame, name) = match tracer {
-                TracerKind::Base => {
-                    let mut t = BaseTracer::new(&ctx, &scene, &shaders, options.clone())?;
-                    (t.render(&scene.camera)?, "base")
-                }
-            };
+            let mut t = tracer::create(tracer, ctx.gl.clone(), &ctx.info, &scene, &shaders, options.clone())?;
+            let frame = t.render(&scene.camera)?;
+            let name = t.name();
             output::write_png(&output, &frame)?;
             if let (Some(dir), Some(aovs)) = (&aov_dir, &frame.aovs) {
                 output::write_aovs(dir, frame.width, frame.height, aovs)?;

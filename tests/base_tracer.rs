@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3};
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::scene::{Light, Scene};
 use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::ShadowFlags;
+use gpgpu_rt::tracer::{ShadowFlags, Tracer};
 
 #[test]
 fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
@@ -74,7 +74,7 @@ fn more_than_four_lights_with_bitwise_shadow_flags() {
     let cpu = render_cpu(&scene, &opts);
     assert_close(&gpu, &cpu, "cow with 37 lights");
     // the thesis' RGBA flags hold 4 lights: a clear error, not a silent drop
-    let err = BaseTracer::new(&ctx, &scene, &ShaderSource::default(), gpgpu_rt::tracer::RenderOptions {
+    let err = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), gpgpu_rt::tracer::RenderOptions {
         shadow_flags: ShadowFlags::Rgba,
         ..opts.clone()
     })
@@ -110,11 +110,11 @@ fn moving_an_object_needs_only_its_model_matrix() {
     let ctx = context();
     let mut scene = load("teapot1.toml");
     let opts = options(48, 48, 1);
-    let mut tracer = BaseTracer::new(&ctx, &scene, &ShaderSource::default(), opts.clone()).unwrap();
+    let mut tracer = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), opts.clone()).unwrap();
     let before = tracer.render(&scene.camera).unwrap();
     // move and turn the teapot; the transform pass puts it into the SSBOs, no re-upload
     let moved = Mat4::from_translation(Vec3::new(0.6, 0.0, -0.4)) * Mat4::from_rotation_y(0.7) * scene.objects[1].model;
-    tracer.models[1] = moved;
+    tracer.set_model(1, moved);
     let after = tracer.render(&scene.camera).unwrap();
     assert_ne!(before.color, after.color);
     scene.objects[1].model = moved;

@@ -10,9 +10,9 @@ use glam::Mat4;
 use glow::HasContext;
 
 use super::gpu_scene::{binding, GpuScene};
-use super::{flip_rows, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS, TRIANGLE_TEST_COUNTERS};
+use super::{flip_rows, Tracer, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS, TRIANGLE_TEST_COUNTERS};
 use crate::gl::resources::{GpuTimers, Image2d, Ssbo};
-use crate::gl::{check_error, compile_program, Defines, Gl, GlContext, ShaderSource};
+use crate::gl::{check_error, compile_program, Defines, Gl, GlInfo, ShaderSource};
 use crate::scene::{Camera, Scene};
 
 /// Image units of the ray-state textures, shared with `glsl/common/images.glsl`.
@@ -122,8 +122,7 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
 }
 
 impl BaseTracer {
-    pub fn new(ctx: &GlContext, scene: &Scene, shaders: &ShaderSource, options: RenderOptions) -> Result<BaseTracer> {
-        let gl = ctx.gl.clone();
+    pub fn new(gl: Arc<Gl>, info: &GlInfo, scene: &Scene, shaders: &ShaderSource, options: RenderOptions) -> Result<BaseTracer> {
         if scene.lights.len() > options.shadow_flags.max_lights() {
             bail!(
                 "{}: {} lights, but --shadow-flags {} holds at most {} (use --shadow-flags bits)",
@@ -136,7 +135,7 @@ impl BaseTracer {
                 options.shadow_flags.max_lights()
             );
         }
-        let max_tex = ctx.info.max_texture_size as u32;
+        let max_tex = info.max_texture_size as u32;
         if options.width == 0 || options.height == 0 || options.width > max_tex || options.height > max_tex {
             bail!(
                 "image size {}x{} outside 1..={} (GL_MAX_TEXTURE_SIZE)",
@@ -148,10 +147,10 @@ impl BaseTracer {
         if options.tile % 8 != 0 {
             bail!("--tile {} must be a multiple of 8 (the kernels' work group size)", options.tile);
         }
-        let gpu_scene = GpuScene::new(&gl, &ctx.info, scene, shaders)?;
+        let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
         let defines = kernel_defines(scene, &options);
         let compute = |name: &str| compile_program(&gl, shaders, &[(glow::COMPUTE_SHADER, name)], &defines);
-        let counters = Ssbo::new(&gl, "counters", 8 * COUNTERS.len(), None, ctx.info.max_ssbo_block_size)?;
+        let counters = Ssbo::new(&gl, "counters", 8 * COUNTERS.len(), None, info.max_ssbo_block_size)?;
         let tracer = BaseTracer {
             eye_ray_generation: compute("eye_ray_generation.comp")?,
             intersect1: compute("intersect1.comp")?,
@@ -166,7 +165,7 @@ impl BaseTracer {
             ambient: scene.settings.ambient,
             models: scene.objects.iter().map(|o| o.model).collect(),
             options,
-            renderer: ctx.info.renderer.clone(),
+            renderer: info.renderer.clone(),
             gl,
         };
         check_error(&tracer.gl, "creating the base tracer")?;
@@ -220,8 +219,19 @@ impl BaseTracer {
         unsafe { self.gl.use_program(Some(p)) };
     }
 
+}
+
+impl Tracer for BaseTracer {
+    fn name(&self) -> &'static str {
+        "base"
+    }
+
+    fn set_model(&mut self, object: usize, model: Mat4) {
+        self.models[object] = model;
+    }
+
     /// Render one frame with the render loop of Fig. 8.
-    pub fn render(&mut self, camera: &Camera) -> Result<Frame> {
+    fn render(&mut self, camera: &Camera) -> Result<Frame> {
         let start = Instant::now();
         let gl = self.gl.clone();
         let (w, h) = (self.options.width, self.options.height);

@@ -5,8 +5,47 @@ pub mod base;
 pub mod gpu_scene;
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
+use anyhow::Result;
+use glam::Mat4;
 use serde::Serialize;
+
+use crate::gl::{Gl, GlInfo, ShaderSource};
+use crate::scene::{Camera, Scene};
+
+/// A tracer design: renders frames of the scene it was made for.
+pub trait Tracer {
+    /// The `--tracer` name.
+    fn name(&self) -> &'static str;
+    /// Move object `object` (index in the scene's objects): its model matrix for the next
+    /// frames. The transform pass applies it; nothing is uploaded again.
+    fn set_model(&mut self, object: usize, model: Mat4);
+    /// Render one frame seen from `camera`.
+    fn render(&mut self, camera: &Camera) -> Result<Frame>;
+}
+
+/// The `--tracer` choices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TracerKind {
+    /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
+    Base,
+}
+
+/// Make the tracer `kind` for `scene` on the current context.
+pub fn create(
+    kind: TracerKind,
+    gl: Arc<Gl>,
+    info: &GlInfo,
+    scene: &Scene,
+    shaders: &ShaderSource,
+    options: RenderOptions,
+) -> Result<Box<dyn Tracer>> {
+    Ok(match kind {
+        TracerKind::Base => Box::new(base::BaseTracer::new(gl, info, scene, shaders, options)?),
+    })
+}
 
 /// How the shadow flags of intersect2 are stored (Müller 2015, Listing 15 and ch. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]

@@ -8,7 +8,7 @@ use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::Scene;
 use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::{Frame, RenderOptions, ShadowFlags};
+use gpgpu_rt::tracer::{Frame, RenderOptions, ShadowFlags, Tracer};
 
 pub fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
@@ -34,7 +34,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
 }
 
 pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
-    let mut t = BaseTracer::new(ctx, scene, &ShaderSource::default(), opts).expect("tracer");
+    let mut t = BaseTracer::new(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default(), opts).expect("tracer");
     t.render(&scene.camera).expect("frame")
 }
 
