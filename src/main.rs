@@ -123,6 +123,7 @@ fn run(cli: Cli) -> Result<()> {
                 tile,
                 shadow_flags,
                 aovs: aov_dir.is_some(),
+                grid: Default::default(),
             };
             let mut t = tracer::create(tracer, ctx.gl.clone(), &ctx.info, &scene, &shaders, options.clone())?;
             let frame = t.render(&scene.camera)?;

@@ -205,6 +205,88 @@ fn locate_obj_error(path: &Path) -> (Option<usize>, String) {
     (None, String::new())
 }
 
+/// Load a PLY file (ASCII or binary; gzip-compressed when the name ends in `.gz`) with
+/// `vertex` x/y/z and `face` vertex_indices (polygons are fanned into triangles). Vertex
+/// normals are the area-weighted face normals.
+pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Property};
+    let file = std::fs::File::open(path)
+        .map_err(|e| SceneError::at(path, None, format!("cannot open PLY file: {e}")))?;
+    let mut reader: Box<dyn std::io::Read> = if path.extension().is_some_and(|e| e == "gz") {
+        Box::new(std::io::BufReader::new(flate2::read::GzDecoder::new(file)))
+    } else {
+        Box::new(std::io::BufReader::new(file))
+    };
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| SceneError::at(path, None, format!("malformed PLY file: {e}")))?;
+    let scalar = |p: Option<&Property>| -> Option<f64> {
+        Some(match p? {
+            Property::Float(v) => *v as f64,
+            Property::Double(v) => *v,
+            Property::Int(v) => *v as f64,
+            Property::UInt(v) => *v as f64,
+            Property::Short(v) => *v as f64,
+            Property::UShort(v) => *v as f64,
+            Property::Char(v) => *v as f64,
+            Property::UChar(v) => *v as f64,
+            _ => return None,
+        })
+    };
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+    let mut pos = Vec::with_capacity(vertices.len());
+    for (i, v) in vertices.iter().enumerate() {
+        let c = ["x", "y", "z"].map(|k| scalar(v.get(k)));
+        match c {
+            [Some(x), Some(y), Some(z)] => pos.push(Vec3::new(x as f32, y as f32, z as f32)),
+            _ => return Err(SceneError::at(path, None, format!("vertex {i} lacks numeric x, y, z"))),
+        }
+    }
+    let faces = ply.payload.get("face").unwrap_or(&empty);
+    let mut tris: Vec<[usize; 3]> = Vec::with_capacity(faces.len());
+    for (i, f) in faces.iter().enumerate() {
+        let idx: Vec<i64> = match f.get("vertex_indices").or_else(|| f.get("vertex_index")) {
+            Some(Property::ListInt(v)) => v.iter().map(|x| *x as i64).collect(),
+            Some(Property::ListUInt(v)) => v.iter().map(|x| *x as i64).collect(),
+            Some(Property::ListShort(v)) => v.iter().map(|x| *x as i64).collect(),
+            Some(Property::ListUShort(v)) => v.iter().map(|x| *x as i64).collect(),
+            Some(Property::ListUChar(v)) => v.iter().map(|x| *x as i64).collect(),
+            _ => return Err(SceneError::at(path, None, format!("face {i} lacks a vertex_indices list"))),
+        };
+        if idx.len() < 3 || idx.iter().any(|&k| k < 0 || k as usize >= pos.len()) {
+            return Err(SceneError::at(
+                path,
+                None,
+                format!("face {i} has indices {idx:?}: needs at least 3, each below {} vertices", pos.len()),
+            ));
+        }
+        for k in 1..idx.len() - 1 {
+            tris.push([idx[0] as usize, idx[k] as usize, idx[k + 1] as usize]);
+        }
+    }
+    if tris.is_empty() {
+        return Err(SceneError::at(path, None, "the PLY file has no faces".into()));
+    }
+    let mut acc = vec![Vec3::ZERO; pos.len()];
+    for t in &tris {
+        let n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
+        t.iter().for_each(|&k| acc[k] += n);
+    }
+    let mut mesh = Mesh::default();
+    for t in &tris {
+        let p = t.map(|k| pos[k]);
+        let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        let n = t.map(|k| {
+            let n = acc[k].normalize_or_zero();
+            if n == Vec3::ZERO { geo } else { n }
+        });
+        mesh.push_triangle(p, n, [Vec3::splat(0.8); 3], [Vec2::ZERO; 3], 0);
+    }
+    Ok(mesh)
+}
+
 /// Newell's teapot: 32 bicubic Bézier patches in the `.bpt` format (a line with the patch
 /// count, then per patch a line `3 3` and 16 control points `x y z`, z up), tessellated
 /// `n`×`n` quads per patch — 32·n·n·2 triangles, 6400 for the thesis' n = 10 (ch. 5.1).

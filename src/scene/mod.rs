@@ -304,6 +304,15 @@ impl Scene {
                 }
                 mesh
             }
+            "ply" => {
+                let path = need_path("model.ply.gz")?;
+                let mut mesh = mesh::load_ply(&path).map_err(ObjectError::File)?;
+                let c = color.unwrap_or(Vec3::splat(0.8));
+                mesh.colors.iter_mut().for_each(|x| *x = c);
+                let id = self.add_material(Material { texture, ..base });
+                mesh.triangle_material.iter_mut().for_each(|m| *m = id);
+                mesh
+            }
             "teapot" => {
                 let path = need_path("models/teapot.bpt")?;
                 let mut mesh = mesh::teapot(&path, def.tessellation.unwrap_or(10)).map_err(ObjectError::File)?;
@@ -330,7 +339,7 @@ impl Scene {
             }
             other => {
                 return Err(ObjectError::Here(format!(
-                    "unknown object type \"{other}\" (expected \"obj\", \"teapot\" or \"floor\")"
+                    "unknown object type \"{other}\" (expected \"obj\", \"ply\", \"teapot\" or \"floor\")"
                 )))
             }
         };

@@ -67,6 +67,41 @@ impl ShadowFlags {
     }
 }
 
+/// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum GridVariant {
+    /// Faithful: triangles registered along their edges into fixed-size voxel lists, per-ray
+    /// voxel lists from the traversal kernel (Listings 17–22).
+    Thesis,
+    /// Exact: triangle/box overlap, compact lists (count, prefix sum, fill), 3D-DDA in the
+    /// intersection kernels.
+    #[default]
+    Exact,
+}
+
+/// Options of the grid tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GridOptions {
+    pub variant: GridVariant,
+    /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
+    pub resolution: Option<u32>,
+    /// The thesis variant's fixed list lengths (voxel_array_length, ray_array_length).
+    pub voxel_array_length: u32,
+    pub ray_array_length: u32,
+}
+
+impl Default for GridOptions {
+    fn default() -> Self {
+        GridOptions {
+            variant: GridVariant::Exact,
+            resolution: None,
+            voxel_array_length: 512,
+            ray_array_length: 128,
+        }
+    }
+}
+
 /// Options of one render.
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
@@ -79,6 +114,8 @@ pub struct RenderOptions {
     pub shadow_flags: ShadowFlags,
     /// Read back the primary rays and first hits for the AOVs.
     pub aovs: bool,
+    /// Grid tracer options (ignored by the base tracer).
+    pub grid: GridOptions,
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.

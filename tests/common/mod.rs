@@ -30,6 +30,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         tile: 256,
         shadow_flags: ShadowFlags::Bits,
         aovs: true,
+        grid: Default::default(),
     }
 }
 
