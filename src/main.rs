@@ -149,10 +149,19 @@ fn run(cli: Cli) -> Result<()> {
                     "tile": options.tile,
                     "triangle_tests": s.triangle_tests,
                     "triangle_tests_total": s.total_triangle_tests(),
+                    "events": s.events,
+                    "truncated_rays": s.truncated_rays,
                     "gpu_ms": s.gpu_ms,
                     "gpu_ms_total": s.total_gpu_ms(),
                     "wall_ms": s.wall_ms,
                 });
+                let mut doc = doc;
+                for (k, v) in &s.facts {
+                    doc[k] = v.clone();
+                }
+                for (k, v) in &s.events {
+                    doc[k] = json!(v);
+                }
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)? + "\n")
                     .with_context(|| format!("cannot write {}", path.display()))?;
             }

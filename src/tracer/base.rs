@@ -230,6 +230,10 @@ impl Tracer for BaseTracer {
         self.models[object] = model;
     }
 
+    fn output_texture(&self) -> glow::Texture {
+        self.images.final_color.texture
+    }
+
     /// Render one frame with the render loop of Fig. 8.
     fn render(&mut self, camera: &Camera) -> Result<Frame> {
         let start = Instant::now();

@@ -23,6 +23,9 @@ pub trait Tracer {
     fn set_model(&mut self, object: usize, model: Mat4);
     /// Render one frame seen from `camera`.
     fn render(&mut self, camera: &Camera) -> Result<Frame>;
+    /// The RGBA32F output texture of the last frame (rgb colour, a weight), GL row order, for
+    /// showing it through a screen-filling quad (Müller 2015, ch. 3.1.3).
+    fn output_texture(&self) -> glow::Texture;
 }
 
 /// The `--tracer` choices.
@@ -134,6 +137,11 @@ pub struct FrameStats {
     /// Rays whose loop the GL implementation ended early (llvmpipe's loop limit); a frame
     /// with any is refused by the host.
     pub truncated_rays: u64,
+    /// Other exact event counts of the design (grid: voxels_visited, dropped_triangle_refs,
+    /// ray_list_overflows, ...).
+    pub events: BTreeMap<String, u64>,
+    /// Design-specific facts (grid: grid_resolution, grid_bytes, grid_build_ms, ...).
+    pub facts: BTreeMap<String, serde_json::Value>,
     /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
     pub wall_ms: f64,
 }
