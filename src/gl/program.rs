@@ -2,9 +2,10 @@
 //! `#include "file"` preprocessor, `#define` injection, and compile/link errors that name the
 //! GLSL file and line.
 //!
-//! Every file of the assembled source gets its own GLSL source-string number through
-//! `#line LINE FILE`, so a driver message such as `3:17(5): error: ...` (Mesa) or
-//! `3(17) : error ...` (NVIDIA) is mapped back to `glsl/common/intersect.glsl:17`.
+//! The assembled source keeps a map from each of its lines to (file, line), so a driver
+//! message such as `0:17(5): error: ...` (Mesa) or `0(17) : error ...` (NVIDIA) is mapped back
+//! to `glsl/common/intersect.glsl:3`. (A line map rather than `#line L FILE`: Mesa drops the
+//! file number in its semantic errors.)
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -25,6 +26,8 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("intersect2.comp", include_str!("../../glsl/intersect2.comp")),
     ("shading.comp", include_str!("../../glsl/shading.comp")),
     ("transform.vert", include_str!("../../glsl/transform.vert")),
+    ("screen_quad.vert", include_str!("../../glsl/screen_quad.vert")),
+    ("screen_quad.frag", include_str!("../../glsl/screen_quad.frag")),
 ];
 
 /// Where kernel sources come from.
@@ -67,36 +70,28 @@ impl ShaderSource {
         }
     }
 
-    /// Assemble `name` with its includes and the given defines. Returns the text and the list
-    /// of file names indexed by GLSL source-string number.
-    pub fn assemble(&self, name: &str, defines: &Defines) -> Result<(String, Vec<String>)> {
-        let mut files = Vec::new();
+    /// Assemble `name` with its includes and the given defines. Returns the text and, for
+    /// every line of it, the file and line it came from.
+    pub fn assemble(&self, name: &str, defines: &Defines) -> Result<(String, LineMap)> {
+        let mut map = LineMap::default();
         let mut out = String::new();
-        // Source string 0 is the generated header: version and defines.
-        files.push("<generated header>".to_string());
+        map.push("<generated header>", 1);
         out.push_str("#version 450 core\n");
-        for (k, v) in &defines.0 {
+        for (i, (k, v)) in defines.0.iter().enumerate() {
             out.push_str(&format!("#define {k} {v}\n"));
+            map.push("<generated header>", i + 2);
         }
-        self.include(name, &mut out, &mut files, &mut Vec::new())?;
-        Ok((out, files))
+        self.include(name, &mut out, &mut map, &mut Vec::new())?;
+        Ok((out, map))
     }
 
-    fn include(
-        &self,
-        name: &str,
-        out: &mut String,
-        files: &mut Vec<String>,
-        stack: &mut Vec<String>,
-    ) -> Result<()> {
+    fn include(&self, name: &str, out: &mut String, map: &mut LineMap, stack: &mut Vec<String>) -> Result<()> {
         if stack.iter().any(|s| s == name) {
             bail!("#include cycle: {} -> {name}", stack.join(" -> "));
         }
         let text = self.read(name)?;
-        let index = files.len();
-        files.push(self.display_name(name));
+        let display = self.display_name(name);
         stack.push(name.to_string());
-        out.push_str(&format!("#line 1 {index}\n"));
         for (lineno, line) in text.lines().enumerate() {
             let trimmed = line.trim_start();
             if let Some(rest) = trimmed.strip_prefix("#include") {
@@ -106,15 +101,17 @@ impl ShaderSource {
                 }
                 let dir = Path::new(name).parent().unwrap_or(Path::new(""));
                 let target = dir.join(target).to_string_lossy().replace('\\', "/");
-                self.include(&normalize(&target), out, files, stack)
+                self.include(&normalize(&target), out, map, stack)
                     .with_context(|| format!("included from {}:{}", self.display_name(name), lineno + 1))?;
-                out.push_str(&format!("#line {} {index}\n", lineno + 2));
-            } else if trimmed.starts_with("#version") {
-                // The header carries the version; keep line numbering.
-                out.push('\n');
             } else {
-                out.push_str(line);
-                out.push('\n');
+                if trimmed.starts_with("#version") {
+                    // the header carries the version
+                    out.push('\n');
+                } else {
+                    out.push_str(line);
+                    out.push('\n');
+                }
+                map.push(&display, lineno + 1);
             }
         }
         stack.pop();
@@ -151,23 +148,41 @@ impl Defines {
     }
 }
 
+/// For every line of an assembled source: the file and line it came from.
+#[derive(Debug, Clone, Default)]
+pub struct LineMap(Vec<(String, usize)>);
+
+impl LineMap {
+    fn push(&mut self, file: &str, line: usize) {
+        self.0.push((file.to_string(), line));
+    }
+
+    /// The origin of assembled line `line` (1-based).
+    pub fn origin(&self, line: usize) -> Option<(&str, usize)> {
+        self.0.get(line.checked_sub(1)?).map(|(f, l)| (f.as_str(), *l))
+    }
+
+    pub fn files(&self) -> impl Iterator<Item = &str> {
+        self.0.iter().map(|(f, _)| f.as_str())
+    }
+}
+
 /// Rewrite a driver's compile log so every `N:LINE(` / `N(LINE)` prefix names the file.
-pub fn map_log(log: &str, files: &[String]) -> String {
+pub fn map_log(log: &str, map: &LineMap) -> String {
     let mut out = String::new();
     for line in log.lines() {
-        out.push_str(&map_line(line, files).unwrap_or_else(|| line.to_string()));
+        out.push_str(&map_line(line, map).unwrap_or_else(|| line.to_string()));
         out.push('\n');
     }
     out
 }
 
-fn map_line(line: &str, files: &[String]) -> Option<String> {
+fn map_line(line: &str, map: &LineMap) -> Option<String> {
     let t = line.trim_start();
     let digits: String = t.chars().take_while(|c| c.is_ascii_digit()).collect();
     if digits.is_empty() {
         return None;
     }
-    let file: usize = digits.parse().ok()?;
     let rest = &t[digits.len()..];
     let (lineno, tail) = if let Some(r) = rest.strip_prefix(':') {
         // Mesa: "0:12(5): error: ..."
@@ -180,8 +195,8 @@ fn map_line(line: &str, files: &[String]) -> Option<String> {
     } else {
         return None;
     };
-    let name = files.get(file)?;
-    Some(format!("{name}:{lineno}{tail}"))
+    let (name, origin) = map.origin(lineno.parse().ok()?)?;
+    Some(format!("{name}:{origin}{tail}"))
 }
 
 /// One stage of a program: kind (glow::COMPUTE_SHADER, ...) and file name below `glsl/`.
@@ -196,12 +211,12 @@ pub fn compile_program(
         let program = gl.create_program().map_err(|e| anyhow!(e))?;
         let mut shaders = Vec::new();
         for &(kind, name) in stages {
-            let (text, files) = source.assemble(name, defines)?;
+            let (text, lines) = source.assemble(name, defines)?;
             let shader = gl.create_shader(kind).map_err(|e| anyhow!(e))?;
             gl.shader_source(shader, &text);
             gl.compile_shader(shader);
             if !gl.get_shader_compile_status(shader) {
-                let log = map_log(&gl.get_shader_info_log(shader), &files);
+                let log = map_log(&gl.get_shader_info_log(shader), &lines);
                 gl.delete_shader(shader);
                 gl.delete_program(program);
                 bail!("GLSL compile error in {}:\n{log}", source.display_name(name));
@@ -230,26 +245,40 @@ mod tests {
 
     #[test]
     fn log_lines_name_files() {
-        let files = vec!["<generated header>".to_string(), "glsl/a.comp".into(), "glsl/common/b.glsl".into()];
+        let mut map = LineMap::default();
+        map.push("<generated header>", 1);
+        for l in 1..=20 {
+            map.push("glsl/a.comp", l);
+        }
+        for l in 1..=5 {
+            map.push("glsl/common/b.glsl", l);
+        }
         assert_eq!(
-            map_line("2:17(5): error: `x' undeclared", &files).unwrap(),
-            "glsl/common/b.glsl:17(5): error: `x' undeclared"
+            map_line("0:23(5): error: `x' undeclared", &map).unwrap(),
+            "glsl/common/b.glsl:2(5): error: `x' undeclared"
         );
         assert_eq!(
-            map_line("1(12) : error C0000: syntax error", &files).unwrap(),
-            "glsl/a.comp:12 : error C0000: syntax error"
+            map_line("0(12) : error C0000: syntax error", &map).unwrap(),
+            "glsl/a.comp:11 : error C0000: syntax error"
         );
-        assert!(map_line("warning: nothing", &files).is_none());
+        assert!(map_line("warning: nothing", &map).is_none());
     }
 
     #[test]
     fn includes_are_resolved_and_numbered() {
         let src = ShaderSource::default();
-        let (text, files) = src
+        let (text, map) = src
             .assemble("intersect1.comp", &Defines::new().set("FOO", 3))
             .unwrap();
         assert!(text.starts_with("#version 450 core\n#define FOO 3\n"));
-        assert!(files.iter().any(|f| f == "glsl/common/intersect.glsl"));
+        assert!(map.files().any(|f| f == "glsl/common/intersect.glsl"));
         assert!(!text.contains("#include"));
+        assert_eq!(text.lines().count(), map.0.len());
+        // an assembled line maps back to the same text in its file
+        let k = text.lines().position(|l| l.contains("bool intersectTriangle(")).unwrap();
+        let (f, l) = map.origin(k + 1).unwrap();
+        assert_eq!(f, "glsl/common/intersect.glsl");
+        let orig = EMBEDDED.iter().find(|(n, _)| *n == "common/intersect.glsl").unwrap().1;
+        assert!(orig.lines().nth(l - 1).unwrap().contains("bool intersectTriangle("));
     }
 }

@@ -1,0 +1,206 @@
+//! The command line as other tools use it: render with AOVs and statistics, export-triangles,
+//! info --json, and clear errors with a non-zero exit on bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name).display().to_string()
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("the binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn read_npy_f32(p: &Path) -> (Vec<u64>, Vec<f32>) {
+    let bytes = std::fs::read(p).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    (npy.shape().to_vec(), npy.into_vec::<f32>().unwrap())
+}
+
+fn read_npy_i32(p: &Path) -> (Vec<u64>, Vec<i32>) {
+    let bytes = std::fs::read(p).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    (npy.shape().to_vec(), npy.into_vec::<i32>().unwrap())
+}
+
+#[test]
+fn render_writes_png_aovs_and_stats() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let png = d.join("out.png");
+    let stats = d.join("s.json");
+    let aov = d.join("aov");
+    let (w, h) = (40u64, 24u64);
+    let o = run(&[
+        "render", &scene("cow.toml"), "-o", png.to_str().unwrap(), "--width", "40", "--height", "24",
+        "--aov-dir", aov.to_str().unwrap(), "--stats", stats.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 24));
+
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in ["renderer", "width", "height", "triangles", "lights", "tracer", "triangle_tests", "gpu_ms"] {
+        assert!(s.get(key).is_some(), "stats lack {key}: {s}");
+    }
+    assert_eq!(s["triangles"], 5804);
+    assert_eq!(s["tracer"], "base");
+    // one light, no reflection on the cow: every primary ray tests every triangle once
+    assert_eq!(s["triangle_tests"]["intersect1"].as_u64().unwrap(), w * h * 5804);
+    assert!(s["triangle_tests"]["intersect2"].as_u64().unwrap() > 0);
+    assert!(s["gpu_ms"]["intersect1"].as_f64().unwrap() > 0.0);
+
+    let (shape, t) = read_npy_f32(&aov.join("hit_t.npy"));
+    assert_eq!(shape, vec![h, w]);
+    let (shape, ids) = read_npy_i32(&aov.join("triangle_id.npy"));
+    assert_eq!(shape, vec![h, w]);
+    let (shape, dirs) = read_npy_f32(&aov.join("ray_direction.npy"));
+    assert_eq!(shape, vec![h, w, 3]);
+    let (_, origins) = read_npy_f32(&aov.join("ray_origin.npy"));
+    let (shape, normals) = read_npy_f32(&aov.join("normal.npy"));
+    assert_eq!(shape, vec![h, w, 3]);
+    let hits = ids.iter().filter(|&&i| i >= 0).count();
+    assert!(hits > 0 && hits < ids.len(), "the cow covers part of the image");
+    // misses: +inf and -1; hits: finite t and an id below the triangle count
+    for (k, (&id, &tk)) in ids.iter().zip(&t).enumerate() {
+        if id < 0 {
+            assert_eq!(id, -1);
+            assert!(tk.is_infinite() && tk > 0.0);
+        } else {
+            assert!(id < 5804 && tk.is_finite() && tk > 0.0);
+            let n = &normals[3 * k..3 * k + 3];
+            assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-3);
+        }
+        let dv = &dirs[3 * k..3 * k + 3];
+        assert!(((dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]).sqrt() - 1.0).abs() < 1e-5);
+    }
+    // row 0 is the top row: the camera looks down a little, so ray directions in row 0 point
+    // higher than in the last row
+    assert!(dirs[1] > dirs[3 * ((h - 1) * w) as usize + 1]);
+    // the hit point o + t·d lies on the reported triangle (export-triangles gives the vertices)
+    let tris = d.join("tris.npy");
+    let o2 = run(&["export-triangles", &scene("cow.toml"), "-o", tris.to_str().unwrap()]);
+    assert!(o2.status.success(), "{}", stderr(&o2));
+    let (shape, v) = read_npy_f32(&tris);
+    assert_eq!(shape, vec![5804, 3, 3]);
+    let k = ids.iter().position(|&i| i >= 0).unwrap();
+    let id = ids[k] as usize;
+    let p: Vec<f32> = (0..3).map(|c| origins[3 * k + c] + t[k] * dirs[3 * k + c]).collect();
+    let tri: Vec<&[f32]> = (0..3).map(|j| &v[9 * id + 3 * j..9 * id + 3 * j + 3]).collect();
+    let sub = |a: &[f32], b: &[f32]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let (e1, e2, ep) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]), sub(&p, tri[0]));
+    let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let dist = (n[0] * ep[0] + n[1] * ep[1] + n[2] * ep[2]).abs() / len;
+    assert!(dist < 1e-4, "hit point is {dist} off its triangle's plane");
+}
+
+#[test]
+fn info_json_reports_gl_and_scene_counts() {
+    let o = run(&["info", &scene("teapot3.toml"), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["triangles"], 27392, "thesis ch. 5.1: 8192 + 3 × 6400");
+    assert_eq!(v["lights"], 1);
+    assert!(v["version"].as_str().unwrap().starts_with("4."), "{v}");
+    assert!(!v["renderer"].as_str().unwrap().is_empty());
+    let o = run(&["info", &scene("teapot6.toml"), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["triangles"], 46592, "thesis ch. 5.1: 8192 + 6 × 6400");
+}
+
+fn assert_fails(o: &Output, needles: &[&str]) {
+    assert!(!o.status.success(), "should fail");
+    let e = stderr(o);
+    for n in needles {
+        assert!(e.contains(n), "message lacks `{n}`: {e}");
+    }
+    assert!(!e.contains("panicked"), "panic: {e}");
+}
+
+#[test]
+fn bad_input_fails_with_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // missing scene file
+    let missing = d.join("nope.toml");
+    assert_fails(&run(&["render", missing.to_str().unwrap(), "-o", "/dev/null"]), &["nope.toml"]);
+    // TOML syntax error on line 3
+    let bad = d.join("bad.toml");
+    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, oops]\n\n[[object]]\ntype = \"floor\"\n").unwrap();
+    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["bad.toml:3"]);
+    // unknown key, reported at its line
+    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfocal = 3\n[[object]]\ntype = \"floor\"\n").unwrap();
+    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["bad.toml:4", "focal"]);
+    // malformed OBJ: the bad line is named
+    std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n").unwrap();
+    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"m.obj\"\n").unwrap();
+    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["m.obj:3"]);
+    // OBJ face index out of range
+    std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n").unwrap();
+    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["m.obj:5"]);
+    // missing OBJ
+    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"gone.obj\"\n").unwrap();
+    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["gone.obj"]);
+    // unknown option
+    assert_fails(&run(&["render", &scene("cow.toml"), "--frobnicate"]), &["--frobnicate"]);
+    // bad tile size
+    assert_fails(&run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--tile", "12"]), &["--tile"]);
+    // more lights than the thesis' RGBA shadow flags hold
+    let mut text = std::fs::read_to_string(scene("cow.toml")).unwrap();
+    text = text.replace("models/cow.obj", &scene("models/cow.obj"));
+    for i in 0..5 {
+        text.push_str(&format!("\n[[light]]\nposition = [{i}.0, 3.0, 1.0]\n"));
+    }
+    std::fs::write(&bad, text).unwrap();
+    assert_fails(
+        &run(&["render", bad.to_str().unwrap(), "-o", "/dev/null", "--width", "8", "--height", "8", "--shadow-flags", "rgba"]),
+        &["6 lights", "at most 4"],
+    );
+    // a GLSL error in an edited kernel names the file and line
+    let glsl = d.join("glsl");
+    copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"), &glsl);
+    let shading = glsl.join("shading.comp");
+    let src = std::fs::read_to_string(&shading).unwrap();
+    let line = src.lines().position(|l| l.contains("void main()")).unwrap() + 1;
+    std::fs::write(&shading, src.replacen("void main()", "void main() { undefined_thing = 1; }\nvoid main2()", 1)).unwrap();
+    assert_fails(
+        &run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--glsl-dir", glsl.to_str().unwrap()]),
+        &[&format!("shading.comp:{line}")],
+    );
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let p = e.path();
+        if p.is_dir() {
+            copy_dir(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+#[test]
+fn every_shipped_scene_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    for s in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")).unwrap() {
+        let p = s.unwrap().path();
+        if p.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let out = dir.path().join("x.png");
+        let o = run(&["render", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "16", "--height", "16"]);
+        assert!(o.status.success(), "{}: {}", p.display(), stderr(&o));
+        assert!(out.exists());
+    }
+}
