@@ -89,9 +89,10 @@ pub struct GridOptions {
     pub variant: GridVariant,
     /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
     pub resolution: Option<u32>,
-    /// The thesis variant's fixed list lengths (voxel_array_length, ray_array_length).
+    /// The thesis variant's fixed list lengths: voxel_array_length (triangle ids per voxel,
+    /// Listing 17: 512) and ray_array_length (voxel ids per ray; `None`: 3·N as Listing 17).
     pub voxel_array_length: u32,
-    pub ray_array_length: u32,
+    pub ray_array_length: Option<u32>,
 }
 
 impl Default for GridOptions {
@@ -100,7 +101,7 @@ impl Default for GridOptions {
             variant: GridVariant::Exact,
             resolution: None,
             voxel_array_length: 512,
-            ray_array_length: 128,
+            ray_array_length: None,
         }
     }
 }
