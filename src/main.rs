@@ -71,6 +71,9 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Replicate a published evaluation (thesis-5.1, thesis-5.2, thesis-5.3: Müller 2015, ch. 5):
+    /// CSVs, plots and report.md with our numbers beside the published ones.
+    Bench(gpgpu_rt::bench::BenchArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
     Info {
         scene: Option<PathBuf>,
@@ -180,6 +183,7 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
+        Command::Bench(args) => gpgpu_rt::bench::run(args),
         Command::ExportTriangles { scene, output } => {
             let scene = load_scene(&scene)?;
             let tris = scene.world_triangles();

@@ -1,0 +1,284 @@
+//! PNG line charts shaped like the thesis' figures, drawn with `plotters` into an RGB buffer
+//! and written with `image`. Text is drawn with a bundled DejaVu Sans through `ab_glyph`, so no
+//! system fonts are needed.
+
+use std::path::Path;
+use std::sync::Once;
+
+use anyhow::{anyhow, Context as _, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+const FONT: &str = "sans-serif";
+static FONT_BYTES: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
+
+fn register_font() -> Result<()> {
+    static ONCE: Once = Once::new();
+    let mut result = Ok(());
+    ONCE.call_once(|| {
+        result = plotters::style::register_font(FONT, FontStyle::Normal, FONT_BYTES)
+            .map_err(|_| anyhow!("the bundled plot font cannot be read"));
+    });
+    result
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Style {
+    /// A line (many points, e.g. one per degree).
+    Line,
+    /// A line with a dot at every point.
+    LinePoints,
+    /// A dashed horizontal reference (e.g. the base tracer beside grid resolutions).
+    Dashed,
+    /// Crosses only (published values).
+    Crosses,
+}
+
+/// One data series of a chart.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    pub style: Style,
+    /// Index into the palette.
+    pub color: usize,
+}
+
+impl Series {
+    pub fn new(
+        name: impl Into<String>,
+        points: Vec<(f64, f64)>,
+        style: Style,
+        color: usize,
+    ) -> Series {
+        Series {
+            name: name.into(),
+            points,
+            style,
+            color,
+        }
+    }
+}
+
+/// One panel: title, axis labels and series.
+#[derive(Debug, Clone, Default)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    /// Fixed x range; default: the data's.
+    pub x_range: Option<(f64, f64)>,
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+];
+
+/// The colour of palette entry `i` (black is the last: published values).
+pub const BLACK_INDEX: usize = PALETTE.len() - 1;
+
+fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Axis numbers: 1.2G, 350M, 12k, 2.5.
+pub fn si(v: f64) -> String {
+    let a = v.abs();
+    let (d, s) = if a >= 1e9 {
+        (1e9, "G")
+    } else if a >= 1e6 {
+        (1e6, "M")
+    } else if a >= 1e4 {
+        (1e3, "k")
+    } else {
+        (1.0, "")
+    };
+    let x = v / d;
+    let digits = if x.abs() >= 100.0 {
+        0
+    } else if x.abs() >= 10.0 {
+        1
+    } else {
+        2
+    };
+    let mut t = format!("{x:.digits$}");
+    if t.contains('.') {
+        t = t.trim_end_matches('0').trim_end_matches('.').to_string();
+    }
+    if t == "-0" {
+        t = "0".into();
+    }
+    format!("{t}{s}")
+}
+
+fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    if from_zero {
+        lo = lo.min(0.0);
+    }
+    if hi - lo <= f64::EPSILON * hi.abs().max(1.0) {
+        let pad = hi.abs().max(1.0) * 0.1;
+        return (lo - pad, hi + pad);
+    }
+    (lo, hi + 0.08 * (hi - lo))
+}
+
+fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Result<()> {
+    let err = |e: &dyn std::fmt::Display| anyhow!("drawing the chart {:?}: {e}", chart.title);
+    let points = || chart.series.iter().flat_map(|s| s.points.iter());
+    let (x0, x1) = chart.x_range.unwrap_or_else(|| {
+        let (lo, hi) = range(points().map(|p| p.0), false);
+        // no extra headroom on x
+        let hi = if hi > lo { lo + (hi - lo) / 1.08 } else { hi };
+        (lo, hi)
+    });
+    let (y0, y1) = range(points().map(|p| p.1), true);
+    let mut c = ChartBuilder::on(area)
+        .caption(&chart.title, (FONT, 17))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    c.configure_mesh()
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .axis_desc_style((FONT, 14))
+        .label_style((FONT, 12))
+        .x_label_formatter(&|v| si(*v))
+        .y_label_formatter(&|v| si(*v))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| err(&e))?;
+    for s in &chart.series {
+        let col = color(s.color);
+        let legend_style = col.stroke_width(2);
+        match s.style {
+            Style::Line | Style::LinePoints => {
+                c.draw_series(LineSeries::new(
+                    s.points.iter().copied(),
+                    col.stroke_width(2),
+                ))
+                .map_err(|e| err(&e))?
+                .label(&s.name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], legend_style));
+                if s.style == Style::LinePoints {
+                    c.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
+                        .map_err(|e| err(&e))?;
+                }
+            }
+            Style::Dashed => {
+                c.draw_series(DashedLineSeries::new(
+                    s.points.iter().copied(),
+                    8,
+                    5,
+                    col.stroke_width(2),
+                ))
+                .map_err(|e| err(&e))?
+                .label(&s.name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], legend_style));
+            }
+            Style::Crosses => {
+                c.draw_series(
+                    s.points
+                        .iter()
+                        .map(|&p| Cross::new(p, 7, col.stroke_width(3))),
+                )
+                .map_err(|e| err(&e))?
+                .label(&s.name)
+                .legend(move |(x, y)| Cross::new((x + 9, y), 5, col.stroke_width(2)));
+            }
+        }
+    }
+    if chart.series.iter().any(|s| !s.name.is_empty()) {
+        c.configure_series_labels()
+            .label_font((FONT, 12))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// Draw `charts` side by side, each `panel_w`×`panel_h` pixels, into a PNG at `path`.
+pub fn save(path: &Path, panel_w: u32, panel_h: u32, charts: &[Chart]) -> Result<()> {
+    register_font()?;
+    let (w, h) = (panel_w * charts.len().max(1) as u32, panel_h);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let panels = root.split_evenly((1, charts.len().max(1)));
+        for (area, chart) in panels.iter().zip(charts) {
+            draw_panel(area, chart)?;
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    img.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn si_labels() {
+        assert_eq!(si(0.0), "0");
+        assert_eq!(si(2.5), "2.5");
+        assert_eq!(si(1_200_000_000.0), "1.2G");
+        assert_eq!(si(350_000_000.0), "350M");
+        assert_eq!(si(12_000.0), "12k");
+        assert_eq!(si(360.0), "360");
+    }
+
+    #[test]
+    fn chart_renders_text_and_lines_without_system_fonts() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.png");
+        let chart = Chart {
+            title: "Fig. 19".into(),
+            x_label: "angle".into(),
+            y_label: "FPS".into(),
+            series: vec![
+                Series::new(
+                    "a",
+                    (0..360)
+                        .map(|x| (x as f64, 2.0 + (x as f64 / 40.0).sin()))
+                        .collect(),
+                    Style::Line,
+                    0,
+                ),
+                Series::new("published", vec![(180.0, 2.5)], Style::Crosses, BLACK_INDEX),
+            ],
+            x_range: Some((0.0, 360.0)),
+        };
+        save(&path, 400, 300, &[chart.clone(), chart]).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (800, 300));
+        // the blue series and black text/axes are there
+        let blue = img.pixels().filter(|p| p.0 == [31, 119, 180]).count();
+        let dark = img.pixels().filter(|p| p.0.iter().all(|&c| c < 80)).count();
+        assert!(blue > 300, "{blue} series pixels");
+        assert!(dark > 500, "{dark} text/axis pixels");
+    }
+}

@@ -1,0 +1,386 @@
+//! `gpgpu-rt bench`: tiny protocol runs (16×16 pixels, two angles) on Mesa llvmpipe whose CSVs,
+//! plots and report must be written and agree with each other and with what the tracers must
+//! count.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use gpgpu_rt::tracer::TracerKind;
+
+const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
+
+fn bench(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .arg("bench")
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run gpgpu-rt")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn has_grid() -> bool {
+    <TracerKind as clap::ValueEnum>::from_str("grid", true).is_ok()
+}
+
+/// A CSV as rows of column → value.
+fn read_csv(path: &Path) -> Vec<HashMap<String, String>> {
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            header
+                .iter()
+                .cloned()
+                .zip(rec.iter().map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+fn f(row: &HashMap<String, String>, col: &str) -> f64 {
+    row.get(col)
+        .unwrap_or_else(|| panic!("no column {col}"))
+        .parse()
+        .unwrap_or_else(|_| panic!("{col} = {:?} is not a number", row[col]))
+}
+
+fn u(row: &HashMap<String, String>, col: &str) -> u64 {
+    row.get(col)
+        .unwrap_or_else(|| panic!("no column {col}"))
+        .parse()
+        .unwrap_or_else(|_| panic!("{col} = {:?} is not an integer", row[col]))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Every summary row's statistics agree with its frames: min ≤ median ≤ max, and the median,
+/// min and max of the per-frame CSV's columns.
+fn check_summary_against_frames(
+    frames: &[HashMap<String, String>],
+    summary: &[HashMap<String, String>],
+) {
+    let key = |r: &HashMap<String, String>| {
+        ["scene", "tracer", "variant", "grid_resolution"]
+            .map(|k| r[k].clone())
+            .join("/")
+    };
+    for s in summary.iter().filter(|s| s["error"].is_empty()) {
+        let mine: Vec<_> = frames.iter().filter(|r| key(r) == key(s)).collect();
+        assert_eq!(mine.len() as u64, u(s, "frames"), "{}", key(s));
+        for (frame_col, stat) in [
+            ("fps", "fps"),
+            ("wall_ms", "wall_ms"),
+            ("triangle_tests", "triangle_tests"),
+        ] {
+            let (lo, med, hi) = (
+                f(s, &format!("{stat}_min")),
+                f(s, &format!("{stat}_median")),
+                f(s, &format!("{stat}_max")),
+            );
+            assert!(
+                lo <= med && med <= hi,
+                "{}: {stat} min {lo} median {med} max {hi}",
+                key(s)
+            );
+            let v: Vec<f64> = mine.iter().map(|r| f(r, frame_col)).collect();
+            let tol = |x: f64| 1e-3 * x.abs().max(1.0);
+            assert!(
+                (median(v.clone()) - med).abs() <= tol(med),
+                "{}: {stat} median",
+                key(s)
+            );
+            let vmin = v.iter().cloned().fold(f64::INFINITY, f64::min);
+            let vmax = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            assert!(
+                (vmin - lo).abs() <= tol(lo) && (vmax - hi).abs() <= tol(hi),
+                "{}: {stat} min/max",
+                key(s)
+            );
+        }
+    }
+}
+
+/// Every file the report links exists; every PNG decodes and is not a blank image.
+fn check_report_links(out: &Path, report: &str) {
+    let mut links = 0;
+    for part in report.split("](").skip(1) {
+        let target = &part[..part.find(')').expect("closed link")];
+        let p = out.join(target);
+        assert!(p.is_file(), "report links {target}, which is missing");
+        if target.ends_with(".png") {
+            let img = image::open(&p)
+                .unwrap_or_else(|e| panic!("{target}: {e}"))
+                .to_rgb8();
+            let first = *img.get_pixel(0, 0);
+            assert!(img.pixels().any(|p| *p != first), "{target} is one colour");
+        }
+        links += 1;
+    }
+    assert!(links >= 4, "only {links} links in the report");
+}
+
+#[test]
+fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b51");
+    let o = bench(&[
+        "thesis-5.1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--angles",
+        "2",
+        "--warmup",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let frames = read_csv(&out.join("thesis-5.1.csv"));
+    assert_eq!(frames.len(), 3 * 2, "three scenes, two angles each");
+    let triangles: HashMap<&str, u64> =
+        [("teapot1", 14592), ("teapot3", 27392), ("teapot6", 46592)].into();
+    for r in &frames {
+        let t = triangles[r["scene"].as_str()];
+        assert_eq!(u(r, "triangles"), t);
+        assert_eq!(r["tracer"], "base");
+        assert_eq!(
+            (u(r, "width"), u(r, "height"), u(r, "refl_depth")),
+            (16, 16, 1)
+        );
+        assert!(
+            ["0", "180"].contains(&r["angle_deg"].as_str()),
+            "{}",
+            r["angle_deg"]
+        );
+        // the total is the sum over the kernels
+        let (i1, i2) = (u(r, "tests_intersect1"), u(r, "tests_intersect2"));
+        assert_eq!(u(r, "triangle_tests"), i1 + i2);
+        // the primary pass tests every triangle for every pixel; the one reflection pass at
+        // most as many again; a pass has at most one shadow feeler per pixel
+        let pass = 16 * 16 * t;
+        assert!(
+            i1 >= pass && i1 <= 2 * pass,
+            "{}: intersect1 {i1} vs W·H·T {pass}",
+            r["scene"]
+        );
+        assert!(i2 <= 2 * pass);
+        let (wall, fps) = (f(r, "wall_ms"), f(r, "fps"));
+        assert!(
+            wall > 0.0 && (fps * wall / 1e3 - 1.0).abs() < 1e-3,
+            "fps {fps} wall {wall}"
+        );
+        assert!(f(r, "gpu_ms_total") > 0.0);
+    }
+    // more triangles, more tests: the brute-force tracer's work grows with the scene
+    let tests_of = |s: &str| {
+        frames
+            .iter()
+            .filter(|r| r["scene"] == s)
+            .map(|r| u(r, "triangle_tests"))
+            .max()
+            .unwrap()
+    };
+    assert!(tests_of("teapot1") < tests_of("teapot3") && tests_of("teapot3") < tests_of("teapot6"));
+
+    let summary = read_csv(&out.join("thesis-5.1_summary.csv"));
+    assert_eq!(summary.len(), 3);
+    check_summary_against_frames(&frames, &summary);
+
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for needle in [
+        "## Machine",
+        "GL renderer",
+        "CPU",
+        "GTX 780",
+        "Fig. 19",
+        "Fig. 20",
+        "14,592 / 14,592",
+        "16×16",
+        "512×512",
+    ] {
+        assert!(report.contains(needle), "report.md lacks {needle:?}");
+    }
+    check_report_links(&out, &report);
+    for png in ["fig19_fps.png", "fig20_tests.png"] {
+        let img = image::open(out.join(png)).unwrap();
+        assert_eq!((img.width(), img.height()), (900, 480), "{png}");
+    }
+}
+
+#[test]
+fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b53");
+    let o = bench(&[
+        "thesis-5.3",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--angles",
+        "2",
+        "--warmup",
+        "0",
+        "--grid-res",
+        "8,24",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    let frames = read_csv(&out.join("thesis-5.3.csv"));
+    let summary = read_csv(&out.join("thesis-5.3_summary.csv"));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    // bunny base + 2 variants × 2 resolutions; dragon 2 variants × 28³
+    assert_eq!(summary.len(), 1 + 4 + 2, "{err}");
+
+    // no reflection on the bunny: intersect1 is exactly W·H·T, intersect2 at most that
+    let base: Vec<_> = frames
+        .iter()
+        .filter(|r| r["scene"] == "bunny" && r["tracer"] == "base")
+        .collect();
+    assert_eq!(base.len(), 2, "{err}");
+    for r in &base {
+        assert_eq!(u(r, "triangles"), 69451);
+        assert_eq!(u(r, "refl_depth"), 0);
+        assert_eq!(u(r, "tests_intersect1"), 16 * 12 * 69451);
+        assert!(u(r, "tests_intersect2") <= 16 * 12 * 69451);
+    }
+    check_summary_against_frames(&frames, &summary);
+    for needle in [
+        "0.8804",
+        "4.8339",
+        "1,137,720,816",
+        "287,728,727.1",
+        "1.396",
+        "204,088",
+        "Fig. 23",
+        "Fig. 24",
+        "16×12",
+    ] {
+        assert!(report.contains(needle), "report.md lacks {needle:?}");
+    }
+    check_report_links(&out, &report);
+
+    if has_grid() {
+        assert!(o.status.success(), "{err}");
+        let base_tests = base.iter().map(|r| u(r, "triangle_tests")).sum::<u64>();
+        for res in ["8", "24"] {
+            for variant in ["thesis", "exact"] {
+                let g: Vec<_> = frames
+                    .iter()
+                    .filter(|r| {
+                        r["scene"] == "bunny"
+                            && r["variant"] == variant
+                            && r["grid_resolution"] == res
+                    })
+                    .collect();
+                assert_eq!(g.len(), 2, "bunny grid {variant} {res}");
+                let tests = g.iter().map(|r| u(r, "triangle_tests")).sum::<u64>();
+                assert!(
+                    tests < base_tests,
+                    "grid {variant} {res}³: {tests} tests vs base {base_tests}"
+                );
+                assert!(
+                    g.iter().all(|r| !r["voxels_visited"].is_empty()),
+                    "voxels_visited missing"
+                );
+            }
+        }
+        let dragon: Vec<_> = frames.iter().filter(|r| r["scene"] == "dragon").collect();
+        assert_eq!(dragon.len(), 2 * 2);
+        assert!(dragon
+            .iter()
+            .all(|r| u(r, "triangles") == 202520 && r["grid_resolution"] == "28"));
+        assert!(
+            report.contains("202,520 (-1568)"),
+            "dragon triangle difference"
+        );
+    } else {
+        // without the grid tracer the grid configurations fail, visibly, and so does the run
+        assert!(!o.status.success());
+        assert!(err.contains("configuration(s) failed"), "{err}");
+        assert!(
+            report.contains("no grid tracer"),
+            "the report names the failures"
+        );
+        assert_eq!(summary.iter().filter(|s| !s["error"].is_empty()).count(), 6);
+    }
+}
+
+#[test]
+fn bad_bench_options_fail_with_a_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec![], "PROTOCOL"),
+        (vec!["thesis-9"], "thesis-5.1"),
+        (vec!["thesis-5.1", "--scale", "huge"], "quick"),
+        (
+            vec!["thesis-5.1", "--out", file.to_str().unwrap()],
+            "not a folder",
+        ),
+        (vec!["thesis-5.1", "--angles", "0"], "--angles"),
+        (vec!["thesis-5.1", "--width", "0"], "--width"),
+        (vec!["thesis-5.2", "--grid-res", "8,0"], "--grid-res"),
+        (vec!["thesis-5.2", "--grid-res", "8,x"], "invalid value"),
+        (vec!["thesis-5.1", "--tile", "12"], "multiple of 8"),
+        (
+            vec!["thesis-5.1", "--scenes", "/nonexistent-scenes"],
+            "not a folder",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = bench(&args);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "bench {args:?} succeeded");
+        assert!(
+            err.contains(needle),
+            "bench {args:?}: {err:?} lacks {needle:?}"
+        );
+        assert!(!err.contains("panicked"), "bench {args:?} panicked: {err}");
+    }
+}
+
+#[test]
+fn missing_scene_fails_the_protocol_and_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let out = dir.path().join("out");
+    let o = bench(&[
+        "thesis-5.1",
+        "--scenes",
+        scenes.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("teapot1.toml"), "{err}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("The protocol failed") && report.contains("teapot1.toml"),
+        "{report}"
+    );
+}
