@@ -63,6 +63,8 @@ enum Command {
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
         #[command(flatten)]
+        soft: gpgpu_rt::tracer::linespace::cli::SoftShadowArgs,
+        #[command(flatten)]
         gpu: GpuArgs,
     },
     /// Write the scene's world-space triangles as f32 [T,3,3] in triangle-id order.
@@ -114,11 +116,18 @@ fn run(cli: Cli) -> Result<()> {
             tile,
             aov_dir,
             stats,
+            soft,
             gpu,
         } => {
             let scene = load_scene(&scene)?;
             let shaders = ShaderSource::from_dir(gpu.glsl_dir)?;
             let ctx = GlContext::headless(gpu.device)?;
+            if let Some(mode) = soft.shadows {
+                // Klee 2016: G-buffer, soft-shadow compute pass, screen-filling quad
+                let (w, h) = (width.unwrap_or(scene.settings.width), height.unwrap_or(scene.settings.height));
+                let opts = soft.options(mode, w, h, tile);
+                return gpgpu_rt::tracer::linespace::cli::render(&ctx, &scene, &shaders, opts, &output, aov_dir.as_deref(), stats.as_deref());
+            }
             let options = RenderOptions {
                 width: width.unwrap_or(scene.settings.width),
                 height: height.unwrap_or(scene.settings.height),

@@ -181,6 +181,7 @@ type ClearBufferDataFn = unsafe extern "system" fn(u32, u32, u32, u32, *const c_
 type ClearTexImageFn = unsafe extern "system" fn(u32, i32, u32, u32, *const c_void);
 type GetQueryIvFn = unsafe extern "system" fn(u32, u32, *mut i32);
 type GetQueryObjectU64Fn = unsafe extern "system" fn(u32, u32, *mut u64);
+type TexBufferFn = unsafe extern "system" fn(u32, u32, u32);
 
 /// The GL functions: glow's, plus the few GL 4.4/4.5 entry points glow does not wrap
 /// (`glClearBufferData` — the thesis clears its grid lists with it every frame —,
@@ -191,6 +192,7 @@ pub struct Gl {
     clear_tex_image: ClearTexImageFn,
     get_query_iv: GetQueryIvFn,
     get_query_object_u64: GetQueryObjectU64Fn,
+    tex_buffer: TexBufferFn,
 }
 
 impl std::ops::Deref for Gl {
@@ -216,6 +218,7 @@ impl Gl {
         let clear_tex_image = get("glClearTexImage")?;
         let get_query_iv = get("glGetQueryiv")?;
         let get_query_object_u64 = get("glGetQueryObjectui64v")?;
+        let tex_buffer = get("glTexBuffer")?;
         Ok(Gl {
             glow: glow::Context::from_loader_function(|n| load(n)),
             // SAFETY: the pointers are the named GL entry points with these signatures.
@@ -229,6 +232,7 @@ impl Gl {
             get_query_object_u64: std::mem::transmute::<*const c_void, GetQueryObjectU64Fn>(
                 get_query_object_u64,
             ),
+            tex_buffer: std::mem::transmute::<*const c_void, TexBufferFn>(tex_buffer),
         })
     }
 
@@ -245,6 +249,13 @@ impl Gl {
                 &value as *const u32 as *const c_void,
             )
         }
+    }
+
+    /// `glTexBuffer(GL_TEXTURE_BUFFER, format, buffer)` on the texture bound to
+    /// GL_TEXTURE_BUFFER (glow does not wrap it): the node pool of the line-space tracer.
+    pub fn tex_buffer(&self, format: u32, buffer: glow::Buffer) {
+        // SAFETY: plain GL call with a buffer name of this context.
+        unsafe { (self.tex_buffer)(glow::TEXTURE_BUFFER, format, buffer.0.get()) }
     }
 
     /// The 64-bit result of a query (`GL_QUERY_RESULT`, waits for it): nanoseconds for

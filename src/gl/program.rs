@@ -26,6 +26,11 @@ pub const EMBEDDED: &[(&str, &str)] = &[
     ("intersect2.comp", include_str!("../../glsl/intersect2.comp")),
     ("shading.comp", include_str!("../../glsl/shading.comp")),
     ("transform.vert", include_str!("../../glsl/transform.vert")),
+    ("gbuffer.vert", include_str!("../../glsl/gbuffer.vert")),
+    ("gbuffer.frag", include_str!("../../glsl/gbuffer.frag")),
+    ("linespace_shadow.comp", include_str!("../../glsl/linespace_shadow.comp")),
+    ("linespace_quad.vert", include_str!("../../glsl/linespace_quad.vert")),
+    ("linespace_quad.frag", include_str!("../../glsl/linespace_quad.frag")),
     ("screen_quad.vert", include_str!("../../glsl/screen_quad.vert")),
     ("screen_quad.frag", include_str!("../../glsl/screen_quad.frag")),
 ];

@@ -3,6 +3,8 @@
 //! arithmetic and the same pass structure as the kernels. It is the oracle of the tests: the
 //! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
 
+pub mod linespace;
+
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 

@@ -61,6 +61,23 @@ pub struct Light {
     pub color: Vec3,
 }
 
+/// A rectangular area light (Klee 2016): the points `corner + s·edge_u + t·edge_v`,
+/// s, t ∈ [0, 1], emitting `color`.
+#[derive(Debug, Clone, Copy)]
+pub struct AreaLight {
+    pub corner: Vec3,
+    pub edge_u: Vec3,
+    pub edge_v: Vec3,
+    pub color: Vec3,
+}
+
+impl AreaLight {
+    /// The centre of the rectangle.
+    pub fn center(&self) -> Vec3 {
+        self.corner + 0.5 * (self.edge_u + self.edge_v)
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Object {
     pub name: String,
@@ -110,6 +127,8 @@ pub struct Scene {
     pub camera: Camera,
     pub settings: RenderSettings,
     pub lights: Vec<Light>,
+    /// Rectangular area lights (`[[area_light]]`), used by the soft-shadow pipeline.
+    pub area_lights: Vec<AreaLight>,
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
     /// Texture images, one layer each; paths for messages.
@@ -215,11 +234,33 @@ impl Scene {
                 color: Vec3::from(l.color),
             })
             .collect();
+        let mut area_lights = Vec::new();
+        for l in file.area_light {
+            let span = l.span();
+            let l = l.into_inner();
+            let a = AreaLight {
+                corner: Vec3::from(l.corner),
+                edge_u: Vec3::from(l.edge_u),
+                edge_v: Vec3::from(l.edge_v),
+                color: Vec3::from(l.color),
+            };
+            let finite = [a.corner, a.edge_u, a.edge_v, a.color].iter().all(|v| v.is_finite());
+            if !finite || a.edge_u.cross(a.edge_v).length() <= 1e-12 {
+                return Err(at(
+                    span,
+                    "area_light: corner, edge_u, edge_v and color must be finite, and edge_u and \
+                     edge_v must span a rectangle (non-zero, not parallel)"
+                        .into(),
+                ));
+            }
+            area_lights.push(a);
+        }
         let mut scene = Scene {
             path: path.to_path_buf(),
             camera,
             settings,
             lights,
+            area_lights,
             objects: Vec::new(),
             materials: Vec::new(),
             textures: Vec::new(),
@@ -397,6 +438,8 @@ struct SceneFile {
     #[serde(default)]
     light: Vec<LightDef>,
     #[serde(default)]
+    area_light: Vec<Spanned<AreaLightDef>>,
+    #[serde(default)]
     object: Vec<ObjectDef>,
 }
 
@@ -404,6 +447,16 @@ struct SceneFile {
 #[serde(deny_unknown_fields)]
 struct LightDef {
     position: [f32; 3],
+    #[serde(default = "white")]
+    color: [f32; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AreaLightDef {
+    corner: [f32; 3],
+    edge_u: [f32; 3],
+    edge_v: [f32; 3],
     #[serde(default = "white")]
     color: [f32; 3],
 }

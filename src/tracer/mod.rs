@@ -3,6 +3,7 @@
 
 pub mod base;
 pub mod gpu_scene;
+pub mod linespace;
 
 use std::collections::BTreeMap;
 use std::sync::Arc;

@@ -1,0 +1,601 @@
+//! The CPU implementation of Klee 2016's soft shadows (ch. 4.3, Algorithms 1–4, Listings
+//! 1–3): the same N-tree, line spaces and traversals as `glsl/linespace_shadow.comp`, in plain
+//! Rust, step by step like the kernel — the oracle of the tests and the CPU side of the
+//! thesis' CPU/GPU comparison (Fig. 12, Table 3).
+//!
+//! * [`ShadowMode::Linespace`]: all shadow rays of a pixel as one packet, coherent grid
+//!   traversal (CGT) slice by slice with the explicit stack of Listing 1 and the shaft of
+//!   Listing 2; at the last stack depth with line spaces, a set line-space bit deactivates the
+//!   ray (a hit, without triangle tests — the thesis' approximation).
+//! * [`ShadowMode::LinespaceDda`]: every ray alone through the same N-tree with a hierarchical
+//!   3D-DDA [AW87] and the same line-space termination (Table 3's DDA).
+//! * [`ShadowMode::Exact`]: the packet traversal of `Linespace` with the line spaces used only
+//!   to skip empty shafts, down to the leaves, where the rays are tested against the leaves'
+//!   triangles (Table 2's "Schnitttests mit Dreiecken"); the reference.
+//!
+//! Where the thesis is silent we do this (and the kernel the same): the node that contains the
+//! rays' common origin has no entry side, so no line-space entry; it is always descended, and
+//! inside it the leaves are tested exactly (otherwise every surface would shadow itself).
+
+use glam::{IVec3, Vec3};
+
+use crate::reference::intersect_triangle;
+use crate::scene::AreaLight;
+use crate::tracer::linespace::ntree::{entry_index, face_axes, NTree, PackedLinespaces, CHILDREN_BIT, GEOMETRY_BIT};
+use crate::tracer::linespace::ShadowMode;
+
+/// Exact event counts of one pixel or frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ShadowCounts {
+    pub triangle_tests: u64,
+    pub linespace_lookups: u64,
+    pub nodes_visited: u64,
+    /// Pixels whose light corners do not all lie on one side of an axis (no packet): lit.
+    pub packet_failures: u64,
+}
+
+impl std::ops::AddAssign for ShadowCounts {
+    fn add_assign(&mut self, o: Self) {
+        self.triangle_tests += o.triangle_tests;
+        self.linespace_lookups += o.linespace_lookups;
+        self.nodes_visited += o.nodes_visited;
+        self.packet_failures += o.packet_failures;
+    }
+}
+
+/// The uniformly spaced sample points of the light: sample r = i·SAMPLES_V + j lies at
+/// corner + (i + ½)/SAMPLES_U · edge_u + (j + ½)/SAMPLES_V · edge_v.
+pub fn light_samples(light: &AreaLight, su: u32, sv: u32) -> Vec<Vec3> {
+    let mut v = Vec::with_capacity((su * sv) as usize);
+    for i in 0..su {
+        for j in 0..sv {
+            v.push(
+                light.corner
+                    + (i as f32 + 0.5) / su as f32 * light.edge_u
+                    + (j as f32 + 0.5) / sv as f32 * light.edge_v,
+            );
+        }
+    }
+    v
+}
+
+/// The light's corners in the order of Listing 2's corner_dir, equation (1):
+/// (u_min, v_min), (u_min, v_max), (u_max, v_min), (u_max, v_max).
+pub fn light_corners(light: &AreaLight) -> [Vec3; 4] {
+    let c = light.corner;
+    [c, c + light.edge_v, c + light.edge_u, c + light.edge_u + light.edge_v]
+}
+
+/// The soft-shadow computation on the CPU.
+pub struct LinespaceShadows<'a> {
+    pub tree: &'a NTree,
+    pub packed: &'a PackedLinespaces,
+    pub triangles: &'a [[Vec3; 3]],
+    pub light: AreaLight,
+    pub samples_u: u32,
+    pub samples_v: u32,
+    /// The shadow-ray origin is moved this far along the normal (world units).
+    pub offset: f32,
+}
+
+/// Kay–Kajiya [KK86] on the node [0, N]³ (Algorithm 3): the entry and exit sides and cells
+/// of the ray, or `None` when it misses the node before `t_end`.
+fn node_intersection(n: u32, start: Vec3, dir: Vec3, t_end: f32) -> Option<(usize, u32, u32, usize, u32, u32)> {
+    let nf = n as f32;
+    let (mut tnear, mut tfar) = (f32::NEG_INFINITY, f32::INFINITY);
+    let (mut near_axis, mut far_axis) = (0usize, 0usize);
+    for a in 0..3 {
+        if dir[a] == 0.0 {
+            if start[a] < 0.0 || start[a] > nf {
+                return None;
+            }
+            continue;
+        }
+        let inv = 1.0 / dir[a];
+        let mut t0 = (0.0 - start[a]) * inv;
+        let mut t1 = (nf - start[a]) * inv;
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        if t0 > tnear {
+            tnear = t0;
+            near_axis = a;
+        }
+        if t1 < tfar {
+            tfar = t1;
+            far_axis = a;
+        }
+    }
+    if tnear > tfar || tfar < 0.0 || tnear > t_end {
+        return None;
+    }
+    let start_vec = start + tnear * dir;
+    let end_vec = start + tfar * dir;
+    let start_face = 2 * near_axis + if dir[near_axis] > 0.0 { 0 } else { 1 };
+    let end_face = 2 * far_axis + if dir[far_axis] > 0.0 { 1 } else { 0 };
+    let cell = |v: Vec3, face: usize| {
+        let (ua, va) = face_axes(face / 2);
+        let c = |x: f32| (x.floor() as i32).clamp(0, n as i32 - 1) as u32;
+        (c(v[ua]), c(v[va]))
+    };
+    let (su, sv) = cell(start_vec, start_face);
+    let (eu, ev) = cell(end_vec, end_face);
+    Some((start_face, su, sv, end_face, eu, ev))
+}
+
+/// Algorithm 4: the line-space entry of a ray through a node (true: geometry in the shaft).
+/// Entry and exit on the same side (a grazing ray) has no shaft: true, conservatively.
+fn get_entry(n: u32, packed: &PackedLinespaces, ls_index: u32, hit: (usize, u32, u32, usize, u32, u32)) -> bool {
+    let (s, su, sv, e, eu, ev) = hit;
+    match entry_index(n, s, su, sv, e, eu, ev) {
+        Some(entry) => packed.get_entry(ls_index, entry),
+        None => true,
+    }
+}
+
+/// One level of Listing 1's stack.
+#[derive(Clone)]
+struct StackLevel {
+    parent_group: u32,
+    nodelist: Vec<([u32; 2], IVec3)>,
+    nodelist_index: usize,
+    traverse_childs: bool,
+    current_slice: i32,
+    last_slice: i32,
+}
+
+/// Listing 2's shaft (ray_start per depth, the ray directions and the active flags).
+struct Shaft {
+    origin_world: Vec3,
+    corner_dir: [Vec3; 4],
+    k: usize,
+    u: usize,
+    v: usize,
+    dir: i32,
+    ray_start: Vec<Vec3>,
+    ray_direction: Vec<Vec3>,
+    light_points: Vec<Vec3>,
+    active_rays: Vec<bool>,
+    active_count: usize,
+}
+
+impl<'a> LinespaceShadows<'a> {
+    fn nn(&self) -> usize {
+        (self.tree.n as usize).pow(3)
+    }
+
+    fn node(&self, group: u32, c: IVec3) -> [u32; 2] {
+        let n = self.tree.n as i32;
+        self.tree.nodes[group as usize * self.nn() + (c.x + n * (c.y + n * c.z)) as usize]
+    }
+
+    /// `t` of the light in a node's coordinates at level `level` (1 in the root's).
+    fn t_end(&self, level: usize) -> f32 {
+        (self.tree.n as f32).powi(level as i32)
+    }
+
+    /// The pixel's shadow value (fraction of unblocked samples) for a surface point `p` with
+    /// normal `normal` (facing the viewer), and the counts.
+    pub fn shadow(&self, mode: ShadowMode, p: Vec3, normal: Vec3) -> (f32, ShadowCounts) {
+        let mut counts = ShadowCounts::default();
+        let origin = p + normal * self.offset;
+        let light_points = light_samples(&self.light, self.samples_u, self.samples_v);
+        let num_rays = light_points.len();
+        // samples behind the surface are blocked by it (N·L <= 0, as Listing 15)
+        let active_rays: Vec<bool> = light_points.iter().map(|l| normal.dot(*l - p) > 0.0).collect();
+        let active_count = active_rays.iter().filter(|a| **a).count();
+        if active_count == 0 {
+            return (0.0, counts);
+        }
+        let inv = self.tree.inv_node_size();
+        let o = self.tree.to_ntree(origin);
+        let ray_direction: Vec<Vec3> = light_points.iter().map(|l| (*l - origin) * inv).collect();
+        let lit = match mode {
+            ShadowMode::LinespaceDda => {
+                let mut lit = 0;
+                for r in 0..num_rays {
+                    if active_rays[r] && !self.dda_blocked(o, ray_direction[r], origin, light_points[r], &mut counts) {
+                        lit += 1;
+                    }
+                }
+                lit
+            }
+            _ => {
+                let corner_dir = light_corners(&self.light).map(|c| (c - origin) * inv);
+                // Algorithm 1: the traversal axis k, the dominant axis of the light vector —
+                // valid when all four corner rays go the same way along it
+                let centre = self.light.center() - origin;
+                let valid = |a: usize| corner_dir.iter().all(|c| c[a] > 0.0) || corner_dir.iter().all(|c| c[a] < 0.0);
+                let lv = centre.abs();
+                let dominant = if lv.x >= lv.y && lv.x >= lv.z { 0 } else if lv.y >= lv.z { 1 } else { 2 };
+                let k = if valid(dominant) {
+                    Some(dominant)
+                } else {
+                    (0..3).filter(|&a| valid(a)).max_by(|&a, &b| {
+                        let m = |a: usize| corner_dir.iter().map(|c| c[a].abs()).fold(f32::INFINITY, f32::min);
+                        m(a).total_cmp(&m(b))
+                    })
+                };
+                let Some(k) = k else {
+                    counts.packet_failures += 1;
+                    return (1.0, counts);
+                };
+                let (u, v) = face_axes(k);
+                let mut shaft = Shaft {
+                    origin_world: origin,
+                    corner_dir,
+                    k,
+                    u,
+                    v,
+                    dir: if corner_dir[0][k] > 0.0 { 1 } else { -1 },
+                    ray_start: vec![Vec3::ZERO; self.tree.depth as usize],
+                    ray_direction,
+                    light_points,
+                    active_rays,
+                    active_count,
+                };
+                shaft.ray_start[0] = o;
+                self.cgt(mode, &mut shaft, &mut counts)
+            }
+        };
+        (lit as f32 / num_rays as f32, counts)
+    }
+
+    /// The slices [first, last] (in traversal order) the packet crosses in a node at stack
+    /// depth `d` (whose local coordinates hold ray_start[d]).
+    fn slice_range(&self, s: &Shaft, d: usize) -> Option<(i32, i32)> {
+        let nf = self.tree.n as f32;
+        let ko = s.ray_start[d][s.k];
+        let te = self.t_end(d);
+        let ends = s.corner_dir.map(|c| ko + c[s.k] * te);
+        if s.dir > 0 {
+            let kfar = ends.iter().copied().fold(f32::NEG_INFINITY, f32::max).min(nf);
+            let knear = ko.max(0.0);
+            if knear >= nf || kfar <= 0.0 || knear > kfar {
+                return None;
+            }
+            let first = (knear.floor() as i32).clamp(0, self.tree.n as i32 - 1);
+            let last = ((kfar.ceil() as i32) - 1).clamp(0, self.tree.n as i32 - 1).max(first);
+            Some((first, last))
+        } else {
+            let kfar = ends.iter().copied().fold(f32::INFINITY, f32::min).max(0.0);
+            let knear = ko.min(nf);
+            if knear <= 0.0 || kfar >= nf || knear < kfar {
+                return None;
+            }
+            let first = ((knear.ceil() as i32) - 1).clamp(0, self.tree.n as i32 - 1);
+            let last = (kfar.floor() as i32).clamp(0, self.tree.n as i32 - 1).min(first);
+            Some((first, last))
+        }
+    }
+
+    /// u_min/u_max/v_min/v_max of the packet within slice `j` at depth `d` (Fig. 10(b)–(c)):
+    /// the corner rays where they enter and leave the slice.
+    fn slice_uv(&self, s: &Shaft, d: usize, j: i32) -> [f32; 4] {
+        let ko = s.ray_start[d][s.k];
+        let te = self.t_end(d);
+        let (a, b) = (j as f32, j as f32 + 1.0);
+        let mut r = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
+        for c in &s.corner_dir {
+            let kend = ko + c[s.k] * te;
+            let (lo, hi) = if s.dir > 0 { (ko, kend) } else { (kend, ko) };
+            for kk in [a.clamp(lo, hi), b.clamp(lo, hi)] {
+                let lambda = (kk - ko) / c[s.k];
+                let pu = s.ray_start[d][s.u] + lambda * c[s.u];
+                let pv = s.ray_start[d][s.v] + lambda * c[s.v];
+                r[0] = r[0].min(pu);
+                r[1] = r[1].max(pu);
+                r[2] = r[2].min(pv);
+                r[3] = r[3].max(pv);
+            }
+        }
+        r
+    }
+
+    fn init_level(&self, s: &Shaft, d: usize, group: u32) -> Option<StackLevel> {
+        let (first, last) = self.slice_range(s, d)?;
+        Some(StackLevel {
+            parent_group: group,
+            nodelist: Vec::with_capacity((self.tree.n * self.tree.n) as usize),
+            nodelist_index: 0,
+            traverse_childs: false,
+            current_slice: first,
+            last_slice: last,
+        })
+    }
+
+    /// Algorithm 2: the line-space check of a node for all active rays. `deactivate`: at the
+    /// last depth with line spaces a set bit is a hit and deactivates the ray; elsewhere the
+    /// first set bit returns true (the node must be descended).
+    fn is_intersection(&self, s: &mut Shaft, node: [u32; 2], child_start: Vec3, level: usize, deactivate: bool, counts: &mut ShadowCounts) -> bool {
+        let mut found = false;
+        let te = self.t_end(level);
+        for r in 0..s.ray_direction.len() {
+            if !s.active_rays[r] {
+                continue;
+            }
+            let Some(hit) = node_intersection(self.tree.n, child_start, s.ray_direction[r], te) else {
+                continue;
+            };
+            counts.linespace_lookups += 1;
+            if get_entry(self.tree.n, self.packed, node[1], hit) {
+                found = true;
+                if deactivate {
+                    s.active_rays[r] = false;
+                    s.active_count -= 1;
+                } else {
+                    return true;
+                }
+            }
+        }
+        found
+    }
+
+    /// Exact triangle tests of a leaf for all active rays that cross it.
+    fn leaf_tests(&self, s: &mut Shaft, node: [u32; 2], child_start: Vec3, level: usize, counts: &mut ShadowCounts) {
+        let te = self.t_end(level);
+        let off = (node[0] >> 2) as usize;
+        let tris = &self.tree.leaf_triangles[off..off + node[1] as usize];
+        for r in 0..s.ray_direction.len() {
+            if !s.active_rays[r] || node_intersection(self.tree.n, child_start, s.ray_direction[r], te).is_none() {
+                continue;
+            }
+            let rd = s.light_points[r] - s.origin_world;
+            for &t in tris {
+                counts.triangle_tests += 1;
+                let tri = &self.triangles[t as usize];
+                if let Some((tt, _, _)) = intersect_triangle(s.origin_world, rd, tri[0], tri[1], tri[2]) {
+                    if tt < 1.0 {
+                        s.active_rays[r] = false;
+                        s.active_count -= 1;
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Algorithm 1 (continuation): the slice-by-slice traversal with the explicit stack.
+    /// Returns the number of rays still active (lit).
+    fn cgt(&self, mode: ShadowMode, s: &mut Shaft, counts: &mut ShadowCounts) -> usize {
+        let n = self.tree.n as i32;
+        let nf = n as f32;
+        let last_ls_depth = self.tree.last_linespace_depth();
+        let max_depth = self.tree.depth as usize - 1;
+        let mut stack: Vec<Option<StackLevel>> = vec![None; max_depth];
+        stack[0] = self.init_level(s, 0, 0);
+        if stack[0].is_none() {
+            return s.active_count;
+        }
+        let mut depth: i32 = 0;
+        while depth >= 0 {
+            let d = depth as usize;
+            let mut next_depth = false;
+            let Some(level) = stack[d].clone() else {
+                depth -= 1;
+                continue;
+            };
+            let mut lvl = level;
+            let mut slice = lvl.current_slice;
+            loop {
+                if !lvl.traverse_childs {
+                    // examine the slice: nodes with geometry inside u/v_min/max
+                    let uv = self.slice_uv(s, d, slice);
+                    let cu0 = (uv[0].floor() as i32).max(0);
+                    let cu1 = (uv[1].floor() as i32).min(n - 1);
+                    let cv0 = (uv[2].floor() as i32).max(0);
+                    let cv1 = (uv[3].floor() as i32).min(n - 1);
+                    lvl.nodelist.clear();
+                    for cu in cu0..=cu1 {
+                        for cv in cv0..=cv1 {
+                            let mut c = IVec3::ZERO;
+                            c[s.k] = slice;
+                            c[s.u] = cu;
+                            c[s.v] = cv;
+                            counts.nodes_visited += 1;
+                            let node = self.node(lvl.parent_group, c);
+                            if node[0] & GEOMETRY_BIT != 0 {
+                                lvl.nodelist.push((node, c));
+                            }
+                        }
+                    }
+                    lvl.nodelist_index = lvl.nodelist.len();
+                }
+                while lvl.nodelist_index > 0 {
+                    lvl.nodelist_index -= 1;
+                    let (node, offset) = lvl.nodelist[lvl.nodelist_index];
+                    let child_start = (s.ray_start[d] - offset.as_vec3()) * nf;
+                    let level_of_node = d + 1;
+                    if node[0] & CHILDREN_BIT == 0 {
+                        self.leaf_tests(s, node, child_start, level_of_node, counts);
+                    } else {
+                        let inside = child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
+                        let descend = if inside {
+                            true
+                        } else if mode == ShadowMode::Linespace && d as i32 == last_ls_depth {
+                            self.is_intersection(s, node, child_start, level_of_node, true, counts);
+                            false
+                        } else {
+                            self.is_intersection(s, node, child_start, level_of_node, false, counts)
+                        };
+                        if descend {
+                            s.ray_start[d + 1] = child_start;
+                            if let Some(next) = self.init_level(s, d + 1, node[0] >> 2) {
+                                lvl.traverse_childs = true;
+                                lvl.current_slice = slice;
+                                stack[d + 1] = Some(next);
+                                next_depth = true;
+                            }
+                        }
+                    }
+                    if s.active_count == 0 {
+                        return 0;
+                    }
+                    if next_depth {
+                        break;
+                    }
+                }
+                if next_depth {
+                    break;
+                }
+                lvl.traverse_childs = false;
+                if slice == lvl.last_slice {
+                    break;
+                }
+                slice += s.dir;
+            }
+            if next_depth {
+                stack[d] = Some(lvl);
+                depth += 1;
+            } else {
+                stack[d] = None;
+                depth -= 1;
+            }
+        }
+        s.active_count
+    }
+
+    /// One ray with a hierarchical 3D-DDA [AW87] through the N-tree, the same line-space
+    /// termination as the packet traversal (Table 3's DDA). True: blocked.
+    fn dda_blocked(&self, o: Vec3, dir: Vec3, origin_world: Vec3, light_point: Vec3, counts: &mut ShadowCounts) -> bool {
+        let n = self.tree.n as i32;
+        let nf = n as f32;
+        let last_ls_depth = self.tree.last_linespace_depth();
+        let max_depth = self.tree.depth as usize - 1;
+        #[derive(Clone, Copy, Default)]
+        struct Dda {
+            group: u32,
+            start: Vec3,
+            cell: IVec3,
+            t_max: Vec3,
+            t: f32,
+            t_end: f32,
+        }
+        let step = IVec3::new(
+            if dir.x > 0.0 { 1 } else { -1 },
+            if dir.y > 0.0 { 1 } else { -1 },
+            if dir.z > 0.0 { 1 } else { -1 },
+        );
+        let t_delta = Vec3::new(1.0 / dir.x.abs(), 1.0 / dir.y.abs(), 1.0 / dir.z.abs());
+        let init = |group: u32, start: Vec3, t_end: f32| -> Option<Dda> {
+            let inside = start.cmpge(Vec3::ZERO).all() && start.cmplt(Vec3::splat(nf)).all();
+            let t0 = if inside {
+                0.0
+            } else {
+                let (mut tnear, mut tfar) = (0.0f32, f32::INFINITY);
+                for a in 0..3 {
+                    if dir[a] == 0.0 {
+                        if start[a] < 0.0 || start[a] > nf {
+                            return None;
+                        }
+                        continue;
+                    }
+                    let mut t0 = -start[a] / dir[a];
+                    let mut t1 = (nf - start[a]) / dir[a];
+                    if t0 > t1 {
+                        std::mem::swap(&mut t0, &mut t1);
+                    }
+                    tnear = tnear.max(t0);
+                    tfar = tfar.min(t1);
+                }
+                if tnear > tfar || tnear > t_end {
+                    return None;
+                }
+                tnear
+            };
+            let p = start + t0 * dir;
+            let cell = p.floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(n - 1));
+            let mut t_max = Vec3::INFINITY;
+            for a in 0..3 {
+                if dir[a] > 0.0 {
+                    t_max[a] = (cell[a] as f32 + 1.0 - start[a]) / dir[a];
+                } else if dir[a] < 0.0 {
+                    t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
+                }
+            }
+            Some(Dda { group, start, cell, t_max, t: t0, t_end })
+        };
+        let mut stack = vec![Dda::default(); max_depth];
+        let Some(root) = init(0, o, 1.0) else {
+            return false;
+        };
+        stack[0] = root;
+        let mut depth: i32 = 0;
+        let rd = light_point - origin_world;
+        while depth >= 0 {
+            let d = depth as usize;
+            let st = stack[d];
+            if st.cell.cmplt(IVec3::ZERO).any() || st.cell.cmpge(IVec3::splat(n)).any() || st.t > st.t_end {
+                depth -= 1;
+                continue;
+            }
+            // advance this level past the current cell before looking into it
+            let tm = st.t_max;
+            let a = if tm.x <= tm.y && tm.x <= tm.z { 0 } else if tm.y <= tm.z { 1 } else { 2 };
+            stack[d].t = st.t_max[a];
+            stack[d].cell[a] += step[a];
+            stack[d].t_max[a] += t_delta[a];
+            counts.nodes_visited += 1;
+            let node = self.node(st.group, st.cell);
+            if node[0] & GEOMETRY_BIT == 0 {
+                continue;
+            }
+            let child_start = (st.start - st.cell.as_vec3()) * nf;
+            let level_of_node = d + 1;
+            let te = self.t_end(level_of_node);
+            if node[0] & CHILDREN_BIT == 0 {
+                let off = (node[0] >> 2) as usize;
+                for &t in &self.tree.leaf_triangles[off..off + node[1] as usize] {
+                    counts.triangle_tests += 1;
+                    let tri = &self.triangles[t as usize];
+                    if let Some((tt, _, _)) = intersect_triangle(origin_world, rd, tri[0], tri[1], tri[2]) {
+                        if tt < 1.0 {
+                            return true;
+                        }
+                    }
+                }
+                continue;
+            }
+            let inside = child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
+            let descend = if inside {
+                true
+            } else if let Some(hit) = node_intersection(self.tree.n, child_start, dir, te) {
+                counts.linespace_lookups += 1;
+                if get_entry(self.tree.n, self.packed, node[1], hit) {
+                    if d as i32 == last_ls_depth {
+                        return true;
+                    }
+                    true
+                } else {
+                    false
+                }
+            } else {
+                false
+            };
+            if descend {
+                if let Some(next) = init(node[0] >> 2, child_start, te) {
+                    stack[d + 1] = next;
+                    depth += 1;
+                }
+            }
+        }
+        false
+    }
+
+    /// The exact shadow value by brute force: every sample ray against every triangle (the
+    /// oracle for `Exact`).
+    pub fn brute_force(&self, p: Vec3, normal: Vec3) -> f32 {
+        let origin = p + normal * self.offset;
+        let pts = light_samples(&self.light, self.samples_u, self.samples_v);
+        let lit = pts
+            .iter()
+            .filter(|l| {
+                normal.dot(**l - p) > 0.0
+                    && !self.triangles.iter().any(|t| {
+                        matches!(intersect_triangle(origin, **l - origin, t[0], t[1], t[2]), Some((tt, _, _)) if tt < 1.0)
+                    })
+            })
+            .count();
+        lit as f32 / pts.len() as f32
+    }
+}

@@ -1,0 +1,542 @@
+//! The N-tree with a line space per inner node — Klee 2016, ch. 3.3 and 4.2 (Fig. 4, 5, 8, 9,
+//! Listing 3), after Keul et al. [KLM].
+//!
+//! * **N-tree**: an octree with N cells per axis (N = 10 in the thesis). Levels: the root (level
+//!   0), its N³ children (level 1), ..., the leaves at level `depth − 1`, which store triangles.
+//!   `depth = 3` (the thesis' "maximale Tiefe 3") therefore gives a root, inner nodes of
+//!   size 1/N and leaves of size 1/N² of the scene cube.
+//! * **Node pool** (Fig. 8–9): groups of N³ nodes, group 0 the children of the root. A node is
+//!   two u32 (red, green): red bit 0 = geometry, bit 1 = children, bits 2.. = the group of
+//!   its children; green = the index of its line space in the line-space pool. A leaf (geometry,
+//!   no children) keeps its triangle list instead: red bits 2.. = offset into `leaf_triangles`,
+//!   green = count (ours: the thesis does not say how its leaves reference triangles).
+//! * **Line space** (Fig. 4–5): for every pair of boundary cells (N×N per side, 6 sides) on
+//!   different sides of the node, one bit: set when a child with geometry lies in the shaft
+//!   between them (the convex hull of the two cells). Symmetric entries are stored once: the
+//!   15 pairs of sides s < e, each N²×N² bits, `entry = pair(s, e)·N⁴ + cell_s·N² + cell_e`
+//!   (150000 bits, 4688 u32 for N = 10; the thesis' own array had all 360000 entries).
+//! * **Packing** (Listing 3): the bits 32 to a u32 in a 3D R32UI texture, a line space's
+//!   words along x, continued on the next y row, line spaces one after the other along y,
+//!   continued along z, at most 2048 (GL_MAX_3D_TEXTURE_SIZE) per axis.
+
+use anyhow::{bail, Result};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// Red-channel flag: the node contains geometry.
+pub const GEOMETRY_BIT: u32 = 1;
+/// Red-channel flag: the node has children (a child group).
+pub const CHILDREN_BIT: u32 = 2;
+
+/// Sides of a node, numbered 2·axis + (0 at coordinate 0, 1 at coordinate N). The thesis
+/// numbers them ±1, ±2, ±3 (positive at 0, negative at N): face f here is thesis side
+/// `(f / 2 + 1)·(f % 2 == 0 ? 1 : −1)`.
+pub const FACES: usize = 6;
+/// Number of pairs of different sides (s < e).
+pub const FACE_PAIRS: usize = 15;
+
+/// Index of the pair of sides s < e in 0..15 (lexicographic order).
+pub fn pair_index(s: usize, e: usize) -> usize {
+    debug_assert!(s < e && e < FACES);
+    s * (11 - s) / 2 + (e - s - 1)
+}
+
+/// The two axes of a side's cells (increasing order) for a side on `axis`.
+pub fn face_axes(axis: usize) -> (usize, usize) {
+    match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    }
+}
+
+/// Number of line-space entries (bits) of one node.
+pub fn linespace_entries(n: u32) -> usize {
+    FACE_PAIRS * (n as usize).pow(4)
+}
+
+/// Number of u32 words of one line space.
+pub fn linespace_words(n: u32) -> usize {
+    linespace_entries(n).div_ceil(32)
+}
+
+/// The entry of the shaft from cell (su, sv) of side `s` to cell (eu, ev) of side `e`
+/// (s ≠ e; the symmetric entry is the same). `None` for two cells of the same side (no shaft).
+pub fn entry_index(n: u32, s: usize, su: u32, sv: u32, e: usize, eu: u32, ev: u32) -> Option<usize> {
+    if s == e {
+        return None;
+    }
+    let n = n as usize;
+    let (s, cs, e, ce) = {
+        let cs = su as usize + n * sv as usize;
+        let ce = eu as usize + n * ev as usize;
+        if s < e {
+            (s, cs, e, ce)
+        } else {
+            (e, ce, s, cs)
+        }
+    };
+    Some(pair_index(s, e) * n * n * n * n + cs * n * n + ce)
+}
+
+/// An axis-aligned box in node-local coordinates ([0, N]³, children are unit cells).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+}
+
+impl Aabb {
+    pub fn cell(i: u32, j: u32, k: u32) -> Aabb {
+        let (i, j, k) = (i as f64, j as f64, k as f64);
+        Aabb { lo: [i, j, k], hi: [i + 1.0, j + 1.0, k + 1.0] }
+    }
+}
+
+/// The rectangle of side `f` covering cells [u0, u1) × [v0, v1), as a flat box.
+pub fn face_rect(n: u32, f: usize, u0: u32, u1: u32, v0: u32, v1: u32) -> Aabb {
+    let axis = f / 2;
+    let c = if f % 2 == 0 { 0.0 } else { n as f64 };
+    let (ua, va) = face_axes(axis);
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    lo[axis] = c;
+    hi[axis] = c;
+    lo[ua] = u0 as f64;
+    hi[ua] = u1 as f64;
+    lo[va] = v0 as f64;
+    hi[va] = v1 as f64;
+    Aabb { lo, hi }
+}
+
+/// Does the shaft between the flat boxes `a` and `b` — their convex hull — overlap the
+/// interior of box `c`? The hull is the union over t ∈ [0, 1] of the boxes (1−t)·a + t·b
+/// (axis-aligned), so the test is: is there a t in [0, 1] where that box overlaps `c`
+/// on every axis? Every axis gives a linear inequality in t; the open interval of t that
+/// satisfies all of them must be non-empty. (Exact; interior overlap, so a shaft that only
+/// touches a child's boundary does not count.)
+pub fn shaft_hits_box(a: &Aabb, b: &Aabb, c: &Aabb) -> bool {
+    let (mut tl, mut th) = (0.0f64, 1.0f64);
+    // α + β t < γ
+    let mut constrain = |alpha: f64, beta: f64, gamma: f64| -> bool {
+        if beta == 0.0 {
+            alpha < gamma
+        } else if beta > 0.0 {
+            th = th.min((gamma - alpha) / beta);
+            true
+        } else {
+            tl = tl.max((gamma - alpha) / beta);
+            true
+        }
+    };
+    for i in 0..3 {
+        // lo_i(t) < c.hi_i
+        if !constrain(a.lo[i], b.lo[i] - a.lo[i], c.hi[i]) {
+            return false;
+        }
+        // hi_i(t) > c.lo_i  ⇔  −hi_i(t) < −c.lo_i
+        if !constrain(-a.hi[i], -(b.hi[i] - a.hi[i]), -c.lo[i]) {
+            return false;
+        }
+    }
+    tl < th
+}
+
+/// The line space of a node from the geometry flags of its N³ children (index x + N(y + Nz)):
+/// one bit per pair of boundary cells, 32 to a word. Hierarchical: a shaft between two
+/// rectangles of cells contains the shafts of all pairs of cells in them, so a child that
+/// misses the big shaft misses all the small ones; the rectangles are halved until single
+/// cells remain (the thesis ORs one mask per filled child, Fig. 5 — the bits are the same).
+pub fn build_linespace(n: u32, filled: &[bool]) -> Vec<u32> {
+    let nn = n as usize;
+    let children: Vec<Aabb> = (0..nn * nn * nn)
+        .filter(|&i| filled[i])
+        .map(|i| Aabb::cell((i % nn) as u32, ((i / nn) % nn) as u32, (i / (nn * nn)) as u32))
+        .collect();
+    let mut words = vec![0u32; linespace_words(n)];
+    if children.is_empty() {
+        return words;
+    }
+    let all: Vec<u32> = (0..children.len() as u32).collect();
+    for s in 0..FACES {
+        for e in s + 1..FACES {
+            let mut cand = Vec::new();
+            subdivide(n, s, e, [0, n, 0, n], [0, n, 0, n], &children, &all, &mut cand, &mut words, 0);
+        }
+    }
+    words
+}
+
+#[allow(clippy::too_many_arguments)]
+fn subdivide(
+    n: u32,
+    s: usize,
+    e: usize,
+    ra: [u32; 4],
+    rb: [u32; 4],
+    children: &[Aabb],
+    cand_in: &[u32],
+    scratch: &mut Vec<u32>,
+    words: &mut [u32],
+    _level: u32,
+) {
+    let a = face_rect(n, s, ra[0], ra[1], ra[2], ra[3]);
+    let b = face_rect(n, e, rb[0], rb[1], rb[2], rb[3]);
+    let cand: Vec<u32> = cand_in.iter().copied().filter(|&c| shaft_hits_box(&a, &b, &children[c as usize])).collect();
+    if cand.is_empty() {
+        return;
+    }
+    let ext = [ra[1] - ra[0], ra[3] - ra[2], rb[1] - rb[0], rb[3] - rb[2]];
+    let (imax, &emax) = ext.iter().enumerate().max_by_key(|(_, v)| **v).unwrap();
+    if emax == 1 {
+        let idx = entry_index(n, s, ra[0], ra[2], e, rb[0], rb[2]).unwrap();
+        words[idx / 32] |= 1 << (idx % 32);
+        return;
+    }
+    let split = |r: [u32; 4], lohi: usize| -> ([u32; 4], [u32; 4]) {
+        let (lo, hi) = (r[2 * lohi], r[2 * lohi + 1]);
+        let mid = lo + (hi - lo) / 2;
+        let mut r1 = r;
+        let mut r2 = r;
+        r1[2 * lohi + 1] = mid;
+        r2[2 * lohi] = mid;
+        (r1, r2)
+    };
+    if imax < 2 {
+        let (r1, r2) = split(ra, imax);
+        subdivide(n, s, e, r1, rb, children, &cand, scratch, words, _level + 1);
+        subdivide(n, s, e, r2, rb, children, &cand, scratch, words, _level + 1);
+    } else {
+        let (r1, r2) = split(rb, imax - 2);
+        subdivide(n, s, e, ra, r1, children, &cand, scratch, words, _level + 1);
+        subdivide(n, s, e, ra, r2, children, &cand, scratch, words, _level + 1);
+    }
+}
+
+/// The brute-force line space: every entry against every filled child (the tests' oracle for
+/// [`build_linespace`]).
+pub fn build_linespace_brute_force(n: u32, filled: &[bool]) -> Vec<u32> {
+    let nn = n as usize;
+    let mut words = vec![0u32; linespace_words(n)];
+    let children: Vec<Aabb> = (0..nn * nn * nn)
+        .filter(|&i| filled[i])
+        .map(|i| Aabb::cell((i % nn) as u32, ((i / nn) % nn) as u32, (i / (nn * nn)) as u32))
+        .collect();
+    for s in 0..FACES {
+        for e in 0..FACES {
+            if s == e {
+                continue;
+            }
+            for sv in 0..n {
+                for su in 0..n {
+                    let a = face_rect(n, s, su, su + 1, sv, sv + 1);
+                    for ev in 0..n {
+                        for eu in 0..n {
+                            let b = face_rect(n, e, eu, eu + 1, ev, ev + 1);
+                            if children.iter().any(|c| shaft_hits_box(&a, &b, c)) {
+                                let idx = entry_index(n, s, su, sv, e, eu, ev).unwrap();
+                                words[idx / 32] |= 1 << (idx % 32);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    words
+}
+
+/// Read one bit of a line space (the thesis' `entry >> bit_position & 1`).
+pub fn get_bit(words: &[u32], entry: usize) -> bool {
+    (words[entry / 32] >> (entry % 32)) & 1 != 0
+}
+
+/// The line spaces packed into a 3D R32UI texture as Listing 3 lays them out.
+#[derive(Debug, Clone)]
+pub struct PackedLinespaces {
+    pub tex_x_res: u32,
+    pub tex_y_res: u32,
+    pub tex_z_res: u32,
+    /// Rows (y) one line space takes.
+    pub ls_y_size: u32,
+    pub words_per_linespace: u32,
+    /// Texels, x fastest, then y, then z.
+    pub texels: Vec<u32>,
+}
+
+impl PackedLinespaces {
+    /// Listing 3: the texel of word `entry_num_comp` of line space `ls_index`.
+    pub fn texel(&self, ls_index: u32, entry_num_comp: u32) -> (u32, u32, u32) {
+        let y_position = ls_index * self.ls_y_size + entry_num_comp / self.tex_x_res;
+        let y_coord = y_position % self.tex_y_res;
+        let x_coord = entry_num_comp % self.tex_x_res;
+        let z_coord = y_position / self.tex_y_res;
+        (x_coord, y_coord, z_coord)
+    }
+
+    fn offset(&self, (x, y, z): (u32, u32, u32)) -> usize {
+        x as usize + self.tex_x_res as usize * (y as usize + self.tex_y_res as usize * z as usize)
+    }
+
+    /// Algorithm 4 / Listing 3: the bit `entry_num` of line space `ls_index`.
+    pub fn get_entry(&self, ls_index: u32, entry_num: usize) -> bool {
+        let comp = (entry_num / 32) as u32;
+        let bit = (entry_num % 32) as u32;
+        (self.texels[self.offset(self.texel(ls_index, comp))] >> bit) & 1 != 0
+    }
+
+    /// The words of line space `ls_index` read back from the texture layout.
+    pub fn unpack(&self, ls_index: u32) -> Vec<u32> {
+        (0..self.words_per_linespace).map(|w| self.texels[self.offset(self.texel(ls_index, w))]).collect()
+    }
+
+    pub fn bytes(&self) -> usize {
+        4 * self.texels.len()
+    }
+}
+
+/// Pack `count` line spaces of `words_per` words each (concatenated in `words`) into the 3D
+/// texture layout of Listing 3 with at most `max_dim` texels per axis.
+pub fn pack_linespaces(words: &[u32], words_per: usize, count: usize, max_dim: u32) -> Result<PackedLinespaces> {
+    assert_eq!(words.len(), words_per * count);
+    let tex_x_res = (words_per as u32).clamp(1, max_dim);
+    let ls_y_size = (words_per as u32).div_ceil(tex_x_res);
+    let rows = (count as u64 * ls_y_size as u64).max(1);
+    let tex_y_res = rows.min(max_dim as u64) as u32;
+    let tex_z_res = rows.div_ceil(tex_y_res as u64);
+    if tex_z_res > max_dim as u64 {
+        bail!(
+            "{count} line spaces of {words_per} words need {rows} texture rows, more than a \
+             {max_dim}×{max_dim}×{max_dim} 3D texture (GL_MAX_3D_TEXTURE_SIZE) holds; use a smaller \
+             --ntree-n or --ntree-depth"
+        );
+    }
+    let mut p = PackedLinespaces {
+        tex_x_res,
+        tex_y_res,
+        tex_z_res: tex_z_res as u32,
+        ls_y_size,
+        words_per_linespace: words_per as u32,
+        texels: Vec::new(),
+    };
+    p.texels = vec![0u32; tex_x_res as usize * tex_y_res as usize * tex_z_res as usize];
+    for ls in 0..count {
+        for w in 0..words_per {
+            let o = p.offset(p.texel(ls as u32, w as u32));
+            p.texels[o] = words[ls * words_per + w];
+        }
+    }
+    Ok(p)
+}
+
+/// The N-tree of a scene with its line spaces.
+#[derive(Debug, Clone)]
+pub struct NTree {
+    /// Cells per axis of every node (N).
+    pub n: u32,
+    /// Levels including the root; the leaves are at level depth − 1.
+    pub depth: u32,
+    /// The root cube's minimum corner (ntree.minBound) in world space.
+    pub min_bound: Vec3,
+    /// Edge of a child of the root in world units (1 / ntree.invNodeSize).
+    pub node_size: f32,
+    /// The node pool: groups of N³ (red, green) texels; group 0 = the children of the root.
+    pub nodes: Vec<[u32; 2]>,
+    /// Line spaces, `linespace_words(n)` words each; line space 0 is the root's.
+    pub linespaces: Vec<u32>,
+    pub linespace_count: usize,
+    /// Triangle ids of the leaves.
+    pub leaf_triangles: Vec<u32>,
+    pub leaf_count: usize,
+    pub build_ms: f64,
+    pub linespace_build_ms: f64,
+}
+
+impl NTree {
+    pub fn inv_node_size(&self) -> f32 {
+        1.0 / self.node_size
+    }
+
+    /// World position to N-tree coordinates (root's children are unit cells), Algorithm 1
+    /// line 5: `(pos − ntree.minBound) × ntree.invNodeSize`.
+    pub fn to_ntree(&self, p: Vec3) -> Vec3 {
+        (p - self.min_bound) * self.inv_node_size()
+    }
+
+    /// The stack depth whose nodes carry the last line spaces (the level above the leaves):
+    /// nodes examined at stack depth d are at level d + 1, so this is depth − 3.
+    pub fn last_linespace_depth(&self) -> i32 {
+        self.depth as i32 - 3
+    }
+
+    /// Bytes of the node pool texture buffer (RG32UI) and of the leaf triangle lists.
+    pub fn node_bytes(&self) -> usize {
+        8 * self.nodes.len() + 4 * self.leaf_triangles.len()
+    }
+
+    /// Geometry flags of a child group.
+    pub fn group_filled(&self, group: u32) -> Vec<bool> {
+        let g = (self.n as usize).pow(3);
+        self.nodes[group as usize * g..(group as usize + 1) * g].iter().map(|t| t[0] & GEOMETRY_BIT != 0).collect()
+    }
+
+    /// Build the N-tree over `triangles` (world space): geometry by exact triangle/box overlap
+    /// (separating axes), children down to level depth − 1, then one line space per node with
+    /// children (the root's included, as line space 0).
+    pub fn build(triangles: &[[Vec3; 3]], n: u32, depth: u32) -> Result<NTree> {
+        if !(2..=16).contains(&n) {
+            bail!("--ntree-n {n}: must lie in 2..=16");
+        }
+        if !(3..=4).contains(&depth) {
+            bail!("--ntree-depth {depth}: must be 3 or 4 (the line spaces sit on the levels above the leaves)");
+        }
+        if triangles.is_empty() {
+            bail!("the scene has no triangles to build an N-tree over");
+        }
+        let t0 = std::time::Instant::now();
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for t in triangles {
+            for p in t {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+        }
+        let center = (lo + hi) * 0.5;
+        // a cube, padded so that no vertex lies on the outer boundary
+        let edge = (hi - lo).max_element().max(1e-6) * 1.01;
+        let min_bound = center - Vec3::splat(edge * 0.5);
+        let node_size = edge / n as f32;
+        let mut tree = NTree {
+            n,
+            depth,
+            min_bound,
+            node_size,
+            nodes: Vec::new(),
+            linespaces: Vec::new(),
+            linespace_count: 0,
+            leaf_triangles: Vec::new(),
+            leaf_count: 0,
+            build_ms: 0.0,
+            linespace_build_ms: 0.0,
+        };
+        let tris: Vec<[DVec3; 3]> = triangles.iter().map(|t| t.map(|p| p.as_dvec3())).collect();
+        let all: Vec<u32> = (0..triangles.len() as u32).collect();
+        // inner nodes in line-space order: (group of its children); the root first
+        let mut inner_groups = vec![0u32];
+        tree.nodes.resize((n as usize).pow(3), [0, 0]);
+        let mut work = vec![(0u32, 1u32, min_bound.as_dvec3(), edge as f64, all)];
+        while let Some((group, level, origin, size, ids)) = work.pop() {
+            let cell = size / n as f64;
+            let nn = n as usize;
+            let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nn * nn * nn];
+            for &id in &ids {
+                let t = &tris[id as usize];
+                let tlo = t[0].min(t[1]).min(t[2]);
+                let thi = t[0].max(t[1]).max(t[2]);
+                let c0 = ((tlo - origin) / cell).floor().as_ivec3().clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
+                let c1 = ((thi - origin) / cell).floor().as_ivec3().clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
+                for z in c0.z..=c1.z {
+                    for y in c0.y..=c1.y {
+                        for x in c0.x..=c1.x {
+                            let bmin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
+                            let eps = cell * 1e-6;
+                            if tri_box_overlap(bmin - eps, bmin + DVec3::splat(cell) + eps, t) {
+                                buckets[x as usize + nn * (y as usize + nn * z as usize)].push(id);
+                            }
+                        }
+                    }
+                }
+            }
+            for (i, b) in buckets.into_iter().enumerate() {
+                if b.is_empty() {
+                    continue;
+                }
+                let slot = group as usize * nn * nn * nn + i;
+                if level < depth - 1 {
+                    let child_group = (tree.nodes.len() / (nn * nn * nn)) as u32;
+                    tree.nodes.resize(tree.nodes.len() + nn * nn * nn, [0, 0]);
+                    let ls = inner_groups.len() as u32;
+                    inner_groups.push(child_group);
+                    tree.nodes[slot] = [GEOMETRY_BIT | CHILDREN_BIT | (child_group << 2), ls];
+                    let (x, y, z) = (i % nn, (i / nn) % nn, i / (nn * nn));
+                    let child_origin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
+                    work.push((child_group, level + 1, child_origin, cell, b));
+                } else {
+                    let off = tree.leaf_triangles.len() as u32;
+                    if off >= 1 << 30 {
+                        bail!("more than 2^30 leaf triangle references");
+                    }
+                    tree.nodes[slot] = [GEOMETRY_BIT | (off << 2), b.len() as u32];
+                    tree.leaf_triangles.extend_from_slice(&b);
+                    tree.leaf_count += 1;
+                }
+            }
+        }
+        if tree.nodes.len() / (n as usize).pow(3) >= 1 << 30 {
+            bail!("more than 2^30 node groups");
+        }
+        tree.build_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let t1 = std::time::Instant::now();
+        let spaces: Vec<Vec<u32>> = inner_groups.par_iter().map(|&g| build_linespace(n, &tree.group_filled(g))).collect();
+        tree.linespace_count = spaces.len();
+        tree.linespaces = spaces.concat();
+        tree.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
+        Ok(tree)
+    }
+
+    /// Line space `i` as words.
+    pub fn linespace(&self, i: usize) -> &[u32] {
+        let w = linespace_words(self.n);
+        &self.linespaces[i * w..(i + 1) * w]
+    }
+
+    /// The child group of every inner node, in line-space order (root first).
+    pub fn inner_groups(&self) -> Vec<u32> {
+        let mut g = vec![0u32; self.linespace_count];
+        for t in &self.nodes {
+            if t[0] & CHILDREN_BIT != 0 {
+                g[t[1] as usize] = t[0] >> 2;
+            }
+        }
+        g
+    }
+}
+
+/// Triangle/box overlap by separating axes (Akenine-Möller 2001): the box's 3 axes, the
+/// triangle's normal and the 9 edge cross products.
+pub fn tri_box_overlap(bmin: DVec3, bmax: DVec3, tri: &[DVec3; 3]) -> bool {
+    let c = (bmin + bmax) * 0.5;
+    let h = (bmax - bmin) * 0.5;
+    let v = [tri[0] - c, tri[1] - c, tri[2] - c];
+    let e = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    // box axes
+    for i in 0..3 {
+        let mn = v[0][i].min(v[1][i]).min(v[2][i]);
+        let mx = v[0][i].max(v[1][i]).max(v[2][i]);
+        if mn > h[i] || mx < -h[i] {
+            return false;
+        }
+    }
+    // edge × box axes
+    let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+    for ed in &e {
+        for a in &axes {
+            let ax = ed.cross(*a);
+            if ax.length_squared() < 1e-30 {
+                continue;
+            }
+            let p = [v[0].dot(ax), v[1].dot(ax), v[2].dot(ax)];
+            let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
+            let mn = p[0].min(p[1]).min(p[2]);
+            let mx = p[0].max(p[1]).max(p[2]);
+            if mn > r || mx < -r {
+                return false;
+            }
+        }
+    }
+    // triangle plane
+    let nrm = e[0].cross(e[1]);
+    let d = nrm.dot(v[0]);
+    let r = h.x * nrm.x.abs() + h.y * nrm.y.abs() + h.z * nrm.z.abs();
+    d.abs() <= r
+}
