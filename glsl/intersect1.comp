@@ -1,29 +1,14 @@
-// intersect1 kernel — Müller 2015, ch. 3.1.1 (Fig. 6) and 4.1.2, Listings 12, 13 and 14.
+// intersect1 kernel of the base tracer — Müller 2015, ch. 3.1.1 (Fig. 6) and 4.1.2,
+// Listings 12, 13 and 14.
 // One invocation per pixel: the active ray (rayState > 0) is tested against every triangle
 // of the scene with Algorithm 1 (Listing 12), skipping the triangle it starts on (lastTriID).
-// At the closest hit the vertex normal is interpolated with (u, v) (Listing 13), the colour
-// is taken from the texture through the sampler or interpolated from the vertex colours, and
-// on a reflecting triangle the rayState is raised, the colour weighted and the direction
-// reflected (Listing 14). A miss writes the background colour and ends the ray.
-layout(local_size_x = 8, local_size_y = 8) in;
-
-#define SCENE_QUALIFIER readonly
-#define COUNTER_SLOTS_PER_KERNEL 2
-#include "common/scene.glsl"
-#include "common/images.glsl"
-#include "common/intersect.glsl"
-#include "common/counters.glsl"
-
-uniform vec4 backgroundColor;
-// 1 in the first pass (primary rays): the first hit is also stored for the AOVs.
-uniform int storePrimaryHit;
-layout(binding = 0) uniform sampler2DArray textures;
+// The evaluation of the closest hit (Listings 13, 14) is in common/intersect1_main.glsl.
+#include "common/intersect_head.glsl"
 
 // Listing 12's loop body: test triangle i (unless it is the one the ray starts on) and keep
 // the closest hit.
 void testTriangle(int i, int n, vec3 ro, vec3 rd, int lastTriID,
-                  inout float t_min, inout int triID, inout float hit_u, inout float hit_v,
-                  inout uint tests)
+                  inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 {
     if (i < n && i != lastTriID) {
         // load the vertices of triangle #i
@@ -39,101 +24,25 @@ void testTriangle(int i, int n, vec3 ro, vec3 rd, int lastTriID,
     }
 }
 
-uint truncated = 0u;
-
-// the number of triangle tests this invocation did
-uint trace(ivec2 storePos)
+// Listing 12: iteration over all triangles of the scene, TRIANGLES_PER_ITERATION at a time
+// (see loopLimit in common/intersect.glsl)
+void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
+                inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 {
-    vec4 originState = imageLoad(rayOriginTexture, storePos);
-    vec4 dirTri = imageLoad(rayDirTexture, storePos);
-    float rayState = originState.w;
-    if (rayState <= 0.0) {
-        // inactive ray: an empty colour buffer (weight -1), nothing for shading to add
-        imageStore(colorBufferTexture, storePos, vec4(0.0, 0.0, 0.0, -1.0));
-        return 0u;
-    }
-    vec3 ro = originState.xyz;
-    vec3 rd = dirTri.xyz;
-    int lastTriID = int(dirTri.w);
-
-    float t_min = 1.0 / 0.0; // +inf
-    int triID = -1;
-    float hit_u = 0.0, hit_v = 0.0;
-    uint tests = 0u;
-
-    // Listing 12: iteration over all triangles of the scene, TRIANGLES_PER_ITERATION at a
-    // time (see loopLimit in common/intersect.glsl)
     int n = triangleCount();
     int i = 0;
     for (; i < n; i += TRIANGLES_PER_ITERATION) {
-        testTriangle(i, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 1, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 2, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 3, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 4, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 5, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 6, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
-        testTriangle(i + 7, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v, tests);
+        testTriangle(i, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 1, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 2, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 3, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 4, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 5, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 6, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+        testTriangle(i + 7, n, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
     }
     // a loop cut short by the implementation is counted, never hidden
     if (i < n) truncated = 1u;
-
-    if (storePrimaryHit != 0)
-        imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
-
-    if (triID < 0) {
-        // no hit: the background colour with full weight; the ray leaves the scene
-        imageStore(colorBufferTexture, storePos, vec4(backgroundColor.rgb, 1.0));
-        imageStore(normalTexture, storePos, vec4(0.0));
-        imageStore(rayOriginTexture, storePos, vec4(ro, 0.0));
-        return tests;
-    }
-
-    // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
-    vec3 direction = rd;
-    float w = 1.0 - hit_u - hit_v;
-    vec3 interpolated_normal = normalize(w * normals[3 * triID].xyz
-                                         + hit_u * normals[3 * triID + 1].xyz
-                                         + hit_v * normals[3 * triID + 2].xyz);
-    // ours: the normal faces the incoming ray (two-sided surfaces)
-    if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
-
-    vec4 mat = material[triMaterial[triID]];
-    vec3 color;
-    if (mat.w >= 0.0) {
-        // textured triangle: interpolated texture coordinates, sampled through the sampler
-        vec2 uv = w * texcoords[3 * triID] + hit_u * texcoords[3 * triID + 1]
-                + hit_v * texcoords[3 * triID + 2];
-        color = textureLod(textures, vec3(uv, mat.w), 0.0).rgb;
-    } else {
-        color = w * colors[3 * triID].rgb + hit_u * colors[3 * triID + 1].rgb
-              + hit_v * colors[3 * triID + 2].rgb;
-    }
-
-    // Listing 14: reflection on the hit triangle?
-    float refl = mat.x;
-    if (refl > 0.0) {
-        rayState += 1.0;
-        direction = reflect(direction, interpolated_normal);
-    }
-    // weight of the hit colour; the reflection gets the rest
-    float weight = 1.0 - refl;
-
-    vec3 hitPoint = ro + t_min * rd;
-    imageStore(rayOriginTexture, storePos, vec4(hitPoint, rayState));
-    imageStore(rayDirTexture, storePos, vec4(direction, float(triID)));
-    imageStore(normalTexture, storePos, vec4(interpolated_normal, 0.0));
-    imageStore(colorBufferTexture, storePos, vec4(color, weight));
-    return tests;
 }
 
-void main()
-{
-    countersBegin();
-    ivec2 storePos = pixelPosition();
-    uint tests = insideImage(storePos) ? trace(storePos) : 0u;
-    countAdd(0, tests);
-    countAdd(1, truncated);
-    countersEnd(0, COUNTER_INTERSECT1);
-    countersEnd(1, COUNTER_TRUNCATED_RAYS);
-}
+#include "common/intersect1_main.glsl"

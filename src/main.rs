@@ -10,7 +10,7 @@ use serde_json::json;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output;
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::{self, RenderOptions, ShadowFlags, TracerKind};
+use gpgpu_rt::tracer::{self, GridArgs, RenderOptions, ShadowFlags, TracerKind};
 
 #[derive(Parser)]
 #[command(name = "gpgpu-rt", version, about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)")]
@@ -62,6 +62,8 @@ enum Command {
         /// Write the statistics of the frame as JSON.
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
+        #[command(flatten)]
+        grid: GridArgs,
         #[command(flatten)]
         soft: gpgpu_rt::tracer::linespace::cli::SoftShadowArgs,
         #[command(flatten)]
@@ -116,6 +118,7 @@ fn run(cli: Cli) -> Result<()> {
             tile,
             aov_dir,
             stats,
+            grid,
             soft,
             gpu,
         } => {
@@ -135,7 +138,7 @@ fn run(cli: Cli) -> Result<()> {
                 tile,
                 shadow_flags,
                 aovs: aov_dir.is_some(),
-                grid: Default::default(),
+                grid: grid.options(),
             };
             let mut t = tracer::create(tracer, ctx.gl.clone(), &ctx.info, &scene, &shaders, options.clone())?;
             let frame = t.render(&scene.camera)?;

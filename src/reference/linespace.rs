@@ -21,7 +21,9 @@ use glam::{IVec3, Vec3};
 
 use crate::reference::intersect_triangle;
 use crate::scene::AreaLight;
-use crate::tracer::linespace::ntree::{entry_index, face_axes, NTree, PackedLinespaces, CHILDREN_BIT, GEOMETRY_BIT};
+use crate::tracer::linespace::ntree::{
+    entry_index, face_axes, NTree, PackedLinespaces, CHILDREN_BIT, GEOMETRY_BIT,
+};
 use crate::tracer::linespace::ShadowMode;
 
 /// Exact event counts of one pixel or frame.
@@ -63,7 +65,12 @@ pub fn light_samples(light: &AreaLight, su: u32, sv: u32) -> Vec<Vec3> {
 /// (u_min, v_min), (u_min, v_max), (u_max, v_min), (u_max, v_max).
 pub fn light_corners(light: &AreaLight) -> [Vec3; 4] {
     let c = light.corner;
-    [c, c + light.edge_v, c + light.edge_u, c + light.edge_u + light.edge_v]
+    [
+        c,
+        c + light.edge_v,
+        c + light.edge_u,
+        c + light.edge_u + light.edge_v,
+    ]
 }
 
 /// The soft-shadow computation on the CPU.
@@ -80,7 +87,12 @@ pub struct LinespaceShadows<'a> {
 
 /// Kay–Kajiya [KK86] on the node [0, N]³ (Algorithm 3): the entry and exit sides and cells
 /// of the ray, or `None` when it misses the node before `t_end`.
-fn node_intersection(n: u32, start: Vec3, dir: Vec3, t_end: f32) -> Option<(usize, u32, u32, usize, u32, u32)> {
+fn node_intersection(
+    n: u32,
+    start: Vec3,
+    dir: Vec3,
+    t_end: f32,
+) -> Option<(usize, u32, u32, usize, u32, u32)> {
     let nf = n as f32;
     let (mut tnear, mut tfar) = (f32::NEG_INFINITY, f32::INFINITY);
     let (mut near_axis, mut far_axis) = (0usize, 0usize);
@@ -125,7 +137,12 @@ fn node_intersection(n: u32, start: Vec3, dir: Vec3, t_end: f32) -> Option<(usiz
 
 /// Algorithm 4: the line-space entry of a ray through a node (true: geometry in the shaft).
 /// Entry and exit on the same side (a grazing ray) has no shaft: true, conservatively.
-fn get_entry(n: u32, packed: &PackedLinespaces, ls_index: u32, hit: (usize, u32, u32, usize, u32, u32)) -> bool {
+fn get_entry(
+    n: u32,
+    packed: &PackedLinespaces,
+    ls_index: u32,
+    hit: (usize, u32, u32, usize, u32, u32),
+) -> bool {
     let (s, su, sv, e, eu, ev) = hit;
     match entry_index(n, s, su, sv, e, eu, ev) {
         Some(entry) => packed.get_entry(ls_index, entry),
@@ -182,7 +199,10 @@ impl<'a> LinespaceShadows<'a> {
         let light_points = light_samples(&self.light, self.samples_u, self.samples_v);
         let num_rays = light_points.len();
         // samples behind the surface are blocked by it (N·L <= 0, as Listing 15)
-        let active_rays: Vec<bool> = light_points.iter().map(|l| normal.dot(*l - p) > 0.0).collect();
+        let active_rays: Vec<bool> = light_points
+            .iter()
+            .map(|l| normal.dot(*l - p) > 0.0)
+            .collect();
         let active_count = active_rays.iter().filter(|a| **a).count();
         if active_count == 0 {
             return (0.0, counts);
@@ -194,7 +214,15 @@ impl<'a> LinespaceShadows<'a> {
             ShadowMode::LinespaceDda => {
                 let mut lit = 0;
                 for r in 0..num_rays {
-                    if active_rays[r] && !self.dda_blocked(o, ray_direction[r], origin, light_points[r], &mut counts) {
+                    if active_rays[r]
+                        && !self.dda_blocked(
+                            o,
+                            ray_direction[r],
+                            origin,
+                            light_points[r],
+                            &mut counts,
+                        )
+                    {
                         lit += 1;
                     }
                 }
@@ -205,14 +233,27 @@ impl<'a> LinespaceShadows<'a> {
                 // Algorithm 1: the traversal axis k, the dominant axis of the light vector —
                 // valid when all four corner rays go the same way along it
                 let centre = self.light.center() - origin;
-                let valid = |a: usize| corner_dir.iter().all(|c| c[a] > 0.0) || corner_dir.iter().all(|c| c[a] < 0.0);
+                let valid = |a: usize| {
+                    corner_dir.iter().all(|c| c[a] > 0.0) || corner_dir.iter().all(|c| c[a] < 0.0)
+                };
                 let lv = centre.abs();
-                let dominant = if lv.x >= lv.y && lv.x >= lv.z { 0 } else if lv.y >= lv.z { 1 } else { 2 };
+                let dominant = if lv.x >= lv.y && lv.x >= lv.z {
+                    0
+                } else if lv.y >= lv.z {
+                    1
+                } else {
+                    2
+                };
                 let k = if valid(dominant) {
                     Some(dominant)
                 } else {
                     (0..3).filter(|&a| valid(a)).max_by(|&a, &b| {
-                        let m = |a: usize| corner_dir.iter().map(|c| c[a].abs()).fold(f32::INFINITY, f32::min);
+                        let m = |a: usize| {
+                            corner_dir
+                                .iter()
+                                .map(|c| c[a].abs())
+                                .fold(f32::INFINITY, f32::min)
+                        };
                         m(a).total_cmp(&m(b))
                     })
                 };
@@ -249,13 +290,19 @@ impl<'a> LinespaceShadows<'a> {
         let te = self.t_end(d);
         let ends = s.corner_dir.map(|c| ko + c[s.k] * te);
         if s.dir > 0 {
-            let kfar = ends.iter().copied().fold(f32::NEG_INFINITY, f32::max).min(nf);
+            let kfar = ends
+                .iter()
+                .copied()
+                .fold(f32::NEG_INFINITY, f32::max)
+                .min(nf);
             let knear = ko.max(0.0);
             if knear >= nf || kfar <= 0.0 || knear > kfar {
                 return None;
             }
             let first = (knear.floor() as i32).clamp(0, self.tree.n as i32 - 1);
-            let last = ((kfar.ceil() as i32) - 1).clamp(0, self.tree.n as i32 - 1).max(first);
+            let last = ((kfar.ceil() as i32) - 1)
+                .clamp(0, self.tree.n as i32 - 1)
+                .max(first);
             Some((first, last))
         } else {
             let kfar = ends.iter().copied().fold(f32::INFINITY, f32::min).max(0.0);
@@ -264,7 +311,9 @@ impl<'a> LinespaceShadows<'a> {
                 return None;
             }
             let first = ((knear.ceil() as i32) - 1).clamp(0, self.tree.n as i32 - 1);
-            let last = (kfar.floor() as i32).clamp(0, self.tree.n as i32 - 1).min(first);
+            let last = (kfar.floor() as i32)
+                .clamp(0, self.tree.n as i32 - 1)
+                .min(first);
             Some((first, last))
         }
     }
@@ -275,7 +324,12 @@ impl<'a> LinespaceShadows<'a> {
         let ko = s.ray_start[d][s.k];
         let te = self.t_end(d);
         let (a, b) = (j as f32, j as f32 + 1.0);
-        let mut r = [f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY];
+        let mut r = [
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
         for c in &s.corner_dir {
             let kend = ko + c[s.k] * te;
             let (lo, hi) = if s.dir > 0 { (ko, kend) } else { (kend, ko) };
@@ -307,14 +361,23 @@ impl<'a> LinespaceShadows<'a> {
     /// Algorithm 2: the line-space check of a node for all active rays. `deactivate`: at the
     /// last depth with line spaces a set bit is a hit and deactivates the ray; elsewhere the
     /// first set bit returns true (the node must be descended).
-    fn is_intersection(&self, s: &mut Shaft, node: [u32; 2], child_start: Vec3, level: usize, deactivate: bool, counts: &mut ShadowCounts) -> bool {
+    fn is_intersection(
+        &self,
+        s: &mut Shaft,
+        node: [u32; 2],
+        child_start: Vec3,
+        level: usize,
+        deactivate: bool,
+        counts: &mut ShadowCounts,
+    ) -> bool {
         let mut found = false;
         let te = self.t_end(level);
         for r in 0..s.ray_direction.len() {
             if !s.active_rays[r] {
                 continue;
             }
-            let Some(hit) = node_intersection(self.tree.n, child_start, s.ray_direction[r], te) else {
+            let Some(hit) = node_intersection(self.tree.n, child_start, s.ray_direction[r], te)
+            else {
                 continue;
             };
             counts.linespace_lookups += 1;
@@ -332,19 +395,30 @@ impl<'a> LinespaceShadows<'a> {
     }
 
     /// Exact triangle tests of a leaf for all active rays that cross it.
-    fn leaf_tests(&self, s: &mut Shaft, node: [u32; 2], child_start: Vec3, level: usize, counts: &mut ShadowCounts) {
+    fn leaf_tests(
+        &self,
+        s: &mut Shaft,
+        node: [u32; 2],
+        child_start: Vec3,
+        level: usize,
+        counts: &mut ShadowCounts,
+    ) {
         let te = self.t_end(level);
         let off = (node[0] >> 2) as usize;
         let tris = &self.tree.leaf_triangles[off..off + node[1] as usize];
         for r in 0..s.ray_direction.len() {
-            if !s.active_rays[r] || node_intersection(self.tree.n, child_start, s.ray_direction[r], te).is_none() {
+            if !s.active_rays[r]
+                || node_intersection(self.tree.n, child_start, s.ray_direction[r], te).is_none()
+            {
                 continue;
             }
             let rd = s.light_points[r] - s.origin_world;
             for &t in tris {
                 counts.triangle_tests += 1;
                 let tri = &self.triangles[t as usize];
-                if let Some((tt, _, _)) = intersect_triangle(s.origin_world, rd, tri[0], tri[1], tri[2]) {
+                if let Some((tt, _, _)) =
+                    intersect_triangle(s.origin_world, rd, tri[0], tri[1], tri[2])
+                {
                     if tt < 1.0 {
                         s.active_rays[r] = false;
                         s.active_count -= 1;
@@ -409,7 +483,8 @@ impl<'a> LinespaceShadows<'a> {
                     if node[0] & CHILDREN_BIT == 0 {
                         self.leaf_tests(s, node, child_start, level_of_node, counts);
                     } else {
-                        let inside = child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
+                        let inside = child_start.cmpge(Vec3::ZERO).all()
+                            && child_start.cmple(Vec3::splat(nf)).all();
                         let descend = if inside {
                             true
                         } else if mode == ShadowMode::Linespace && d as i32 == last_ls_depth {
@@ -457,7 +532,14 @@ impl<'a> LinespaceShadows<'a> {
 
     /// One ray with a hierarchical 3D-DDA [AW87] through the N-tree, the same line-space
     /// termination as the packet traversal (Table 3's DDA). True: blocked.
-    fn dda_blocked(&self, o: Vec3, dir: Vec3, origin_world: Vec3, light_point: Vec3, counts: &mut ShadowCounts) -> bool {
+    fn dda_blocked(
+        &self,
+        o: Vec3,
+        dir: Vec3,
+        origin_world: Vec3,
+        light_point: Vec3,
+        counts: &mut ShadowCounts,
+    ) -> bool {
         let n = self.tree.n as i32;
         let nf = n as f32;
         let last_ls_depth = self.tree.last_linespace_depth();
@@ -513,7 +595,14 @@ impl<'a> LinespaceShadows<'a> {
                     t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
                 }
             }
-            Some(Dda { group, start, cell, t_max, t: t0, t_end })
+            Some(Dda {
+                group,
+                start,
+                cell,
+                t_max,
+                t: t0,
+                t_end,
+            })
         };
         let mut stack = vec![Dda::default(); max_depth];
         let Some(root) = init(0, o, 1.0) else {
@@ -525,13 +614,22 @@ impl<'a> LinespaceShadows<'a> {
         while depth >= 0 {
             let d = depth as usize;
             let st = stack[d];
-            if st.cell.cmplt(IVec3::ZERO).any() || st.cell.cmpge(IVec3::splat(n)).any() || st.t > st.t_end {
+            if st.cell.cmplt(IVec3::ZERO).any()
+                || st.cell.cmpge(IVec3::splat(n)).any()
+                || st.t > st.t_end
+            {
                 depth -= 1;
                 continue;
             }
             // advance this level past the current cell before looking into it
             let tm = st.t_max;
-            let a = if tm.x <= tm.y && tm.x <= tm.z { 0 } else if tm.y <= tm.z { 1 } else { 2 };
+            let a = if tm.x <= tm.y && tm.x <= tm.z {
+                0
+            } else if tm.y <= tm.z {
+                1
+            } else {
+                2
+            };
             stack[d].t = st.t_max[a];
             stack[d].cell[a] += step[a];
             stack[d].t_max[a] += t_delta[a];
@@ -548,7 +646,9 @@ impl<'a> LinespaceShadows<'a> {
                 for &t in &self.tree.leaf_triangles[off..off + node[1] as usize] {
                     counts.triangle_tests += 1;
                     let tri = &self.triangles[t as usize];
-                    if let Some((tt, _, _)) = intersect_triangle(origin_world, rd, tri[0], tri[1], tri[2]) {
+                    if let Some((tt, _, _)) =
+                        intersect_triangle(origin_world, rd, tri[0], tri[1], tri[2])
+                    {
                         if tt < 1.0 {
                             return true;
                         }
@@ -556,7 +656,8 @@ impl<'a> LinespaceShadows<'a> {
                 }
                 continue;
             }
-            let inside = child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
+            let inside =
+                child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
             let descend = if inside {
                 true
             } else if let Some(hit) = node_intersection(self.tree.n, child_start, dir, te) {

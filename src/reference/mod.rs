@@ -5,6 +5,8 @@
 
 pub mod linespace;
 
+pub mod grid;
+
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 

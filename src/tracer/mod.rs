@@ -3,7 +3,9 @@
 
 pub mod base;
 pub mod gpu_scene;
+pub mod grid;
 pub mod linespace;
+pub mod pipeline;
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -35,6 +37,8 @@ pub trait Tracer {
 pub enum TracerKind {
     /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
     Base,
+    /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
+    Grid,
 }
 
 /// Make the tracer `kind` for `scene` on the current context.
@@ -48,6 +52,7 @@ pub fn create(
 ) -> Result<Box<dyn Tracer>> {
     Ok(match kind {
         TracerKind::Base => Box::new(base::BaseTracer::new(gl, info, scene, shaders, options)?),
+        TracerKind::Grid => Box::new(grid::GridTracer::new(gl, info, scene, shaders, options)?),
     })
 }
 
@@ -107,6 +112,58 @@ impl Default for GridOptions {
     }
 }
 
+/// `--grid N|auto`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridResolution {
+    Auto,
+    N(u32),
+}
+
+impl std::str::FromStr for GridResolution {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(GridResolution::Auto);
+        }
+        match s.parse::<u32>() {
+            Ok(n) if n > 0 => Ok(GridResolution::N(n)),
+            _ => Err(format!("`{s}` is neither `auto` nor a positive voxel count per axis")),
+        }
+    }
+}
+
+/// The grid tracer's command-line options (`render`, `view`, `bench`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct GridArgs {
+    /// Grid resolution N (N³ voxels), or `auto`: N = cbrt(triangles / 5), within 4..=64.
+    #[arg(long, default_value = "auto", value_name = "N|auto")]
+    pub grid: GridResolution,
+    /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
+    /// compact lists, 3D-DDA.
+    #[arg(long, value_enum, default_value = "exact")]
+    pub grid_variant: GridVariant,
+    /// Thesis variant: triangle ids per voxel list (Listing 17: 512).
+    #[arg(long, default_value_t = 512, value_name = "L")]
+    pub voxel_array_length: u32,
+    /// Thesis variant: voxel ids per ray list (default 3·N, as Listing 17).
+    #[arg(long, value_name = "R")]
+    pub ray_array_length: Option<u32>,
+}
+
+impl GridArgs {
+    pub fn options(&self) -> GridOptions {
+        GridOptions {
+            variant: self.grid_variant,
+            resolution: match self.grid {
+                GridResolution::Auto => None,
+                GridResolution::N(n) => Some(n),
+            },
+            voxel_array_length: self.voxel_array_length,
+            ray_array_length: self.ray_array_length,
+        }
+    }
+}
+
 /// Options of one render.
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
@@ -124,7 +181,14 @@ pub struct RenderOptions {
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
-pub const COUNTERS: &[&str] = &["intersect1", "intersect2", "truncated_rays"];
+pub const COUNTERS: &[&str] = &[
+    "intersect1",
+    "intersect2",
+    "truncated_rays",
+    "voxels_visited",
+    "dropped_triangle_refs",
+    "ray_list_overflows",
+];
 
 /// The counters that count ray–triangle tests (the rest count events).
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];

@@ -33,7 +33,13 @@ pub struct SoftShadowArgs {
 }
 
 impl SoftShadowArgs {
-    pub fn options(&self, mode: ShadowMode, width: u32, height: u32, tile: u32) -> SoftShadowOptions {
+    pub fn options(
+        &self,
+        mode: ShadowMode,
+        width: u32,
+        height: u32,
+        tile: u32,
+    ) -> SoftShadowOptions {
         SoftShadowOptions {
             mode,
             samples_u: self.light_samples.0,
@@ -48,7 +54,12 @@ impl SoftShadowArgs {
 }
 
 /// The statistics document of a soft-shadow frame (the keys of `render --stats`).
-pub fn stats_json(ctx: &GlContext, scene: &Scene, r: &SoftShadowRenderer, f: &SoftShadowFrame) -> serde_json::Value {
+pub fn stats_json(
+    ctx: &GlContext,
+    scene: &Scene,
+    r: &SoftShadowRenderer,
+    f: &SoftShadowFrame,
+) -> serde_json::Value {
     let s = &f.stats;
     let mut doc = json!({
         "scene": scene.path,
@@ -92,11 +103,21 @@ pub fn render(
 ) -> Result<()> {
     let mut r = SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, scene, shaders, options)?;
     let f = r.render(&scene.camera)?;
-    let frame = Frame { width: f.width, height: f.height, color: f.color.clone(), aovs: None, stats: f.stats.clone() };
+    let frame = Frame {
+        width: f.width,
+        height: f.height,
+        color: f.color.clone(),
+        aovs: None,
+        stats: f.stats.clone(),
+    };
     output::write_png(out, &frame)?;
     if let Some(dir) = aov_dir {
         output::write_aovs(dir, f.width, f.height, &f.aovs)?;
-        output::write_npy(&dir.join("shadow.npy"), &[f.height as u64, f.width as u64], f.shadow.iter().copied())?;
+        output::write_npy(
+            &dir.join("shadow.npy"),
+            &[f.height as u64, f.width as u64],
+            f.shadow.iter().copied(),
+        )?;
     }
     if let Some(path) = stats {
         let doc = stats_json(ctx, scene, &r, &f);

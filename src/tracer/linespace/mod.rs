@@ -68,11 +68,21 @@ impl ShadowMode {
 
 /// Parse `UxV` (e.g. `5x5`) light samples.
 pub fn parse_samples(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected UxV, e.g. 5x5"))?;
-    let a: u32 = a.trim().parse().map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
-    let b: u32 = b.trim().parse().map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    let (a, b) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    let a: u32 = a
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    let b: u32 = b
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
     if !(1..=10).contains(&a) || !(1..=10).contains(&b) {
-        return Err(format!("`{s}`: 1x1 to 10x10 samples (the thesis uses 2x2 to 10x10)"));
+        return Err(format!(
+            "`{s}`: 1x1 to 10x10 samples (the thesis uses 2x2 to 10x10)"
+        ));
     }
     Ok((a, b))
 }
@@ -109,13 +119,22 @@ pub struct SoftShadowFrame {
 }
 
 /// Counter slots of the shadow kernel.
-const COUNTERS: [&str; 5] = ["triangle_tests", "linespace_lookups", "nodes_visited", "truncated", "packet_failures"];
+const COUNTERS: [&str; 5] = [
+    "triangle_tests",
+    "linespace_lookups",
+    "nodes_visited",
+    "truncated",
+    "packet_failures",
+];
 
 /// The scene's single area light (the thesis lights with one).
 pub fn scene_light(scene: &Scene) -> Result<AreaLight> {
     match scene.area_lights.as_slice() {
         [l] => Ok(*l),
-        [] => bail!("{}: --shadows needs an [[area_light]] in the scene file", scene.path.display()),
+        [] => bail!(
+            "{}: --shadows needs an [[area_light]] in the scene file",
+            scene.path.display()
+        ),
         _ => bail!(
             "{}: {} area lights; the soft-shadow pipeline (Klee 2016) lights with exactly one",
             scene.path.display(),
@@ -125,16 +144,31 @@ pub fn scene_light(scene: &Scene) -> Result<AreaLight> {
 }
 
 /// The view-projection matrix matching `Camera::rays` (pixel centres, image plane at near).
-pub fn view_projection(camera: &Camera, width: u32, height: u32, scene_lo: Vec3, scene_hi: Vec3) -> Mat4 {
+pub fn view_projection(
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    scene_lo: Vec3,
+    scene_hi: Vec3,
+) -> Mat4 {
     let eye = Vec3::from(camera.position);
     let view = Mat4::look_at_rh(eye, Vec3::from(camera.look_at), Vec3::from(camera.up));
     let far_corner = [scene_lo, scene_hi]
         .iter()
         .flat_map(|a| [scene_lo, scene_hi].map(move |b| (*a, b)))
-        .map(|(a, b)| Vec3::new(a.x, b.y, a.z).distance(eye).max(Vec3::new(b.x, a.y, b.z).distance(eye)))
+        .map(|(a, b)| {
+            Vec3::new(a.x, b.y, a.z)
+                .distance(eye)
+                .max(Vec3::new(b.x, a.y, b.z).distance(eye))
+        })
         .fold(0.0f32, f32::max);
     let far = (far_corner * 2.0).max(camera.near * 10.0);
-    let proj = Mat4::perspective_rh_gl(camera.fov_y.to_radians(), width as f32 / height as f32, camera.near, far);
+    let proj = Mat4::perspective_rh_gl(
+        camera.fov_y.to_radians(),
+        width as f32 / height as f32,
+        camera.near,
+        far,
+    );
     proj * view
 }
 
@@ -181,8 +215,16 @@ fn rgba32f_texture(gl: &Gl, w: u32, h: u32) -> Result<glow::Texture> {
         let t = gl.create_texture().map_err(|e| anyhow!(e))?;
         gl.bind_texture(glow::TEXTURE_2D, Some(t));
         gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA32F, w as i32, h as i32);
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
-        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+        gl.tex_parameter_i32(
+            glow::TEXTURE_2D,
+            glow::TEXTURE_MIN_FILTER,
+            glow::NEAREST as i32,
+        );
+        gl.tex_parameter_i32(
+            glow::TEXTURE_2D,
+            glow::TEXTURE_MAG_FILTER,
+            glow::NEAREST as i32,
+        );
         gl.bind_texture(glow::TEXTURE_2D, None);
         Ok(t)
     }
@@ -208,19 +250,91 @@ fn read_rgba32f(gl: &Gl, t: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {
 }
 
 impl SoftShadowRenderer {
-    pub fn new(gl: Arc<Gl>, info: &GlInfo, scene: &Scene, shaders: &ShaderSource, options: SoftShadowOptions) -> Result<Self> {
+    pub fn new(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: SoftShadowOptions,
+    ) -> Result<Self> {
+        scene_light(scene)?;
+        let tree = NTree::build(
+            &scene.world_triangles(),
+            options.ntree_n,
+            options.ntree_depth,
+        )?;
+        Self::with_tree(gl, info, scene, shaders, options, tree)
+    }
+
+    /// The shadow kernel for a mode and a number of samples (the defines of Algorithm 1).
+    fn shadow_kernel(
+        gl: &Gl,
+        shaders: &ShaderSource,
+        tree: &NTree,
+        mode: ShadowMode,
+        su: u32,
+        sv: u32,
+    ) -> Result<glow::Program> {
+        if !(1..=10).contains(&su) || !(1..=10).contains(&sv) {
+            bail!("{su}x{sv} light samples: 1x1 to 10x10");
+        }
+        let defines = Defines::new()
+            .set("NTREE_N", tree.n)
+            .set("NUM_MAX_DEPTH", tree.depth - 1)
+            .set("LAST_LS_DEPTH", tree.last_linespace_depth())
+            .set("SAMPLES_U", su)
+            .set("SAMPLES_V", sv)
+            .set("NUM_RAYS", su * sv)
+            .set("SHADOW_MODE", mode.kernel_mode());
+        compile_program(
+            gl,
+            shaders,
+            &[(glow::COMPUTE_SHADER, "linespace_shadow.comp")],
+            &defines,
+        )
+    }
+
+    /// Switch the shadow mode and the light samples (recompiles the shadow kernel only; the
+    /// N-tree and the line spaces stay).
+    pub fn reconfigure(
+        &mut self,
+        shaders: &ShaderSource,
+        mode: ShadowMode,
+        su: u32,
+        sv: u32,
+    ) -> Result<()> {
+        let p = Self::shadow_kernel(&self.gl, shaders, &self.tree, mode, su, sv)?;
+        // SAFETY: deleting our old program.
+        unsafe { self.gl.delete_program(self.shadow_program) };
+        self.shadow_program = p;
+        self.options.mode = mode;
+        self.options.samples_u = su;
+        self.options.samples_v = sv;
+        Ok(())
+    }
+
+    /// Like [`SoftShadowRenderer::new`] with an N-tree built before (over the scene's
+    /// world triangles).
+    pub fn with_tree(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: SoftShadowOptions,
+        tree: NTree,
+    ) -> Result<Self> {
         let light = scene_light(scene)?;
         if options.width == 0 || options.height == 0 {
             bail!("width and height must be positive");
         }
-        if options.tile != 0 && options.tile % 8 != 0 {
+        if options.tile != 0 && !options.tile.is_multiple_of(8) {
             bail!("--tile {} must be a multiple of 8 (or 0)", options.tile);
         }
         let triangles = scene.world_triangles();
-        let tree = NTree::build(&triangles, options.ntree_n, options.ntree_depth)?;
         let words = ntree::linespace_words(tree.n);
         let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
-        let packed = ntree::pack_linespaces(&tree.linespaces, words, tree.linespace_count, max_dim)?;
+        let packed =
+            ntree::pack_linespaces(&tree.linespaces, words, tree.linespace_count, max_dim)?;
         let max_tb = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
         if tree.nodes.len() as i64 > max_tb {
             bail!(
@@ -240,26 +354,30 @@ impl SoftShadowRenderer {
             tree.build_ms,
             tree.linespace_build_ms
         );
-        let num_rays = options.samples_u * options.samples_v;
-        let defines = Defines::new()
-            .set("NTREE_N", tree.n)
-            .set("NUM_MAX_DEPTH", tree.depth - 1)
-            .set("LAST_LS_DEPTH", tree.last_linespace_depth())
-            .set("SAMPLES_U", options.samples_u)
-            .set("SAMPLES_V", options.samples_v)
-            .set("NUM_RAYS", num_rays)
-            .set("SHADOW_MODE", options.mode.kernel_mode());
-        let shadow_program = compile_program(&gl, shaders, &[(glow::COMPUTE_SHADER, "linespace_shadow.comp")], &defines)?;
+        let shadow_program = Self::shadow_kernel(
+            &gl,
+            shaders,
+            &tree,
+            options.mode,
+            options.samples_u,
+            options.samples_v,
+        )?;
         let raster = compile_program(
             &gl,
             shaders,
-            &[(glow::VERTEX_SHADER, "gbuffer.vert"), (glow::FRAGMENT_SHADER, "gbuffer.frag")],
+            &[
+                (glow::VERTEX_SHADER, "gbuffer.vert"),
+                (glow::FRAGMENT_SHADER, "gbuffer.frag"),
+            ],
             &Defines::new(),
         )?;
         let quad_program = compile_program(
             &gl,
             shaders,
-            &[(glow::VERTEX_SHADER, "linespace_quad.vert"), (glow::FRAGMENT_SHADER, "linespace_quad.frag")],
+            &[
+                (glow::VERTEX_SHADER, "linespace_quad.vert"),
+                (glow::FRAGMENT_SHADER, "linespace_quad.frag"),
+            ],
             &Defines::new(),
         )?;
         let attrs = scene.world_attributes();
@@ -267,8 +385,18 @@ impl SoftShadowRenderer {
         let nor: Vec<[f32; 3]> = attrs.normals.iter().map(|v| v.to_array()).collect();
         let col: Vec<[f32; 3]> = attrs.colors.iter().map(|v| v.to_array()).collect();
         let max = info.max_ssbo_block_size;
-        let tri4: Vec<[f32; 4]> = triangles.iter().flatten().map(|v| [v.x, v.y, v.z, 1.0]).collect();
-        let tri_ssbo = Ssbo::new(&gl, "triVertex", 16 * tri4.len(), Some(bytemuck::cast_slice(&tri4)), max)?;
+        let tri4: Vec<[f32; 4]> = triangles
+            .iter()
+            .flatten()
+            .map(|v| [v.x, v.y, v.z, 1.0])
+            .collect();
+        let tri_ssbo = Ssbo::new(
+            &gl,
+            "triVertex",
+            16 * tri4.len(),
+            Some(bytemuck::cast_slice(&tri4)),
+            max,
+        )?;
         let leaf_ssbo = Ssbo::new(
             &gl,
             "leafTriangles",
@@ -286,7 +414,11 @@ impl SoftShadowRenderer {
             for (loc, data) in [(0u32, &pos), (1, &nor), (2, &col)] {
                 let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
                 gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
-                gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, bytemuck::cast_slice(&data[..]), glow::STATIC_DRAW);
+                gl.buffer_data_u8_slice(
+                    glow::ARRAY_BUFFER,
+                    bytemuck::cast_slice(&data[..]),
+                    glow::STATIC_DRAW,
+                );
                 gl.enable_vertex_attrib_array(loc);
                 gl.vertex_attrib_pointer_f32(loc, 3, glow::FLOAT, false, 0, 0);
                 vbos.push(b);
@@ -294,24 +426,54 @@ impl SoftShadowRenderer {
             gl.bind_vertex_array(None);
             gl.bind_buffer(glow::ARRAY_BUFFER, None);
 
-            let gbuffer = [rgba32f_texture(&gl, w, h)?, rgba32f_texture(&gl, w, h)?, rgba32f_texture(&gl, w, h)?];
+            let gbuffer = [
+                rgba32f_texture(&gl, w, h)?,
+                rgba32f_texture(&gl, w, h)?,
+                rgba32f_texture(&gl, w, h)?,
+            ];
             let gbuffer_fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
             let gbuffer_depth = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(gbuffer_depth));
-            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::DEPTH_COMPONENT32F, w as i32, h as i32);
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                glow::DEPTH_COMPONENT32F,
+                w as i32,
+                h as i32,
+            );
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(gbuffer_fbo));
             for (i, t) in gbuffer.iter().enumerate() {
-                gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0 + i as u32, glow::TEXTURE_2D, Some(*t), 0);
+                gl.framebuffer_texture_2d(
+                    glow::FRAMEBUFFER,
+                    glow::COLOR_ATTACHMENT0 + i as u32,
+                    glow::TEXTURE_2D,
+                    Some(*t),
+                    0,
+                );
             }
-            gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::DEPTH_ATTACHMENT, glow::RENDERBUFFER, Some(gbuffer_depth));
-            gl.draw_buffers(&[glow::COLOR_ATTACHMENT0, glow::COLOR_ATTACHMENT1, glow::COLOR_ATTACHMENT2]);
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::DEPTH_ATTACHMENT,
+                glow::RENDERBUFFER,
+                Some(gbuffer_depth),
+            );
+            gl.draw_buffers(&[
+                glow::COLOR_ATTACHMENT0,
+                glow::COLOR_ATTACHMENT1,
+                glow::COLOR_ATTACHMENT2,
+            ]);
             if gl.check_framebuffer_status(glow::FRAMEBUFFER) != glow::FRAMEBUFFER_COMPLETE {
                 bail!("the G-buffer FBO is incomplete");
             }
             let output_texture = rgba32f_texture(&gl, w, h)?;
             let output_fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(output_fbo));
-            gl.framebuffer_texture_2d(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::TEXTURE_2D, Some(output_texture), 0);
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(output_texture),
+                0,
+            );
             if gl.check_framebuffer_status(glow::FRAMEBUFFER) != glow::FRAMEBUFFER_COMPLETE {
                 bail!("the output FBO is incomplete");
             }
@@ -322,7 +484,11 @@ impl SoftShadowRenderer {
             // the node pool: a texture buffer of (red, green) texels (Fig. 8–9)
             let node_buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
             gl.bind_buffer(glow::TEXTURE_BUFFER, Some(node_buffer));
-            gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, bytemuck::cast_slice(&tree.nodes), glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(
+                glow::TEXTURE_BUFFER,
+                bytemuck::cast_slice(&tree.nodes),
+                glow::STATIC_DRAW,
+            );
             gl.bind_buffer(glow::TEXTURE_BUFFER, None);
             let node_texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(node_texture));
@@ -354,8 +520,16 @@ impl SoftShadowRenderer {
                 glow::UNSIGNED_INT,
                 glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(&packed.texels))),
             );
-            gl.tex_parameter_i32(glow::TEXTURE_3D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
-            gl.tex_parameter_i32(glow::TEXTURE_3D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+            gl.tex_parameter_i32(
+                glow::TEXTURE_3D,
+                glow::TEXTURE_MIN_FILTER,
+                glow::NEAREST as i32,
+            );
+            gl.tex_parameter_i32(
+                glow::TEXTURE_3D,
+                glow::TEXTURE_MAG_FILTER,
+                glow::NEAREST as i32,
+            );
             gl.bind_texture(glow::TEXTURE_3D, None);
             crate::gl::check_error(&gl, "uploading the N-tree and the line spaces")?;
 
@@ -452,13 +626,18 @@ impl SoftShadowRenderer {
                     false,
                     &vp.to_cols_array(),
                 );
-                gl.uniform_3_f32_slice(gl.get_uniform_location(raster, "cameraPosition").as_ref(), &camera.position);
+                gl.uniform_3_f32_slice(
+                    gl.get_uniform_location(raster, "cameraPosition").as_ref(),
+                    &camera.position,
+                );
                 gl.bind_vertex_array(Some(vao));
                 gl.draw_arrays(glow::TRIANGLES, 0, 3 * tri_count);
                 gl.bind_vertex_array(None);
                 gl.disable(glow::DEPTH_TEST);
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-                gl.memory_barrier(glow::SHADER_IMAGE_ACCESS_BARRIER_BIT | glow::TEXTURE_FETCH_BARRIER_BIT);
+                gl.memory_barrier(
+                    glow::SHADER_IMAGE_ACCESS_BARRIER_BIT | glow::TEXTURE_FETCH_BARRIER_BIT,
+                );
             }
         });
         crate::gl::check_error(&gl, "the G-buffer pass")?;
@@ -486,13 +665,33 @@ impl SoftShadowRenderer {
             gl.bind_image_texture(0, Some(gb[0]), 0, false, 0, glow::READ_ONLY, glow::RGBA32F);
             gl.bind_image_texture(1, Some(gb[1]), 0, false, 0, glow::READ_ONLY, glow::RGBA32F);
             gl.bind_image_texture(2, Some(gb[2]), 0, false, 0, glow::READ_WRITE, glow::RGBA32F);
-            gl.bind_image_texture(3, Some(self.shadow_texture), 0, false, 0, glow::WRITE_ONLY, glow::RGBA32F);
-            gl.bind_image_texture(4, Some(self.linespace_texture), 0, true, 0, glow::READ_ONLY, glow::R32UI);
+            gl.bind_image_texture(
+                3,
+                Some(self.shadow_texture),
+                0,
+                false,
+                0,
+                glow::WRITE_ONLY,
+                glow::RGBA32F,
+            );
+            gl.bind_image_texture(
+                4,
+                Some(self.linespace_texture),
+                0,
+                true,
+                0,
+                glow::READ_ONLY,
+                glow::R32UI,
+            );
         }
         self.tri_ssbo.bind(&gl, 0);
         self.leaf_ssbo.bind(&gl, 1);
         self.counter_ssbo.bind(&gl, 8);
-        let tile = if self.options.tile == 0 { w.max(h) } else { self.options.tile };
+        let tile = if self.options.tile == 0 {
+            w.max(h)
+        } else {
+            self.options.tile
+        };
         let kernel: &'static str = match self.options.mode {
             ShadowMode::Exact => "shadow_exact",
             ShadowMode::Linespace => "shadow_linespace",
@@ -504,7 +703,11 @@ impl SoftShadowRenderer {
                 self.timers.time(&gl, kernel, || {
                     // SAFETY: dispatch of our program.
                     unsafe {
-                        gl.uniform_2_i32(gl.get_uniform_location(p, "tileOffset").as_ref(), tx as i32, ty as i32);
+                        gl.uniform_2_i32(
+                            gl.get_uniform_location(p, "tileOffset").as_ref(),
+                            tx as i32,
+                            ty as i32,
+                        );
                         gl.dispatch_compute(tw.div_ceil(8), th.div_ceil(8), 1);
                         gl.memory_barrier(glow::ALL_BARRIER_BITS);
                     }
@@ -535,7 +738,10 @@ impl SoftShadowRenderer {
         let counters = self.counter_ssbo.read_u32(&gl);
         let count = |i: usize| counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
         let color = flip_rows(&read_rgba32f(&gl, self.output_texture, w, h), w, h);
-        let shadow: Vec<f32> = flip_rows(&read_rgba32f(&gl, self.shadow_texture, w, h), w, h).iter().map(|c| c[0]).collect();
+        let shadow: Vec<f32> = flip_rows(&read_rgba32f(&gl, self.shadow_texture, w, h), w, h)
+            .iter()
+            .map(|c| c[0])
+            .collect();
         let gbuffer_position = flip_rows(&read_rgba32f(&gl, gb[0], w, h), w, h);
         let gbuffer_normal = flip_rows(&read_rgba32f(&gl, gb[1], w, h), w, h);
         let truncated = count(3);
@@ -578,20 +784,36 @@ impl SoftShadowRenderer {
         stats.events.insert("packet_failures".into(), count(4));
         let facts: BTreeMap<String, serde_json::Value> = [
             ("shadows", json!(self.options.mode)),
-            ("light_samples", json!(format!("{}x{}", self.options.samples_u, self.options.samples_v))),
-            ("num_rays", json!(self.options.samples_u * self.options.samples_v)),
+            (
+                "light_samples",
+                json!(format!(
+                    "{}x{}",
+                    self.options.samples_u, self.options.samples_v
+                )),
+            ),
+            (
+                "num_rays",
+                json!(self.options.samples_u * self.options.samples_v),
+            ),
             ("ntree_n", json!(self.tree.n)),
             ("ntree_depth", json!(self.tree.depth)),
             ("ntree_bytes", json!(self.ntree_bytes())),
             ("linespace_bytes", json!(self.linespace_bytes())),
             ("linespaces", json!(self.tree.linespace_count)),
-            ("ntree_node_groups", json!(self.tree.nodes.len() / (self.tree.n as usize).pow(3))),
+            (
+                "ntree_node_groups",
+                json!(self.tree.nodes.len() / (self.tree.n as usize).pow(3)),
+            ),
             ("ntree_leaves", json!(self.tree.leaf_count)),
             ("ntree_build_ms", json!(self.tree.build_ms)),
             ("linespace_build_ms", json!(self.tree.linespace_build_ms)),
             (
                 "linespace_texture",
-                json!([self.packed.tex_x_res, self.packed.tex_y_res, self.packed.tex_z_res]),
+                json!([
+                    self.packed.tex_x_res,
+                    self.packed.tex_y_res,
+                    self.packed.tex_z_res
+                ]),
             ),
         ]
         .into_iter()
@@ -599,7 +821,16 @@ impl SoftShadowRenderer {
         .collect();
         stats.facts = facts;
         stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok(SoftShadowFrame { width: w, height: h, color, shadow, gbuffer_position, gbuffer_normal, aovs, stats })
+        Ok(SoftShadowFrame {
+            width: w,
+            height: h,
+            color,
+            shadow,
+            gbuffer_position,
+            gbuffer_normal,
+            aovs,
+            stats,
+        })
     }
 
     /// The CPU implementation over the same N-tree and light (src/reference/linespace.rs).

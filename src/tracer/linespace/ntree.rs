@@ -62,7 +62,15 @@ pub fn linespace_words(n: u32) -> usize {
 
 /// The entry of the shaft from cell (su, sv) of side `s` to cell (eu, ev) of side `e`
 /// (s ≠ e; the symmetric entry is the same). `None` for two cells of the same side (no shaft).
-pub fn entry_index(n: u32, s: usize, su: u32, sv: u32, e: usize, eu: u32, ev: u32) -> Option<usize> {
+pub fn entry_index(
+    n: u32,
+    s: usize,
+    su: u32,
+    sv: u32,
+    e: usize,
+    eu: u32,
+    ev: u32,
+) -> Option<usize> {
     if s == e {
         return None;
     }
@@ -89,14 +97,17 @@ pub struct Aabb {
 impl Aabb {
     pub fn cell(i: u32, j: u32, k: u32) -> Aabb {
         let (i, j, k) = (i as f64, j as f64, k as f64);
-        Aabb { lo: [i, j, k], hi: [i + 1.0, j + 1.0, k + 1.0] }
+        Aabb {
+            lo: [i, j, k],
+            hi: [i + 1.0, j + 1.0, k + 1.0],
+        }
     }
 }
 
 /// The rectangle of side `f` covering cells [u0, u1) × [v0, v1), as a flat box.
 pub fn face_rect(n: u32, f: usize, u0: u32, u1: u32, v0: u32, v1: u32) -> Aabb {
     let axis = f / 2;
-    let c = if f % 2 == 0 { 0.0 } else { n as f64 };
+    let c = if f.is_multiple_of(2) { 0.0 } else { n as f64 };
     let (ua, va) = face_axes(axis);
     let mut lo = [0.0; 3];
     let mut hi = [0.0; 3];
@@ -151,22 +162,42 @@ pub fn build_linespace(n: u32, filled: &[bool]) -> Vec<u32> {
     let nn = n as usize;
     let children: Vec<Aabb> = (0..nn * nn * nn)
         .filter(|&i| filled[i])
-        .map(|i| Aabb::cell((i % nn) as u32, ((i / nn) % nn) as u32, (i / (nn * nn)) as u32))
+        .map(|i| {
+            Aabb::cell(
+                (i % nn) as u32,
+                ((i / nn) % nn) as u32,
+                (i / (nn * nn)) as u32,
+            )
+        })
         .collect();
     let mut words = vec![0u32; linespace_words(n)];
     if children.is_empty() {
         return words;
     }
-    let all: Vec<u32> = (0..children.len() as u32).collect();
+    let mut scratch: Vec<u32> = (0..children.len() as u32).collect();
     for s in 0..FACES {
         for e in s + 1..FACES {
-            let mut cand = Vec::new();
-            subdivide(n, s, e, [0, n, 0, n], [0, n, 0, n], &children, &all, &mut cand, &mut words, 0);
+            let full = [0, n, 0, n];
+            subdivide(
+                n,
+                s,
+                e,
+                full,
+                full,
+                &children,
+                &mut scratch,
+                0,
+                children.len(),
+                &mut words,
+            );
         }
     }
     words
 }
 
+/// One step of [`build_linespace`]: the candidates (children that may lie in the shaft of the
+/// rectangles `ra` of side `s` and `rb` of side `e`) are `scratch[from..to]`; the ones inside
+/// are pushed after them for the halves.
 #[allow(clippy::too_many_arguments)]
 fn subdivide(
     n: u32,
@@ -175,42 +206,55 @@ fn subdivide(
     ra: [u32; 4],
     rb: [u32; 4],
     children: &[Aabb],
-    cand_in: &[u32],
     scratch: &mut Vec<u32>,
+    from: usize,
+    to: usize,
     words: &mut [u32],
-    _level: u32,
 ) {
     let a = face_rect(n, s, ra[0], ra[1], ra[2], ra[3]);
     let b = face_rect(n, e, rb[0], rb[1], rb[2], rb[3]);
-    let cand: Vec<u32> = cand_in.iter().copied().filter(|&c| shaft_hits_box(&a, &b, &children[c as usize])).collect();
-    if cand.is_empty() {
-        return;
-    }
     let ext = [ra[1] - ra[0], ra[3] - ra[2], rb[1] - rb[0], rb[3] - rb[2]];
     let (imax, &emax) = ext.iter().enumerate().max_by_key(|(_, v)| **v).unwrap();
     if emax == 1 {
-        let idx = entry_index(n, s, ra[0], ra[2], e, rb[0], rb[2]).unwrap();
-        words[idx / 32] |= 1 << (idx % 32);
+        // two single cells: one child in the shaft is enough
+        if scratch[from..to]
+            .iter()
+            .any(|&c| shaft_hits_box(&a, &b, &children[c as usize]))
+        {
+            let idx = entry_index(n, s, ra[0], ra[2], e, rb[0], rb[2]).unwrap();
+            words[idx / 32] |= 1 << (idx % 32);
+        }
         return;
     }
-    let split = |r: [u32; 4], lohi: usize| -> ([u32; 4], [u32; 4]) {
-        let (lo, hi) = (r[2 * lohi], r[2 * lohi + 1]);
-        let mid = lo + (hi - lo) / 2;
-        let mut r1 = r;
-        let mut r2 = r;
-        r1[2 * lohi + 1] = mid;
-        r2[2 * lohi] = mid;
-        (r1, r2)
-    };
-    if imax < 2 {
-        let (r1, r2) = split(ra, imax);
-        subdivide(n, s, e, r1, rb, children, &cand, scratch, words, _level + 1);
-        subdivide(n, s, e, r2, rb, children, &cand, scratch, words, _level + 1);
-    } else {
-        let (r1, r2) = split(rb, imax - 2);
-        subdivide(n, s, e, ra, r1, children, &cand, scratch, words, _level + 1);
-        subdivide(n, s, e, ra, r2, children, &cand, scratch, words, _level + 1);
+    let base = scratch.len();
+    for i in from..to {
+        let c = scratch[i];
+        if shaft_hits_box(&a, &b, &children[c as usize]) {
+            scratch.push(c);
+        }
     }
+    let end = scratch.len();
+    if end > base {
+        let split = |r: [u32; 4], lohi: usize| -> ([u32; 4], [u32; 4]) {
+            let (lo, hi) = (r[2 * lohi], r[2 * lohi + 1]);
+            let mid = lo + (hi - lo) / 2;
+            let mut r1 = r;
+            let mut r2 = r;
+            r1[2 * lohi + 1] = mid;
+            r2[2 * lohi] = mid;
+            (r1, r2)
+        };
+        if imax < 2 {
+            let (r1, r2) = split(ra, imax);
+            subdivide(n, s, e, r1, rb, children, scratch, base, end, words);
+            subdivide(n, s, e, r2, rb, children, scratch, base, end, words);
+        } else {
+            let (r1, r2) = split(rb, imax - 2);
+            subdivide(n, s, e, ra, r1, children, scratch, base, end, words);
+            subdivide(n, s, e, ra, r2, children, scratch, base, end, words);
+        }
+    }
+    scratch.truncate(base);
 }
 
 /// The brute-force line space: every entry against every filled child (the tests' oracle for
@@ -220,7 +264,13 @@ pub fn build_linespace_brute_force(n: u32, filled: &[bool]) -> Vec<u32> {
     let mut words = vec![0u32; linespace_words(n)];
     let children: Vec<Aabb> = (0..nn * nn * nn)
         .filter(|&i| filled[i])
-        .map(|i| Aabb::cell((i % nn) as u32, ((i / nn) % nn) as u32, (i / (nn * nn)) as u32))
+        .map(|i| {
+            Aabb::cell(
+                (i % nn) as u32,
+                ((i / nn) % nn) as u32,
+                (i / (nn * nn)) as u32,
+            )
+        })
         .collect();
     for s in 0..FACES {
         for e in 0..FACES {
@@ -287,7 +337,9 @@ impl PackedLinespaces {
 
     /// The words of line space `ls_index` read back from the texture layout.
     pub fn unpack(&self, ls_index: u32) -> Vec<u32> {
-        (0..self.words_per_linespace).map(|w| self.texels[self.offset(self.texel(ls_index, w))]).collect()
+        (0..self.words_per_linespace)
+            .map(|w| self.texels[self.offset(self.texel(ls_index, w))])
+            .collect()
     }
 
     pub fn bytes(&self) -> usize {
@@ -297,7 +349,12 @@ impl PackedLinespaces {
 
 /// Pack `count` line spaces of `words_per` words each (concatenated in `words`) into the 3D
 /// texture layout of Listing 3 with at most `max_dim` texels per axis.
-pub fn pack_linespaces(words: &[u32], words_per: usize, count: usize, max_dim: u32) -> Result<PackedLinespaces> {
+pub fn pack_linespaces(
+    words: &[u32],
+    words_per: usize,
+    count: usize,
+    max_dim: u32,
+) -> Result<PackedLinespaces> {
     assert_eq!(words.len(), words_per * count);
     let tex_x_res = (words_per as u32).clamp(1, max_dim);
     let ls_y_size = (words_per as u32).div_ceil(tex_x_res);
@@ -377,7 +434,10 @@ impl NTree {
     /// Geometry flags of a child group.
     pub fn group_filled(&self, group: u32) -> Vec<bool> {
         let g = (self.n as usize).pow(3);
-        self.nodes[group as usize * g..(group as usize + 1) * g].iter().map(|t| t[0] & GEOMETRY_BIT != 0).collect()
+        self.nodes[group as usize * g..(group as usize + 1) * g]
+            .iter()
+            .map(|t| t[0] & GEOMETRY_BIT != 0)
+            .collect()
     }
 
     /// Build the N-tree over `triangles` (world space): geometry by exact triangle/box overlap
@@ -433,8 +493,14 @@ impl NTree {
                 let t = &tris[id as usize];
                 let tlo = t[0].min(t[1]).min(t[2]);
                 let thi = t[0].max(t[1]).max(t[2]);
-                let c0 = ((tlo - origin) / cell).floor().as_ivec3().clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
-                let c1 = ((thi - origin) / cell).floor().as_ivec3().clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
+                let c0 = ((tlo - origin) / cell)
+                    .floor()
+                    .as_ivec3()
+                    .clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
+                let c1 = ((thi - origin) / cell)
+                    .floor()
+                    .as_ivec3()
+                    .clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
                 for z in c0.z..=c1.z {
                     for y in c0.y..=c1.y {
                         for x in c0.x..=c1.x {
@@ -477,7 +543,10 @@ impl NTree {
         }
         tree.build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let t1 = std::time::Instant::now();
-        let spaces: Vec<Vec<u32>> = inner_groups.par_iter().map(|&g| build_linespace(n, &tree.group_filled(g))).collect();
+        let spaces: Vec<Vec<u32>> = inner_groups
+            .par_iter()
+            .map(|&g| build_linespace(n, &tree.group_filled(g)))
+            .collect();
         tree.linespace_count = spaces.len();
         tree.linespaces = spaces.concat();
         tree.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;

@@ -1,0 +1,62 @@
+// The part of the intersect2 kernel all tracer designs share — Müller 2015, ch. 4.1.2,
+// Listing 15 — around the any-hit search of the design, which the including kernel defines
+// before including this file:
+//     bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
+// (true if a triangle other than lastTriID is hit with SHADOW_OFFSET < t < lightDistance).
+//
+// Dispatched once per light source (uniform lightSource). One shadow feeler per pixel from
+// the hit point of intersect1 towards the light. Early out: N·L <= 0 means the light is behind
+// the surface — shadow without a test. The 0.02 offset (SHADOW_OFFSET) is the thesis'
+// correction for smoother transitions between the shadow and the lighting. The flag goes into
+// the shadow texture: one RGBA channel per light (the thesis, lights 0..3) or one bit per
+// light in an RGBA32UI texture (SHADOW_BITS, the bitwise flags of ch. 5).
+
+uniform int lightSource;
+
+void trace(ivec2 storePos)
+{
+    vec4 originState = imageLoad(rayOriginTexture, storePos);
+    // only rays that hit something in this pass have rayState > 0 here
+    if (originState.w <= 0.0) return;
+    int lastTriID = int(imageLoad(rayDirTexture, storePos).w);
+    vec3 n = imageLoad(normalTexture, storePos).xyz;
+    vec3 ro = originState.xyz;
+    vec3 toLight = lightPos[lightSource].xyz - ro;
+    float lightDistance = length(toLight);
+    vec3 rd = toLight / lightDistance;
+
+    // light in the back half-space of the hit point: shadow without a test
+    bool shadow = dot(n, rd) <= 0.0;
+    if (!shadow) shadow = occluded(storePos, ro, rd, lightDistance, lastTriID);
+
+    // set the shadow flag if needed
+    if (shadow) {
+#if SHADOW_BITS
+        uvec4 flags = imageLoad(shadowTexture, storePos);
+        flags[lightSource >> 5] |= 1u << uint(lightSource & 31);
+        imageStore(shadowTexture, storePos, flags);
+#else
+        vec4 shadows = imageLoad(shadowTexture, storePos);
+        switch (lightSource) {
+            case 0: shadows.x = 1.0; break;
+            case 1: shadows.y = 1.0; break;
+            case 2: shadows.z = 1.0; break;
+            case 3: shadows.w = 1.0; break;
+        }
+        imageStore(shadowTexture, storePos, shadows);
+#endif
+    }
+}
+
+void main()
+{
+    countersBegin();
+    ivec2 storePos = pixelPosition();
+    if (insideImage(storePos)) trace(storePos);
+    countAdd(0, tests);
+    countAdd(1, truncated);
+    countAdd(2, voxelsVisited);
+    countersEnd(0, COUNTER_INTERSECT2);
+    countersEnd(1, COUNTER_TRUNCATED_RAYS);
+    countersEnd(2, COUNTER_VOXELS_VISITED);
+}

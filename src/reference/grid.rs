@@ -1,0 +1,184 @@
+//! CPU reference of the uniform grid (Müller 2015, ch. 3.2): Algorithms 2 and 3 with the
+//! special cases of Fig. 13, the thesis' edge-walk registration of triangles, and the exact
+//! variant's triangle/box overlap registration — the same arithmetic as the GLSL in
+//! `glsl/common/voxelwalk.glsl`, `glsl/build.comp` and `glsl/common/tribox.glsl`, in f32.
+
+use glam::{IVec3, Vec3};
+
+/// A uniform grid of `n`³ voxels over [-1, 1)³ (the thesis' scene space).
+#[derive(Debug, Clone, Copy)]
+pub struct GridSpace {
+    pub n: u32,
+}
+
+impl GridSpace {
+    /// length of a voxel edge (Listing 19)
+    pub fn vx_edge(&self) -> f32 {
+        2.0 / self.n as f32
+    }
+
+    /// Listing 18 / Eq. 6 (with floor, as the kernels).
+    pub fn get_voxel(&self, p: Vec3) -> IVec3 {
+        ((p + Vec3::ONE) / self.vx_edge()).floor().as_ivec3()
+    }
+
+    pub fn clamp(&self, v: IVec3) -> IVec3 {
+        v.clamp(IVec3::ZERO, IVec3::splat(self.n as i32 - 1))
+    }
+
+    pub fn voxel_id(&self, v: IVec3) -> Option<usize> {
+        let n = self.n as i32;
+        if v.cmpge(IVec3::ZERO).all() && v.cmplt(IVec3::splat(n)).all() {
+            Some((v.z * n * n + v.y * n + v.x) as usize)
+        } else {
+            None
+        }
+    }
+
+    /// Algorithms 2 and 3: the voxels the segment a -> b passes, in order, from vox_min to
+    /// vox_max (start voxel first). Equal crossing parameters (the segment passes a voxel edge
+    /// or corner, Fig. 13): the moves along axes with positive direction are made together
+    /// first, then those with negative direction.
+    pub fn traverse_connection(&self, a: Vec3, b: Vec3, vox_min: IVec3, vox_max: IVec3) -> Vec<IVec3> {
+        let rd = b - a;
+        let t_max = 1.0f32;
+        let mut list: Vec<(f32, usize)> = Vec::new();
+        for d in 0..3 {
+            if rd[d] == 0.0 {
+                continue;
+            }
+            let direction = if rd[d] > 0.0 { 1 } else { -1 };
+            let (mut i, mut j) = (vox_min[d], vox_max[d]);
+            if rd[d] > 0.0 {
+                i += 1;
+                j += 1;
+            }
+            while i != j {
+                let t = (i as f32 * self.vx_edge() - 1.0 - a[d]) / rd[d];
+                if i >= 0 {
+                    list.push((t.min(t_max), d));
+                }
+                i += direction;
+            }
+        }
+        // BubbleSort (stable: equal parameters keep their axis order, as in the kernel)
+        let n = list.len();
+        for end in (1..n).rev() {
+            let mut swapped = false;
+            for k in 0..end {
+                if list[k].0 > list[k + 1].0 {
+                    list.swap(k, k + 1);
+                    swapped = true;
+                }
+            }
+            if !swapped {
+                break;
+            }
+        }
+        let mut current = vox_min;
+        let mut out = vec![current];
+        let mut k = 0;
+        while k < list.len() {
+            let mut g = k;
+            while g + 1 < list.len() && list[g + 1].0 == list[k].0 {
+                g += 1;
+            }
+            let (mut pos, mut neg) = (IVec3::ZERO, IVec3::ZERO);
+            for &(_, d) in &list[k..=g] {
+                if rd[d] > 0.0 {
+                    pos[d] = 1;
+                } else {
+                    neg[d] = -1;
+                }
+            }
+            if pos != IVec3::ZERO {
+                current += pos;
+                out.push(current);
+            }
+            if neg != IVec3::ZERO {
+                current += neg;
+                out.push(current);
+            }
+            k = g + 1;
+        }
+        out
+    }
+
+    /// The thesis' build: the voxels of a triangle's vertices and of its edge walks (each
+    /// vertex voxel once; walks skip vertex voxels), as `glsl/build.comp` stores them.
+    pub fn thesis_voxels(&self, tri: [Vec3; 3]) -> Vec<usize> {
+        let vox = tri.map(|p| self.clamp(self.get_voxel(p)));
+        let ids = vox.map(|v| self.voxel_id(v).expect("clamped"));
+        let mut out = Vec::new();
+        for (k, id) in ids.iter().enumerate() {
+            if !ids[..k].contains(id) {
+                out.push(*id);
+            }
+        }
+        for k in 0..3 {
+            let l = (k + 1) % 3;
+            if vox[k] != vox[l] {
+                for v in self.traverse_connection(tri[k], tri[l], vox[k], vox[l]) {
+                    if let Some(id) = self.voxel_id(v) {
+                        if !ids.contains(&id) {
+                            out.push(id);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The exact grid: every voxel whose box (enlarged by the kernels' margin) the triangle
+    /// overlaps.
+    pub fn exact_voxels(&self, tri: [Vec3; 3]) -> Vec<usize> {
+        let e = self.vx_edge();
+        let margin = Vec3::splat(e * 1e-4);
+        let lo = self.clamp(self.get_voxel(tri[0].min(tri[1]).min(tri[2]) - margin));
+        let hi = self.clamp(self.get_voxel(tri[0].max(tri[1]).max(tri[2]) + margin));
+        let half = Vec3::splat(0.5 * e) + margin;
+        let mut out = Vec::new();
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let c = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * e - 1.0;
+                    if tri_box_overlap(c, half, tri) {
+                        out.push(self.voxel_id(IVec3::new(x, y, z)).expect("clamped"));
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+fn axis_separates(axis: Vec3, v: [Vec3; 3], half: Vec3) -> bool {
+    let p = v.map(|x| x.dot(axis));
+    let r = half.dot(axis.abs());
+    p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r
+}
+
+/// Triangle/box overlap by separating axes (Akenine-Möller 2001), boundary included — as
+/// `glsl/common/tribox.glsl`.
+pub fn tri_box_overlap(center: Vec3, half: Vec3, tri: [Vec3; 3]) -> bool {
+    let v = tri.map(|p| p - center);
+    let lo = v[0].min(v[1]).min(v[2]);
+    let hi = v[0].max(v[1]).max(v[2]);
+    if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
+        return false;
+    }
+    let e = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let n = e[0].cross(e[1]);
+    if n.dot(v[0]).abs() > half.dot(n.abs()) {
+        return false;
+    }
+    for e in e {
+        for axis in [Vec3::new(0.0, -e.z, e.y), Vec3::new(e.z, 0.0, -e.x), Vec3::new(-e.y, e.x, 0.0)] {
+            if axis_separates(axis, v, half) {
+                return false;
+            }
+        }
+    }
+    true
+}

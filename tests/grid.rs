@@ -1,0 +1,299 @@
+//! The uniform grid (Müller 2015, ch. 3.2, 4.2): Algorithms 2/3 against a brute-force voxel
+//! walk, the triangle/box test against dense sampling, the GPU's voxel lists against the CPU
+//! reference, the exact grid's image against the base tracer's, the thesis variant's
+//! documented losses, and a moving object with the per-frame rebuild.
+
+mod common;
+
+use common::*;
+use glam::{IVec3, Mat4, Vec3};
+use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::reference::grid::{tri_box_overlap, GridSpace};
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::base::BaseTracer;
+use gpgpu_rt::tracer::grid::GridTracer;
+use gpgpu_rt::tracer::{GridOptions, GridVariant, RenderOptions, Tracer};
+
+/// A small deterministic generator (no dependency needed for test data).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+    }
+    fn point(&mut self) -> Vec3 {
+        Vec3::new(self.next(), self.next(), self.next()) * 1.98 - 0.99
+    }
+}
+
+/// Does the segment a -> b pass through the box lo..hi, with positive length inside the open
+/// box (interior = true) or touching the closed box grown by `eps` (interior = false)?
+fn segment_meets_box(a: Vec3, b: Vec3, lo: Vec3, hi: Vec3, interior: bool, eps: f32) -> bool {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for k in 0..3 {
+        let (l, h) = if interior { (lo[k], hi[k]) } else { (lo[k] - eps, hi[k] + eps) };
+        if d[k].abs() < 1e-12 {
+            let inside = if interior { a[k] > l && a[k] < h } else { a[k] >= l && a[k] <= h };
+            if !inside {
+                return false;
+            }
+        } else {
+            let (mut u, mut v) = ((l - a[k]) / d[k], (h - a[k]) / d[k]);
+            if u > v {
+                std::mem::swap(&mut u, &mut v);
+            }
+            t0 = t0.max(u);
+            t1 = t1.min(v);
+        }
+    }
+    if interior {
+        t1 - t0 > 1e-4
+    } else {
+        t1 >= t0
+    }
+}
+
+fn check_walk(g: &GridSpace, a: Vec3, b: Vec3) {
+    let (vmin, vmax) = (g.clamp(g.get_voxel(a)), g.clamp(g.get_voxel(b)));
+    let walk = g.traverse_connection(a, b, vmin, vmax);
+    assert_eq!(walk[0], vmin);
+    assert_eq!(*walk.last().unwrap(), vmax, "walk {a} -> {b} does not end in the end voxel");
+    let e = g.vx_edge();
+    for w in walk.windows(2) {
+        let step = w[1] - w[0];
+        assert!(step != IVec3::ZERO && step.abs().max_element() == 1, "not a unit move: {step}");
+    }
+    let boxes = |v: IVec3| {
+        let lo = v.as_vec3() * e - 1.0;
+        (lo, lo + e)
+    };
+    // every visited voxel touches the segment
+    for v in &walk {
+        let (lo, hi) = boxes(*v);
+        assert!(segment_meets_box(a, b, lo, hi, false, 1e-4), "{a} -> {b} visits {v} it does not touch");
+    }
+    // every voxel whose interior the segment crosses is visited (brute force over all voxels)
+    let n = g.n as i32;
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let v = IVec3::new(x, y, z);
+                let (lo, hi) = boxes(v);
+                if segment_meets_box(a, b, lo, hi, true, 0.0) {
+                    assert!(walk.contains(&v), "{a} -> {b} misses voxel {v}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn algorithms_2_and_3_match_a_brute_force_walk() {
+    let g = GridSpace { n: 8 };
+    let mut rng = Lcg(7);
+    let e = g.vx_edge();
+    for _ in 0..300 {
+        check_walk(&g, rng.point(), rng.point());
+    }
+    // axis-aligned segments, segments along voxel faces and edges, through voxel corners
+    let corner = |i: i32, j: i32, k: i32| Vec3::new(i as f32, j as f32, k as f32) * e - 1.0;
+    let cases = [
+        (Vec3::new(-0.9, 0.1, 0.1), Vec3::new(0.9, 0.1, 0.1)),
+        (Vec3::new(0.3, 0.9, -0.3), Vec3::new(0.3, -0.9, -0.3)),
+        (corner(1, 1, 1), corner(6, 6, 6)),               // through corners (Fig. 13b)
+        (corner(1, 1, 1) + 0.01, corner(6, 6, 6) + 0.01), // diagonal, off the corners
+        (corner(1, 2, 0) + Vec3::new(0.01, 0.0, 0.1), corner(5, 6, 0) + Vec3::new(0.01, 0.0, 0.1)), // through edges (Fig. 13a)
+        (corner(6, 1, 3), corner(1, 6, 3) + Vec3::new(0.0, 0.0, 0.05)), // mixed directions at edges
+        (corner(7, 2, 2) + 0.05, corner(2, 7, 7) + 0.05), // -x, +y, +z through corners
+        (Vec3::new(0.0, 0.0, -0.95), Vec3::new(0.0, 0.0, 0.95)), // on voxel edges all along
+        (corner(2, 3, 4), corner(2, 3, 4) + Vec3::new(0.0, 0.0, 3.0 * e)),
+    ];
+    for (a, b) in cases {
+        check_walk(&g, a, b);
+        check_walk(&g, b, a);
+    }
+}
+
+#[test]
+fn triangle_box_overlap_matches_dense_sampling() {
+    let mut rng = Lcg(11);
+    let half = Vec3::splat(0.25);
+    for _ in 0..400 {
+        let c = rng.point() * 0.5;
+        let tri = [rng.point(), rng.point(), rng.point()].map(|p| c + p * 0.6);
+        let overlap = tri_box_overlap(Vec3::ZERO, half, tri);
+        // dense barycentric samples
+        let steps = 120;
+        let mut inside = false;
+        let mut near = false;
+        let spacing = (tri[1] - tri[0]).length().max((tri[2] - tri[0]).length()) / steps as f32;
+        for i in 0..=steps {
+            for j in 0..=(steps - i) {
+                let (u, v) = (i as f32 / steps as f32, j as f32 / steps as f32);
+                let p = tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]);
+                inside |= p.abs().cmple(half).all();
+                near |= p.abs().cmple(half + spacing * 2.0).all();
+            }
+        }
+        if inside {
+            assert!(overlap, "a sample of {tri:?} lies in the box, the test says no overlap");
+        }
+        if overlap {
+            assert!(near, "the test says {tri:?} overlaps, no sample comes near the box");
+        }
+    }
+}
+
+fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
+    RenderOptions {
+        grid: GridOptions {
+            variant,
+            resolution: Some(n),
+            ..GridOptions::default()
+        },
+        ..options(w, h, 1)
+    }
+}
+
+fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions) -> GridTracer {
+    GridTracer::new(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default(), opts).expect("grid tracer")
+}
+
+/// The GPU's voxel lists equal the CPU reference's, as sets per voxel.
+fn check_lists(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, variant: GridVariant, n: u32) {
+    let mut t = grid_tracer(ctx, scene, grid_options(16, 16, variant, n));
+    t.render(&scene.camera).unwrap();
+    let (lists, center, scale) = t.read_lists();
+    let g = GridSpace { n };
+    let mut expected = vec![Vec::new(); (n * n * n) as usize];
+    for (id, tri) in scene.world_triangles().iter().enumerate() {
+        let tg = tri.map(|p| (p - center) * scale);
+        let voxels = match variant {
+            GridVariant::Thesis => g.thesis_voxels(tg),
+            GridVariant::Exact => g.exact_voxels(tg),
+        };
+        for v in voxels {
+            expected[v].push(id as i32);
+        }
+    }
+    let mut differing = 0;
+    for (got, want) in lists.iter().zip(&expected) {
+        let mut got = got.clone();
+        got.sort();
+        if &got != want {
+            differing += 1;
+        }
+    }
+    let refs: usize = expected.iter().map(|l| l.len()).sum();
+    assert!(refs > scene.triangle_count(), "{variant:?}: {refs} references");
+    // f32 on GPU and CPU may put a triangle exactly on a voxel face on either side
+    assert!(differing <= (n * n * n) as usize / 500, "{variant:?}: {differing} voxel lists differ");
+}
+
+#[test]
+fn gpu_voxel_lists_match_the_reference() {
+    let ctx = context();
+    let scene = load("cow.toml");
+    check_lists(&ctx, &scene, GridVariant::Thesis, 12);
+    check_lists(&ctx, &scene, GridVariant::Exact, 12);
+}
+
+#[test]
+fn exact_grid_gives_the_base_tracers_image() {
+    let ctx = context();
+    for (name, n, refl) in [("teapot1.toml", 16, 1), ("bunny.toml", 24, 1), ("teapot3.toml", 20, 2)] {
+        let scene = load(name);
+        let base = render_gpu(&ctx, &scene, options(48, 40, refl));
+        let mut t = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: refl, ..grid_options(48, 40, GridVariant::Exact, n) });
+        let grid = t.render(&scene.camera).unwrap();
+        let (a, b) = (base.aovs.unwrap(), grid.aovs.unwrap());
+        let differ = a.triangle_id.iter().zip(&b.triangle_id).filter(|(x, y)| x != y).count();
+        assert_eq!(differ, 0, "{name}: {differ} triangle ids differ from the base tracer");
+        assert_eq!(a.hit_t, b.hit_t, "{name}");
+        let colour_diff = base.color.iter().zip(&grid.color).map(|(x, y)| (x[0] - y[0]).abs().max((x[1] - y[1]).abs()).max((x[2] - y[2]).abs())).fold(0.0f32, f32::max);
+        assert!(colour_diff < 1e-4, "{name}: colours differ by {colour_diff}");
+        // far fewer tests
+        let (tb, tg) = (base.stats.total_triangle_tests(), grid.stats.total_triangle_tests());
+        assert!(tg * 10 < tb, "{name}: grid {tg} vs base {tb} tests");
+        assert!(grid.stats.events["voxels_visited"] > 0);
+        assert_eq!(grid.stats.events["dropped_triangle_refs"], 0);
+        assert_eq!(grid.stats.facts["grid_resolution"], n);
+    }
+}
+
+/// Two big triangles (a quad of 4×4 units) seen from above, and a small one.
+fn big_triangle_scene(dir: &std::path::Path) -> Scene {
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nv -0.2 0.5 -0.2\nv 0.2 0.5 -0.2\nv 0 0.8 0.2\nf 1 4 3\nf 1 3 2\nf 5 6 7\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        "[camera]\nposition = [0.0, 5.0, 0.01]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 50.0\n[[light]]\nposition = [1.0, 4.0, 1.0]\n[[object]]\ntype = \"obj\"\npath = \"quad.obj\"\n",
+    )
+    .unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap()
+}
+
+#[test]
+fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = big_triangle_scene(dir.path());
+    let ctx = context();
+    let base = render_gpu(&ctx, &scene, options(48, 48, 0));
+    let hits = |f: &gpgpu_rt::tracer::Frame| f.aovs.as_ref().unwrap().triangle_id.iter().filter(|&&i| i >= 0).count();
+    let mut thesis = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: 0, ..grid_options(48, 48, GridVariant::Thesis, 16) });
+    let mut exact = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: 0, ..grid_options(48, 48, GridVariant::Exact, 16) });
+    let (ft, fe) = (thesis.render(&scene.camera).unwrap(), exact.render(&scene.camera).unwrap());
+    assert!(hits(&base) > 1500, "the quad fills most of the image");
+    assert_eq!(hits(&fe), hits(&base), "the exact grid sees the whole quad");
+    // edge-only registration: the quad's interior voxels hold no triangle, rays pass through
+    assert!(hits(&ft) < hits(&base) / 2, "thesis grid: {} of {} hits", hits(&ft), hits(&base));
+    assert_eq!(ft.stats.events["dropped_triangle_refs"], 0, "the holes are not list overflows");
+}
+
+#[test]
+fn thesis_grid_counts_what_its_fixed_lists_drop() {
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let opts = RenderOptions {
+        grid: GridOptions {
+            variant: GridVariant::Thesis,
+            resolution: Some(8),
+            voxel_array_length: 16,
+            ray_array_length: Some(2),
+        },
+        ..options(24, 24, 0)
+    };
+    let mut t = grid_tracer(&ctx, &scene, opts);
+    let f = t.render(&scene.camera).unwrap();
+    let dropped = f.stats.events["dropped_triangle_refs"];
+    let overflows = f.stats.events["ray_list_overflows"];
+    // 69451 triangles in 8³ voxels with 16 entries each: most references are dropped
+    assert!(dropped > 50_000, "dropped {dropped}");
+    assert!(overflows > 0, "ray list overflows {overflows}");
+    // the references kept are exactly what the lists hold
+    let (lists, _, _) = t.read_lists();
+    assert!(lists.iter().all(|l| l.len() <= 16));
+}
+
+#[test]
+fn moving_object_is_rebuilt_every_frame() {
+    let ctx = context();
+    let mut scene = load("teapot1.toml");
+    let opts = grid_options(40, 40, GridVariant::Exact, 16);
+    let mut grid = grid_tracer(&ctx, &scene, opts.clone());
+    let mut base = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), opts).unwrap();
+    let first = grid.render(&scene.camera).unwrap();
+    // lift the teapot far up: the scene's bounds change, the grid follows
+    let moved = Mat4::from_translation(Vec3::new(0.5, 1.5, -0.5)) * Mat4::from_rotation_y(1.0) * scene.objects[1].model;
+    grid.set_model(1, moved);
+    base.set_model(1, moved);
+    let (g, b) = (grid.render(&scene.camera).unwrap(), base.render(&scene.camera).unwrap());
+    assert_ne!(first.color, g.color);
+    assert_eq!(g.aovs.as_ref().unwrap().triangle_id, b.aovs.as_ref().unwrap().triangle_id);
+    scene.objects[1].model = moved;
+    assert_close(&g, &render_cpu(&scene, &options(40, 40, 1)), "moved teapot, grid");
+}

@@ -1,0 +1,421 @@
+//! Soft shadows with the Cascaded Line Space (Klee 2016): line-space bits against a brute-force
+//! shaft test, the Listing 3 texture layout, GPU against CPU, line space against exact.
+
+mod common;
+
+use glam::Vec3;
+use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::linespace::ntree::{
+    self, build_linespace, build_linespace_brute_force, entry_index, face_rect, get_bit,
+    pack_linespaces, shaft_hits_box, Aabb, NTree,
+};
+use gpgpu_rt::tracer::linespace::{ShadowMode, SoftShadowOptions, SoftShadowRenderer};
+
+/// A small deterministic generator (xorshift).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn linespace_bits_equal_brute_force_shaft_test() {
+    let mut rng = Rng(0x9E3779B97F4A7C15);
+    for (n, density) in [
+        (3u32, 0.2),
+        (4, 0.1),
+        (5, 0.04),
+        (4, 0.0),
+        (3, 1.0),
+        (6, 0.01),
+    ] {
+        let filled: Vec<bool> = (0..n.pow(3)).map(|_| rng.unit() < density).collect();
+        let fast = build_linespace(n, &filled);
+        let brute = build_linespace_brute_force(n, &filled);
+        assert_eq!(fast.len(), ntree::linespace_words(n));
+        assert_eq!(fast, brute, "N = {n}, density {density}");
+        if density == 0.0 {
+            assert!(fast.iter().all(|w| *w == 0));
+        }
+    }
+    // a real node: the bunny's N-tree at N = 6, its root and its fullest inner node
+    let scene = common::load("bunny_area.toml");
+    let tree = NTree::build(&scene.world_triangles(), 6, 3).unwrap();
+    let groups = tree.inner_groups();
+    let fullest = (1..groups.len())
+        .max_by_key(|&i| tree.group_filled(groups[i]).iter().filter(|f| **f).count())
+        .unwrap();
+    for i in [0, fullest] {
+        let filled = tree.group_filled(groups[i]);
+        assert!(filled.iter().any(|f| *f));
+        assert_eq!(
+            tree.linespace(i),
+            &build_linespace_brute_force(6, &filled)[..],
+            "line space {i}"
+        );
+    }
+}
+
+#[test]
+fn shaft_test_is_exact_on_simple_cases_and_conservative_against_sampled_lines() {
+    let n = 4;
+    // one filled child in the middle of a 4³ node
+    let c = Aabb::cell(1, 1, 1);
+    // x = 0 side to x = N side straight through it: set; a parallel shaft beside it: not set
+    assert!(shaft_hits_box(
+        &face_rect(n, 0, 1, 2, 1, 2),
+        &face_rect(n, 1, 1, 2, 1, 2),
+        &c
+    ));
+    assert!(!shaft_hits_box(
+        &face_rect(n, 0, 2, 3, 1, 2),
+        &face_rect(n, 1, 2, 3, 1, 2),
+        &c
+    ));
+    // touching the child's boundary only does not count
+    assert!(!shaft_hits_box(
+        &face_rect(n, 0, 0, 1, 1, 2),
+        &face_rect(n, 1, 0, 1, 1, 2),
+        &c
+    ));
+    // a diagonal shaft from cell (0,0) of side y=0 to cell (3,3) of side y=N passes (1,1,1)
+    assert!(shaft_hits_box(
+        &face_rect(n, 2, 0, 1, 0, 1),
+        &face_rect(n, 3, 3, 4, 3, 4),
+        &c
+    ));
+    // symmetric entries are one
+    assert_eq!(
+        entry_index(n, 0, 1, 2, 3, 2, 1),
+        entry_index(n, 3, 2, 1, 0, 1, 2)
+    );
+    assert_eq!(entry_index(n, 2, 0, 0, 2, 1, 1), None);
+    // every sampled line between two cells that passes through a child's interior must find
+    // the shaft's bit set
+    let mut rng = Rng(12345);
+    let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
+    let mut hits = 0;
+    for _ in 0..4000 {
+        let s = (rng.next() % 6) as usize;
+        let e = (rng.next() % 6) as usize;
+        if s == e {
+            continue;
+        }
+        let cell = |rng: &mut Rng| {
+            (
+                (rng.next() % n as u64) as u32,
+                (rng.next() % n as u64) as u32,
+            )
+        };
+        let (su, sv) = cell(&mut rng);
+        let (eu, ev) = cell(&mut rng);
+        let a = face_rect(n, s, su, su + 1, sv, sv + 1);
+        let b = face_rect(n, e, eu, eu + 1, ev, ev + 1);
+        let child = Aabb::cell(
+            (rng.next() % 4) as u32,
+            (rng.next() % 4) as u32,
+            (rng.next() % 4) as u32,
+        );
+        let pa: [f64; 3] = std::array::from_fn(|i| lerp(a.lo[i], a.hi[i], rng.unit()));
+        let pb: [f64; 3] = std::array::from_fn(|i| lerp(b.lo[i], b.hi[i], rng.unit()));
+        let through = (1..200).any(|k| {
+            let t = k as f64 / 200.0;
+            (0..3).all(|i| {
+                let x = lerp(pa[i], pb[i], t);
+                x > child.lo[i] + 1e-9 && x < child.hi[i] - 1e-9
+            })
+        });
+        if through {
+            hits += 1;
+            assert!(
+                shaft_hits_box(&a, &b, &child),
+                "sides {s}->{e}, a line passes the child, shaft test says no"
+            );
+        }
+    }
+    assert!(
+        hits > 100,
+        "the sampling found only {hits} lines through children"
+    );
+}
+
+#[test]
+fn packed_texture_layout_round_trips() {
+    let mut rng = Rng(777);
+    let words_per = ntree::linespace_words(10);
+    assert_eq!(words_per, 4688); // 15 · 10⁴ bits
+    let count = 7;
+    let words: Vec<u32> = (0..words_per * count).map(|_| rng.next() as u32).collect();
+    for max_dim in [2048u32, 64, 50] {
+        let p = pack_linespaces(&words, words_per, count, max_dim).unwrap();
+        assert!(p.tex_x_res <= max_dim && p.tex_y_res <= max_dim && p.tex_z_res <= max_dim);
+        assert_eq!(
+            p.texels.len(),
+            (p.tex_x_res * p.tex_y_res * p.tex_z_res) as usize
+        );
+        let mut seen = std::collections::HashSet::new();
+        for ls in 0..count {
+            assert_eq!(
+                p.unpack(ls as u32),
+                words[ls * words_per..(ls + 1) * words_per],
+                "max_dim {max_dim}"
+            );
+            for w in 0..words_per as u32 {
+                assert!(
+                    seen.insert(p.texel(ls as u32, w)),
+                    "two words share a texel"
+                );
+            }
+            for _ in 0..200 {
+                let e = (rng.next() % (words_per as u64 * 32)) as usize;
+                assert_eq!(
+                    p.get_entry(ls as u32, e),
+                    get_bit(&words[ls * words_per..], e)
+                );
+            }
+        }
+        if max_dim == 50 {
+            assert!(p.tex_z_res > 1, "the layout continues along z");
+        }
+    }
+    assert!(pack_linespaces(&words, words_per, count, 8).is_err());
+}
+
+fn opts(mode: ShadowMode, s: u32, w: u32) -> SoftShadowOptions {
+    SoftShadowOptions {
+        mode,
+        samples_u: s,
+        samples_v: s,
+        ntree_n: 10,
+        ntree_depth: 3,
+        width: w,
+        height: w,
+        tile: 32,
+    }
+}
+
+#[test]
+fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_shafts() {
+    let ctx = common::context();
+    let scene = common::load("bunny_area.toml");
+    let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
+    let shaders = ShaderSource::default();
+    let mut r = SoftShadowRenderer::with_tree(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &shaders,
+        opts(ShadowMode::Exact, 3, 64),
+        tree,
+    )
+    .unwrap();
+    // the 3D texture holds exactly the packed layout
+    assert_eq!(r.read_linespace_texture(), r.packed.texels);
+    let mut shadows = Vec::new();
+    for mode in [
+        ShadowMode::Exact,
+        ShadowMode::Linespace,
+        ShadowMode::LinespaceDda,
+    ] {
+        r.reconfigure(&shaders, mode, 3, 3).unwrap();
+        let f = r.render(&scene.camera).unwrap();
+        let cpu = r.cpu();
+        let (mut hits, mut off, mut cpu_tests) = (0usize, 0usize, 0u64);
+        for (i, p) in f.gbuffer_position.iter().enumerate() {
+            if p[3] <= 0.0 {
+                assert_eq!(f.shadow[i], 1.0);
+                assert_eq!(f.aovs.triangle_id[i], -1);
+                continue;
+            }
+            hits += 1;
+            let nrm = f.gbuffer_normal[i];
+            let (s, c) = cpu.shadow(
+                mode,
+                Vec3::new(p[0], p[1], p[2]),
+                Vec3::new(nrm[0], nrm[1], nrm[2]).normalize(),
+            );
+            cpu_tests += c.triangle_tests;
+            if (s - f.shadow[i]).abs() > 1e-6 {
+                off += 1;
+            }
+        }
+        assert!(hits > 1500, "{hits} pixels hit geometry");
+        assert!(
+            off * 100 <= hits,
+            "{mode:?}: {off} of {hits} pixels differ between GPU and CPU"
+        );
+        let gpu_tests = f.stats.total_triangle_tests();
+        assert!(
+            (gpu_tests as f64 - cpu_tests as f64).abs() <= 0.02 * cpu_tests as f64 + 100.0,
+            "{mode:?}: triangle tests GPU {gpu_tests} CPU {cpu_tests}"
+        );
+        assert!(f.stats.events["linespace_lookups"] > 0);
+        shadows.push((
+            f.shadow.clone(),
+            f.gbuffer_position.clone(),
+            f.gbuffer_normal.clone(),
+        ));
+    }
+    let (exact, pos, nrm) = &shadows[0];
+    let (ls, _, _) = &shadows[1];
+    let (dda, _, _) = &shadows[2];
+    let hit: Vec<usize> = (0..pos.len()).filter(|&i| pos[i][3] > 0.0).collect();
+    // the exact mode is exact: every sample against every triangle on the CPU, every 9th pixel
+    let cpu = r.cpu();
+    let mut wrong = 0;
+    let checked: Vec<usize> = hit.iter().copied().step_by(9).collect();
+    for &i in &checked {
+        let b = cpu.brute_force(
+            Vec3::new(pos[i][0], pos[i][1], pos[i][2]),
+            Vec3::new(nrm[i][0], nrm[i][1], nrm[i][2]).normalize(),
+        );
+        if (b - exact[i]).abs() > 1e-6 {
+            wrong += 1;
+        }
+    }
+    assert!(
+        wrong * 100 <= checked.len(),
+        "exact vs brute force: {wrong} of {} pixels differ",
+        checked.len()
+    );
+    // the line space only adds occluders (a set bit may be an empty part of the shaft), never
+    // removes them: linespace <= exact, and the packet and the DDA decide alike
+    let brighter = hit.iter().filter(|&&i| ls[i] > exact[i] + 1e-6).count();
+    assert!(
+        brighter * 200 <= hit.len(),
+        "{brighter} pixels lighter with the line space than exact"
+    );
+    let dda_off = hit
+        .iter()
+        .filter(|&&i| (dda[i] - ls[i]).abs() > 1e-6)
+        .count();
+    assert!(
+        dda_off * 100 <= hit.len(),
+        "{dda_off} pixels differ between packet and DDA"
+    );
+    let mean = hit.iter().map(|&i| (ls[i] - exact[i]).abs()).sum::<f32>() / hit.len() as f32;
+    assert!(mean <= 0.1, "mean |linespace - exact| = {mean}");
+    let penumbra = hit
+        .iter()
+        .filter(|&&i| exact[i] > 0.0 && exact[i] < 1.0)
+        .count();
+    assert!(
+        penumbra * 50 > hit.len(),
+        "no visible penumbra: {penumbra} pixels"
+    );
+}
+
+#[test]
+fn render_cli_writes_shadow_aov_and_stats() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args([
+            "render",
+            common::scene_path("bunny_area.toml").to_str().unwrap(),
+        ])
+        .args([
+            "--shadows",
+            "linespace",
+            "--light-samples",
+            "2x2",
+            "--width",
+            "40",
+            "--height",
+            "32",
+        ])
+        .arg("-o")
+        .arg(dir.path().join("a.png"))
+        .arg("--aov-dir")
+        .arg(dir.path())
+        .arg("--stats")
+        .arg(dir.path().join("s.json"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let npy = std::fs::read(dir.path().join("shadow.npy")).unwrap();
+    assert!(String::from_utf8_lossy(&npy[..128]).contains("(32, 40, )"));
+    assert_eq!(npy.len() % 64, (32 * 40 * 4) % 64);
+    for f in [
+        "ray_origin.npy",
+        "ray_direction.npy",
+        "hit_t.npy",
+        "triangle_id.npy",
+        "normal.npy",
+        "a.png",
+    ] {
+        assert!(dir.path().join(f).exists(), "{f}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    for k in [
+        "gpu_ms",
+        "triangle_tests",
+        "linespace_lookups",
+        "ntree_bytes",
+        "linespace_bytes",
+    ] {
+        assert!(!s[k].is_null(), "stats lack {k}");
+    }
+    assert!(s["linespace_bytes"].as_u64().unwrap() > 0);
+    // bad samples and a scene without an area light fail with a message
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args([
+            "render",
+            common::scene_path("bunny.toml").to_str().unwrap(),
+            "--shadows",
+            "exact",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .arg("-o")
+        .arg(dir.path().join("b.png"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("area_light"));
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args([
+            "render",
+            "x.toml",
+            "--shadows",
+            "exact",
+            "--light-samples",
+            "11x2",
+        ])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+}
+
+#[test]
+fn area_light_errors_name_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("s.toml");
+    std::fs::write(
+        &p,
+        "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[area_light]]\ncorner = [0, 2, 0]\n\
+         edge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\n\n[[object]]\ntype = \"floor\"\n",
+    )
+    .unwrap();
+    let e = Scene::load(&p).unwrap_err();
+    assert_eq!(e.line, Some(5), "{e}");
+    assert!(e.to_string().contains("area_light"), "{e}");
+    std::fs::write(&p, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[area_light]]\ncorner = [0, 2, 0]\nedge_u = [1, 0, 0]\nsize = 3\n").unwrap();
+    assert!(Scene::load(&p).is_err());
+    let s = common::load("bunny_area.toml");
+    assert_eq!(s.area_lights.len(), 1);
+}
