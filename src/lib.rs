@@ -7,3 +7,4 @@ pub mod output;
 pub mod reference;
 pub mod scene;
 pub mod tracer;
+pub mod view;

@@ -78,6 +78,9 @@ enum Command {
     /// Replicate a published evaluation (thesis-5.1, thesis-5.2, thesis-5.3: Müller 2015, ch. 5):
     /// CSVs, plots and report.md with our numbers beside the published ones.
     Bench(gpgpu_rt::bench::BenchArgs),
+    /// Open a window that shows the scene live (orbit, pan, zoom; live-editable kernels with
+    /// --glsl-dir); --screenshot FILE.png --frames N saves the N-th frame and exits.
+    View(gpgpu_rt::view::ViewArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
     Info {
         scene: Option<PathBuf>,
@@ -196,6 +199,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Bench(args) => gpgpu_rt::bench::run(args),
+        Command::View(args) => gpgpu_rt::view::run(args),
         Command::ExportTriangles { scene, output } => {
             let scene = load_scene(&scene)?;
             let tris = scene.world_triangles();

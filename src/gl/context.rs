@@ -142,7 +142,9 @@ impl GlContext {
     }
 }
 
-fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
+/// Query the facts of `GlInfo` on a current context (headless or a window's); `device` and
+/// `device_name` name where the context comes from.
+pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
     // SAFETY: plain queries on a current context.
     unsafe {
         let int = |p: u32| gl.get_parameter_i32(p);

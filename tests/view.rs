@@ -1,0 +1,400 @@
+//! `gpgpu-rt view` under Xvfb (Mesa llvmpipe through GLX): the window's screenshot equals
+//! `render`'s PNG, and an edited kernel in a `--glsl-dir` is reloaded live — a compile error
+//! is reported with file and line while the last good program keeps running, and the fixed
+//! kernel's effect reaches the window.
+//!
+//! The tests start the binary through `xvfb-run -a`. Without `xvfb-run` they are skipped with
+//! a message, except in CI (`CI` set), where they fail: `.ci/run` installs `xvfb`.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
+/// Upper bound for one viewer run on 2 shared llvmpipe cores (normally a few seconds).
+const TIMEOUT: Duration = Duration::from_secs(300);
+/// Largest per-channel difference (8-bit units) between the window's screenshot and the PNG of
+/// `render`: both come from the same RGBA32F output texture, clamped to [0, 1]; the window
+/// converts to 8 bits in the GL pipeline, the PNG writer with round(), so a value exactly
+/// between two steps may land on either side. In practice the images are identical.
+const MAX_CHANNEL_DIFF: u8 = 1;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn in_ci() -> bool {
+    std::env::var("CI")
+        .map(|v| !v.is_empty() && v != "0" && v != "false")
+        .unwrap_or(false)
+}
+
+/// `xvfb-run`, or `None` (test skipped) when it is missing outside CI.
+fn xvfb_run() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    if let Some(p) = std::env::split_paths(&path)
+        .map(|d| d.join("xvfb-run"))
+        .find(|p| p.is_file())
+    {
+        return Some(p);
+    }
+    if in_ci() {
+        panic!("xvfb-run is missing, but CI is set: the viewer tests must run (.ci/run installs the Debian package xvfb)");
+    }
+    eprintln!("SKIPPED: xvfb-run not found (Debian: apt-get install xvfb); the viewer tests need an X server");
+    None
+}
+
+/// The viewer command under its own X server.
+fn view(xvfb: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(xvfb);
+    c.args(["-a", "-s", "-screen 0 1024x768x24", BIN, "view"])
+        .args(args)
+        .current_dir(root());
+    // its own process group, so a hung run can be ended with everything it started
+    std::os::unix::process::CommandExt::process_group(&mut c, 0);
+    c
+}
+
+/// A child process that is ended (with its process group) if the test gives up on it.
+struct Running {
+    child: Child,
+}
+
+impl Running {
+    fn wait(mut self, deadline: Instant) -> std::process::ExitStatus {
+        loop {
+            if let Some(status) = self.child.try_wait().expect("wait for the viewer") {
+                return status;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "the viewer did not finish within {TIMEOUT:?}"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = Command::new("kill")
+                .args(["-TERM", "--", &format!("-{}", self.child.id())])
+                .status();
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// Run to completion with the timeout; returns the output.
+fn run_bounded(mut cmd: Command) -> Output {
+    let child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start the viewer");
+    let mut running = Running { child };
+    let out = running.child.stdout.take().unwrap();
+    let err = running.child.stderr.take().unwrap();
+    let out = std::thread::spawn(move || std::io::read_to_string(out).unwrap_or_default());
+    let err = std::thread::spawn(move || std::io::read_to_string(err).unwrap_or_default());
+    let status = running.wait(Instant::now() + TIMEOUT);
+    Output {
+        status,
+        stdout: out.join().unwrap().into_bytes(),
+        stderr: err.join().unwrap().into_bytes(),
+    }
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn screenshot_equals_render() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let rendered = dir.path().join("render.png");
+    let shot = dir.path().join("view.png");
+    let size = ["--width", "96", "--height", "96"];
+
+    let out = Command::new(BIN)
+        .current_dir(root())
+        .args(["render", "scenes/teapot1.toml", "-o"])
+        .arg(&rendered)
+        .args(size)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "render failed: {}", text(&out.stderr));
+
+    let mut cmd = view(
+        &xvfb,
+        &[
+            "scenes/teapot1.toml",
+            "--frames",
+            "3",
+            "--log-frames",
+            "--screenshot",
+        ],
+    );
+    cmd.arg(&shot).args(size);
+    let out = run_bounded(cmd);
+    let stdout = text(&out.stdout);
+    assert!(
+        out.status.success(),
+        "view failed ({}):\nstdout:\n{stdout}\nstderr:\n{}",
+        out.status,
+        text(&out.stderr)
+    );
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("frame ")).count(),
+        3,
+        "{stdout}"
+    );
+    // the screenshot is the window's own framebuffer, not an offscreen copy
+    assert!(stdout.contains("frame 3, window framebuffer"), "{stdout}");
+
+    let a = image::open(&rendered).unwrap().to_rgb8();
+    let b = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), (96, 96));
+    assert_eq!(b.dimensions(), a.dimensions());
+    let mut max = 0u8;
+    let mut differing = 0;
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        let d = (0..3).map(|k| pa[k].abs_diff(pb[k])).max().unwrap();
+        max = max.max(d);
+        differing += (d > 0) as usize;
+    }
+    assert!(
+        max <= MAX_CHANNEL_DIFF,
+        "screenshot differs from render by up to {max} (8-bit) in {differing} pixels"
+    );
+    // not a trivially equal pair of blank images: the teapot and the checker floor are there
+    let mut colours: Vec<[u8; 3]> = a.pixels().map(|p| p.0).collect();
+    colours.sort();
+    colours.dedup();
+    assert!(
+        colours.len() > 200,
+        "only {} distinct colours in the render",
+        colours.len()
+    );
+    // and a flipped image would differ: the top row is background, the bottom row floor
+    assert_ne!(b.get_pixel(48, 0), b.get_pixel(48, 95));
+}
+
+/// Lines of the viewer's stdout, with a deadline.
+struct Lines {
+    rx: Receiver<String>,
+    seen: Vec<String>,
+    deadline: Instant,
+}
+
+impl Lines {
+    /// Wait for a line starting with `prefix`; returns it.
+    fn expect(&mut self, prefix: &str) -> String {
+        loop {
+            let left = self.deadline.saturating_duration_since(Instant::now());
+            match self.rx.recv_timeout(left) {
+                Ok(line) => {
+                    self.seen.push(line.clone());
+                    if line.starts_with(prefix) {
+                        return line;
+                    }
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    panic!(
+                        "no `{prefix}` line within {TIMEOUT:?}; stdout so far:\n{}",
+                        self.seen.join("\n")
+                    )
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    panic!(
+                        "the viewer ended before a `{prefix}` line; stdout:\n{}",
+                        self.seen.join("\n")
+                    )
+                }
+            }
+        }
+    }
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let target = to.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), target).unwrap();
+        }
+    }
+}
+
+/// Replace a file the way editors save: write a sibling, rename it over the original.
+fn save(path: &Path, contents: &str) {
+    let tmp = path.with_file_name(".edit.tmp");
+    std::fs::write(&tmp, contents).unwrap();
+    std::fs::rename(&tmp, path).unwrap();
+}
+
+#[test]
+fn kernel_edit_reloads_live() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let glsl = dir.path().join("glsl");
+    copy_dir(&root().join("glsl"), &glsl);
+    let shading = glsl.join("shading.comp");
+    let original = std::fs::read_to_string(&shading).unwrap();
+
+    // a compile error on a known line: a line of garbage before `void main()`
+    let main_line = original
+        .lines()
+        .position(|l| l.starts_with("void main()"))
+        .expect("shading.comp has main")
+        + 1;
+    let mut broken: Vec<&str> = original.lines().collect();
+    broken.insert(main_line - 1, "this is not GLSL;");
+    let broken = broken.join("\n") + "\n";
+    // the fix: Listing 16's store replaced by a constant colour
+    let store = "imageStore(finalTexture, storePos, final_color);";
+    assert_eq!(
+        original.matches(store).count(),
+        1,
+        "shading.comp changed; update this test"
+    );
+    let magenta = original.replace(
+        store,
+        "imageStore(finalTexture, storePos, vec4(1.0, 0.0, 1.0, 1.0));",
+    );
+
+    let shot = dir.path().join("after.png");
+    let mut cmd = view(
+        &xvfb,
+        &[
+            "scenes/teapot1.toml",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--refl-depth",
+            "0",
+            "--log-frames",
+            "--wait-reload",
+            "--frames",
+            "2",
+        ],
+    );
+    cmd.arg("--glsl-dir")
+        .arg(&glsl)
+        .arg("--screenshot")
+        .arg(&shot);
+    let mut child = Running {
+        child: cmd
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start the viewer"),
+    };
+    let (tx, rx) = mpsc::channel();
+    let stdout = child.child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let stderr = child.child.stderr.take().unwrap();
+    let stderr = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
+    let deadline = Instant::now() + TIMEOUT;
+    let mut lines = Lines {
+        rx,
+        seen: Vec::new(),
+        deadline,
+    };
+
+    lines.expect("watching ");
+    // the original kernels render
+    lines.expect("frame ");
+
+    save(&shading, &broken);
+    let failed = lines.expect("reload failed: ");
+    let located = format!("shading.comp:{main_line}");
+    assert!(
+        failed.contains(&located),
+        "the error does not name {located}: {failed}"
+    );
+    // the last good program keeps running
+    lines.expect("frame ");
+
+    save(&shading, &magenta);
+    lines.expect("reload ok: shading.comp");
+    let shot_line = lines.expect("screenshot: ");
+    assert!(shot_line.contains("window framebuffer"), "{shot_line}");
+    let status = child.wait(deadline);
+    assert!(
+        status.success(),
+        "viewer failed ({status}): {}",
+        stderr.join().unwrap()
+    );
+
+    let img = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (64, 64));
+    let off = img.pixels().filter(|p| p.0 != [255, 0, 255]).count();
+    assert_eq!(
+        off, 0,
+        "{off} pixels are not the edited kernel's constant colour"
+    );
+}
+
+#[test]
+fn bad_view_input_fails_cleanly() {
+    // no display needed: these fail before a window is opened
+    let run = |args: &[&str]| {
+        let out = Command::new(BIN)
+            .current_dir(root())
+            .arg("view")
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        text(&out.stderr)
+    };
+    assert!(run(&["scenes/missing.toml"]).contains("missing.toml"));
+    assert!(run(&["scenes/teapot1.toml", "--frames", "0"]).contains("--frames"));
+    assert!(run(&["scenes/teapot1.toml", "--wait-reload", "--frames", "1"]).contains("--glsl-dir"));
+    assert!(run(&["scenes/teapot1.toml", "--screenshot", "x.jpg"]).contains(".png"));
+    assert!(run(&["scenes/teapot1.toml", "--glsl-dir", "no/such/dir"]).contains("no/such/dir"));
+    // no window system: a message that says what to do, not a panic
+    let out = Command::new(BIN)
+        .current_dir(root())
+        .args([
+            "view",
+            "scenes/teapot1.toml",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("xvfb-run"),
+        "{}",
+        text(&out.stderr)
+    );
+}
