@@ -62,6 +62,10 @@ enum Command {
         /// Write the statistics of the frame as JSON.
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
+        /// Render the frame this many times and report the last (the first ones warm up:
+        /// shader compilation on first use, caches).
+        #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+        frames: u32,
         #[command(flatten)]
         grid: GridArgs,
         #[command(flatten)]
@@ -75,12 +79,12 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// Replicate a published evaluation (thesis-5.1, thesis-5.2, thesis-5.3: Müller 2015, ch. 5):
-    /// CSVs, plots and report.md with our numbers beside the published ones.
-    Bench(gpgpu_rt::bench::BenchArgs),
     /// Open a window that shows the scene live (orbit, pan, zoom; live-editable kernels with
     /// --glsl-dir); --screenshot FILE.png --frames N saves the N-th frame and exits.
     View(gpgpu_rt::view::ViewArgs),
+    /// Replicate a published evaluation (thesis-5.1, thesis-5.2, thesis-5.3: Müller 2015, ch. 5):
+    /// CSVs, plots and report.md with our numbers beside the published ones.
+    Bench(gpgpu_rt::bench::BenchArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
     Info {
         scene: Option<PathBuf>,
@@ -121,6 +125,7 @@ fn run(cli: Cli) -> Result<()> {
             tile,
             aov_dir,
             stats,
+            frames,
             grid,
             soft,
             gpu,
@@ -144,7 +149,10 @@ fn run(cli: Cli) -> Result<()> {
                 grid: grid.options(),
             };
             let mut t = tracer::create(tracer, ctx.gl.clone(), &ctx.info, &scene, &shaders, options.clone())?;
-            let frame = t.render(&scene.camera)?;
+            let mut frame = t.render(&scene.camera)?;
+            for _ in 1..frames {
+                frame = t.render(&scene.camera)?;
+            }
             let name = t.name();
             output::write_png(&output, &frame)?;
             if let (Some(dir), Some(aovs)) = (&aov_dir, &frame.aovs) {
@@ -198,8 +206,8 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Bench(args) => gpgpu_rt::bench::run(args),
         Command::View(args) => gpgpu_rt::view::run(args),
+        Command::Bench(args) => gpgpu_rt::bench::run(args),
         Command::ExportTriangles { scene, output } => {
             let scene = load_scene(&scene)?;
             let tris = scene.world_triangles();
