@@ -150,7 +150,7 @@ impl RayPipeline {
         if options.width == 0 || options.height == 0 || options.width > max_tex || options.height > max_tex {
             bail!("image size {}x{} outside 1..={} (GL_MAX_TEXTURE_SIZE)", options.width, options.height, max_tex);
         }
-        if options.tile % 8 != 0 {
+        if !options.tile.is_multiple_of(8) {
             bail!("--tile {} must be a multiple of 8 (the kernels' work group size)", options.tile);
         }
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
