@@ -164,6 +164,19 @@ fn bad_input_fails_with_file_and_line() {
         &run(&["render", bad.to_str().unwrap(), "-o", "/dev/null", "--width", "8", "--height", "8", "--shadow-flags", "rgba"]),
         &["6 lights", "at most 4"],
     );
+    // buffers beyond the GL limits: named, with the limit
+    assert_fails(
+        &run(&[
+            "render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--tracer", "grid",
+            "--grid-variant", "thesis", "--grid", "64", "--voxel-array-length", "4096",
+        ]),
+        &["voxelslist", "GL_MAX_SHADER_STORAGE_BLOCK_SIZE"],
+    );
+    assert_fails(&run(&["render", &scene("cow.toml"), "--tracer", "grid", "--grid", "abc"]), &["abc"]);
+    assert_fails(
+        &run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--tracer", "grid", "--grid-variant", "thesis", "--grid", "65"]),
+        &["--grid 65", "1..=64"],
+    );
     // a GLSL error in an edited kernel names the file and line
     let glsl = d.join("glsl");
     copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"), &glsl);
