@@ -88,14 +88,19 @@ struct GridStages {
     max_ssbo: i64,
 }
 
+/// The scene-to-grid mapping of `glsl/common/grid.glsl` for the program in use.
+fn grid_uniforms(p: &RayPipeline, prog: glow::Program, center: Vec3, scale: f32) {
+    p.uniform_vec4(prog, "gridCenter", center.into(), 0.0);
+    // SAFETY: setting a uniform of the program in use.
+    unsafe {
+        let loc = p.gl.get_uniform_location(prog, "gridScale");
+        p.gl.uniform_1_f32(loc.as_ref(), scale);
+    }
+}
+
 impl GridStages {
     fn set_grid_uniforms(&self, p: &RayPipeline, prog: glow::Program) {
-        p.uniform_vec4(prog, "gridCenter", self.center.into(), 0.0);
-        // SAFETY: setting a uniform of the program in use.
-        unsafe {
-            let loc = p.gl.get_uniform_location(prog, "gridScale");
-            p.gl.uniform_1_f32(loc.as_ref(), self.scale);
-        }
+        grid_uniforms(p, prog, self.center, self.scale);
     }
 
     /// The scene's bounds from the objects' bounds and current model matrices, mapped onto
@@ -236,15 +241,7 @@ impl Stages for GridStages {
                 grid_total.bind(&gl, binding::B14);
                 p.use_program(count);
                 let (center, scale) = (self.center, self.scale);
-                let set = |p: &RayPipeline, prog| {
-                    p.uniform_vec4(prog, "gridCenter", center.into(), 0.0);
-                    // SAFETY: setting a uniform of the program in use.
-                    unsafe {
-                        let loc = p.gl.get_uniform_location(prog, "gridScale");
-                        p.gl.uniform_1_f32(loc.as_ref(), scale);
-                    }
-                };
-                set(p, count);
+                grid_uniforms(p, count, center, scale);
                 p.dispatch_1d("grid_count", tri_groups);
                 p.use_program(scan);
                 let blocks = (n3 as u32).div_ceil(1024);
@@ -264,7 +261,7 @@ impl Stages for GridStages {
                 }
                 voxel_tris.bind(&gl, binding::B15);
                 p.use_program(fill);
-                set(p, fill);
+                grid_uniforms(p, fill, center, scale);
                 p.dispatch_1d("grid_fill", tri_groups);
             }
         }
