@@ -13,7 +13,7 @@
 //                              same line-space termination (Table 3).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
-// it every surface would shadow itself). The shadow value (fraction of unblocked rays) goes to
+// it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it. The shadow value (fraction of unblocked rays) goes to
 // shadowTexture and, multiplied into the diffuse colour, back into the diffuse texture.
 // loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total; every
 // loop iteration here is counted and an invocation that would pass LOOP_BUDGET stops and is
@@ -153,6 +153,16 @@ bool isNodeIntersection(vec3 startPoint, vec3 direction, float t_end,
     startDim = clamp(ivec2(floor(vec2(startVec[sa.x], startVec[sa.y]))), ivec2(0), ivec2(N - 1));
     endDim = clamp(ivec2(floor(vec2(endVec[ea.x], endVec[ea.y]))), ivec2(0), ivec2(N - 1));
     return true;
+}
+
+// Ours: a node whose box, grown by NEAR_MARGIN child cells, holds the rays' origin is
+// descended instead of asking its line space (rays starting just beside a node boundary would
+// otherwise enter the neighbour through the side cell next to their own surface, whose shaft
+// holds that surface: thin dark lines along every node boundary).
+#define NEAR_MARGIN 1.0
+bool nearOrigin(vec3 childStart)
+{
+    return all(greaterThanEqual(childStart, vec3(-NEAR_MARGIN))) && all(lessThanEqual(childStart, vec3(float(N) + NEAR_MARGIN)));
 }
 
 // Algorithm 4 and Listing 3: getEntry — the bit of the shaft between two boundary cells.
@@ -362,7 +372,7 @@ int traverse()
                 if ((node.r & CHILDREN_BIT) == 0u) {
                     leafTests(node, childStart, depth + 1);
                 } else {
-                    bool inside = all(greaterThanEqual(childStart, vec3(0.0))) && all(lessThanEqual(childStart, vec3(fN)));
+                    bool inside = nearOrigin(childStart);
                     bool descend;
                     if (inside) {
                         descend = true;
@@ -465,7 +475,7 @@ bool ddaBlocked(int r)
             }
             continue;
         }
-        bool inside = all(greaterThanEqual(childStart, vec3(0.0))) && all(lessThanEqual(childStart, vec3(fN)));
+        bool inside = nearOrigin(childStart);
         bool descend = inside;
         if (!inside) {
             int sf, ef;

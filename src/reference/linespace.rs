@@ -15,7 +15,8 @@
 //!
 //! Where the thesis is silent we do this (and the kernel the same): the node that contains the
 //! rays' common origin has no entry side, so no line-space entry; it is always descended, and
-//! inside it the leaves are tested exactly (otherwise every surface would shadow itself).
+//! inside it the leaves are tested exactly (otherwise every surface would shadow itself); the
+//! same for a node whose box, grown by one child cell, holds the origin ([`NEAR_MARGIN`]).
 
 use glam::{IVec3, Vec3};
 
@@ -133,6 +134,20 @@ fn node_intersection(
     let (su, sv) = cell(start_vec, start_face);
     let (eu, ev) = cell(end_vec, end_face);
     Some((start_face, su, sv, end_face, eu, ev))
+}
+
+/// Margin, in child cells, around a node within which the rays' origin counts as "in the
+/// node": such a node is descended (and its leaves tested exactly) instead of asking its line
+/// space. Without it, rays that start just beside a node boundary enter the neighbour through
+/// the side cell next to the surface they start on, whose shaft holds that surface: thin dark
+/// lines along every node boundary.
+pub const NEAR_MARGIN: f32 = 1.0;
+
+/// Does the origin (at `child_start` in the node's coordinates) lie in the node or within
+/// [`NEAR_MARGIN`] child cells of it?
+pub fn near_origin(child_start: Vec3, nf: f32) -> bool {
+    child_start.cmpge(Vec3::splat(-NEAR_MARGIN)).all()
+        && child_start.cmple(Vec3::splat(nf + NEAR_MARGIN)).all()
 }
 
 /// Algorithm 4: the line-space entry of a ray through a node (true: geometry in the shaft).
@@ -483,8 +498,7 @@ impl<'a> LinespaceShadows<'a> {
                     if node[0] & CHILDREN_BIT == 0 {
                         self.leaf_tests(s, node, child_start, level_of_node, counts);
                     } else {
-                        let inside = child_start.cmpge(Vec3::ZERO).all()
-                            && child_start.cmple(Vec3::splat(nf)).all();
+                        let inside = near_origin(child_start, nf);
                         let descend = if inside {
                             true
                         } else if mode == ShadowMode::Linespace && d as i32 == last_ls_depth {
@@ -656,8 +670,7 @@ impl<'a> LinespaceShadows<'a> {
                 }
                 continue;
             }
-            let inside =
-                child_start.cmpge(Vec3::ZERO).all() && child_start.cmple(Vec3::splat(nf)).all();
+            let inside = near_origin(child_start, nf);
             let descend = if inside {
                 true
             } else if let Some(hit) = node_intersection(self.tree.n, child_start, dir, te) {
