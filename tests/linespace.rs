@@ -264,6 +264,32 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             f.gbuffer_normal.clone(),
         ));
     }
+    // the CPU's primary rays (Table 1: ray traced on the CPU) find what the G-buffer rasterised
+    let f = r.render(&scene.camera).unwrap();
+    let cpu = r.cpu();
+    let rays = scene.camera.rays(64, 64);
+    let (mut same, mut hit_px) = (0, 0);
+    for row in 0..64u32 {
+        for x in 0..64u32 {
+            let (o, d) = rays.primary_ray(x, 63 - row);
+            let i = (row * 64 + x) as usize;
+            let mut c = Default::default();
+            let hit = cpu.closest_hit(o, d, &mut c);
+            if f.aovs.triangle_id[i] >= 0 {
+                hit_px += 1;
+                if let Some((t, id)) = hit {
+                    if id as i32 == f.aovs.triangle_id[i] || (t - f.aovs.hit_t[i]).abs() < 1e-3 * t
+                    {
+                        same += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        same * 100 >= hit_px * 97,
+        "CPU primary hits agree with the G-buffer at {same} of {hit_px} pixels"
+    );
     let (exact, pos, nrm) = &shadows[0];
     let (ls, _, _) = &shadows[1];
     let (dda, _, _) = &shadows[2];

@@ -696,6 +696,140 @@ impl<'a> LinespaceShadows<'a> {
         false
     }
 
+    /// Primary-ray casting on the CPU (Table 1's "CPU": the thesis ray traces the initial image
+    /// on the CPU): the closest hit (world t along the normalised `d`, triangle id) by a
+    /// hierarchical 3D-DDA through the N-tree, front to back, testing the leaves' triangles
+    /// and stopping once the closest hit lies before the current leaf's exit.
+    pub fn closest_hit(
+        &self,
+        o_world: Vec3,
+        d_world: Vec3,
+        counts: &mut ShadowCounts,
+    ) -> Option<(f32, u32)> {
+        let n = self.tree.n as i32;
+        let nf = n as f32;
+        let max_depth = self.tree.depth as usize - 1;
+        let o = self.tree.to_ntree(o_world);
+        let dir = d_world * self.tree.inv_node_size();
+        #[allow(dead_code)]
+        #[derive(Clone, Copy, Default)]
+        struct Dda {
+            group: u32,
+            start: Vec3,
+            cell: IVec3,
+            t_max: Vec3,
+            t: f32,
+            t_end: f32,
+        }
+        let step = IVec3::new(
+            if dir.x > 0.0 { 1 } else { -1 },
+            if dir.y > 0.0 { 1 } else { -1 },
+            if dir.z > 0.0 { 1 } else { -1 },
+        );
+        let t_delta = Vec3::new(1.0 / dir.x.abs(), 1.0 / dir.y.abs(), 1.0 / dir.z.abs());
+        let init = |group: u32, start: Vec3, t_end: f32| -> Option<Dda> {
+            let inside = start.cmpge(Vec3::ZERO).all() && start.cmplt(Vec3::splat(nf)).all();
+            let t0 = if inside {
+                0.0
+            } else {
+                let (mut tnear, mut tfar) = (0.0f32, f32::INFINITY);
+                for a in 0..3 {
+                    if dir[a] == 0.0 {
+                        if start[a] < 0.0 || start[a] > nf {
+                            return None;
+                        }
+                        continue;
+                    }
+                    let mut t0 = -start[a] / dir[a];
+                    let mut t1 = (nf - start[a]) / dir[a];
+                    if t0 > t1 {
+                        std::mem::swap(&mut t0, &mut t1);
+                    }
+                    tnear = tnear.max(t0);
+                    tfar = tfar.min(t1);
+                }
+                if tnear > tfar || tnear > t_end {
+                    return None;
+                }
+                tnear
+            };
+            let p = start + t0 * dir;
+            let cell = p.floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(n - 1));
+            let mut t_max = Vec3::INFINITY;
+            for a in 0..3 {
+                if dir[a] > 0.0 {
+                    t_max[a] = (cell[a] as f32 + 1.0 - start[a]) / dir[a];
+                } else if dir[a] < 0.0 {
+                    t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
+                }
+            }
+            Some(Dda {
+                group,
+                start,
+                cell,
+                t_max,
+                t: t0,
+                t_end,
+            })
+        };
+        let mut stack = vec![Dda::default(); max_depth];
+        stack[0] = init(0, o, f32::INFINITY)?;
+        let mut depth: i32 = 0;
+        let mut best: Option<(f32, u32)> = None;
+        while depth >= 0 {
+            let d = depth as usize;
+            let st = stack[d];
+            if st.cell.cmplt(IVec3::ZERO).any() || st.cell.cmpge(IVec3::splat(n)).any() {
+                depth -= 1;
+                continue;
+            }
+            let tm = st.t_max;
+            let a = if tm.x <= tm.y && tm.x <= tm.z {
+                0
+            } else if tm.y <= tm.z {
+                1
+            } else {
+                2
+            };
+            stack[d].t = st.t_max[a];
+            stack[d].cell[a] += step[a];
+            stack[d].t_max[a] += t_delta[a];
+            counts.nodes_visited += 1;
+            let node = self.node(st.group, st.cell);
+            if node[0] & GEOMETRY_BIT == 0 {
+                continue;
+            }
+            if node[0] & CHILDREN_BIT == 0 {
+                let off = (node[0] >> 2) as usize;
+                for &t in &self.tree.leaf_triangles[off..off + node[1] as usize] {
+                    counts.triangle_tests += 1;
+                    let tri = &self.triangles[t as usize];
+                    if let Some((tt, _, _)) =
+                        intersect_triangle(o_world, d_world, tri[0], tri[1], tri[2])
+                    {
+                        if best.is_none_or(|b| tt < b.0) {
+                            best = Some((tt, t));
+                        }
+                    }
+                }
+                // the leaf's exit in world units (t of depth d is N^d times the root's)
+                let exit = stack[d].t / self.t_end(d);
+                if let Some(b) = best {
+                    if b.0 <= exit {
+                        return best;
+                    }
+                }
+                continue;
+            }
+            let child_start = (st.start - st.cell.as_vec3()) * nf;
+            if let Some(next) = init(node[0] >> 2, child_start, f32::INFINITY) {
+                stack[d + 1] = next;
+                depth += 1;
+            }
+        }
+        best
+    }
+
     /// The exact shadow value by brute force: every sample ray against every triangle (the
     /// oracle for `Exact`).
     pub fn brute_force(&self, p: Vec3, normal: Vec3) -> f32 {
