@@ -15,9 +15,13 @@
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
 // it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it. The shadow value (fraction of unblocked rays) goes to
 // shadowTexture and, multiplied into the diffuse colour, back into the diffuse texture.
-// loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total; every
-// loop iteration here is counted and an invocation that would pass LOOP_BUDGET stops and is
-// counted as truncated (the host refuses the frame).
+// loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total — and it
+// runs 8 invocations as one SIMD vector whose loops iterate while any lane is active, so the
+// budget is spent by the vector, not by one pixel. Two guards: every loop iteration here is
+// counted and an invocation past LOOP_BUDGET stops; and after the work a sentinel loop of
+// loopSentinel (= 2, a uniform so that it is not unrolled) iterations must run completely —
+// if llvmpipe's limit was reached it ends after one. Either way the pixel is counted as
+// truncated and the host refuses the frame.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
@@ -51,6 +55,7 @@ uniform int tex_x_res;
 uniform int tex_y_res;
 uniform int ls_y_size;
 uniform ivec2 tileOffset;
+uniform int loopSentinel;
 
 uint triangleTests = 0u;
 uint linespaceLookups = 0u;
@@ -195,27 +200,40 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
     return ((entry >> uint(bit_position)) & 1u) != 0u;
 }
 
+// Algorithm 2, one ray: true if the ray crosses the node and its line-space bit is set; at
+// the last depth with line spaces (deactivate) the ray is then deactivated.
+bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
+{
+    if (r >= NUM_RAYS || !shaft.active_rays[r]) return false;
+    int sf, ef;
+    ivec2 sd, ed;
+    if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
+    if (!getEntry(node, sf, sd, ef, ed)) return false;
+    if (deactivate) {
+        shaft.active_rays[r] = false;
+        active_rays--;
+    }
+    return true;
+}
+
 // Algorithm 2: isIntersection. deactivate: at the last depth with line spaces a set bit is a
-// hit and deactivates the ray; elsewhere the first set bit returns true (descend).
+// hit and deactivates the ray; elsewhere the first set bit returns true (descend). Four rays
+// per loop iteration (see loopLimit).
 bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 {
     bool found_intersection = false;
     float te = tEnd(level);
-    for (int r = 0; r < NUM_RAYS; r++) {
+    for (int r = 0; r < NUM_RAYS; r += 4) {
         if (!loopStep()) return false;
-        if (!shaft.active_rays[r]) continue;
-        int sf, ef;
-        ivec2 sd, ed;
-        if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) continue;
-        if (getEntry(node, sf, sd, ef, ed)) {
-            found_intersection = true;
-            if (deactivate) {
-                shaft.active_rays[r] = false;
-                active_rays--;
-            } else {
-                return true;
-            }
-        }
+        bool f0 = lineSpaceRay(r, node, childStart, te, deactivate);
+        if (f0 && !deactivate) return true;
+        bool f1 = lineSpaceRay(r + 1, node, childStart, te, deactivate);
+        if (f1 && !deactivate) return true;
+        bool f2 = lineSpaceRay(r + 2, node, childStart, te, deactivate);
+        if (f2 && !deactivate) return true;
+        bool f3 = lineSpaceRay(r + 3, node, childStart, te, deactivate);
+        if (f3 && !deactivate) return true;
+        found_intersection = found_intersection || f0 || f1 || f2 || f3;
     }
     return found_intersection;
 }
@@ -238,27 +256,40 @@ bool occludes(uint t, vec3 ro, vec3 rd)
     return uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < 1.0;
 }
 
-// the exact triangle tests of a leaf for every active ray crossing it
+// the exact triangle tests of a leaf for ray r, four triangles per loop iteration
+void leafRay(int r, uvec2 node, vec3 childStart, float te)
+{
+    if (r >= NUM_RAYS || !shaft.active_rays[r]) return;
+    int sf, ef;
+    ivec2 sd, ed;
+    if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return;
+    vec3 rd = samplePoint(r) - originWorld;
+    uint off = node.r >> 2;
+    uint count = node.g;
+    for (uint i = 0u; i < count; i += 4u) {
+        if (!loopStep()) return;
+        if (occludes(leafTriangles[off + i], originWorld, rd)
+            || (i + 1u < count && occludes(leafTriangles[off + i + 1u], originWorld, rd))
+            || (i + 2u < count && occludes(leafTriangles[off + i + 2u], originWorld, rd))
+            || (i + 3u < count && occludes(leafTriangles[off + i + 3u], originWorld, rd))) {
+            shaft.active_rays[r] = false;
+            active_rays--;
+            return;
+        }
+    }
+}
+
+// the exact triangle tests of a leaf for every active ray crossing it, four rays per loop
+// iteration (see loopLimit)
 void leafTests(uvec2 node, vec3 childStart, int level)
 {
     float te = tEnd(level);
-    uint off = node.r >> 2;
-    uint count = node.g;
-    for (int r = 0; r < NUM_RAYS; r++) {
+    for (int r = 0; r < NUM_RAYS; r += 4) {
         if (!loopStep()) return;
-        if (!shaft.active_rays[r]) continue;
-        int sf, ef;
-        ivec2 sd, ed;
-        if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) continue;
-        vec3 rd = samplePoint(r) - originWorld;
-        for (uint i = 0u; i < count; i++) {
-            if (!loopStep()) return;
-            if (occludes(leafTriangles[off + i], originWorld, rd)) {
-                shaft.active_rays[r] = false;
-                active_rays--;
-                break;
-            }
-        }
+        leafRay(r, node, childStart, te);
+        leafRay(r + 1, node, childStart, te);
+        leafRay(r + 2, node, childStart, te);
+        leafRay(r + 3, node, childStart, te);
     }
 }
 
@@ -546,6 +577,14 @@ float shadowValue(vec3 pos, vec3 normal)
     return float(traverse()) / float(NUM_RAYS);
 }
 
+// false if the GL implementation's loop limit ended loops early (see loopLimit above)
+bool loopsComplete()
+{
+    int c = 0;
+    for (int i = 0; i < loopSentinel; i++) c++;
+    return c == loopSentinel;
+}
+
 void main()
 {
     countersBegin();
@@ -555,6 +594,7 @@ void main()
         if (pos.w > 0.0) {
             vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
             float s = shadowValue(pos.xyz, n);
+            if (!loopsComplete()) truncated = 1u;
             imageStore(shadowTexture, storePos, vec4(s, 0.0, 0.0, 1.0));
             // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
             vec4 diffuse = imageLoad(diffuseTexture, storePos);

@@ -45,6 +45,7 @@ pub mod sweep;
 pub mod thesis_5_1;
 pub mod thesis_5_2;
 pub mod thesis_5_3;
+pub mod klee;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -83,6 +84,21 @@ pub enum ProtocolId {
     /// Müller 2015, ch. 5.3: bunny, base vs grid; dragon with the grid (Fig. 23, 24).
     #[value(name = "thesis-5.3")]
     Thesis53,
+    /// Klee 2016, Table 1: primary rays, GPU rasterisation vs CPU ray casting (bunny, dragon).
+    #[value(name = "klee-table1")]
+    KleeTable1,
+    /// Klee 2016, Table 2: triangle tests vs line-space lookups on the CPU (bunny, 4 rays).
+    #[value(name = "klee-table2")]
+    KleeTable2,
+    /// Klee 2016, Table 3: coherent grid traversal vs 3D-DDA on the CPU (4/9/16/100 rays).
+    #[value(name = "klee-table3")]
+    KleeTable3,
+    /// Klee 2016, Fig. 12: 2×2 … 10×10 shadow rays, CPU vs GPU (bunny).
+    #[value(name = "klee-fig12")]
+    KleeFig12,
+    /// Klee 2016, Fig. 13: bunny vs dragon on the GPU, 2×2 … 10×10 shadow rays.
+    #[value(name = "klee-fig13")]
+    KleeFig13,
 }
 
 impl ProtocolId {
@@ -91,6 +107,11 @@ impl ProtocolId {
             ProtocolId::Thesis51 => &thesis_5_1::Thesis51,
             ProtocolId::Thesis52 => &thesis_5_2::Thesis52,
             ProtocolId::Thesis53 => &thesis_5_3::Thesis53,
+            ProtocolId::KleeTable1 => &klee::KleeTable1,
+            ProtocolId::KleeTable2 => &klee::KleeTable2,
+            ProtocolId::KleeTable3 => &klee::KleeTable3,
+            ProtocolId::KleeFig12 => &klee::KleeFig12,
+            ProtocolId::KleeFig13 => &klee::KleeFig13,
         }
     }
 }

@@ -659,6 +659,7 @@ impl SoftShadowRenderer {
             gl.uniform_1_i32(loc("tex_y_res").as_ref(), self.packed.tex_y_res as i32);
             gl.uniform_1_i32(loc("ls_y_size").as_ref(), self.packed.ls_y_size as i32);
             gl.uniform_1_i32(loc("nodePool").as_ref(), 1);
+            gl.uniform_1_i32(loc("loopSentinel").as_ref(), 2);
             gl.active_texture(glow::TEXTURE1);
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.node_texture));
             gl.active_texture(glow::TEXTURE0);
