@@ -638,9 +638,7 @@ impl Protocol for KleeFig13 {
             by_scene.push(pts);
         }
         let mut table = Vec::new();
-        for j in 0..by_scene[0].len() {
-            let (rays, b) = by_scene[0][j];
-            let d = by_scene[1][j].1;
+        for (&(rays, b), &(_, d)) in by_scene[0].iter().zip(&by_scene[1]) {
             let published = FIG13_DRAGON_EXTRA
                 .iter()
                 .find(|p| p.0 as f64 == rays)
