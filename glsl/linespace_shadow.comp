@@ -256,7 +256,7 @@ bool occludes(uint t, vec3 ro, vec3 rd)
     return uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < 1.0;
 }
 
-// the exact triangle tests of a leaf for ray r, eight triangles per loop iteration
+// the exact triangle tests of a leaf for ray r, four triangles per loop iteration
 void leafRay(int r, uvec2 node, vec3 childStart, float te)
 {
     if (r >= NUM_RAYS || !shaft.active_rays[r]) return;
@@ -266,16 +266,12 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     vec3 rd = samplePoint(r) - originWorld;
     uint off = node.r >> 2;
     uint count = node.g;
-    for (uint i = 0u; i < count; i += 8u) {
+    for (uint i = 0u; i < count; i += 4u) {
         if (!loopStep()) return;
         if (occludes(leafTriangles[off + i], originWorld, rd)
             || (i + 1u < count && occludes(leafTriangles[off + i + 1u], originWorld, rd))
             || (i + 2u < count && occludes(leafTriangles[off + i + 2u], originWorld, rd))
-            || (i + 3u < count && occludes(leafTriangles[off + i + 3u], originWorld, rd))
-            || (i + 4u < count && occludes(leafTriangles[off + i + 4u], originWorld, rd))
-            || (i + 5u < count && occludes(leafTriangles[off + i + 5u], originWorld, rd))
-            || (i + 6u < count && occludes(leafTriangles[off + i + 6u], originWorld, rd))
-            || (i + 7u < count && occludes(leafTriangles[off + i + 7u], originWorld, rd))) {
+            || (i + 3u < count && occludes(leafTriangles[off + i + 3u], originWorld, rd))) {
             shaft.active_rays[r] = false;
             active_rays--;
             return;
@@ -363,20 +359,6 @@ bool initLevel(int d, uvec2 parent)
     return true;
 }
 
-// Algorithm 1, line 24–25: a node of the slice with geometry goes into the nodelist
-void gatherCell(int depth, int slice, int cu, int cv, int cv1)
-{
-    if (cv > cv1) return;
-    ivec3 c;
-    c[k] = slice; c[u] = cu; c[v] = cv;
-    uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
-    if ((node.r & GEOMETRY_BIT) != 0u) {
-        int i = stack[depth].nodelist_index++;
-        stack[depth].nodelist[i] = node;
-        stack[depth].offset[i] = ivec2(cu, cv);
-    }
-}
-
 // Algorithm 1 (continuation): returns the number of rays still active
 int traverse()
 {
@@ -396,14 +378,17 @@ int traverse()
                 int cv0 = max(int(floor(stack[depth].v_min)), 0);
                 int cv1 = min(int(floor(stack[depth].v_max)), N - 1);
                 stack[depth].nodelist_index = 0;
-                // four cells per loop iteration (see loopLimit)
                 for (int cu = cu0; cu <= cu1; cu++) {
-                    for (int cv = cv0; cv <= cv1; cv += 4) {
+                    for (int cv = cv0; cv <= cv1; cv++) {
                         if (!loopStep()) return active_rays;
-                        gatherCell(depth, slice, cu, cv, cv1);
-                        gatherCell(depth, slice, cu, cv + 1, cv1);
-                        gatherCell(depth, slice, cu, cv + 2, cv1);
-                        gatherCell(depth, slice, cu, cv + 3, cv1);
+                        ivec3 c;
+                        c[k] = slice; c[u] = cu; c[v] = cv;
+                        uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
+                        if ((node.r & GEOMETRY_BIT) != 0u) {
+                            int i = stack[depth].nodelist_index++;
+                            stack[depth].nodelist[i] = node;
+                            stack[depth].offset[i] = ivec2(cu, cv);
+                        }
                     }
                 }
             }
