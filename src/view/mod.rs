@@ -51,22 +51,6 @@ const MAX_REFL_DEPTH: u32 = 16;
 /// Grid resolution step of the G keys.
 const GRID_STEP: u32 = 4;
 
-/// `--grid N|auto`: voxels per axis, `None` for auto.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct GridResolution(pub Option<u32>);
-
-fn parse_grid(s: &str) -> Result<GridResolution, String> {
-    if s == "auto" {
-        return Ok(GridResolution(None));
-    }
-    match s.parse::<u32>() {
-        Ok(n) if n >= 1 => Ok(GridResolution(Some(n))),
-        _ => Err(format!(
-            "`{s}` is neither `auto` nor a positive voxel count per axis"
-        )),
-    }
-}
-
 /// Options of `gpgpu-rt view`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ViewArgs {
@@ -90,12 +74,10 @@ pub struct ViewArgs {
     /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling).
     #[arg(long, default_value_t = 256, value_name = "N")]
     pub tile: u32,
-    /// Grid tracer: voxels per axis, or `auto` (G / shift+G / A change it).
-    #[arg(long, value_name = "N|auto", value_parser = parse_grid, default_value = "auto")]
-    pub grid: GridResolution,
-    /// Grid tracer: the design variant (V switches).
-    #[arg(long, value_enum, default_value = "exact")]
-    pub grid_variant: GridVariant,
+    /// The grid tracer's options, as for `render` (G / shift+G / A change the resolution, V
+    /// the variant).
+    #[command(flatten)]
+    pub grid: tracer::GridArgs,
     /// Load the kernels from this directory and reload them whenever a file in it changes.
     #[arg(long, value_name = "DIR")]
     pub glsl_dir: Option<PathBuf>,
@@ -146,11 +128,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         tile: args.tile,
         shadow_flags: args.shadow_flags,
         aovs: false,
-        grid: tracer::GridOptions {
-            variant: args.grid_variant,
-            resolution: args.grid.0,
-            ..Default::default()
-        },
+        grid: args.grid.options(),
     };
     if options.width == 0 || options.height == 0 {
         bail!(
@@ -903,14 +881,6 @@ mod tests {
             headline("cannot read GLSL file x\n"),
             "cannot read GLSL file x"
         );
-    }
-
-    #[test]
-    fn grid_option_parses_auto_and_counts() {
-        assert_eq!(parse_grid("auto"), Ok(GridResolution(None)));
-        assert_eq!(parse_grid("24"), Ok(GridResolution(Some(24))));
-        assert!(parse_grid("0").is_err());
-        assert!(parse_grid("x").is_err());
     }
 
     #[test]
