@@ -311,7 +311,7 @@ fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
             .iter()
             .all(|r| u(r, "triangles") == 202520 && r["grid_resolution"] == "28"));
         assert!(
-            report.contains("202,520 (-1568)"),
+            report.contains("202,520 (1,568 fewer)"),
             "dragon triangle difference"
         );
     } else {

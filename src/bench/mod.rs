@@ -165,6 +165,12 @@ pub struct BenchArgs {
     /// Grid variants to measure, comma-separated (default: both).
     #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
     pub variants: Option<Vec<GridVariant>>,
+    /// Thesis grid variant: triangle ids per voxel list (default: the tracer's, Listing 17: 512).
+    #[arg(long, value_name = "L")]
+    pub voxel_array_length: Option<u32>,
+    /// Thesis grid variant: voxel ids per ray list (default: the tracer's, 3·N as Listing 17).
+    #[arg(long, value_name = "R")]
+    pub ray_array_length: Option<u32>,
     /// How the scene turns: its objects (default) or the camera around them.
     #[arg(long, value_enum, default_value = "objects")]
     pub rotate: Rotation,

@@ -6,6 +6,8 @@ use std::path::Path;
 use std::sync::Once;
 
 use anyhow::{anyhow, Context as _, Result};
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -70,6 +72,8 @@ pub struct Chart {
     pub series: Vec<Series>,
     /// Fixed x range; default: the data's.
     pub x_range: Option<(f64, f64)>,
+    /// A logarithmic y axis (for series that differ by orders of magnitude).
+    pub log_y: bool,
 }
 
 const PALETTE: [RGBColor; 8] = [
@@ -140,7 +144,6 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
 }
 
 fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Result<()> {
-    let err = |e: &dyn std::fmt::Display| anyhow!("drawing the chart {:?}: {e}", chart.title);
     let points = || chart.series.iter().flat_map(|s| s.points.iter());
     let (x0, x1) = chart.x_range.unwrap_or_else(|| {
         let (lo, hi) = range(points().map(|p| p.0), false);
@@ -148,22 +151,50 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Re
         let hi = if hi > lo { lo + (hi - lo) / 1.08 } else { hi };
         (lo, hi)
     });
-    let (y0, y1) = range(points().map(|p| p.1), true);
+    let positive: Vec<f64> = points()
+        .map(|p| p.1)
+        .filter(|y| *y > 0.0 && y.is_finite())
+        .collect();
+    if chart.log_y && !positive.is_empty() {
+        let lo = positive.iter().cloned().fold(f64::INFINITY, f64::min) / 1.6;
+        let hi = positive.iter().cloned().fold(f64::NEG_INFINITY, f64::max) * 1.6;
+        draw_on(area, chart, x0..x1, (lo..hi).log_scale())
+    } else {
+        let (y0, y1) = range(points().map(|p| p.1), true);
+        draw_on(area, chart, x0..x1, y0..y1)
+    }
+}
+
+fn draw_on<Y>(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    chart: &Chart,
+    x: std::ops::Range<f64>,
+    y: Y,
+) -> Result<()>
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let err = |e: &dyn std::fmt::Display| anyhow!("drawing the chart {:?}: {e}", chart.title);
     let mut c = ChartBuilder::on(area)
         .caption(&chart.title, (FONT, 17))
         .margin(12)
         .x_label_area_size(42)
         .y_label_area_size(64)
-        .build_cartesian_2d(x0..x1, y0..y1)
+        .build_cartesian_2d(x, y)
         .map_err(|e| err(&e))?;
     c.configure_mesh()
         .x_desc(chart.x_label.as_str())
-        .y_desc(chart.y_label.as_str())
+        .y_desc(if chart.log_y {
+            format!("{} (log scale)", chart.y_label)
+        } else {
+            chart.y_label.clone()
+        })
         .axis_desc_style((FONT, 14))
         .label_style((FONT, 12))
         .x_label_formatter(&|v| si(*v))
         .y_label_formatter(&|v| si(*v))
-        .light_line_style(RGBColor(235, 235, 235))
+        .light_line_style(if chart.log_y { WHITE } else { RGBColor(235, 235, 235) })
         .draw()
         .map_err(|e| err(&e))?;
     for s in &chart.series {
@@ -207,15 +238,71 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Re
         }
     }
     if chart.series.iter().any(|s| !s.name.is_empty()) {
+        let corner = legend_corner::<Y>(&c, chart);
         c.configure_series_labels()
             .label_font((FONT, 12))
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(160, 160, 160))
-            .position(SeriesLabelPosition::LowerRight)
+            .position(corner)
             .draw()
             .map_err(|e| err(&e))?;
     }
     Ok(())
+}
+
+/// The corner of the plotting area the data covers least, for the legend.
+fn legend_corner<Y>(
+    c: &ChartContext<'_, BitMapBackend<'_>, Cartesian2d<RangedCoordf64, Y::CoordDescType>>,
+    chart: &Chart,
+) -> SeriesLabelPosition
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: Ranged<ValueType = f64>,
+{
+    let (xr, yr) = c.plotting_area().get_pixel_range();
+    let (w, h) = ((xr.end - xr.start) as f64, (yr.end - yr.start) as f64);
+    // points along every drawn segment, in pixels relative to the plotting area
+    let mut px = Vec::new();
+    for s in &chart.series {
+        let p: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|&q| {
+                let (x, y) = c.backend_coord(&q);
+                ((x - xr.start) as f64 / w, (y - yr.start) as f64 / h)
+            })
+            .collect();
+        px.extend(p.iter().copied());
+        if s.style != Style::Crosses {
+            for seg in p.windows(2) {
+                px.extend((1..20).map(|i| {
+                    let t = i as f64 / 20.0;
+                    (
+                        seg[0].0 + t * (seg[1].0 - seg[0].0),
+                        seg[0].1 + t * (seg[1].1 - seg[0].1),
+                    )
+                }));
+            }
+        }
+    }
+    let count = |right: bool, bottom: bool| {
+        px.iter()
+            .filter(|(x, y)| {
+                (if right { *x > 0.6 } else { *x < 0.4 })
+                    && (if bottom { *y > 0.6 } else { *y < 0.4 })
+            })
+            .count()
+    };
+    [
+        (count(true, true), SeriesLabelPosition::LowerRight),
+        (count(true, false), SeriesLabelPosition::UpperRight),
+        (count(false, false), SeriesLabelPosition::UpperLeft),
+        (count(false, true), SeriesLabelPosition::LowerLeft),
+    ]
+    .into_iter()
+    .min_by_key(|(n, _)| *n)
+    .map(|(_, pos)| pos)
+    .unwrap_or(SeriesLabelPosition::LowerRight)
 }
 
 /// Draw `charts` side by side, each `panel_w`×`panel_h` pixels, into a PNG at `path`.
@@ -271,8 +358,13 @@ mod tests {
                 Series::new("published", vec![(180.0, 2.5)], Style::Crosses, BLACK_INDEX),
             ],
             x_range: Some((0.0, 360.0)),
+            log_y: false,
         };
-        save(&path, 400, 300, &[chart.clone(), chart]).unwrap();
+        let log = Chart {
+            log_y: true,
+            ..chart.clone()
+        };
+        save(&path, 400, 300, &[chart, log]).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (800, 300));
         // the blue series and black text/axes are there

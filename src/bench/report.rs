@@ -291,6 +291,17 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         a.tile,
         if a.tile == 0 { "one dispatch per kernel and pass, as the thesis" } else { "tiles of at most this many pixels squared" }
     );
+    let d = crate::tracer::GridOptions::default();
+    let _ = writeln!(
+        s,
+        "- Grid list lengths of the thesis variant: voxel_array_length {}, ray_array_length {} \
+         (`--voxel-array-length`, `--ray-array-length`).",
+        a.voxel_array_length.unwrap_or(d.voxel_array_length),
+        match (a.ray_array_length, d.ray_array_length) {
+            (Some(r), _) | (None, Some(r)) => r.to_string(),
+            (None, None) => "3·N (Listing 17)".to_string(),
+        }
+    );
     let _ = writeln!(
         s,
         "- Müller 2015's test system: {}. It measured {}.",

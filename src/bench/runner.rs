@@ -383,7 +383,13 @@ impl Bench {
         pb: &ProgressBar,
         out: &mut Outcome,
     ) -> Result<()> {
-        let (kind, grid) = tracer_kind(c.tracer)?;
+        let (kind, mut grid) = tracer_kind(c.tracer)?;
+        if let Some(l) = self.args.voxel_array_length {
+            grid.voxel_array_length = l;
+        }
+        if let Some(r) = self.args.ray_array_length {
+            grid.ray_array_length = Some(r);
+        }
         let options = RenderOptions {
             width: c.width,
             height: c.height,
@@ -450,6 +456,14 @@ impl Bench {
 
 fn validate_args(a: &BenchArgs) -> Result<()> {
     for (name, v) in [("--width", a.width), ("--height", a.height)] {
+        if v == Some(0) {
+            bail!("{name} must be at least 1");
+        }
+    }
+    for (name, v) in [
+        ("--voxel-array-length", a.voxel_array_length),
+        ("--ray-array-length", a.ray_array_length),
+    ] {
         if v == Some(0) {
             bail!("{name} must be at least 1");
         }

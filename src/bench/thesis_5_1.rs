@@ -92,6 +92,7 @@ impl Protocol for Thesis51 {
                 y_label: "FPS".into(),
                 series: curve(&|f| f.fps()),
                 x_range: Some((0.0, 360.0)),
+                log_y: false,
             }],
         )?;
         let fig20 = PathBuf::from("fig20_tests.png");
@@ -105,6 +106,7 @@ impl Protocol for Thesis51 {
                 y_label: "triangle tests per frame".into(),
                 series: curve(&|f| f.tests() as f64),
                 x_range: Some((0.0, 360.0)),
+                log_y: false,
             }],
         )?;
 

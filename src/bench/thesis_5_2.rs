@@ -90,6 +90,7 @@ impl Protocol for Thesis52 {
                 y_label: "FPS (frames / total time)".into(),
                 series: fps_series,
                 x_range: None,
+                log_y: true,
             }],
         )?;
         let fig22 = PathBuf::from("fig22_tests_vs_resolution.png");
@@ -105,6 +106,7 @@ impl Protocol for Thesis52 {
                 y_label: "mean triangle tests per frame".into(),
                 series: test_curves,
                 x_range: None,
+                log_y: true,
             }],
         )?;
 
