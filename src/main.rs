@@ -13,7 +13,11 @@ use gpgpu_rt::scene::Scene;
 use gpgpu_rt::tracer::{self, GridArgs, RenderOptions, ShadowFlags, TracerKind};
 
 #[derive(Parser)]
-#[command(name = "gpgpu-rt", version, about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)")]
+#[command(
+    name = "gpgpu-rt",
+    version,
+    about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -135,9 +139,20 @@ fn run(cli: Cli) -> Result<()> {
             let ctx = GlContext::headless(gpu.device)?;
             if let Some(mode) = soft.shadows {
                 // Klee 2016: G-buffer, soft-shadow compute pass, screen-filling quad
-                let (w, h) = (width.unwrap_or(scene.settings.width), height.unwrap_or(scene.settings.height));
+                let (w, h) = (
+                    width.unwrap_or(scene.settings.width),
+                    height.unwrap_or(scene.settings.height),
+                );
                 let opts = soft.options(mode, w, h, tile);
-                return gpgpu_rt::tracer::linespace::cli::render(&ctx, &scene, &shaders, opts, &output, aov_dir.as_deref(), stats.as_deref());
+                return gpgpu_rt::tracer::linespace::cli::render(
+                    &ctx,
+                    &scene,
+                    &shaders,
+                    opts,
+                    &output,
+                    aov_dir.as_deref(),
+                    stats.as_deref(),
+                );
             }
             let options = RenderOptions {
                 width: width.unwrap_or(scene.settings.width),
@@ -148,7 +163,14 @@ fn run(cli: Cli) -> Result<()> {
                 aovs: aov_dir.is_some(),
                 grid: grid.options(),
             };
-            let mut t = tracer::create(tracer, ctx.gl.clone(), &ctx.info, &scene, &shaders, options.clone())?;
+            let mut t = tracer::create(
+                tracer,
+                ctx.gl.clone(),
+                &ctx.info,
+                &scene,
+                &shaders,
+                options.clone(),
+            )?;
             let mut frame = t.render(&scene.camera)?;
             for _ in 1..frames {
                 frame = t.render(&scene.camera)?;
@@ -214,7 +236,8 @@ fn run(cli: Cli) -> Result<()> {
             output::write_npy(
                 &output,
                 &[tris.len() as u64, 3, 3],
-                tris.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())),
+                tris.iter()
+                    .flat_map(|t| t.iter().flat_map(|v| v.to_array())),
             )
         }
         Command::Info { scene, json, gpu } => {

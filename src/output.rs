@@ -15,11 +15,16 @@ pub fn write_png(path: &Path, frame: &Frame) -> Result<()> {
         let c = frame.color[(y * frame.width + x) as usize];
         image::Rgb([0, 1, 2].map(|k| (c[k].clamp(0.0, 1.0) * 255.0).round() as u8))
     });
-    img.save(path).with_context(|| format!("cannot write {}", path.display()))
+    img.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Write one array to `.npy` with the given shape.
-pub fn write_npy<T: npyz::AutoSerialize + Copy>(path: &Path, shape: &[u64], data: impl IntoIterator<Item = T>) -> Result<()> {
+pub fn write_npy<T: npyz::AutoSerialize + Copy>(
+    path: &Path,
+    shape: &[u64],
+    data: impl IntoIterator<Item = T>,
+) -> Result<()> {
     let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut w = npyz::WriteOptions::new()
         .default_dtype()
@@ -37,10 +42,22 @@ pub fn write_aovs(dir: &Path, width: u32, height: u32, aovs: &Aovs) -> Result<()
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (h, w) = (height as u64, width as u64);
     let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
-    write_npy(&dir.join("ray_origin.npy"), &[h, w, 3], flat3(&aovs.ray_origin))?;
-    write_npy(&dir.join("ray_direction.npy"), &[h, w, 3], flat3(&aovs.ray_direction))?;
+    write_npy(
+        &dir.join("ray_origin.npy"),
+        &[h, w, 3],
+        flat3(&aovs.ray_origin),
+    )?;
+    write_npy(
+        &dir.join("ray_direction.npy"),
+        &[h, w, 3],
+        flat3(&aovs.ray_direction),
+    )?;
     write_npy(&dir.join("hit_t.npy"), &[h, w], aovs.hit_t.iter().copied())?;
-    write_npy(&dir.join("triangle_id.npy"), &[h, w], aovs.triangle_id.iter().copied())?;
+    write_npy(
+        &dir.join("triangle_id.npy"),
+        &[h, w],
+        aovs.triangle_id.iter().copied(),
+    )?;
     write_npy(&dir.join("normal.npy"), &[h, w, 3], flat3(&aovs.normal))?;
     Ok(())
 }

@@ -19,7 +19,10 @@ fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
     let opts = options(w, h, 1);
     let gpu = render_gpu(&ctx, &scene, opts.clone());
     // every primary ray is tested against all triangles; no reflection, so no second pass
-    assert_eq!(gpu.stats.triangle_tests["intersect1"], (w * h) as u64 * 69451);
+    assert_eq!(
+        gpu.stats.triangle_tests["intersect1"],
+        (w * h) as u64 * 69451
+    );
     let cpu = render_cpu(&scene, &opts);
     assert_eq!(cpu.intersect1_tests, (w * h) as u64 * 69451);
     assert_close(&gpu, &cpu, "bunny");
@@ -27,8 +30,17 @@ fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
     // few pixels whose decisions differ in the last bits
     let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
     assert!(g2 > 0);
-    assert!((g2 as f64 - c2 as f64).abs() <= 0.01 * c2 as f64, "intersect2 {g2} vs {c2}");
-    for k in ["eye_ray_generation", "intersect1", "intersect2", "shading", "transform"] {
+    assert!(
+        (g2 as f64 - c2 as f64).abs() <= 0.01 * c2 as f64,
+        "intersect2 {g2} vs {c2}"
+    );
+    for k in [
+        "eye_ray_generation",
+        "intersect1",
+        "intersect2",
+        "shading",
+        "transform",
+    ] {
         assert!(gpu.stats.gpu_ms.contains_key(k), "no GPU time for {k}");
     }
 }
@@ -37,7 +49,11 @@ fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
 fn teapot_with_two_reflection_passes_matches_reference() {
     let ctx = context();
     let scene = load("teapot1.toml");
-    assert_eq!(scene.triangle_count(), 14592, "thesis ch. 5.1: 8192 floor + 6400 teapot");
+    assert_eq!(
+        scene.triangle_count(),
+        14592,
+        "thesis ch. 5.1: 8192 floor + 6400 teapot"
+    );
     let opts = options(64, 48, 2);
     let gpu = render_gpu(&ctx, &scene, opts.clone());
     let cpu = render_cpu(&scene, &opts);
@@ -45,10 +61,18 @@ fn teapot_with_two_reflection_passes_matches_reference() {
     // reflected rays were traced: more intersect1 tests than one per pixel and triangle
     let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
     assert!(g1 > 64 * 48 * 14592, "no reflection pass ran: {g1}");
-    assert!((g1 as f64 - c1 as f64).abs() <= 0.005 * c1 as f64, "intersect1 {g1} vs {c1}");
+    assert!(
+        (g1 as f64 - c1 as f64).abs() <= 0.005 * c1 as f64,
+        "intersect1 {g1} vs {c1}"
+    );
     // the reflective teapot shows the floor: its pixels differ from a render without reflection
     let flat = render_gpu(&ctx, &scene, options(64, 48, 0));
-    let changed = gpu.color.iter().zip(&flat.color).filter(|(a, b)| (a[0] - b[0]).abs() > 0.01).count();
+    let changed = gpu
+        .color
+        .iter()
+        .zip(&flat.color)
+        .filter(|(a, b)| (a[0] - b[0]).abs() > 0.01)
+        .count();
     assert!(changed > 50, "reflections changed only {changed} pixels");
 }
 
@@ -58,7 +82,8 @@ fn ring_of_lights(scene: &mut Scene, n: usize) {
             let a = i as f32 / n as f32 * std::f32::consts::TAU;
             Light {
                 position: Vec3::new(3.0 * a.cos(), 3.0 + (i % 3) as f32, 3.0 * a.sin()),
-                color: Vec3::splat(0.9 / n as f32 * 2.0) * Vec3::new(1.0, 0.6 + 0.4 * (i % 2) as f32, 0.8),
+                color: Vec3::splat(0.9 / n as f32 * 2.0)
+                    * Vec3::new(1.0, 0.6 + 0.4 * (i % 2) as f32, 0.8),
             }
         })
         .collect();
@@ -74,10 +99,16 @@ fn more_than_four_lights_with_bitwise_shadow_flags() {
     let cpu = render_cpu(&scene, &opts);
     assert_close(&gpu, &cpu, "cow with 37 lights");
     // the thesis' RGBA flags hold 4 lights: a clear error, not a silent drop
-    let err = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), gpgpu_rt::tracer::RenderOptions {
-        shadow_flags: ShadowFlags::Rgba,
-        ..opts.clone()
-    })
+    let err = BaseTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &ShaderSource::default(),
+        gpgpu_rt::tracer::RenderOptions {
+            shadow_flags: ShadowFlags::Rgba,
+            ..opts.clone()
+        },
+    )
     .err()
     .expect("37 lights must not fit the RGBA flags");
     assert!(format!("{err:#}").contains("at most 4"), "{err:#}");
@@ -89,7 +120,14 @@ fn thesis_rgba_flags_equal_bitwise_flags_for_four_lights() {
     let mut scene = load("teapot1.toml");
     ring_of_lights(&mut scene, 4);
     let bits = render_gpu(&ctx, &scene, options(48, 40, 1));
-    let rgba = render_gpu(&ctx, &scene, gpgpu_rt::tracer::RenderOptions { shadow_flags: ShadowFlags::Rgba, ..options(48, 40, 1) });
+    let rgba = render_gpu(
+        &ctx,
+        &scene,
+        gpgpu_rt::tracer::RenderOptions {
+            shadow_flags: ShadowFlags::Rgba,
+            ..options(48, 40, 1)
+        },
+    );
     assert_eq!(bits.color, rgba.color);
     let cpu = render_cpu(&scene, &options(48, 40, 1));
     assert_close(&rgba, &cpu, "teapot1 with 4 lights, RGBA flags");
@@ -99,8 +137,22 @@ fn thesis_rgba_flags_equal_bitwise_flags_for_four_lights() {
 fn tiling_does_not_change_the_image() {
     let ctx = context();
     let scene = load("cow.toml");
-    let whole = render_gpu(&ctx, &scene, gpgpu_rt::tracer::RenderOptions { tile: 0, ..options(72, 40, 1) });
-    let tiled = render_gpu(&ctx, &scene, gpgpu_rt::tracer::RenderOptions { tile: 16, ..options(72, 40, 1) });
+    let whole = render_gpu(
+        &ctx,
+        &scene,
+        gpgpu_rt::tracer::RenderOptions {
+            tile: 0,
+            ..options(72, 40, 1)
+        },
+    );
+    let tiled = render_gpu(
+        &ctx,
+        &scene,
+        gpgpu_rt::tracer::RenderOptions {
+            tile: 16,
+            ..options(72, 40, 1)
+        },
+    );
     assert_eq!(whole.color, tiled.color);
     assert_eq!(whole.stats.triangle_tests, tiled.stats.triangle_tests);
 }
@@ -110,10 +162,19 @@ fn moving_an_object_needs_only_its_model_matrix() {
     let ctx = context();
     let mut scene = load("teapot1.toml");
     let opts = options(48, 48, 1);
-    let mut tracer = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), opts.clone()).unwrap();
+    let mut tracer = BaseTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &ShaderSource::default(),
+        opts.clone(),
+    )
+    .unwrap();
     let before = tracer.render(&scene.camera).unwrap();
     // move and turn the teapot; the transform pass puts it into the SSBOs, no re-upload
-    let moved = Mat4::from_translation(Vec3::new(0.6, 0.0, -0.4)) * Mat4::from_rotation_y(0.7) * scene.objects[1].model;
+    let moved = Mat4::from_translation(Vec3::new(0.6, 0.0, -0.4))
+        * Mat4::from_rotation_y(0.7)
+        * scene.objects[1].model;
     tracer.set_model(1, moved);
     let after = tracer.render(&scene.camera).unwrap();
     assert_ne!(before.color, after.color);
@@ -126,7 +187,9 @@ fn textured_object_is_sampled_like_the_reference() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // a 16×8 texture with a distinct colour in every texel
-    let img = image::RgbaImage::from_fn(16, 8, |x, y| image::Rgba([(x * 16) as u8, (y * 32) as u8, ((x + y) * 8) as u8, 255]));
+    let img = image::RgbaImage::from_fn(16, 8, |x, y| {
+        image::Rgba([(x * 16) as u8, (y * 32) as u8, ((x + y) * 8) as u8, 255])
+    });
     img.save(d.join("tex.png")).unwrap();
     std::fs::write(d.join("quad.mtl"), "newmtl tex\nKd 1 1 1\nmap_Kd tex.png\n").unwrap();
     std::fs::write(
@@ -149,8 +212,16 @@ fn textured_object_is_sampled_like_the_reference() {
     let c = assert_close(&gpu, &cpu, "textured quad");
     assert!(c.hits > 1000);
     // the texture is really there: many distinct colours on the quad
-    let mut distinct: Vec<[u8; 3]> = gpu.color.iter().map(|c| [0, 1, 2].map(|k| (c[k] * 40.0) as u8)).collect();
+    let mut distinct: Vec<[u8; 3]> = gpu
+        .color
+        .iter()
+        .map(|c| [0, 1, 2].map(|k| (c[k] * 40.0) as u8))
+        .collect();
     distinct.sort();
     distinct.dedup();
-    assert!(distinct.len() > 30, "only {} distinct colours", distinct.len());
+    assert!(
+        distinct.len() > 30,
+        "only {} distinct colours",
+        distinct.len()
+    );
 }

@@ -7,11 +7,18 @@ use std::process::{Command, Output};
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 
 fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name).display().to_string()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .display()
+        .to_string()
 }
 
 fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("the binary runs")
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("the binary runs")
 }
 
 fn stderr(o: &Output) -> String {
@@ -39,21 +46,44 @@ fn render_writes_png_aovs_and_stats() {
     let aov = d.join("aov");
     let (w, h) = (40u64, 24u64);
     let o = run(&[
-        "render", &scene("cow.toml"), "-o", png.to_str().unwrap(), "--width", "40", "--height", "24",
-        "--aov-dir", aov.to_str().unwrap(), "--stats", stats.to_str().unwrap(),
+        "render",
+        &scene("cow.toml"),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "40",
+        "--height",
+        "24",
+        "--aov-dir",
+        aov.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(&png).unwrap();
     assert_eq!((img.width(), img.height()), (40, 24));
 
-    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
-    for key in ["renderer", "width", "height", "triangles", "lights", "tracer", "triangle_tests", "gpu_ms"] {
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in [
+        "renderer",
+        "width",
+        "height",
+        "triangles",
+        "lights",
+        "tracer",
+        "triangle_tests",
+        "gpu_ms",
+    ] {
         assert!(s.get(key).is_some(), "stats lack {key}: {s}");
     }
     assert_eq!(s["triangles"], 5804);
     assert_eq!(s["tracer"], "base");
     // one light, no reflection on the cow: every primary ray tests every triangle once
-    assert_eq!(s["triangle_tests"]["intersect1"].as_u64().unwrap(), w * h * 5804);
+    assert_eq!(
+        s["triangle_tests"]["intersect1"].as_u64().unwrap(),
+        w * h * 5804
+    );
     assert!(s["triangle_tests"]["intersect2"].as_u64().unwrap() > 0);
     assert!(s["gpu_ms"]["intersect1"].as_f64().unwrap() > 0.0);
 
@@ -67,7 +97,10 @@ fn render_writes_png_aovs_and_stats() {
     let (shape, normals) = read_npy_f32(&aov.join("normal.npy"));
     assert_eq!(shape, vec![h, w, 3]);
     let hits = ids.iter().filter(|&&i| i >= 0).count();
-    assert!(hits > 0 && hits < ids.len(), "the cow covers part of the image");
+    assert!(
+        hits > 0 && hits < ids.len(),
+        "the cow covers part of the image"
+    );
     // misses: +inf and -1; hits: finite t and an id below the triangle count
     for (k, (&id, &tk)) in ids.iter().zip(&t).enumerate() {
         if id < 0 {
@@ -86,17 +119,30 @@ fn render_writes_png_aovs_and_stats() {
     assert!(dirs[1] > dirs[3 * ((h - 1) * w) as usize + 1]);
     // the hit point o + t·d lies on the reported triangle (export-triangles gives the vertices)
     let tris = d.join("tris.npy");
-    let o2 = run(&["export-triangles", &scene("cow.toml"), "-o", tris.to_str().unwrap()]);
+    let o2 = run(&[
+        "export-triangles",
+        &scene("cow.toml"),
+        "-o",
+        tris.to_str().unwrap(),
+    ]);
     assert!(o2.status.success(), "{}", stderr(&o2));
     let (shape, v) = read_npy_f32(&tris);
     assert_eq!(shape, vec![5804, 3, 3]);
     let k = ids.iter().position(|&i| i >= 0).unwrap();
     let id = ids[k] as usize;
-    let p: Vec<f32> = (0..3).map(|c| origins[3 * k + c] + t[k] * dirs[3 * k + c]).collect();
-    let tri: Vec<&[f32]> = (0..3).map(|j| &v[9 * id + 3 * j..9 * id + 3 * j + 3]).collect();
+    let p: Vec<f32> = (0..3)
+        .map(|c| origins[3 * k + c] + t[k] * dirs[3 * k + c])
+        .collect();
+    let tri: Vec<&[f32]> = (0..3)
+        .map(|j| &v[9 * id + 3 * j..9 * id + 3 * j + 3])
+        .collect();
     let sub = |a: &[f32], b: &[f32]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let (e1, e2, ep) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]), sub(&p, tri[0]));
-    let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     let dist = (n[0] * ep[0] + n[1] * ep[1] + n[2] * ep[2]).abs() / len;
     assert!(dist < 1e-4, "hit point is {dist} off its triangle's plane");
@@ -131,28 +177,59 @@ fn bad_input_fails_with_file_and_line() {
     let d = dir.path();
     // missing scene file
     let missing = d.join("nope.toml");
-    assert_fails(&run(&["render", missing.to_str().unwrap(), "-o", "/dev/null"]), &["nope.toml"]);
+    assert_fails(
+        &run(&["render", missing.to_str().unwrap(), "-o", "/dev/null"]),
+        &["nope.toml"],
+    );
     // TOML syntax error on line 3
     let bad = d.join("bad.toml");
-    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, oops]\n\n[[object]]\ntype = \"floor\"\n").unwrap();
+    std::fs::write(
+        &bad,
+        "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, oops]\n\n[[object]]\ntype = \"floor\"\n",
+    )
+    .unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["bad.toml:3"]);
     // unknown key, reported at its line
     std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfocal = 3\n[[object]]\ntype = \"floor\"\n").unwrap();
-    assert_fails(&run(&["info", bad.to_str().unwrap()]), &["bad.toml:4", "focal"]);
+    assert_fails(
+        &run(&["info", bad.to_str().unwrap()]),
+        &["bad.toml:4", "focal"],
+    );
     // malformed OBJ: the bad line is named
     std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n").unwrap();
     std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"m.obj\"\n").unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["m.obj:3"]);
     // OBJ face index out of range
-    std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n").unwrap();
+    std::fs::write(
+        d.join("m.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
+    )
+    .unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["m.obj:5"]);
     // missing OBJ
     std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"gone.obj\"\n").unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["gone.obj"]);
     // unknown option
-    assert_fails(&run(&["render", &scene("cow.toml"), "--frobnicate"]), &["--frobnicate"]);
+    assert_fails(
+        &run(&["render", &scene("cow.toml"), "--frobnicate"]),
+        &["--frobnicate"],
+    );
     // bad tile size
-    assert_fails(&run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--tile", "12"]), &["--tile"]);
+    assert_fails(
+        &run(&[
+            "render",
+            &scene("cow.toml"),
+            "-o",
+            "/dev/null",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--tile",
+            "12",
+        ]),
+        &["--tile"],
+    );
     // more lights than the thesis' RGBA shadow flags hold
     let mut text = std::fs::read_to_string(scene("cow.toml")).unwrap();
     text = text.replace("models/cow.obj", &scene("models/cow.obj"));
@@ -161,20 +238,66 @@ fn bad_input_fails_with_file_and_line() {
     }
     std::fs::write(&bad, text).unwrap();
     assert_fails(
-        &run(&["render", bad.to_str().unwrap(), "-o", "/dev/null", "--width", "8", "--height", "8", "--shadow-flags", "rgba"]),
+        &run(&[
+            "render",
+            bad.to_str().unwrap(),
+            "-o",
+            "/dev/null",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--shadow-flags",
+            "rgba",
+        ]),
         &["6 lights", "at most 4"],
     );
     // buffers beyond the GL limits: named, with the limit
     assert_fails(
         &run(&[
-            "render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--tracer", "grid",
-            "--grid-variant", "thesis", "--grid", "64", "--voxel-array-length", "4096",
+            "render",
+            &scene("cow.toml"),
+            "-o",
+            "/dev/null",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--tracer",
+            "grid",
+            "--grid-variant",
+            "thesis",
+            "--grid",
+            "64",
+            "--voxel-array-length",
+            "4096",
         ]),
         &["voxelslist", "GL_MAX_SHADER_STORAGE_BLOCK_SIZE"],
     );
-    assert_fails(&run(&["render", &scene("cow.toml"), "--tracer", "grid", "--grid", "abc"]), &["abc"]);
     assert_fails(
-        &run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--tracer", "grid", "--grid-variant", "thesis", "--grid", "65"]),
+        &run(&[
+            "render",
+            &scene("cow.toml"),
+            "--tracer",
+            "grid",
+            "--grid",
+            "abc",
+        ]),
+        &["abc"],
+    );
+    assert_fails(
+        &run(&[
+            "render",
+            &scene("cow.toml"),
+            "-o",
+            "/dev/null",
+            "--tracer",
+            "grid",
+            "--grid-variant",
+            "thesis",
+            "--grid",
+            "65",
+        ]),
         &["--grid 65", "1..=64"],
     );
     // a GLSL error in an edited kernel names the file and line
@@ -183,9 +306,28 @@ fn bad_input_fails_with_file_and_line() {
     let shading = glsl.join("shading.comp");
     let src = std::fs::read_to_string(&shading).unwrap();
     let line = src.lines().position(|l| l.contains("void main()")).unwrap() + 1;
-    std::fs::write(&shading, src.replacen("void main()", "void main() { undefined_thing = 1; }\nvoid main2()", 1)).unwrap();
+    std::fs::write(
+        &shading,
+        src.replacen(
+            "void main()",
+            "void main() { undefined_thing = 1; }\nvoid main2()",
+            1,
+        ),
+    )
+    .unwrap();
     assert_fails(
-        &run(&["render", &scene("cow.toml"), "-o", "/dev/null", "--width", "8", "--height", "8", "--glsl-dir", glsl.to_str().unwrap()]),
+        &run(&[
+            "render",
+            &scene("cow.toml"),
+            "-o",
+            "/dev/null",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--glsl-dir",
+            glsl.to_str().unwrap(),
+        ]),
         &[&format!("shading.comp:{line}")],
     );
 }
@@ -212,7 +354,16 @@ fn every_shipped_scene_renders() {
             continue;
         }
         let out = dir.path().join("x.png");
-        let o = run(&["render", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "16", "--height", "16"]);
+        let o = run(&[
+            "render",
+            p.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ]);
         assert!(o.status.success(), "{}: {}", p.display(), stderr(&o));
         assert!(out.exists());
     }

@@ -18,7 +18,10 @@ use gpgpu_rt::tracer::{GridOptions, GridVariant, RenderOptions, Tracer};
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 40) as f32) / (1u64 << 24) as f32
     }
     fn point(&mut self) -> Vec3 {
@@ -32,9 +35,17 @@ fn segment_meets_box(a: Vec3, b: Vec3, lo: Vec3, hi: Vec3, interior: bool, eps: 
     let d = b - a;
     let (mut t0, mut t1) = (0.0f32, 1.0f32);
     for k in 0..3 {
-        let (l, h) = if interior { (lo[k], hi[k]) } else { (lo[k] - eps, hi[k] + eps) };
+        let (l, h) = if interior {
+            (lo[k], hi[k])
+        } else {
+            (lo[k] - eps, hi[k] + eps)
+        };
         if d[k].abs() < 1e-12 {
-            let inside = if interior { a[k] > l && a[k] < h } else { a[k] >= l && a[k] <= h };
+            let inside = if interior {
+                a[k] > l && a[k] < h
+            } else {
+                a[k] >= l && a[k] <= h
+            };
             if !inside {
                 return false;
             }
@@ -58,11 +69,18 @@ fn check_walk(g: &GridSpace, a: Vec3, b: Vec3) {
     let (vmin, vmax) = (g.clamp(g.get_voxel(a)), g.clamp(g.get_voxel(b)));
     let walk = g.traverse_connection(a, b, vmin, vmax);
     assert_eq!(walk[0], vmin);
-    assert_eq!(*walk.last().unwrap(), vmax, "walk {a} -> {b} does not end in the end voxel");
+    assert_eq!(
+        *walk.last().unwrap(),
+        vmax,
+        "walk {a} -> {b} does not end in the end voxel"
+    );
     let e = g.vx_edge();
     for w in walk.windows(2) {
         let step = w[1] - w[0];
-        assert!(step != IVec3::ZERO && step.abs().max_element() == 1, "not a unit move: {step}");
+        assert!(
+            step != IVec3::ZERO && step.abs().max_element() == 1,
+            "not a unit move: {step}"
+        );
     }
     let boxes = |v: IVec3| {
         let lo = v.as_vec3() * e - 1.0;
@@ -71,7 +89,10 @@ fn check_walk(g: &GridSpace, a: Vec3, b: Vec3) {
     // every visited voxel touches the segment
     for v in &walk {
         let (lo, hi) = boxes(*v);
-        assert!(segment_meets_box(a, b, lo, hi, false, 1e-4), "{a} -> {b} visits {v} it does not touch");
+        assert!(
+            segment_meets_box(a, b, lo, hi, false, 1e-4),
+            "{a} -> {b} visits {v} it does not touch"
+        );
     }
     // every voxel whose interior the segment crosses is visited (brute force over all voxels)
     let n = g.n as i32;
@@ -101,13 +122,19 @@ fn algorithms_2_and_3_match_a_brute_force_walk() {
     let cases = [
         (Vec3::new(-0.9, 0.1, 0.1), Vec3::new(0.9, 0.1, 0.1)),
         (Vec3::new(0.3, 0.9, -0.3), Vec3::new(0.3, -0.9, -0.3)),
-        (corner(1, 1, 1), corner(6, 6, 6)),               // through corners (Fig. 13b)
+        (corner(1, 1, 1), corner(6, 6, 6)), // through corners (Fig. 13b)
         (corner(1, 1, 1) + 0.01, corner(6, 6, 6) + 0.01), // diagonal, off the corners
-        (corner(1, 2, 0) + Vec3::new(0.01, 0.0, 0.1), corner(5, 6, 0) + Vec3::new(0.01, 0.0, 0.1)), // through edges (Fig. 13a)
+        (
+            corner(1, 2, 0) + Vec3::new(0.01, 0.0, 0.1),
+            corner(5, 6, 0) + Vec3::new(0.01, 0.0, 0.1),
+        ), // through edges (Fig. 13a)
         (corner(6, 1, 3), corner(1, 6, 3) + Vec3::new(0.0, 0.0, 0.05)), // mixed directions at edges
         (corner(7, 2, 2) + 0.05, corner(2, 7, 7) + 0.05), // -x, +y, +z through corners
         (Vec3::new(0.0, 0.0, -0.95), Vec3::new(0.0, 0.0, 0.95)), // on voxel edges all along
-        (corner(2, 3, 4), corner(2, 3, 4) + Vec3::new(0.0, 0.0, 3.0 * e)),
+        (
+            corner(2, 3, 4),
+            corner(2, 3, 4) + Vec3::new(0.0, 0.0, 3.0 * e),
+        ),
     ];
     for (a, b) in cases {
         check_walk(&g, a, b);
@@ -137,10 +164,16 @@ fn triangle_box_overlap_matches_dense_sampling() {
             }
         }
         if inside {
-            assert!(overlap, "a sample of {tri:?} lies in the box, the test says no overlap");
+            assert!(
+                overlap,
+                "a sample of {tri:?} lies in the box, the test says no overlap"
+            );
         }
         if overlap {
-            assert!(near, "the test says {tri:?} overlaps, no sample comes near the box");
+            assert!(
+                near,
+                "the test says {tri:?} overlaps, no sample comes near the box"
+            );
         }
     }
 }
@@ -157,7 +190,14 @@ fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
 }
 
 fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions) -> GridTracer {
-    GridTracer::new(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default(), opts).expect("grid tracer")
+    GridTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        scene,
+        &ShaderSource::default(),
+        opts,
+    )
+    .expect("grid tracer")
 }
 
 /// The GPU's voxel lists equal the CPU reference's, as sets per voxel.
@@ -186,9 +226,15 @@ fn check_lists(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, variant: GridVarian
         }
     }
     let refs: usize = expected.iter().map(|l| l.len()).sum();
-    assert!(refs > scene.triangle_count(), "{variant:?}: {refs} references");
+    assert!(
+        refs > scene.triangle_count(),
+        "{variant:?}: {refs} references"
+    );
     // f32 on GPU and CPU may put a triangle exactly on a voxel face on either side
-    assert!(differing <= (n * n * n) as usize / 500, "{variant:?}: {differing} voxel lists differ");
+    assert!(
+        differing <= (n * n * n) as usize / 500,
+        "{variant:?}: {differing} voxel lists differ"
+    );
 }
 
 #[test]
@@ -202,19 +248,54 @@ fn gpu_voxel_lists_match_the_reference() {
 #[test]
 fn exact_grid_gives_the_base_tracers_image() {
     let ctx = context();
-    for (name, n, refl) in [("teapot1.toml", 16, 1), ("bunny.toml", 24, 1), ("teapot3.toml", 20, 2)] {
+    for (name, n, refl) in [
+        ("teapot1.toml", 16, 1),
+        ("bunny.toml", 24, 1),
+        ("teapot3.toml", 20, 2),
+    ] {
         let scene = load(name);
         let base = render_gpu(&ctx, &scene, options(48, 40, refl));
-        let mut t = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: refl, ..grid_options(48, 40, GridVariant::Exact, n) });
+        let mut t = grid_tracer(
+            &ctx,
+            &scene,
+            RenderOptions {
+                refl_depth: refl,
+                ..grid_options(48, 40, GridVariant::Exact, n)
+            },
+        );
         let grid = t.render(&scene.camera).unwrap();
         let (a, b) = (base.aovs.unwrap(), grid.aovs.unwrap());
-        let differ = a.triangle_id.iter().zip(&b.triangle_id).filter(|(x, y)| x != y).count();
-        assert_eq!(differ, 0, "{name}: {differ} triangle ids differ from the base tracer");
+        let differ = a
+            .triangle_id
+            .iter()
+            .zip(&b.triangle_id)
+            .filter(|(x, y)| x != y)
+            .count();
+        assert_eq!(
+            differ, 0,
+            "{name}: {differ} triangle ids differ from the base tracer"
+        );
         assert_eq!(a.hit_t, b.hit_t, "{name}");
-        let colour_diff = base.color.iter().zip(&grid.color).map(|(x, y)| (x[0] - y[0]).abs().max((x[1] - y[1]).abs()).max((x[2] - y[2]).abs())).fold(0.0f32, f32::max);
-        assert!(colour_diff < 1e-4, "{name}: colours differ by {colour_diff}");
+        let colour_diff = base
+            .color
+            .iter()
+            .zip(&grid.color)
+            .map(|(x, y)| {
+                (x[0] - y[0])
+                    .abs()
+                    .max((x[1] - y[1]).abs())
+                    .max((x[2] - y[2]).abs())
+            })
+            .fold(0.0f32, f32::max);
+        assert!(
+            colour_diff < 1e-4,
+            "{name}: colours differ by {colour_diff}"
+        );
         // far fewer tests
-        let (tb, tg) = (base.stats.total_triangle_tests(), grid.stats.total_triangle_tests());
+        let (tb, tg) = (
+            base.stats.total_triangle_tests(),
+            grid.stats.total_triangle_tests(),
+        );
         assert!(tg * 10 < tb, "{name}: grid {tg} vs base {tb} tests");
         assert!(grid.stats.events["voxels_visited"] > 0);
         assert_eq!(grid.stats.events["dropped_triangle_refs"], 0);
@@ -243,15 +324,48 @@ fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
     let scene = big_triangle_scene(dir.path());
     let ctx = context();
     let base = render_gpu(&ctx, &scene, options(48, 48, 0));
-    let hits = |f: &gpgpu_rt::tracer::Frame| f.aovs.as_ref().unwrap().triangle_id.iter().filter(|&&i| i >= 0).count();
-    let mut thesis = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: 0, ..grid_options(48, 48, GridVariant::Thesis, 16) });
-    let mut exact = grid_tracer(&ctx, &scene, RenderOptions { refl_depth: 0, ..grid_options(48, 48, GridVariant::Exact, 16) });
-    let (ft, fe) = (thesis.render(&scene.camera).unwrap(), exact.render(&scene.camera).unwrap());
+    let hits = |f: &gpgpu_rt::tracer::Frame| {
+        f.aovs
+            .as_ref()
+            .unwrap()
+            .triangle_id
+            .iter()
+            .filter(|&&i| i >= 0)
+            .count()
+    };
+    let mut thesis = grid_tracer(
+        &ctx,
+        &scene,
+        RenderOptions {
+            refl_depth: 0,
+            ..grid_options(48, 48, GridVariant::Thesis, 16)
+        },
+    );
+    let mut exact = grid_tracer(
+        &ctx,
+        &scene,
+        RenderOptions {
+            refl_depth: 0,
+            ..grid_options(48, 48, GridVariant::Exact, 16)
+        },
+    );
+    let (ft, fe) = (
+        thesis.render(&scene.camera).unwrap(),
+        exact.render(&scene.camera).unwrap(),
+    );
     assert!(hits(&base) > 1500, "the quad fills most of the image");
     assert_eq!(hits(&fe), hits(&base), "the exact grid sees the whole quad");
     // edge-only registration: the quad's interior voxels hold no triangle, rays pass through
-    assert!(hits(&ft) < hits(&base) / 2, "thesis grid: {} of {} hits", hits(&ft), hits(&base));
-    assert_eq!(ft.stats.events["dropped_triangle_refs"], 0, "the holes are not list overflows");
+    assert!(
+        hits(&ft) < hits(&base) / 2,
+        "thesis grid: {} of {} hits",
+        hits(&ft),
+        hits(&base)
+    );
+    assert_eq!(
+        ft.stats.events["dropped_triangle_refs"], 0,
+        "the holes are not list overflows"
+    );
 }
 
 #[test]
@@ -285,15 +399,34 @@ fn moving_object_is_rebuilt_every_frame() {
     let mut scene = load("teapot1.toml");
     let opts = grid_options(40, 40, GridVariant::Exact, 16);
     let mut grid = grid_tracer(&ctx, &scene, opts.clone());
-    let mut base = BaseTracer::new(ctx.gl.clone(), &ctx.info, &scene, &ShaderSource::default(), opts).unwrap();
+    let mut base = BaseTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &ShaderSource::default(),
+        opts,
+    )
+    .unwrap();
     let first = grid.render(&scene.camera).unwrap();
     // lift the teapot far up: the scene's bounds change, the grid follows
-    let moved = Mat4::from_translation(Vec3::new(0.5, 1.5, -0.5)) * Mat4::from_rotation_y(1.0) * scene.objects[1].model;
+    let moved = Mat4::from_translation(Vec3::new(0.5, 1.5, -0.5))
+        * Mat4::from_rotation_y(1.0)
+        * scene.objects[1].model;
     grid.set_model(1, moved);
     base.set_model(1, moved);
-    let (g, b) = (grid.render(&scene.camera).unwrap(), base.render(&scene.camera).unwrap());
+    let (g, b) = (
+        grid.render(&scene.camera).unwrap(),
+        base.render(&scene.camera).unwrap(),
+    );
     assert_ne!(first.color, g.color);
-    assert_eq!(g.aovs.as_ref().unwrap().triangle_id, b.aovs.as_ref().unwrap().triangle_id);
+    assert_eq!(
+        g.aovs.as_ref().unwrap().triangle_id,
+        b.aovs.as_ref().unwrap().triangle_id
+    );
     scene.objects[1].model = moved;
-    assert_close(&g, &render_cpu(&scene, &options(40, 40, 1)), "moved teapot, grid");
+    assert_close(
+        &g,
+        &render_cpu(&scene, &options(40, 40, 1)),
+        "moved teapot, grid",
+    );
 }

@@ -35,6 +35,7 @@
 //! 3. Add a variant with `#[value(name = "klee-table1")]` to [`ProtocolId`] and its line in
 //!    [`ProtocolId::protocol`]; mention it in the README's benchmark section.
 
+pub mod klee;
 pub mod machine;
 pub mod plots;
 pub mod published;
@@ -45,7 +46,6 @@ pub mod sweep;
 pub mod thesis_5_1;
 pub mod thesis_5_2;
 pub mod thesis_5_3;
-pub mod klee;
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -194,7 +194,11 @@ where
         .label_style((FONT, 12))
         .x_label_formatter(&|v| si(*v))
         .y_label_formatter(&|v| si(*v))
-        .light_line_style(if chart.log_y { WHITE } else { RGBColor(235, 235, 235) })
+        .light_line_style(if chart.log_y {
+            WHITE
+        } else {
+            RGBColor(235, 235, 235)
+        })
         .draw()
         .map_err(|e| err(&e))?;
     for s in &chart.series {

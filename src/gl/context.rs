@@ -227,9 +227,7 @@ impl Gl {
             clear_buffer_data: std::mem::transmute::<*const c_void, ClearBufferDataFn>(
                 clear_buffer_data,
             ),
-            clear_tex_image: std::mem::transmute::<*const c_void, ClearTexImageFn>(
-                clear_tex_image,
-            ),
+            clear_tex_image: std::mem::transmute::<*const c_void, ClearTexImageFn>(clear_tex_image),
             get_query_iv: std::mem::transmute::<*const c_void, GetQueryIvFn>(get_query_iv),
             get_query_object_u64: std::mem::transmute::<*const c_void, GetQueryObjectU64Fn>(
                 get_query_object_u64,

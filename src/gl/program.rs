@@ -17,39 +17,114 @@ use super::context::Gl;
 
 /// The kernel files compiled into the binary, keyed by their path below `glsl/`.
 pub const EMBEDDED: &[(&str, &str)] = &[
-    ("common/scene.glsl", include_str!("../../glsl/common/scene.glsl")),
-    ("common/images.glsl", include_str!("../../glsl/common/images.glsl")),
-    ("common/intersect.glsl", include_str!("../../glsl/common/intersect.glsl")),
-    ("common/counters.glsl", include_str!("../../glsl/common/counters.glsl")),
-    ("common/intersect_head.glsl", include_str!("../../glsl/common/intersect_head.glsl")),
-    ("common/intersect1_main.glsl", include_str!("../../glsl/common/intersect1_main.glsl")),
-    ("common/intersect2_main.glsl", include_str!("../../glsl/common/intersect2_main.glsl")),
-    ("common/grid.glsl", include_str!("../../glsl/common/grid.glsl")),
-    ("common/voxelwalk.glsl", include_str!("../../glsl/common/voxelwalk.glsl")),
-    ("common/tribox.glsl", include_str!("../../glsl/common/tribox.glsl")),
-    ("common/grid_overlap.glsl", include_str!("../../glsl/common/grid_overlap.glsl")),
-    ("common/dda.glsl", include_str!("../../glsl/common/dda.glsl")),
-    ("eye_ray_generation.comp", include_str!("../../glsl/eye_ray_generation.comp")),
-    ("intersect1.comp", include_str!("../../glsl/intersect1.comp")),
-    ("intersect2.comp", include_str!("../../glsl/intersect2.comp")),
+    (
+        "common/scene.glsl",
+        include_str!("../../glsl/common/scene.glsl"),
+    ),
+    (
+        "common/images.glsl",
+        include_str!("../../glsl/common/images.glsl"),
+    ),
+    (
+        "common/intersect.glsl",
+        include_str!("../../glsl/common/intersect.glsl"),
+    ),
+    (
+        "common/counters.glsl",
+        include_str!("../../glsl/common/counters.glsl"),
+    ),
+    (
+        "common/intersect_head.glsl",
+        include_str!("../../glsl/common/intersect_head.glsl"),
+    ),
+    (
+        "common/intersect1_main.glsl",
+        include_str!("../../glsl/common/intersect1_main.glsl"),
+    ),
+    (
+        "common/intersect2_main.glsl",
+        include_str!("../../glsl/common/intersect2_main.glsl"),
+    ),
+    (
+        "common/grid.glsl",
+        include_str!("../../glsl/common/grid.glsl"),
+    ),
+    (
+        "common/voxelwalk.glsl",
+        include_str!("../../glsl/common/voxelwalk.glsl"),
+    ),
+    (
+        "common/tribox.glsl",
+        include_str!("../../glsl/common/tribox.glsl"),
+    ),
+    (
+        "common/grid_overlap.glsl",
+        include_str!("../../glsl/common/grid_overlap.glsl"),
+    ),
+    (
+        "common/dda.glsl",
+        include_str!("../../glsl/common/dda.glsl"),
+    ),
+    (
+        "eye_ray_generation.comp",
+        include_str!("../../glsl/eye_ray_generation.comp"),
+    ),
+    (
+        "intersect1.comp",
+        include_str!("../../glsl/intersect1.comp"),
+    ),
+    (
+        "intersect2.comp",
+        include_str!("../../glsl/intersect2.comp"),
+    ),
     ("shading.comp", include_str!("../../glsl/shading.comp")),
     ("build.comp", include_str!("../../glsl/build.comp")),
     ("traversal.comp", include_str!("../../glsl/traversal.comp")),
-    ("intersect1_grid.comp", include_str!("../../glsl/intersect1_grid.comp")),
-    ("intersect2_grid.comp", include_str!("../../glsl/intersect2_grid.comp")),
-    ("grid_count.comp", include_str!("../../glsl/grid_count.comp")),
+    (
+        "intersect1_grid.comp",
+        include_str!("../../glsl/intersect1_grid.comp"),
+    ),
+    (
+        "intersect2_grid.comp",
+        include_str!("../../glsl/intersect2_grid.comp"),
+    ),
+    (
+        "grid_count.comp",
+        include_str!("../../glsl/grid_count.comp"),
+    ),
     ("grid_scan.comp", include_str!("../../glsl/grid_scan.comp")),
     ("grid_fill.comp", include_str!("../../glsl/grid_fill.comp")),
-    ("intersect1_dda.comp", include_str!("../../glsl/intersect1_dda.comp")),
-    ("intersect2_dda.comp", include_str!("../../glsl/intersect2_dda.comp")),
+    (
+        "intersect1_dda.comp",
+        include_str!("../../glsl/intersect1_dda.comp"),
+    ),
+    (
+        "intersect2_dda.comp",
+        include_str!("../../glsl/intersect2_dda.comp"),
+    ),
     ("transform.vert", include_str!("../../glsl/transform.vert")),
     ("gbuffer.vert", include_str!("../../glsl/gbuffer.vert")),
     ("gbuffer.frag", include_str!("../../glsl/gbuffer.frag")),
-    ("linespace_shadow.comp", include_str!("../../glsl/linespace_shadow.comp")),
-    ("linespace_quad.vert", include_str!("../../glsl/linespace_quad.vert")),
-    ("linespace_quad.frag", include_str!("../../glsl/linespace_quad.frag")),
-    ("screen_quad.vert", include_str!("../../glsl/screen_quad.vert")),
-    ("screen_quad.frag", include_str!("../../glsl/screen_quad.frag")),
+    (
+        "linespace_shadow.comp",
+        include_str!("../../glsl/linespace_shadow.comp"),
+    ),
+    (
+        "linespace_quad.vert",
+        include_str!("../../glsl/linespace_quad.vert"),
+    ),
+    (
+        "linespace_quad.frag",
+        include_str!("../../glsl/linespace_quad.frag"),
+    ),
+    (
+        "screen_quad.vert",
+        include_str!("../../glsl/screen_quad.vert"),
+    ),
+    (
+        "screen_quad.frag",
+        include_str!("../../glsl/screen_quad.frag"),
+    ),
 ];
 
 /// Where kernel sources come from.
@@ -107,7 +182,13 @@ impl ShaderSource {
         Ok((out, map))
     }
 
-    fn include(&self, name: &str, out: &mut String, map: &mut LineMap, stack: &mut Vec<String>) -> Result<()> {
+    fn include(
+        &self,
+        name: &str,
+        out: &mut String,
+        map: &mut LineMap,
+        stack: &mut Vec<String>,
+    ) -> Result<()> {
         if stack.iter().any(|s| s == name) {
             bail!("#include cycle: {} -> {name}", stack.join(" -> "));
         }
@@ -119,12 +200,18 @@ impl ShaderSource {
             if let Some(rest) = trimmed.strip_prefix("#include") {
                 let target = rest.trim().trim_matches('"');
                 if target.is_empty() {
-                    bail!("{}:{}: malformed #include", self.display_name(name), lineno + 1);
+                    bail!(
+                        "{}:{}: malformed #include",
+                        self.display_name(name),
+                        lineno + 1
+                    );
                 }
                 let dir = Path::new(name).parent().unwrap_or(Path::new(""));
                 let target = dir.join(target).to_string_lossy().replace('\\', "/");
                 self.include(&normalize(&target), out, map, stack)
-                    .with_context(|| format!("included from {}:{}", self.display_name(name), lineno + 1))?;
+                    .with_context(|| {
+                        format!("included from {}:{}", self.display_name(name), lineno + 1)
+                    })?;
             } else {
                 if trimmed.starts_with("#version") {
                     // the header carries the version
@@ -181,7 +268,9 @@ impl LineMap {
 
     /// The origin of assembled line `line` (1-based).
     pub fn origin(&self, line: usize) -> Option<(&str, usize)> {
-        self.0.get(line.checked_sub(1)?).map(|(f, l)| (f.as_str(), *l))
+        self.0
+            .get(line.checked_sub(1)?)
+            .map(|(f, l)| (f.as_str(), *l))
     }
 
     pub fn files(&self) -> impl Iterator<Item = &str> {
@@ -241,7 +330,10 @@ pub fn compile_program(
                 let log = map_log(&gl.get_shader_info_log(shader), &lines);
                 gl.delete_shader(shader);
                 gl.delete_program(program);
-                bail!("GLSL compile error in {}:\n{log}", source.display_name(name));
+                bail!(
+                    "GLSL compile error in {}:\n{log}",
+                    source.display_name(name)
+                );
             }
             gl.attach_shader(program, shader);
             shaders.push(shader);
@@ -297,10 +389,21 @@ mod tests {
         assert!(!text.contains("#include"));
         assert_eq!(text.lines().count(), map.0.len());
         // an assembled line maps back to the same text in its file
-        let k = text.lines().position(|l| l.contains("bool intersectTriangle(")).unwrap();
+        let k = text
+            .lines()
+            .position(|l| l.contains("bool intersectTriangle("))
+            .unwrap();
         let (f, l) = map.origin(k + 1).unwrap();
         assert_eq!(f, "glsl/common/intersect.glsl");
-        let orig = EMBEDDED.iter().find(|(n, _)| *n == "common/intersect.glsl").unwrap().1;
-        assert!(orig.lines().nth(l - 1).unwrap().contains("bool intersectTriangle("));
+        let orig = EMBEDDED
+            .iter()
+            .find(|(n, _)| *n == "common/intersect.glsl")
+            .unwrap()
+            .1;
+        assert!(orig
+            .lines()
+            .nth(l - 1)
+            .unwrap()
+            .contains("bool intersectTriangle("));
     }
 }

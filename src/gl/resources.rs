@@ -18,7 +18,13 @@ pub struct Ssbo {
 impl Ssbo {
     /// Allocate `bytes` (at least 16) of immutable storage, optionally filled with `data`,
     /// after checking the size against `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`.
-    pub fn new(gl: &Gl, name: &'static str, bytes: usize, data: Option<&[u8]>, max_block: i64) -> Result<Ssbo> {
+    pub fn new(
+        gl: &Gl,
+        name: &'static str,
+        bytes: usize,
+        data: Option<&[u8]>,
+        max_block: i64,
+    ) -> Result<Ssbo> {
         let bytes = bytes.max(16);
         if bytes as i64 > max_block {
             bail!(
@@ -43,9 +49,18 @@ impl Ssbo {
                 }
                 d => d,
             };
-            gl.buffer_storage(glow::SHADER_STORAGE_BUFFER, bytes as i32, data, glow::DYNAMIC_STORAGE_BIT);
+            gl.buffer_storage(
+                glow::SHADER_STORAGE_BUFFER,
+                bytes as i32,
+                data,
+                glow::DYNAMIC_STORAGE_BIT,
+            );
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
-            Ok(Ssbo { buffer, bytes, name })
+            Ok(Ssbo {
+                buffer,
+                bytes,
+                name,
+            })
         }
     }
 
@@ -95,17 +110,38 @@ impl Image2d {
             let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_2D, Some(texture));
             gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+            gl.tex_parameter_i32(
+                glow::TEXTURE_2D,
+                glow::TEXTURE_MIN_FILTER,
+                glow::NEAREST as i32,
+            );
+            gl.tex_parameter_i32(
+                glow::TEXTURE_2D,
+                glow::TEXTURE_MAG_FILTER,
+                glow::NEAREST as i32,
+            );
             gl.bind_texture(glow::TEXTURE_2D, None);
-            Ok(Image2d { texture, width, height, format })
+            Ok(Image2d {
+                texture,
+                width,
+                height,
+                format,
+            })
         }
     }
 
     pub fn bind_image(&self, gl: &Gl, unit: u32) {
         // SAFETY: binding an existing texture to an image unit.
         unsafe {
-            gl.bind_image_texture(unit, Some(self.texture), 0, false, 0, glow::READ_WRITE, self.format)
+            gl.bind_image_texture(
+                unit,
+                Some(self.texture),
+                0,
+                false,
+                0,
+                glow::READ_WRITE,
+                self.format,
+            )
         };
     }
 
@@ -176,7 +212,9 @@ impl GpuTimers {
     pub fn resolve(&mut self, gl: &Gl) -> BTreeMap<String, f64> {
         let mut out = BTreeMap::new();
         for (name, a, b) in std::mem::take(&mut self.pending) {
-            let ns = gl.query_result_u64(b).saturating_sub(gl.query_result_u64(a));
+            let ns = gl
+                .query_result_u64(b)
+                .saturating_sub(gl.query_result_u64(a));
             *out.entry(name.to_string()).or_insert(0.0) += ns as f64 / 1e6;
             self.free.push(a);
             self.free.push(b);
@@ -186,7 +224,11 @@ impl GpuTimers {
 
     pub fn delete(&mut self, gl: &Gl) {
         let pending = std::mem::take(&mut self.pending);
-        for q in self.free.drain(..).chain(pending.into_iter().flat_map(|p| [p.1, p.2])) {
+        for q in self
+            .free
+            .drain(..)
+            .chain(pending.into_iter().flat_map(|p| [p.1, p.2]))
+        {
             // SAFETY: deleting our own queries.
             unsafe { gl.delete_query(q) };
         }

@@ -39,7 +39,13 @@ impl GridSpace {
     /// vox_max (start voxel first). Equal crossing parameters (the segment passes a voxel edge
     /// or corner, Fig. 13): the moves along axes with positive direction are made together
     /// first, then those with negative direction.
-    pub fn traverse_connection(&self, a: Vec3, b: Vec3, vox_min: IVec3, vox_max: IVec3) -> Vec<IVec3> {
+    pub fn traverse_connection(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        vox_min: IVec3,
+        vox_max: IVec3,
+    ) -> Vec<IVec3> {
         let rd = b - a;
         let t_max = 1.0f32;
         let mut list: Vec<(f32, usize)> = Vec::new();
@@ -174,7 +180,11 @@ pub fn tri_box_overlap(center: Vec3, half: Vec3, tri: [Vec3; 3]) -> bool {
         return false;
     }
     for e in e {
-        for axis in [Vec3::new(0.0, -e.z, e.y), Vec3::new(e.z, 0.0, -e.x), Vec3::new(-e.y, e.x, 0.0)] {
+        for axis in [
+            Vec3::new(0.0, -e.z, e.y),
+            Vec3::new(e.z, 0.0, -e.x),
+            Vec3::new(-e.y, e.x, 0.0),
+        ] {
             if axis_separates(axis, v, half) {
                 return false;
             }

@@ -38,7 +38,13 @@ pub struct ReferenceFrame {
 
 /// Algorithm 1 (Möller–Trumbore without a determinant epsilon), as `glsl/common/intersect.glsl`.
 #[inline]
-pub fn intersect_triangle(r0: Vec3, rd: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<(f32, f32, f32)> {
+pub fn intersect_triangle(
+    r0: Vec3,
+    rd: Vec3,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+) -> Option<(f32, f32, f32)> {
     let edge1 = v1 - v0;
     let edge2 = v2 - v0;
     let pvec = rd.cross(edge2);
@@ -69,7 +75,14 @@ impl Reference {
             materials: scene
                 .materials
                 .iter()
-                .map(|m| Vec4::new(m.reflection, m.specular, m.shininess, m.texture.map(|t| t as f32).unwrap_or(-1.0)))
+                .map(|m| {
+                    Vec4::new(
+                        m.reflection,
+                        m.specular,
+                        m.shininess,
+                        m.texture.map(|t| t as f32).unwrap_or(-1.0),
+                    )
+                })
                 .collect(),
             lights: scene.lights.iter().map(|l| (l.position, l.color)).collect(),
             layers: scene.texture_layers(16384),
@@ -167,13 +180,15 @@ impl Reference {
                 Some((t, id, u, v)) => {
                     let w = 1.0 - u - v;
                     let k = 3 * id;
-                    let mut n = (w * a.normals[k] + u * a.normals[k + 1] + v * a.normals[k + 2]).normalize();
+                    let mut n = (w * a.normals[k] + u * a.normals[k + 1] + v * a.normals[k + 2])
+                        .normalize();
                     if n.dot(rd) > 0.0 {
                         n = -n;
                     }
                     let mat = self.materials[a.triangle_material[id] as usize];
                     let color = if mat.w >= 0.0 {
-                        let uv = w * a.texcoords[k] + u * a.texcoords[k + 1] + v * a.texcoords[k + 2];
+                        let uv =
+                            w * a.texcoords[k] + u * a.texcoords[k + 1] + v * a.texcoords[k + 2];
                         self.sample(mat.w as usize, uv)
                     } else {
                         w * a.colors[k] + u * a.colors[k + 1] + v * a.colors[k + 2]
@@ -222,7 +237,13 @@ impl Reference {
     }
 
     /// Render a `width`×`height` frame with `refl_depth` reflection passes.
-    pub fn render(&self, camera: &Camera, width: u32, height: u32, refl_depth: u32) -> ReferenceFrame {
+    pub fn render(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        refl_depth: u32,
+    ) -> ReferenceFrame {
         let cam = camera.rays(width, height);
         let pixels: Vec<(PixelResult, (Vec3, Vec3))> = (0..height)
             .into_par_iter()
@@ -275,7 +296,8 @@ mod tests {
     #[test]
     fn algorithm1_hits_inside_and_misses_outside() {
         let (v0, v1, v2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let (t, u, v) = intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, v0, v1, v2).unwrap();
+        let (t, u, v) =
+            intersect_triangle(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z, v0, v1, v2).unwrap();
         assert!((t - 1.0).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.25).abs() < 1e-6);
         assert!(intersect_triangle(Vec3::new(0.75, 0.75, 1.0), -Vec3::Z, v0, v1, v2).is_none());
         // behind the origin: t < 0 is no hit

@@ -54,7 +54,10 @@ impl Camera {
             return Err("camera.up is parallel to the viewing direction".into());
         }
         if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
-            return Err(format!("camera.fov_y = {} must lie in (0, 180) degrees", self.fov_y));
+            return Err(format!(
+                "camera.fov_y = {} must lie in (0, 180) degrees",
+                self.fov_y
+            ));
         }
         if self.near.is_nan() || self.near <= 0.0 {
             return Err(format!("camera.near = {} must be positive", self.near));

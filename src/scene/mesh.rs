@@ -89,7 +89,11 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
             .collect(),
         Err(tobj::LoadError::OpenFileFailed) => Vec::new(),
         Err(e) => {
-            return Err(SceneError::at(path, None, format!("cannot load its MTL file: {e}")))
+            return Err(SceneError::at(
+                path,
+                None,
+                format!("cannot load its MTL file: {e}"),
+            ))
         }
     };
     let none = materials.len() as u32;
@@ -98,11 +102,20 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
     for model in &models {
         let m = &model.mesh;
         let count = m.positions.len() / 3;
-        let pos = |i: usize| Vec3::new(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]);
+        let pos = |i: usize| {
+            Vec3::new(
+                m.positions[3 * i],
+                m.positions[3 * i + 1],
+                m.positions[3 * i + 2],
+            )
+        };
         // smooth normals (area weighted) when the file has none
         let normals: Vec<Vec3> = if m.normals.len() == m.positions.len() {
             (0..count)
-                .map(|i| Vec3::new(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]).normalize_or_zero())
+                .map(|i| {
+                    Vec3::new(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2])
+                        .normalize_or_zero()
+                })
                 .collect()
         } else {
             let mut acc = vec![Vec3::ZERO; count];
@@ -128,10 +141,20 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
             let p = idx.map(pos);
             // a face whose normals are all zero (degenerate) gets its geometric normal
             let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-            let n = idx.map(|i| if normals[i] == Vec3::ZERO { geo } else { normals[i] });
+            let n = idx.map(|i| {
+                if normals[i] == Vec3::ZERO {
+                    geo
+                } else {
+                    normals[i]
+                }
+            });
             let c = idx.map(|i| {
                 if vcol {
-                    Vec3::new(m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2])
+                    Vec3::new(
+                        m.vertex_color[3 * i],
+                        m.vertex_color[3 * i + 1],
+                        m.vertex_color[3 * i + 2],
+                    )
                 } else {
                     diffuse
                 }
@@ -147,7 +170,11 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
         }
     }
     if mesh.positions.is_empty() {
-        return Err(SceneError::at(path, None, "the OBJ file has no faces".into()));
+        return Err(SceneError::at(
+            path,
+            None,
+            "the OBJ file has no faces".into(),
+        ));
     }
     Ok(LoadedObj {
         mesh,
@@ -167,7 +194,8 @@ fn locate_obj_error(path: &Path) -> (Option<usize>, String) {
         let mut it = line.split_whitespace();
         let Some(tag) = it.next() else { continue };
         let rest: Vec<&str> = it.collect();
-        let floats_ok = |min: usize| rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok());
+        let floats_ok =
+            |min: usize| rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok());
         let bad = match tag {
             "v" => {
                 nv += 1;
@@ -241,7 +269,13 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
         let c = ["x", "y", "z"].map(|k| scalar(v.get(k)));
         match c {
             [Some(x), Some(y), Some(z)] => pos.push(Vec3::new(x as f32, y as f32, z as f32)),
-            _ => return Err(SceneError::at(path, None, format!("vertex {i} lacks numeric x, y, z"))),
+            _ => {
+                return Err(SceneError::at(
+                    path,
+                    None,
+                    format!("vertex {i} lacks numeric x, y, z"),
+                ))
+            }
         }
     }
     let faces = ply.payload.get("face").unwrap_or(&empty);
@@ -253,13 +287,22 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
             Some(Property::ListShort(v)) => v.iter().map(|x| *x as i64).collect(),
             Some(Property::ListUShort(v)) => v.iter().map(|x| *x as i64).collect(),
             Some(Property::ListUChar(v)) => v.iter().map(|x| *x as i64).collect(),
-            _ => return Err(SceneError::at(path, None, format!("face {i} lacks a vertex_indices list"))),
+            _ => {
+                return Err(SceneError::at(
+                    path,
+                    None,
+                    format!("face {i} lacks a vertex_indices list"),
+                ))
+            }
         };
         if idx.len() < 3 || idx.iter().any(|&k| k < 0 || k as usize >= pos.len()) {
             return Err(SceneError::at(
                 path,
                 None,
-                format!("face {i} has indices {idx:?}: needs at least 3, each below {} vertices", pos.len()),
+                format!(
+                    "face {i} has indices {idx:?}: needs at least 3, each below {} vertices",
+                    pos.len()
+                ),
             ));
         }
         for k in 1..idx.len() - 1 {
@@ -267,7 +310,11 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
         }
     }
     if tris.is_empty() {
-        return Err(SceneError::at(path, None, "the PLY file has no faces".into()));
+        return Err(SceneError::at(
+            path,
+            None,
+            "the PLY file has no faces".into(),
+        ));
     }
     let mut acc = vec![Vec3::ZERO; pos.len()];
     for t in &tris {
@@ -280,7 +327,11 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
         let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
         let n = t.map(|k| {
             let n = acc[k].normalize_or_zero();
-            if n == Vec3::ZERO { geo } else { n }
+            if n == Vec3::ZERO {
+                geo
+            } else {
+                n
+            }
         });
         mesh.push_triangle(p, n, [Vec3::splat(0.8); 3], [Vec2::ZERO; 3], 0);
     }
@@ -330,29 +381,49 @@ pub fn teapot(path: &Path, n: u32) -> Result<Mesh, SceneError> {
 }
 
 fn parse_bpt(path: &Path, text: &str) -> Result<Vec<[Vec3; 16]>, SceneError> {
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
     let err = |line: usize, msg: String| SceneError::at(path, Some(line + 1), msg);
-    let (l0, first) = lines.next().ok_or_else(|| SceneError::at(path, None, "empty patch file".into()))?;
-    let count: usize = first
-        .trim()
-        .parse()
-        .map_err(|_| err(l0, format!("expected the patch count, found `{}`", first.trim())))?;
+    let (l0, first) = lines
+        .next()
+        .ok_or_else(|| SceneError::at(path, None, "empty patch file".into()))?;
+    let count: usize = first.trim().parse().map_err(|_| {
+        err(
+            l0,
+            format!("expected the patch count, found `{}`", first.trim()),
+        )
+    })?;
     let mut patches = Vec::with_capacity(count);
     for _ in 0..count {
-        let (ln, deg) = lines
-            .next()
-            .ok_or_else(|| SceneError::at(path, None, format!("file ends before patch {} of {count}", patches.len() + 1)))?;
+        let (ln, deg) = lines.next().ok_or_else(|| {
+            SceneError::at(
+                path,
+                None,
+                format!("file ends before patch {} of {count}", patches.len() + 1),
+            )
+        })?;
         if deg.split_whitespace().collect::<Vec<_>>() != ["3", "3"] {
-            return Err(err(ln, format!("expected `3 3` (bicubic patch), found `{}`", deg.trim())));
+            return Err(err(
+                ln,
+                format!("expected `3 3` (bicubic patch), found `{}`", deg.trim()),
+            ));
         }
         let mut cp = [Vec3::ZERO; 16];
         for p in cp.iter_mut() {
             let (ln, l) = lines
                 .next()
                 .ok_or_else(|| SceneError::at(path, None, "file ends inside a patch".into()))?;
-            let v: Vec<f32> = l.split_whitespace().filter_map(|s| s.parse().ok()).collect();
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .filter_map(|s| s.parse().ok())
+                .collect();
             if v.len() != 3 || l.split_whitespace().count() != 3 {
-                return Err(err(ln, format!("expected a control point `x y z`, found `{}`", l.trim())));
+                return Err(err(
+                    ln,
+                    format!("expected a control point `x y z`, found `{}`", l.trim()),
+                ));
             }
             *p = Vec3::new(v[0], v[1], v[2]);
         }
@@ -368,7 +439,12 @@ fn bernstein(t: f32) -> [f32; 4] {
 
 fn bernstein_d(t: f32) -> [f32; 4] {
     let s = 1.0 - t;
-    [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t]
+    [
+        -3.0 * s * s,
+        3.0 * s * s - 6.0 * t * s,
+        6.0 * t * s - 3.0 * t * t,
+        3.0 * t * t,
+    ]
 }
 
 /// Point and unit normal of a bicubic patch (control point (i, j) at index 4i + j).
@@ -406,9 +482,8 @@ pub fn floor(size: f32, quads: u32, checker: [Vec3; 2]) -> Mesh {
         for j in 0..quads {
             let x0 = -half + i as f32 * step;
             let z0 = -half + j as f32 * step;
-            let corner = |di: u32, dj: u32| {
-                Vec3::new(x0 + di as f32 * step, 0.0, z0 + dj as f32 * step)
-            };
+            let corner =
+                |di: u32, dj: u32| Vec3::new(x0 + di as f32 * step, 0.0, z0 + dj as f32 * step);
             let tc = |di: u32, dj: u32| Vec2::new((i + di) as f32, (j + dj) as f32);
             let q = [(0, 0), (0, 1), (1, 1), (1, 0)];
             let c = checker[((i + j) % 2) as usize];
@@ -449,7 +524,9 @@ mod tests {
 
     #[test]
     fn bezier_corners_interpolate_control_points() {
-        let cp: [Vec3; 16] = std::array::from_fn(|k| Vec3::new((k / 4) as f32, (k % 4) as f32, ((k * 7) % 5) as f32));
+        let cp: [Vec3; 16] = std::array::from_fn(|k| {
+            Vec3::new((k / 4) as f32, (k % 4) as f32, ((k * 7) % 5) as f32)
+        });
         assert!((bezier_point_normal(&cp, 0.0, 0.0).0 - cp[0]).length() < 1e-6);
         assert!((bezier_point_normal(&cp, 1.0, 1.0).0 - cp[15]).length() < 1e-6);
         assert!((bezier_point_normal(&cp, 1.0, 0.0).0 - cp[12]).length() < 1e-6);

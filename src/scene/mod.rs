@@ -168,10 +168,12 @@ impl Scene {
         let mut a = WorldAttributes::default();
         for o in &self.objects {
             let nm = o.normal_matrix();
-            a.normals.extend(o.mesh.normals.iter().map(|n| (nm * *n).normalize_or_zero()));
+            a.normals
+                .extend(o.mesh.normals.iter().map(|n| (nm * *n).normalize_or_zero()));
             a.colors.extend_from_slice(&o.mesh.colors);
             a.texcoords.extend_from_slice(&o.mesh.texcoords);
-            a.triangle_material.extend_from_slice(&o.mesh.triangle_material);
+            a.triangle_material
+                .extend_from_slice(&o.mesh.triangle_material);
         }
         a
     }
@@ -182,10 +184,26 @@ impl Scene {
     /// without textures gets a single white texel. The CPU reference samples the same layers.
     pub fn texture_layers(&self, max_size: u32) -> (u32, u32, Vec<image::RgbaImage>) {
         if self.textures.is_empty() {
-            return (1, 1, vec![image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]))]);
+            return (
+                1,
+                1,
+                vec![image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]))],
+            );
         }
-        let w = self.textures.iter().map(|(_, t)| t.width()).max().unwrap_or(1).min(max_size);
-        let h = self.textures.iter().map(|(_, t)| t.height()).max().unwrap_or(1).min(max_size);
+        let w = self
+            .textures
+            .iter()
+            .map(|(_, t)| t.width())
+            .max()
+            .unwrap_or(1)
+            .min(max_size);
+        let h = self
+            .textures
+            .iter()
+            .map(|(_, t)| t.height())
+            .max()
+            .unwrap_or(1)
+            .min(max_size);
         let layers = self
             .textures
             .iter()
@@ -215,16 +233,26 @@ impl Scene {
             SceneError::at(path, line, e.message().to_string())
         })?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        let at = |span: std::ops::Range<usize>, msg: String| SceneError::at(path, Some(line_of(text, span.start)), msg);
+        let at = |span: std::ops::Range<usize>, msg: String| {
+            SceneError::at(path, Some(line_of(text, span.start)), msg)
+        };
         let cam_span = file.camera.span();
         let camera = file.camera.into_inner();
         camera.validate().map_err(|m| at(cam_span.clone(), m))?;
         let settings = file.render.map(|r| r.into_inner()).unwrap_or_default();
         if settings.width == 0 || settings.height == 0 {
-            return Err(SceneError::at(path, None, "render.width and render.height must be positive".into()));
+            return Err(SceneError::at(
+                path,
+                None,
+                "render.width and render.height must be positive".into(),
+            ));
         }
         if settings.shadow_offset.is_nan() || settings.shadow_offset < 0.0 {
-            return Err(SceneError::at(path, None, "render.shadow_offset must be >= 0".into()));
+            return Err(SceneError::at(
+                path,
+                None,
+                "render.shadow_offset must be >= 0".into(),
+            ));
         }
         let lights = file
             .light
@@ -244,7 +272,9 @@ impl Scene {
                 edge_v: Vec3::from(l.edge_v),
                 color: Vec3::from(l.color),
             };
-            let finite = [a.corner, a.edge_u, a.edge_v, a.color].iter().all(|v| v.is_finite());
+            let finite = [a.corner, a.edge_u, a.edge_v, a.color]
+                .iter()
+                .all(|v| v.is_finite());
             if !finite || a.edge_u.cross(a.edge_v).length() <= 1e-12 {
                 return Err(at(
                     span,
@@ -266,7 +296,11 @@ impl Scene {
             textures: Vec::new(),
         };
         if file.object.is_empty() {
-            return Err(SceneError::at(path, None, "the scene has no [[object]]".into()));
+            return Err(SceneError::at(
+                path,
+                None,
+                "the scene has no [[object]]".into(),
+            ));
         }
         for (k, def) in file.object.into_iter().enumerate() {
             let span = def.kind.span();
@@ -299,7 +333,12 @@ impl Scene {
         self.materials.len() as u32 - 1
     }
 
-    fn build_object(&mut self, dir: &Path, index: usize, def: ObjectDef) -> Result<Object, ObjectError> {
+    fn build_object(
+        &mut self,
+        dir: &Path,
+        index: usize,
+        def: ObjectDef,
+    ) -> Result<Object, ObjectError> {
         let kind = def.kind.get_ref().as_str();
         let base = Material {
             reflection: def.reflection,
@@ -308,7 +347,10 @@ impl Scene {
             texture: None,
         };
         if !(0.0..=1.0).contains(&def.reflection) {
-            return Err(ObjectError::Here(format!("reflection = {} must lie in [0, 1]", def.reflection)));
+            return Err(ObjectError::Here(format!(
+                "reflection = {} must lie in [0, 1]",
+                def.reflection
+            )));
         }
         let color = def.color.map(Vec3::from);
         let texture = match &def.texture {
@@ -319,7 +361,11 @@ impl Scene {
             def.path
                 .as_ref()
                 .map(|p| dir.join(p.get_ref()))
-                .ok_or_else(|| ObjectError::Here(format!("an object of type \"{kind}\" needs path = \"{what}\"")))
+                .ok_or_else(|| {
+                    ObjectError::Here(format!(
+                        "an object of type \"{kind}\" needs path = \"{what}\""
+                    ))
+                })
         };
         let mut mesh = match kind {
             "obj" => {
@@ -389,7 +435,9 @@ impl Scene {
             let extent = (hi - lo).max_element();
             let center = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
             let s = fit / extent;
-            mesh.positions.iter_mut().for_each(|p| *p = (*p - center) * s);
+            mesh.positions
+                .iter_mut()
+                .for_each(|p| *p = (*p - center) * s);
         }
         let scale = match def.scale {
             Scale::Uniform(s) => Vec3::splat(s),
@@ -402,7 +450,9 @@ impl Scene {
             Vec3::from(def.translate),
         );
         if Mat3::from_mat4(model).determinant().abs() < 1e-12 {
-            return Err(ObjectError::Here("the transform is singular (a zero scale)".into()));
+            return Err(ObjectError::Here(
+                "the transform is singular (a zero scale)".into(),
+            ));
         }
         Ok(Object {
             name: def.name.unwrap_or_else(|| format!("{kind}#{index}")),

@@ -47,7 +47,13 @@ pub struct BaseTracer {
 }
 
 impl BaseTracer {
-    pub fn new(gl: Arc<Gl>, info: &GlInfo, scene: &Scene, shaders: &ShaderSource, options: RenderOptions) -> Result<BaseTracer> {
+    pub fn new(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: RenderOptions,
+    ) -> Result<BaseTracer> {
         let pipeline = RayPipeline::new(gl, info, scene, shaders, options)?;
         let stages = BaseStages {
             intersect1: pipeline.compute_program("intersect1.comp", &[])?,

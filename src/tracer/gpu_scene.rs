@@ -57,7 +57,10 @@ impl GpuScene {
         let vertices = 3 * triangles;
         let max = info.max_ssbo_block_size;
         if scene.lights.is_empty() {
-            log::warn!("{}: the scene has no lights; only ambient light", scene.path.display());
+            log::warn!(
+                "{}: the scene has no lights; only ambient light",
+                scene.path.display()
+            );
         }
         if info.max_vertex_shader_storage_blocks < 8 {
             bail!(
@@ -81,7 +84,12 @@ impl GpuScene {
             tex.extend(o.mesh.texcoords.iter().map(|v| v.to_array()));
             mat.extend(o.mesh.triangle_material.iter().flat_map(|m| [*m as i32; 3]));
         }
-        let program = compile_program(gl, shaders, &[(glow::VERTEX_SHADER, "transform.vert")], &Defines::new())?;
+        let program = compile_program(
+            gl,
+            shaders,
+            &[(glow::VERTEX_SHADER, "transform.vert")],
+            &Defines::new(),
+        )?;
         // SAFETY: VAO/VBO setup on a current context.
         unsafe {
             let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
@@ -119,18 +127,55 @@ impl GpuScene {
             let materials: Vec<[f32; 4]> = scene
                 .materials
                 .iter()
-                .map(|m| [m.reflection, m.specular, m.shininess, m.texture.map(|t| t as f32).unwrap_or(-1.0)])
+                .map(|m| {
+                    [
+                        m.reflection,
+                        m.specular,
+                        m.shininess,
+                        m.texture.map(|t| t as f32).unwrap_or(-1.0),
+                    ]
+                })
                 .collect();
             let lights = scene.lights.len().max(1);
             let ssbos = vec![
-                (binding::VERTEX, Ssbo::new(gl, "vertex", 16 * vertices, None, max)?),
-                (binding::NORMAL, Ssbo::new(gl, "normals", 16 * vertices, None, max)?),
-                (binding::COLOR, Ssbo::new(gl, "colors", 16 * vertices, None, max)?),
-                (binding::TEXCOORD, Ssbo::new(gl, "texcoords", 8 * vertices, None, max)?),
-                (binding::TRI_MATERIAL, Ssbo::new(gl, "triMaterial", 4 * triangles, None, max)?),
-                (binding::MATERIAL, Ssbo::new(gl, "material", 16 * materials.len(), Some(bytemuck::cast_slice(&materials)), max)?),
-                (binding::LIGHT_POS, Ssbo::new(gl, "lightPos", 16 * lights, None, max)?),
-                (binding::LIGHT_COLOR, Ssbo::new(gl, "lightColor", 16 * lights, None, max)?),
+                (
+                    binding::VERTEX,
+                    Ssbo::new(gl, "vertex", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::NORMAL,
+                    Ssbo::new(gl, "normals", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::COLOR,
+                    Ssbo::new(gl, "colors", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::TEXCOORD,
+                    Ssbo::new(gl, "texcoords", 8 * vertices, None, max)?,
+                ),
+                (
+                    binding::TRI_MATERIAL,
+                    Ssbo::new(gl, "triMaterial", 4 * triangles, None, max)?,
+                ),
+                (
+                    binding::MATERIAL,
+                    Ssbo::new(
+                        gl,
+                        "material",
+                        16 * materials.len(),
+                        Some(bytemuck::cast_slice(&materials)),
+                        max,
+                    )?,
+                ),
+                (
+                    binding::LIGHT_POS,
+                    Ssbo::new(gl, "lightPos", 16 * lights, None, max)?,
+                ),
+                (
+                    binding::LIGHT_COLOR,
+                    Ssbo::new(gl, "lightColor", 16 * lights, None, max)?,
+                ),
             ];
 
             let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
@@ -138,7 +183,12 @@ impl GpuScene {
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo));
             gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 1, 1);
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-            gl.framebuffer_renderbuffer(glow::FRAMEBUFFER, glow::COLOR_ATTACHMENT0, glow::RENDERBUFFER, Some(rbo));
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::RENDERBUFFER,
+                Some(rbo),
+            );
             gl.bind_framebuffer(glow::FRAMEBUFFER, None);
 
             let textures = upload_textures(gl, info, scene)?;
@@ -190,13 +240,25 @@ impl GpuScene {
                 gl.bind_vertex_array(Some(self.vao));
                 for (&(first, count), model) in self.ranges.iter().zip(models) {
                     let normal = Mat3::from_mat4(*model).inverse().transpose();
-                    gl.uniform_matrix_4_f32_slice(loc("modelMatrix").as_ref(), false, &model.to_cols_array());
-                    gl.uniform_matrix_3_f32_slice(loc("normalMatrix").as_ref(), false, &normal.to_cols_array());
+                    gl.uniform_matrix_4_f32_slice(
+                        loc("modelMatrix").as_ref(),
+                        false,
+                        &model.to_cols_array(),
+                    );
+                    gl.uniform_matrix_3_f32_slice(
+                        loc("normalMatrix").as_ref(),
+                        false,
+                        &normal.to_cols_array(),
+                    );
                     gl.draw_arrays(glow::POINTS, first, count);
                 }
                 if self.light_count > 0 {
                     gl.uniform_1_i32(loc("transformLights").as_ref(), 1);
-                    gl.uniform_matrix_4_f32_slice(loc("modelMatrix").as_ref(), false, &Mat4::IDENTITY.to_cols_array());
+                    gl.uniform_matrix_4_f32_slice(
+                        loc("modelMatrix").as_ref(),
+                        false,
+                        &Mat4::IDENTITY.to_cols_array(),
+                    );
                     gl.bind_vertex_array(Some(self.light_vao));
                     gl.draw_arrays(glow::POINTS, 0, self.light_count);
                 }

@@ -143,7 +143,12 @@ impl GridStages {
                 voxel_tris,
                 ..
             } => {
-                voxel_count.bytes + voxel_start.bytes + voxel_fill.bytes + block_sums.bytes + grid_total.bytes + voxel_tris.bytes
+                voxel_count.bytes
+                    + voxel_start.bytes
+                    + voxel_fill.bytes
+                    + block_sums.bytes
+                    + grid_total.bytes
+                    + voxel_tris.bytes
             }
         }
     }
@@ -185,7 +190,14 @@ impl GridStages {
                 grid_total,
                 voxel_tris,
                 ..
-            } => vec![voxel_count, voxel_start, voxel_fill, block_sums, grid_total, voxel_tris],
+            } => vec![
+                voxel_count,
+                voxel_start,
+                voxel_fill,
+                block_sums,
+                grid_total,
+                voxel_tris,
+            ],
         }
     }
 }
@@ -271,7 +283,9 @@ impl Stages for GridStages {
     fn intersect1(&mut self, p: &mut RayPipeline, pass: u32) {
         let prog = match &self.variant {
             Variant::Thesis {
-                traversal, intersect1, ..
+                traversal,
+                intersect1,
+                ..
             } => {
                 let t = *traversal;
                 self.bind_ray_lists(p);
@@ -294,7 +308,9 @@ impl Stages for GridStages {
     fn intersect2(&mut self, p: &mut RayPipeline, light: usize) {
         let prog = match &self.variant {
             Variant::Thesis {
-                traversal, intersect2, ..
+                traversal,
+                intersect2,
+                ..
             } => {
                 let t = *traversal;
                 self.bind_ray_lists(p);
@@ -314,18 +330,29 @@ impl Stages for GridStages {
     }
 
     fn finish_stats(&mut self, stats: &mut FrameStats) {
-        let build: f64 = ["grid_clear", "build", "grid_count", "grid_scan", "grid_fill"]
-            .iter()
-            .filter_map(|k| stats.gpu_ms.get(*k))
-            .sum();
+        let build: f64 = [
+            "grid_clear",
+            "build",
+            "grid_count",
+            "grid_scan",
+            "grid_fill",
+        ]
+        .iter()
+        .filter_map(|k| stats.gpu_ms.get(*k))
+        .sum();
         let f = &mut stats.facts;
         f.insert("grid_resolution".into(), json!(self.n));
         f.insert("grid_bytes".into(), json!(self.bytes()));
         f.insert("grid_build_ms".into(), json!(build));
         match &self.variant {
-            Variant::Thesis { ray_array_length, .. } => {
+            Variant::Thesis {
+                ray_array_length, ..
+            } => {
                 f.insert("grid_variant".into(), json!("thesis"));
-                f.insert("voxel_array_length".into(), json!(self.voxel_array_length()));
+                f.insert(
+                    "voxel_array_length".into(),
+                    json!(self.voxel_array_length()),
+                );
                 f.insert("ray_array_length".into(), json!(ray_array_length));
             }
             Variant::Exact { refs, .. } => {
@@ -373,15 +400,26 @@ pub struct GridTracer {
 }
 
 impl GridTracer {
-    pub fn new(gl: Arc<Gl>, info: &GlInfo, scene: &Scene, shaders: &ShaderSource, options: RenderOptions) -> Result<GridTracer> {
+    pub fn new(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: RenderOptions,
+    ) -> Result<GridTracer> {
         let g: GridOptions = options.grid;
-        let n = g.resolution.unwrap_or_else(|| auto_resolution(scene.triangle_count()));
+        let n = g
+            .resolution
+            .unwrap_or_else(|| auto_resolution(scene.triangle_count()));
         let max = match g.variant {
             GridVariant::Thesis => MAX_RESOLUTION_THESIS,
             GridVariant::Exact => MAX_RESOLUTION_EXACT,
         };
         if n == 0 || n > max {
-            bail!("--grid {n}: the {:?} grid supports 1..={max} voxels per axis", g.variant);
+            bail!(
+                "--grid {n}: the {:?} grid supports 1..={max} voxels per axis",
+                g.variant
+            );
         }
         let (w, h) = (options.width as usize, options.height as usize);
         let pipeline = RayPipeline::new(gl.clone(), info, scene, shaders, options)?;
@@ -465,7 +503,12 @@ impl GridTracer {
                 let ids = voxelslist.read_u32(gl);
                 let fill = voxelcontains.read_u32(gl);
                 (0..n3)
-                    .map(|v| ids[v * l..v * l + fill[v] as usize].iter().map(|&x| x as i32).collect())
+                    .map(|v| {
+                        ids[v * l..v * l + fill[v] as usize]
+                            .iter()
+                            .map(|&x| x as i32)
+                            .collect()
+                    })
                     .collect()
             }
             Variant::Exact {
@@ -480,7 +523,10 @@ impl GridTracer {
                 (0..n3)
                     .map(|v| {
                         let s = start[v] as usize;
-                        tris[s..s + count[v] as usize].iter().map(|&x| x as i32).collect()
+                        tris[s..s + count[v] as usize]
+                            .iter()
+                            .map(|&x| x as i32)
+                            .collect()
                     })
                     .collect()
             }

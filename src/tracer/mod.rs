@@ -127,7 +127,9 @@ impl std::str::FromStr for GridResolution {
         }
         match s.parse::<u32>() {
             Ok(n) if n > 0 => Ok(GridResolution::N(n)),
-            _ => Err(format!("`{s}` is neither `auto` nor a positive voxel count per axis")),
+            _ => Err(format!(
+                "`{s}` is neither `auto` nor a positive voxel count per axis"
+            )),
         }
     }
 }

@@ -11,7 +11,10 @@ use glam::Mat4;
 use glow::HasContext;
 
 use super::gpu_scene::{binding, GpuScene};
-use super::{flip_rows, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS, TRIANGLE_TEST_COUNTERS};
+use super::{
+    flip_rows, Aovs, Frame, FrameStats, RenderOptions, ShadowFlags, COUNTERS,
+    TRIANGLE_TEST_COUNTERS,
+};
 use crate::gl::resources::{GpuTimers, Image2d, Ssbo};
 use crate::gl::{check_error, compile_program, Defines, Gl, GlInfo, ShaderSource};
 use crate::scene::{Camera, Scene};
@@ -124,8 +127,14 @@ pub struct RayPipeline {
 /// `#define`s every kernel gets: counter slots and the shadow-flag layout.
 pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
     let mut d = Defines::new()
-        .set("SHADOW_BITS", (options.shadow_flags == ShadowFlags::Bits) as i32)
-        .set("SHADOW_OFFSET", format!("{:?}", scene.settings.shadow_offset));
+        .set(
+            "SHADOW_BITS",
+            (options.shadow_flags == ShadowFlags::Bits) as i32,
+        )
+        .set(
+            "SHADOW_OFFSET",
+            format!("{:?}", scene.settings.shadow_offset),
+        );
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -133,7 +142,13 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
 }
 
 impl RayPipeline {
-    pub fn new(gl: Arc<Gl>, info: &GlInfo, scene: &Scene, shaders: &ShaderSource, options: RenderOptions) -> Result<RayPipeline> {
+    pub fn new(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: RenderOptions,
+    ) -> Result<RayPipeline> {
         if scene.lights.len() > options.shadow_flags.max_lights() {
             bail!(
                 "{}: {} lights, but --shadow-flags {} holds at most {} (use --shadow-flags bits)",
@@ -147,16 +162,35 @@ impl RayPipeline {
             );
         }
         let max_tex = info.max_texture_size as u32;
-        if options.width == 0 || options.height == 0 || options.width > max_tex || options.height > max_tex {
-            bail!("image size {}x{} outside 1..={} (GL_MAX_TEXTURE_SIZE)", options.width, options.height, max_tex);
+        if options.width == 0
+            || options.height == 0
+            || options.width > max_tex
+            || options.height > max_tex
+        {
+            bail!(
+                "image size {}x{} outside 1..={} (GL_MAX_TEXTURE_SIZE)",
+                options.width,
+                options.height,
+                max_tex
+            );
         }
         if !options.tile.is_multiple_of(8) {
-            bail!("--tile {} must be a multiple of 8 (the kernels' work group size)", options.tile);
+            bail!(
+                "--tile {} must be a multiple of 8 (the kernels' work group size)",
+                options.tile
+            );
         }
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
         let defines = kernel_defines(scene, &options);
-        let compute = |name: &str| compile_program(&gl, shaders, &[(glow::COMPUTE_SHADER, name)], &defines);
-        let counters = Ssbo::new(&gl, "counters", 8 * COUNTERS.len(), None, info.max_ssbo_block_size)?;
+        let compute =
+            |name: &str| compile_program(&gl, shaders, &[(glow::COMPUTE_SHADER, name)], &defines);
+        let counters = Ssbo::new(
+            &gl,
+            "counters",
+            8 * COUNTERS.len(),
+            None,
+            info.max_ssbo_block_size,
+        )?;
         let p = RayPipeline {
             eye_ray_generation: compute("eye_ray_generation.comp")?,
             shading: compute("shading.comp")?,
@@ -212,7 +246,11 @@ impl RayPipeline {
     /// barrier.
     pub fn dispatch_pixels(&mut self, program: glow::Program, name: &'static str) {
         let (w, h) = (self.options.width, self.options.height);
-        let tile = if self.options.tile == 0 { w.max(h) } else { self.options.tile };
+        let tile = if self.options.tile == 0 {
+            w.max(h)
+        } else {
+            self.options.tile
+        };
         let gl = self.gl.clone();
         // SAFETY: uniform lookup on our program.
         let loc = unsafe { gl.get_uniform_location(program, "tileOffset") };
@@ -235,7 +273,8 @@ impl RayPipeline {
         let gl = self.gl.clone();
         if groups > 0 {
             // SAFETY: dispatch of the program in use.
-            self.timers.time(&gl, name, || unsafe { gl.dispatch_compute(groups, 1, 1) });
+            self.timers
+                .time(&gl, name, || unsafe { gl.dispatch_compute(groups, 1, 1) });
         }
         barrier(&gl);
     }
@@ -268,8 +307,14 @@ impl RayPipeline {
             let o = self.images.ray_origin.read_f32(&gl);
             let d = self.images.ray_dir.read_f32(&gl);
             aovs = Some(Aovs {
-                ray_origin: flip_rows(&o, w, h).iter().map(|v| [v[0], v[1], v[2]]).collect(),
-                ray_direction: flip_rows(&d, w, h).iter().map(|v| [v[0], v[1], v[2]]).collect(),
+                ray_origin: flip_rows(&o, w, h)
+                    .iter()
+                    .map(|v| [v[0], v[1], v[2]])
+                    .collect(),
+                ray_direction: flip_rows(&d, w, h)
+                    .iter()
+                    .map(|v| [v[0], v[1], v[2]])
+                    .collect(),
                 ..Default::default()
             });
         }
@@ -347,7 +392,9 @@ pub fn barrier(gl: &Gl) {
     // SAFETY: glMemoryBarrier on a current context.
     unsafe {
         gl.memory_barrier(
-            glow::SHADER_IMAGE_ACCESS_BARRIER_BIT | glow::SHADER_STORAGE_BARRIER_BIT | glow::BUFFER_UPDATE_BARRIER_BIT,
+            glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
+                | glow::SHADER_STORAGE_BARRIER_BIT
+                | glow::BUFFER_UPDATE_BARRIER_BIT,
         )
     };
 }

@@ -11,7 +11,9 @@ use gpgpu_rt::tracer::base::BaseTracer;
 use gpgpu_rt::tracer::{Frame, RenderOptions, ShadowFlags, Tracer};
 
 pub fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
 }
 
 pub fn load(name: &str) -> Scene {
@@ -35,7 +37,14 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
 }
 
 pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
-    let mut t = BaseTracer::new(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default(), opts).expect("tracer");
+    let mut t = BaseTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        scene,
+        &ShaderSource::default(),
+        opts,
+    )
+    .expect("tracer");
     t.render(&scene.camera).expect("frame")
 }
 
@@ -83,7 +92,10 @@ pub fn compare(gpu: &Frame, cpu: &ReferenceFrame) -> Comparison {
             let rel = (a.hit_t[i] - cpu.aovs.hit_t[i]).abs() / cpu.aovs.hit_t[i].max(1e-3);
             c.max_t_rel = c.max_t_rel.max(rel);
         } else {
-            assert!(a.hit_t[i].is_infinite() && a.hit_t[i] > 0.0, "miss must have hit_t = +inf");
+            assert!(
+                a.hit_t[i].is_infinite() && a.hit_t[i] > 0.0,
+                "miss must have hit_t = +inf"
+            );
         }
         let mut worst = 0.0f32;
         for k in 0..3 {
@@ -109,7 +121,10 @@ pub fn assert_close(gpu: &Frame, cpu: &ReferenceFrame, what: &str) -> Comparison
     let c = compare(gpu, cpu);
     eprintln!("{what}: {c:?}");
     assert!(c.hits > 0, "{what}: the image shows no geometry");
-    assert!(c.id_mismatches as f32 <= 0.005 * c.pixels as f32, "{what}: triangle ids differ: {c:?}");
+    assert!(
+        c.id_mismatches as f32 <= 0.005 * c.pixels as f32,
+        "{what}: triangle ids differ: {c:?}"
+    );
     assert!(c.max_t_rel < 1e-4, "{what}: hit distances differ: {c:?}");
     assert!(c.mean_color_diff < 0.005, "{what}: colours differ: {c:?}");
     assert!(c.color_outliers < 0.01, "{what}: colours differ: {c:?}");
