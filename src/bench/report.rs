@@ -9,7 +9,7 @@ use anyhow::{Context as _, Result};
 use super::published;
 use super::runner::{Bench, Outcome};
 use super::stats::Stats;
-use super::{Rotation, Scale};
+use super::{Protocol, Rotation, Scale};
 
 /// A protocol's part of the report.
 #[derive(Debug, Clone, Default)]
@@ -21,6 +21,40 @@ pub struct Section {
     pub failures: usize,
     /// Files written, relative to the output folder.
     pub files: Vec<PathBuf>,
+}
+
+impl Section {
+    /// The section of a protocol that measured `outcomes`: `markdown`, then the `figures` (path,
+    /// caption) and the failed configurations; its files are the protocol's CSV and summary
+    /// CSV, the figures and each configuration's first frame.
+    pub fn of_sweep(
+        protocol: &dyn Protocol,
+        mut markdown: String,
+        outcomes: &[Outcome],
+        figures: Vec<(PathBuf, &str)>,
+    ) -> Section {
+        let name = protocol.name();
+        let mut files = vec![
+            PathBuf::from(format!("{name}.csv")),
+            PathBuf::from(format!("{name}_summary.csv")),
+        ];
+        for (k, (fig, caption)) in figures.into_iter().enumerate() {
+            if k > 0 {
+                markdown.push('\n');
+            }
+            markdown.push_str(&image(&fig, caption));
+            files.push(fig);
+        }
+        markdown.push_str(&failures(outcomes));
+        files.extend(outcomes.iter().filter_map(|o| o.image.clone()));
+        Section {
+            protocol: name.into(),
+            title: protocol.title().into(),
+            markdown,
+            failures: outcomes.iter().filter(|o| o.error.is_some()).count(),
+            files,
+        }
+    }
 }
 
 /// An integer with thousands separators: 1,137,720,816.

@@ -225,24 +225,11 @@ impl Protocol for Thesis51 {
         ]);
         md.push_str(&table(&["Müller 2015", "ours"], &cmp));
         md.push('\n');
-        md.push_str(&report::image(&fig19, "Fig. 19 (ours)"));
-        md.push('\n');
-        md.push_str(&report::image(&fig20, "Fig. 20 (ours)"));
-        md.push_str(&report::failures(&outcomes));
-
-        let mut files = vec![
-            PathBuf::from(format!("{}.csv", self.name())),
-            PathBuf::from(format!("{}_summary.csv", self.name())),
-            fig19,
-            fig20,
-        ];
-        files.extend(outcomes.iter().filter_map(|o| o.image.clone()));
-        Ok(Section {
-            protocol: self.name().into(),
-            title: self.title().into(),
-            markdown: md,
-            failures: outcomes.iter().filter(|o| o.error.is_some()).count(),
-            files,
-        })
+        Ok(Section::of_sweep(
+            self,
+            md,
+            &outcomes,
+            vec![(fig19, "Fig. 19 (ours)"), (fig20, "Fig. 20 (ours)")],
+        ))
     }
 }

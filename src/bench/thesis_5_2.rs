@@ -188,24 +188,11 @@ impl Protocol for Thesis52 {
         ];
         md.push_str(&report::table(&["Müller 2015", "ours"], &rows));
         md.push('\n');
-        md.push_str(&report::image(&fig21, "Fig. 21 (ours)"));
-        md.push('\n');
-        md.push_str(&report::image(&fig22, "Fig. 22 (ours)"));
-        md.push_str(&report::failures(&outcomes));
-
-        let mut files = vec![
-            PathBuf::from(format!("{}.csv", self.name())),
-            PathBuf::from(format!("{}_summary.csv", self.name())),
-            fig21,
-            fig22,
-        ];
-        files.extend(outcomes.iter().filter_map(|o| o.image.clone()));
-        Ok(Section {
-            protocol: self.name().into(),
-            title: self.title().into(),
-            markdown: md,
-            failures: outcomes.iter().filter(|o| o.error.is_some()).count(),
-            files,
-        })
+        Ok(Section::of_sweep(
+            self,
+            md,
+            &outcomes,
+            vec![(fig21, "Fig. 21 (ours)"), (fig22, "Fig. 22 (ours)")],
+        ))
     }
 }

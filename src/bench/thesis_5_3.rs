@@ -12,7 +12,7 @@ use anyhow::Result;
 use super::plots::{self, Chart, Series, Style, BLACK_INDEX};
 use super::published::{self as p, Published};
 use super::report::{self, int, num, ratio, Section};
-use super::runner::{rotation_angles, variant_name, Bench, Config, Outcome, Sizing, TracerSpec};
+use super::runner::{rotation_angles, variant_name, Bench, Config, Sizing, TracerSpec};
 use super::sweep;
 use super::{Protocol, Scale, FULL_SIZE, QUICK_SIZE};
 use crate::tracer::GridVariant;
@@ -370,24 +370,11 @@ impl Protocol for Thesis53 {
         let _ = writeln!(md, "\n### Dragon\n");
         md.push_str(&sweep::resolution_table(&dragon_grid, dragon_base));
         md.push('\n');
-        md.push_str(&report::image(&fig23, "Fig. 23 (ours)"));
-        md.push('\n');
-        md.push_str(&report::image(&fig24, "Fig. 24 (ours)"));
-        md.push_str(&report::failures(&outcomes));
-
-        let mut files = vec![
-            PathBuf::from(format!("{}.csv", self.name())),
-            PathBuf::from(format!("{}_summary.csv", self.name())),
-            fig23,
-            fig24,
-        ];
-        files.extend(outcomes.iter().filter_map(|o: &Outcome| o.image.clone()));
-        Ok(Section {
-            protocol: self.name().into(),
-            title: self.title().into(),
-            markdown: md,
-            failures: outcomes.iter().filter(|o| o.error.is_some()).count(),
-            files,
-        })
+        Ok(Section::of_sweep(
+            self,
+            md,
+            &outcomes,
+            vec![(fig23, "Fig. 23 (ours)"), (fig24, "Fig. 24 (ours)")],
+        ))
     }
 }

@@ -165,6 +165,103 @@ fn get_entry(
     }
 }
 
+/// A ray's direction in N-tree cell units with its 3D-DDA constants [AW87].
+struct DdaRay {
+    dir: Vec3,
+    step: IVec3,
+    t_delta: Vec3,
+}
+
+impl DdaRay {
+    fn new(dir: Vec3) -> DdaRay {
+        let sign = |x: f32| if x > 0.0 { 1 } else { -1 };
+        DdaRay {
+            dir,
+            step: IVec3::new(sign(dir.x), sign(dir.y), sign(dir.z)),
+            t_delta: Vec3::ONE / dir.abs(),
+        }
+    }
+}
+
+/// One level of the hierarchical 3D-DDA: the N×N×N cells of one node group, in that node's
+/// cell units (`start` is the ray origin there, `t` runs along the ray's direction in them).
+#[derive(Clone, Copy, Default)]
+struct Dda {
+    group: u32,
+    start: Vec3,
+    cell: IVec3,
+    t_max: Vec3,
+    t: f32,
+    t_end: f32,
+}
+
+impl Dda {
+    /// Enters the node group `group` whose local ray origin is `start`: None when the ray
+    /// misses the node's [0,N)³ before `t_end`.
+    fn enter(ray: &DdaRay, n: i32, group: u32, start: Vec3, t_end: f32) -> Option<Dda> {
+        let nf = n as f32;
+        let dir = ray.dir;
+        let inside = start.cmpge(Vec3::ZERO).all() && start.cmplt(Vec3::splat(nf)).all();
+        let t0 = if inside {
+            0.0
+        } else {
+            let (mut tnear, mut tfar) = (0.0f32, f32::INFINITY);
+            for a in 0..3 {
+                if dir[a] == 0.0 {
+                    if start[a] < 0.0 || start[a] > nf {
+                        return None;
+                    }
+                    continue;
+                }
+                let mut t0 = -start[a] / dir[a];
+                let mut t1 = (nf - start[a]) / dir[a];
+                if t0 > t1 {
+                    std::mem::swap(&mut t0, &mut t1);
+                }
+                tnear = tnear.max(t0);
+                tfar = tfar.min(t1);
+            }
+            if tnear > tfar || tnear > t_end {
+                return None;
+            }
+            tnear
+        };
+        let p = start + t0 * dir;
+        let cell = p.floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(n - 1));
+        let mut t_max = Vec3::INFINITY;
+        for a in 0..3 {
+            if dir[a] > 0.0 {
+                t_max[a] = (cell[a] as f32 + 1.0 - start[a]) / dir[a];
+            } else if dir[a] < 0.0 {
+                t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
+            }
+        }
+        Some(Dda {
+            group,
+            start,
+            cell,
+            t_max,
+            t: t0,
+            t_end,
+        })
+    }
+
+    /// Steps to the next cell along the axis whose boundary comes first.
+    fn advance(&mut self, ray: &DdaRay) {
+        let tm = self.t_max;
+        let a = if tm.x <= tm.y && tm.x <= tm.z {
+            0
+        } else if tm.y <= tm.z {
+            1
+        } else {
+            2
+        };
+        self.t = tm[a];
+        self.cell[a] += ray.step[a];
+        self.t_max[a] += ray.t_delta[a];
+    }
+}
+
 /// One level of Listing 1's stack.
 #[derive(Clone)]
 struct StackLevel {
@@ -558,66 +655,8 @@ impl<'a> LinespaceShadows<'a> {
         let nf = n as f32;
         let last_ls_depth = self.tree.last_linespace_depth();
         let max_depth = self.tree.depth as usize - 1;
-        #[derive(Clone, Copy, Default)]
-        struct Dda {
-            group: u32,
-            start: Vec3,
-            cell: IVec3,
-            t_max: Vec3,
-            t: f32,
-            t_end: f32,
-        }
-        let step = IVec3::new(
-            if dir.x > 0.0 { 1 } else { -1 },
-            if dir.y > 0.0 { 1 } else { -1 },
-            if dir.z > 0.0 { 1 } else { -1 },
-        );
-        let t_delta = Vec3::new(1.0 / dir.x.abs(), 1.0 / dir.y.abs(), 1.0 / dir.z.abs());
-        let init = |group: u32, start: Vec3, t_end: f32| -> Option<Dda> {
-            let inside = start.cmpge(Vec3::ZERO).all() && start.cmplt(Vec3::splat(nf)).all();
-            let t0 = if inside {
-                0.0
-            } else {
-                let (mut tnear, mut tfar) = (0.0f32, f32::INFINITY);
-                for a in 0..3 {
-                    if dir[a] == 0.0 {
-                        if start[a] < 0.0 || start[a] > nf {
-                            return None;
-                        }
-                        continue;
-                    }
-                    let mut t0 = -start[a] / dir[a];
-                    let mut t1 = (nf - start[a]) / dir[a];
-                    if t0 > t1 {
-                        std::mem::swap(&mut t0, &mut t1);
-                    }
-                    tnear = tnear.max(t0);
-                    tfar = tfar.min(t1);
-                }
-                if tnear > tfar || tnear > t_end {
-                    return None;
-                }
-                tnear
-            };
-            let p = start + t0 * dir;
-            let cell = p.floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(n - 1));
-            let mut t_max = Vec3::INFINITY;
-            for a in 0..3 {
-                if dir[a] > 0.0 {
-                    t_max[a] = (cell[a] as f32 + 1.0 - start[a]) / dir[a];
-                } else if dir[a] < 0.0 {
-                    t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
-                }
-            }
-            Some(Dda {
-                group,
-                start,
-                cell,
-                t_max,
-                t: t0,
-                t_end,
-            })
-        };
+        let ray = DdaRay::new(dir);
+        let init = |group: u32, start: Vec3, t_end: f32| Dda::enter(&ray, n, group, start, t_end);
         let mut stack = vec![Dda::default(); max_depth];
         let Some(root) = init(0, o, 1.0) else {
             return false;
@@ -636,17 +675,7 @@ impl<'a> LinespaceShadows<'a> {
                 continue;
             }
             // advance this level past the current cell before looking into it
-            let tm = st.t_max;
-            let a = if tm.x <= tm.y && tm.x <= tm.z {
-                0
-            } else if tm.y <= tm.z {
-                1
-            } else {
-                2
-            };
-            stack[d].t = st.t_max[a];
-            stack[d].cell[a] += step[a];
-            stack[d].t_max[a] += t_delta[a];
+            stack[d].advance(&ray);
             counts.nodes_visited += 1;
             let node = self.node(st.group, st.cell);
             if node[0] & GEOMETRY_BIT == 0 {
@@ -711,67 +740,8 @@ impl<'a> LinespaceShadows<'a> {
         let max_depth = self.tree.depth as usize - 1;
         let o = self.tree.to_ntree(o_world);
         let dir = d_world * self.tree.inv_node_size();
-        #[allow(dead_code)]
-        #[derive(Clone, Copy, Default)]
-        struct Dda {
-            group: u32,
-            start: Vec3,
-            cell: IVec3,
-            t_max: Vec3,
-            t: f32,
-            t_end: f32,
-        }
-        let step = IVec3::new(
-            if dir.x > 0.0 { 1 } else { -1 },
-            if dir.y > 0.0 { 1 } else { -1 },
-            if dir.z > 0.0 { 1 } else { -1 },
-        );
-        let t_delta = Vec3::new(1.0 / dir.x.abs(), 1.0 / dir.y.abs(), 1.0 / dir.z.abs());
-        let init = |group: u32, start: Vec3, t_end: f32| -> Option<Dda> {
-            let inside = start.cmpge(Vec3::ZERO).all() && start.cmplt(Vec3::splat(nf)).all();
-            let t0 = if inside {
-                0.0
-            } else {
-                let (mut tnear, mut tfar) = (0.0f32, f32::INFINITY);
-                for a in 0..3 {
-                    if dir[a] == 0.0 {
-                        if start[a] < 0.0 || start[a] > nf {
-                            return None;
-                        }
-                        continue;
-                    }
-                    let mut t0 = -start[a] / dir[a];
-                    let mut t1 = (nf - start[a]) / dir[a];
-                    if t0 > t1 {
-                        std::mem::swap(&mut t0, &mut t1);
-                    }
-                    tnear = tnear.max(t0);
-                    tfar = tfar.min(t1);
-                }
-                if tnear > tfar || tnear > t_end {
-                    return None;
-                }
-                tnear
-            };
-            let p = start + t0 * dir;
-            let cell = p.floor().as_ivec3().clamp(IVec3::ZERO, IVec3::splat(n - 1));
-            let mut t_max = Vec3::INFINITY;
-            for a in 0..3 {
-                if dir[a] > 0.0 {
-                    t_max[a] = (cell[a] as f32 + 1.0 - start[a]) / dir[a];
-                } else if dir[a] < 0.0 {
-                    t_max[a] = (cell[a] as f32 - start[a]) / dir[a];
-                }
-            }
-            Some(Dda {
-                group,
-                start,
-                cell,
-                t_max,
-                t: t0,
-                t_end,
-            })
-        };
+        let ray = DdaRay::new(dir);
+        let init = |group: u32, start: Vec3, t_end: f32| Dda::enter(&ray, n, group, start, t_end);
         let mut stack = vec![Dda::default(); max_depth];
         stack[0] = init(0, o, f32::INFINITY)?;
         let mut depth: i32 = 0;
@@ -783,17 +753,7 @@ impl<'a> LinespaceShadows<'a> {
                 depth -= 1;
                 continue;
             }
-            let tm = st.t_max;
-            let a = if tm.x <= tm.y && tm.x <= tm.z {
-                0
-            } else if tm.y <= tm.z {
-                1
-            } else {
-                2
-            };
-            stack[d].t = st.t_max[a];
-            stack[d].cell[a] += step[a];
-            stack[d].t_max[a] += t_delta[a];
+            stack[d].advance(&ray);
             counts.nodes_visited += 1;
             let node = self.node(st.group, st.cell);
             if node[0] & GEOMETRY_BIT == 0 {

@@ -287,12 +287,7 @@ impl Stages for GridStages {
                 intersect1,
                 ..
             } => {
-                let t = *traversal;
-                self.bind_ray_lists(p);
-                p.use_program(t);
-                self.set_grid_uniforms(p, t);
-                p.uniform_i32(t, "traversalMode", 0);
-                p.dispatch_pixels(t, "traversal");
+                self.traverse(p, *traversal, 0, None);
                 *intersect1
             }
             Variant::Exact { intersect1, .. } => *intersect1,
@@ -312,13 +307,7 @@ impl Stages for GridStages {
                 intersect2,
                 ..
             } => {
-                let t = *traversal;
-                self.bind_ray_lists(p);
-                p.use_program(t);
-                self.set_grid_uniforms(p, t);
-                p.uniform_i32(t, "traversalMode", 1);
-                p.uniform_i32(t, "lightSource", light as i32);
-                p.dispatch_pixels(t, "traversal");
+                self.traverse(p, *traversal, 1, Some(light));
                 *intersect2
             }
             Variant::Exact { intersect2, .. } => *intersect2,
@@ -367,6 +356,26 @@ impl Stages for GridStages {
 }
 
 impl GridStages {
+    /// The thesis variant's traversal.comp (Listing 21): every ray's non-empty voxels into
+    /// `rayslist` — the primary or reflected rays (mode 0) or the shadow feelers towards
+    /// `light` (mode 1).
+    fn traverse(
+        &self,
+        p: &mut RayPipeline,
+        traversal: glow::Program,
+        mode: i32,
+        light: Option<usize>,
+    ) {
+        self.bind_ray_lists(p);
+        p.use_program(traversal);
+        self.set_grid_uniforms(p, traversal);
+        p.uniform_i32(traversal, "traversalMode", mode);
+        if let Some(light) = light {
+            p.uniform_i32(traversal, "lightSource", light as i32);
+        }
+        p.dispatch_pixels(traversal, "traversal");
+    }
+
     fn bind_ray_lists(&self, p: &RayPipeline) {
         if let Variant::Thesis {
             voxelslist,
