@@ -137,6 +137,7 @@ fn run(cli: Cli) -> Result<()> {
             let scene = load_scene(&scene)?;
             let shaders = ShaderSource::from_dir(gpu.glsl_dir)?;
             let ctx = GlContext::headless(gpu.device)?;
+            let soft = soft.with_scene_defaults(&scene.settings);
             if let Some(mode) = soft.shadows {
                 // Klee 2016: G-buffer, soft-shadow compute pass, screen-filling quad
                 let (w, h) = (

@@ -492,3 +492,51 @@ fn area_light_errors_name_the_line() {
     let s = common::load("bunny_area.toml");
     assert_eq!(s.area_lights.len(), 1);
 }
+
+/// `render.shadows` / `render.light_samples` in a scene file are the defaults of `render`;
+/// the command line overrides them; a bad value or a missing area light names the line.
+#[test]
+fn scene_file_soft_shadow_defaults() {
+    let s = common::load("bunny_area.toml");
+    assert_eq!(s.settings.shadows, Some(ShadowMode::Linespace));
+    assert_eq!(s.settings.light_samples, Some((5, 5)));
+
+    let dir = tempfile::tempdir().unwrap();
+    let stats = |extra: &[&str]| -> serde_json::Value {
+        let json = dir.path().join("s.json");
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+            .arg("render")
+            .arg(common::scene_path("bunny_area.toml"))
+            .args(["--width", "24", "--height", "16", "-o"])
+            .arg(dir.path().join("a.png"))
+            .arg("--stats")
+            .arg(&json)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
+    };
+    let d = stats(&[]);
+    assert_eq!(d["shadows"], "linespace", "{d}");
+    assert_eq!(d["light_samples"], "5x5", "{d}");
+    let d = stats(&["--shadows", "exact", "--light-samples", "2x3"]);
+    assert_eq!(d["shadows"], "exact", "{d}");
+    assert_eq!(d["light_samples"], "2x3", "{d}");
+
+    let p = dir.path().join("bad.toml");
+    let head = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[render]\n";
+    let floor = "\n[[object]]\ntype = \"floor\"\n";
+    std::fs::write(&p, format!("{head}light_samples = \"5y5\"\n{floor}")).unwrap();
+    let e = Scene::load(&p).unwrap_err();
+    assert_eq!(e.line, Some(6), "{e}");
+    assert!(e.to_string().contains("5y5"), "{e}");
+    std::fs::write(&p, format!("{head}shadows = \"linespace\"\n{floor}")).unwrap();
+    let e = Scene::load(&p).unwrap_err();
+    assert_eq!(e.line, Some(5), "{e}");
+    assert!(e.to_string().contains("area_light"), "{e}");
+}

@@ -8,6 +8,7 @@ pub mod mesh;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use crate::tracer::linespace::{parse_samples, ShadowMode};
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
@@ -105,6 +106,19 @@ pub struct RenderSettings {
     pub ambient: [f32; 3],
     /// The thesis' 0.02 offset of shadow feelers (Listing 15), in scene units.
     pub shadow_offset: f32,
+    /// Soft shadows from the `[[area_light]]` by default (`render --shadows` overrides):
+    /// `exact`, `linespace` or `linespace-dda`.
+    pub shadows: Option<ShadowMode>,
+    /// Light samples `UxV` for the soft shadows (`--light-samples` overrides).
+    #[serde(deserialize_with = "light_samples")]
+    pub light_samples: Option<(u32, u32)>,
+}
+
+fn light_samples<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, u32)>, D::Error> {
+    let s = String::deserialize(d)?;
+    parse_samples(&s)
+        .map(Some)
+        .map_err(serde::de::Error::custom)
 }
 
 impl Default for RenderSettings {
@@ -116,6 +130,8 @@ impl Default for RenderSettings {
             background: [0.1, 0.1, 0.15],
             ambient: [0.15, 0.15, 0.15],
             shadow_offset: 0.02,
+            shadows: None,
+            light_samples: None,
         }
     }
 }
@@ -239,18 +255,21 @@ impl Scene {
         let cam_span = file.camera.span();
         let camera = file.camera.into_inner();
         camera.validate().map_err(|m| at(cam_span.clone(), m))?;
-        let settings = file.render.map(|r| r.into_inner()).unwrap_or_default();
+        let (settings, render_line) = match file.render {
+            Some(r) => (*r.get_ref(), Some(line_of(text, r.span().start))),
+            None => (RenderSettings::default(), None),
+        };
         if settings.width == 0 || settings.height == 0 {
             return Err(SceneError::at(
                 path,
-                None,
+                render_line,
                 "render.width and render.height must be positive".into(),
             ));
         }
         if settings.shadow_offset.is_nan() || settings.shadow_offset < 0.0 {
             return Err(SceneError::at(
                 path,
-                None,
+                render_line,
                 "render.shadow_offset must be >= 0".into(),
             ));
         }
@@ -284,6 +303,13 @@ impl Scene {
                 ));
             }
             area_lights.push(a);
+        }
+        if settings.shadows.is_some() && area_lights.is_empty() {
+            return Err(SceneError::at(
+                path,
+                render_line,
+                "render.shadows needs an [[area_light]] in the scene".into(),
+            ));
         }
         let mut scene = Scene {
             path: path.to_path_buf(),

@@ -9,7 +9,7 @@ use serde_json::json;
 use super::{parse_samples, ShadowMode, SoftShadowFrame, SoftShadowOptions, SoftShadowRenderer};
 use crate::gl::{GlContext, ShaderSource};
 use crate::output;
-use crate::scene::Scene;
+use crate::scene::{RenderSettings, Scene};
 use crate::tracer::Frame;
 
 /// The soft-shadow options of `render`.
@@ -19,11 +19,13 @@ pub struct SoftShadowArgs {
     /// G-buffer, shadow compute pass, screen-filling quad. `exact`: triangle tests (the
     /// reference); `linespace`: packet traversal, the line-space bit decides a hit;
     /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination.
+    /// [default: the scene's render.shadows, else the point-light ray tracer]
     #[arg(long, value_enum)]
     pub shadows: Option<ShadowMode>,
-    /// Uniform samples of the area light, UxV (2x2 … 10x10 in the thesis).
-    #[arg(long, default_value = "4x4", value_parser = parse_samples, value_name = "UxV")]
-    pub light_samples: (u32, u32),
+    /// Uniform samples of the area light, UxV (2x2 … 10x10 in the thesis) [default: the
+    /// scene's render.light_samples, else 4x4].
+    #[arg(long, value_parser = parse_samples, value_name = "UxV")]
+    pub light_samples: Option<(u32, u32)>,
     /// Cells per axis of every N-tree node (N; 10 in the thesis).
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub ntree_n: u32,
@@ -33,6 +35,19 @@ pub struct SoftShadowArgs {
 }
 
 impl SoftShadowArgs {
+    /// The scene file's `render.shadows` and `render.light_samples` where the command line
+    /// gives none.
+    pub fn with_scene_defaults(mut self, settings: &RenderSettings) -> SoftShadowArgs {
+        self.shadows = self.shadows.or(settings.shadows);
+        self.light_samples = self.light_samples.or(settings.light_samples);
+        self
+    }
+
+    /// The light samples: the option, else 4x4.
+    pub fn samples(&self) -> (u32, u32) {
+        self.light_samples.unwrap_or((4, 4))
+    }
+
     pub fn options(
         &self,
         mode: ShadowMode,
@@ -42,8 +57,8 @@ impl SoftShadowArgs {
     ) -> SoftShadowOptions {
         SoftShadowOptions {
             mode,
-            samples_u: self.light_samples.0,
-            samples_v: self.light_samples.1,
+            samples_u: self.samples().0,
+            samples_v: self.samples().1,
             ntree_n: self.ntree_n,
             ntree_depth: self.ntree_depth,
             width,

@@ -35,7 +35,7 @@ use crate::tracer::{flip_rows, Aovs, FrameStats};
 pub use ntree::{NTree, PackedLinespaces};
 
 /// `render --shadows`: how the shadow rays are answered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadowMode {
     /// The packet traversal down to the leaves with real triangle tests (line spaces only
