@@ -1,7 +1,8 @@
 //! `gpgpu-rt view` under Xvfb (Mesa llvmpipe through GLX): the window's screenshot equals
-//! `render`'s PNG, and an edited kernel in a `--glsl-dir` is reloaded live — a compile error
-//! is reported with file and line while the last good program keeps running, and the fixed
-//! kernel's effect reaches the window.
+//! `render`'s PNG (the ray tracer, and the soft shadows of Klee 2016), and an edited kernel in a
+//! `--glsl-dir` is reloaded live — a compile error is reported with file and line while the
+//! last good program keeps running, and the fixed kernel's effect reaches the window (also a
+//! soft-shadow kernel).
 //!
 //! The tests start the binary through `xvfb-run -a`. Without `xvfb-run` they are skipped with
 //! a message, except in CI (`CI` set), where they fail: `.ci/run` installs `xvfb`.
@@ -11,6 +12,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
+
+use image::RgbImage;
 
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 /// Upper bound for one viewer run on 2 shared llvmpipe cores (normally a few seconds).
@@ -114,9 +117,9 @@ fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
-#[test]
-fn screenshot_equals_render() {
-    let Some(xvfb) = xvfb_run() else { return };
+/// `render ARGS` and `view ARGS --frames N --log-frames --screenshot` at 96×96: both images
+/// and the viewer's stdout, after checking that it logged N frames and read the window back.
+fn render_and_view(xvfb: &Path, args: &[&str], frames: u32) -> (RgbImage, RgbImage, String) {
     let dir = tempfile::tempdir().unwrap();
     let rendered = dir.path().join("render.png");
     let shot = dir.path().join("view.png");
@@ -124,24 +127,20 @@ fn screenshot_equals_render() {
 
     let out = Command::new(BIN)
         .current_dir(root())
-        .args(["render", "scenes/teapot1.toml", "-o"])
+        .arg("render")
+        .args(args)
+        .arg("-o")
         .arg(&rendered)
         .args(size)
         .output()
         .unwrap();
     assert!(out.status.success(), "render failed: {}", text(&out.stderr));
 
-    let mut cmd = view(
-        &xvfb,
-        &[
-            "scenes/teapot1.toml",
-            "--frames",
-            "3",
-            "--log-frames",
-            "--screenshot",
-        ],
-    );
-    cmd.arg(&shot).args(size);
+    let frames = frames.to_string();
+    let mut cmd = view(xvfb, args);
+    cmd.args(["--frames", &frames, "--log-frames", "--screenshot"])
+        .arg(&shot)
+        .args(size);
     let out = run_bounded(cmd);
     let stdout = text(&out.stdout);
     assert!(
@@ -151,17 +150,30 @@ fn screenshot_equals_render() {
         text(&out.stderr)
     );
     assert_eq!(
-        stdout.lines().filter(|l| l.starts_with("frame ")).count(),
-        3,
+        stdout
+            .lines()
+            .filter(|l| l.starts_with("frame "))
+            .count()
+            .to_string(),
+        frames,
         "{stdout}"
     );
     // the screenshot is the window's own framebuffer, not an offscreen copy
-    assert!(stdout.contains("frame 3, window framebuffer"), "{stdout}");
-
+    assert!(
+        stdout.contains(&format!("frame {frames}, window framebuffer")),
+        "{stdout}"
+    );
     let a = image::open(&rendered).unwrap().to_rgb8();
     let b = image::open(&shot).unwrap().to_rgb8();
     assert_eq!(a.dimensions(), (96, 96));
     assert_eq!(b.dimensions(), a.dimensions());
+    (a, b, stdout)
+}
+
+/// Every channel of `b` within MAX_CHANNEL_DIFF of `a`; `a` has more than `min_colours`
+/// distinct colours (not a trivially equal pair of blank images), and `b`'s top and bottom
+/// rows differ (a flipped image would not match).
+fn assert_same_image(a: &RgbImage, b: &RgbImage, min_colours: usize) {
     let mut max = 0u8;
     let mut differing = 0;
     for (pa, pb) in a.pixels().zip(b.pixels()) {
@@ -173,17 +185,60 @@ fn screenshot_equals_render() {
         max <= MAX_CHANNEL_DIFF,
         "screenshot differs from render by up to {max} (8-bit) in {differing} pixels"
     );
-    // not a trivially equal pair of blank images: the teapot and the checker floor are there
     let mut colours: Vec<[u8; 3]> = a.pixels().map(|p| p.0).collect();
     colours.sort();
     colours.dedup();
     assert!(
-        colours.len() > 200,
+        colours.len() > min_colours,
         "only {} distinct colours in the render",
         colours.len()
     );
-    // and a flipped image would differ: the top row is background, the bottom row floor
+    // the top row is background, the bottom row floor
     assert_ne!(b.get_pixel(48, 0), b.get_pixel(48, 95));
+}
+
+#[test]
+fn screenshot_equals_render() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let (a, b, _) = render_and_view(&xvfb, &["scenes/teapot1.toml"], 3);
+    // the teapot and the checker floor are there
+    assert_same_image(&a, &b, 200);
+}
+
+/// The soft shadows of Klee 2016 in the window (G-buffer, shadow pass, quad into the
+/// renderer's output texture, shown by the viewer's screen-filling quad) equal `render`'s.
+#[test]
+fn soft_shadow_screenshot_equals_render() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let args = [
+        "scenes/bunny_area.toml",
+        "--shadows",
+        "linespace",
+        "--light-samples",
+        "3x3",
+    ];
+    let (a, b, stdout) = render_and_view(&xvfb, &args, 2);
+    // the title's figures per frame: the shadow kernels' GPU times, tests and lookups
+    let frame = stdout
+        .lines()
+        .find(|l| l.starts_with("frame 2: soft shadows linespace 3x3,"))
+        .unwrap_or_else(|| panic!("no soft-shadow frame line: {stdout}"));
+    for part in [
+        "gbuffer=",
+        "shadow_linespace=",
+        "present=",
+        "line-space lookups ",
+    ] {
+        assert!(frame.contains(part), "{part} missing: {frame}");
+    }
+    let lookups: u64 = frame
+        .rsplit("line-space lookups ")
+        .next()
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no lookup count: {frame}"));
+    assert!(lookups > 0, "{frame}");
+    // the bunny, the checker floor and a penumbra: many grey levels
+    assert_same_image(&a, &b, 100);
 }
 
 /// Lines of the viewer's stdout, with a deadline.
@@ -220,6 +275,34 @@ impl Lines {
             }
         }
     }
+}
+
+/// Start the viewer; its stdout line by line (deadline TIMEOUT from now), its stderr at the end.
+fn spawn_lines(mut cmd: Command) -> (Running, Lines, std::thread::JoinHandle<String>) {
+    let mut child = Running {
+        child: cmd
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start the viewer"),
+    };
+    let (tx, rx) = mpsc::channel();
+    let stdout = child.child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let stderr = child.child.stderr.take().unwrap();
+    let stderr = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
+    let lines = Lines {
+        rx,
+        seen: Vec::new(),
+        deadline: Instant::now() + TIMEOUT,
+    };
+    (child, lines, stderr)
 }
 
 fn copy_dir(from: &Path, to: &Path) {
@@ -293,30 +376,8 @@ fn kernel_edit_reloads_live() {
         .arg(&glsl)
         .arg("--screenshot")
         .arg(&shot);
-    let mut child = Running {
-        child: cmd
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("start the viewer"),
-    };
-    let (tx, rx) = mpsc::channel();
-    let stdout = child.child.stdout.take().unwrap();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
-    let stderr = child.child.stderr.take().unwrap();
-    let stderr = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
-    let deadline = Instant::now() + TIMEOUT;
-    let mut lines = Lines {
-        rx,
-        seen: Vec::new(),
-        deadline,
-    };
+    let (child, mut lines, stderr) = spawn_lines(cmd);
+    let deadline = lines.deadline;
 
     lines.expect("watching ");
     // the original kernels render
@@ -352,6 +413,69 @@ fn kernel_edit_reloads_live() {
     );
 }
 
+/// With soft shadows shown, an edit of their quad kernel (`linespace_quad.frag`) is reloaded
+/// live and reaches the window.
+#[test]
+fn soft_shadow_kernel_edit_reloads_live() {
+    let Some(xvfb) = xvfb_run() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let glsl = dir.path().join("glsl");
+    copy_dir(&root().join("glsl"), &glsl);
+    let quad = glsl.join("linespace_quad.frag");
+    let original = std::fs::read_to_string(&quad).unwrap();
+    let store = "fragColor = vec4(texture(colorTexture, texCoord).rgb, 1.0);";
+    assert_eq!(
+        original.matches(store).count(),
+        1,
+        "linespace_quad.frag changed; update this test"
+    );
+    let magenta = original.replace(store, "fragColor = vec4(1.0, 0.0, 1.0, 1.0);");
+
+    let shot = dir.path().join("after.png");
+    let mut cmd = view(
+        &xvfb,
+        &[
+            "scenes/bunny_area.toml",
+            "--shadows",
+            "linespace",
+            "--light-samples",
+            "2x2",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--log-frames",
+            "--wait-reload",
+            "--frames",
+            "1",
+        ],
+    );
+    cmd.arg("--glsl-dir")
+        .arg(&glsl)
+        .arg("--screenshot")
+        .arg(&shot);
+    let (child, mut lines, stderr) = spawn_lines(cmd);
+    let deadline = lines.deadline;
+    lines.expect("watching ");
+    lines.expect("frame 1: soft shadows linespace 2x2");
+    save(&quad, &magenta);
+    let ok = lines.expect("reload ok: linespace_quad.frag");
+    assert!(ok.contains("soft shadows linespace 2x2"), "{ok}");
+    lines.expect("screenshot: ");
+    let status = child.wait(deadline);
+    assert!(
+        status.success(),
+        "viewer failed ({status}): {}",
+        stderr.join().unwrap()
+    );
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let off = img.pixels().filter(|p| p.0 != [255, 0, 255]).count();
+    assert_eq!(
+        off, 0,
+        "{off} pixels are not the edited kernel's constant colour"
+    );
+}
+
 #[test]
 fn bad_view_input_fails_cleanly() {
     // no display needed: these fail before a window is opened
@@ -375,6 +499,12 @@ fn bad_view_input_fails_cleanly() {
     assert!(run(&["scenes/teapot1.toml", "--wait-reload", "--frames", "1"]).contains("--glsl-dir"));
     assert!(run(&["scenes/teapot1.toml", "--screenshot", "x.jpg"]).contains(".png"));
     assert!(run(&["scenes/teapot1.toml", "--glsl-dir", "no/such/dir"]).contains("no/such/dir"));
+    // soft shadows need an area light: render's message, before a window is opened
+    let e = run(&["scenes/teapot1.toml", "--shadows", "linespace"]);
+    assert!(
+        e.contains("teapot1.toml: --shadows needs an [[area_light]] in the scene file"),
+        "{e}"
+    );
     // no window system: a message that says what to do, not a panic
     let out = Command::new(BIN)
         .current_dir(root())

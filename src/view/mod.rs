@@ -7,6 +7,12 @@
 //! frames per second, GPU milliseconds per kernel and triangle tests. With `--glsl-dir` the
 //! kernels are live: saving a kernel file rebuilds the tracer from the edited sources, and a
 //! compile error is shown with file and line while the last good program keeps running.
+//!
+//! In a scene with an `[[area_light]]` the viewer also shows the soft shadows of Klee 2016
+//! ([`SoftShadowRenderer`]: G-buffer from the current camera, shadow pass, quad into its output
+//! texture, which the same screen-filling quad shows): `--shadows` starts with them, `S`
+//! cycles off (the ray tracer) / exact / linespace / linespace-dda, `L` / shift+`L` change the
+//! light samples (only the shadow kernel is recompiled; the N-tree is built once).
 
 pub mod orbit;
 pub mod watch;
@@ -26,6 +32,8 @@ use winit::window::WindowId;
 
 use crate::gl::ShaderSource;
 use crate::scene::{Camera, Scene};
+use crate::tracer::linespace::cli::SoftShadowArgs;
+use crate::tracer::linespace::{scene_light, ShadowMode, SoftShadowRenderer};
 use crate::tracer::{
     self, FrameStats, GridVariant, RenderOptions, ShadowFlags, Tracer, TracerKind,
 };
@@ -42,6 +50,8 @@ keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
        T / shift+T next / previous tracer | V next grid variant
        G / shift+G grid resolution +4 / -4 | A grid resolution auto
        ] / [ reflection depth +1 / -1
+       S / shift+S soft shadows next / previous (off, exact, linespace, linespace-dda)
+       L / shift+L light samples +1 / -1 per axis (2x2 ... 10x10; S and L: [[area_light]] scenes)
        R or F5 reload kernels | P save a screenshot | space pause | H help | Q or Esc quit";
 
 /// How often `--glsl-dir` is polled for changes.
@@ -50,6 +60,9 @@ const WATCH_INTERVAL: Duration = Duration::from_millis(200);
 const MAX_REFL_DEPTH: u32 = 16;
 /// Grid resolution step of the G keys.
 const GRID_STEP: u32 = 4;
+/// Light samples per axis the L keys go between (Klee 2016: 2×2 … 10×10).
+const MIN_LIGHT_SAMPLES: u32 = 2;
+const MAX_LIGHT_SAMPLES: u32 = 10;
 
 /// Options of `gpgpu-rt view`.
 #[derive(clap::Args, Debug, Clone)]
@@ -78,6 +91,10 @@ pub struct ViewArgs {
     /// the variant).
     #[command(flatten)]
     pub grid: tracer::GridArgs,
+    /// The soft-shadow options, as for `render` (scenes with an [[area_light]]; S cycles the
+    /// mode, L / shift+L the samples).
+    #[command(flatten)]
+    pub soft: SoftShadowArgs,
     /// Load the kernels from this directory and reload them whenever a file in it changes.
     #[arg(long, value_name = "DIR")]
     pub glsl_dir: Option<PathBuf>,
@@ -97,7 +114,7 @@ pub struct ViewArgs {
 }
 
 /// Open the viewer and run it until the window closes (or --frames are done).
-pub fn run(args: ViewArgs) -> Result<()> {
+pub fn run(mut args: ViewArgs) -> Result<()> {
     if args.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
@@ -120,6 +137,12 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }
     }
     let scene = Scene::load(&args.scene)?;
+    // as `render`: the scene file's render.shadows and render.light_samples by default
+    args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
+    if args.soft.shadows.is_some() {
+        // the same message as `render --shadows`
+        scene_light(&scene)?;
+    }
     let shaders = ShaderSource::from_dir(args.glsl_dir.clone())?;
     let options = RenderOptions {
         width: args.width.unwrap_or(scene.settings.width),
@@ -153,10 +176,34 @@ pub fn run(args: ViewArgs) -> Result<()> {
 
 /// What runs while the window is open. Field order is drop order: GL objects before the window.
 struct Running {
-    tracer: Box<dyn Tracer>,
+    /// The ray tracer (`App::kind`, `App::options`); `None` until it is first shown, and after
+    /// a change or a reload while the soft shadows are shown (built again when shown).
+    tracer: Option<Box<dyn Tracer>>,
+    /// The soft-shadow renderer, built when first shown and kept while the ray tracer is shown
+    /// (its N-tree is built once).
+    soft: Option<SoftShadowRenderer>,
     quad: ScreenQuad,
     watcher: Option<GlslWatcher>,
     window: GlWindow,
+}
+
+impl Running {
+    /// Render a frame from `camera` with the soft shadows `shadows`, else the ray tracer.
+    fn render(&mut self, shadows: Option<ShadowMode>, camera: &Camera) -> Result<FrameStats> {
+        match (shadows, self.soft.as_mut(), self.tracer.as_mut()) {
+            (Some(_), Some(soft), _) => soft.draw(camera),
+            (None, _, Some(tracer)) => tracer.render(camera).map(|f| f.stats),
+            _ => bail!("no renderer is built"),
+        }
+    }
+
+    /// The output texture of what is shown (the soft shadows or the ray tracer).
+    fn output_texture(&self, shadows: Option<ShadowMode>) -> Option<glow::Texture> {
+        match shadows {
+            Some(_) => self.soft.as_ref().map(SoftShadowRenderer::output_texture),
+            None => self.tracer.as_ref().map(|t| t.output_texture()),
+        }
+    }
 }
 
 #[derive(Default)]
@@ -173,6 +220,17 @@ struct App {
     shaders: ShaderSource,
     kind: TracerKind,
     options: RenderOptions,
+    /// Soft shadows shown (`None`: the ray tracer `kind`).
+    shadows: Option<ShadowMode>,
+    /// Light samples U×V of the soft shadows.
+    samples: (u32, u32),
+    /// Why the scene cannot have soft shadows (no or several area lights); `None`: it can.
+    no_soft: Option<String>,
+    /// The soft-shadow renderer's kernels are older than the sources (a reload while the ray
+    /// tracer was shown): recompiled when it is shown again.
+    soft_stale: bool,
+    /// The grid resolution the grid tracer last reported (for `auto`).
+    grid_in_use: Option<u32>,
     camera: Camera,
     running: Option<Running>,
     result: Result<()>,
@@ -234,6 +292,11 @@ impl App {
     fn new(args: ViewArgs, scene: Scene, shaders: ShaderSource, options: RenderOptions) -> App {
         App {
             kind: args.tracer,
+            shadows: args.soft.shadows,
+            samples: args.soft.samples(),
+            no_soft: scene_light(&scene).err().map(|e| format!("{e:#}")),
+            soft_stale: false,
+            grid_in_use: None,
             camera: scene.camera,
             counting: !args.wait_reload,
             args,
@@ -285,47 +348,131 @@ impl App {
             .dir
             .as_ref()
             .map(|d| GlslWatcher::new(d, WATCH_INTERVAL));
-        let quad = ScreenQuad::new(gl.clone(), compile_quad_program(&gl, &self.shaders)?)?;
-        let tracer = tracer::create(
-            self.kind,
-            gl,
-            &window.info,
-            &self.scene,
-            &self.shaders,
-            self.options.clone(),
-        )?;
-        eprintln!(
-            "{}: {} triangles, {} lights, {}x{}, {} tracer on {} ({}, {})\n{CONTROLS}",
-            self.scene.path.display(),
-            self.scene.triangle_count(),
-            self.scene.lights.len(),
-            self.options.width,
-            self.options.height,
-            tracer.name(),
-            window.info.renderer,
-            window.info.version,
-            window.info.egl_device_name,
-        );
-        if let Some(w) = &watcher {
-            println!("watching {} for kernel changes", w.dir().display());
-        }
+        let quad = ScreenQuad::new(gl, compile_quad_program(&window.gl, &self.shaders)?)?;
+        let info = window.info.clone();
         self.running = Some(Running {
-            tracer,
+            tracer: None,
+            soft: None,
             quad,
             watcher,
             window,
         });
+        match self.shadows {
+            Some(mode) => self.show_soft(mode, self.samples)?,
+            None => self.show_tracer(self.kind, self.options.clone(), false)?,
+        }
+        eprintln!(
+            "{}: {} triangles, {} lights, {} area lights, {}x{}, {} on {} ({}, {})\n{CONTROLS}",
+            self.scene.path.display(),
+            self.scene.triangle_count(),
+            self.scene.lights.len(),
+            self.scene.area_lights.len(),
+            self.options.width,
+            self.options.height,
+            self.shown_name(),
+            info.renderer,
+            info.version,
+            info.egl_device_name,
+        );
+        if let Some(w) = self.running.as_ref().and_then(|r| r.watcher.as_ref()) {
+            println!("watching {} for kernel changes", w.dir().display());
+        }
         Ok(())
     }
 
-    /// Rebuild the tracer (and with `quad` the screen quad's program) from the current kernel
-    /// sources and options. On failure the running ones stay and the error is returned.
-    fn rebuild(
+    /// What the window shows: "base tracer", "soft shadows linespace 3x3".
+    fn shown_name(&self) -> String {
+        match self.shadows {
+            Some(mode) => format!(
+                "soft shadows {} {}x{}",
+                mode.name(),
+                self.samples.0,
+                self.samples.1
+            ),
+            None => format!("{} tracer", kind_name(self.kind)),
+        }
+    }
+
+    /// A new renderer or new options: the next frame is rendered, the old statistics go.
+    fn new_picture(&mut self) {
+        self.has_frame = false;
+        self.last_stats = None;
+        self.render_failed = false;
+        self.dirty = true;
+    }
+
+    /// Show the ray tracer `kind` with `options`; it is built unless `rebuild` is false and one
+    /// runs already. On failure what runs stays.
+    fn show_tracer(
         &mut self,
-        quad: bool,
-        options: RenderOptions,
         kind: TracerKind,
-    ) -> Result<Duration> {
+        options: RenderOptions,
+        rebuild: bool,
+    ) -> Result<()> {
+        let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
+        if rebuild || running.tracer.is_none() {
+            let tracer = tracer::create(
+                kind,
+                running.window.gl.clone(),
+                &running.window.info,
+                &self.scene,
+                &self.shaders,
+                options.clone(),
+            )?;
+            running.tracer = Some(tracer);
+        }
+        self.kind = kind;
+        self.options = options;
+        self.shadows = None;
+        self.new_picture();
+        Ok(())
+    }
+
+    /// Show the soft shadows `mode` with `samples`: the renderer is built the first time (the
+    /// N-tree with it); later only its shadow kernel is recompiled (all its kernels after a
+    /// reload). On failure what runs stays.
+    fn show_soft(&mut self, mode: ShadowMode, samples: (u32, u32)) -> Result<()> {
+        if let Some(why) = &self.no_soft {
+            bail!("{why}");
+        }
+        let mut options = self.args.soft.options(
+            mode,
+            self.options.width,
+            self.options.height,
+            self.options.tile,
+        );
+        (options.samples_u, options.samples_v) = samples;
+        let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
+        match running.soft.as_mut() {
+            None => {
+                let soft = SoftShadowRenderer::new(
+                    running.window.gl.clone(),
+                    &running.window.info,
+                    &self.scene,
+                    &self.shaders,
+                    options,
+                )?;
+                running.soft = Some(soft);
+            }
+            Some(s) if self.soft_stale => s.recompile(&self.shaders, mode, samples.0, samples.1)?,
+            Some(s) => {
+                let o = &s.options;
+                if (o.mode, o.samples_u, o.samples_v) != (mode, samples.0, samples.1) {
+                    s.reconfigure(&self.shaders, mode, samples.0, samples.1)?;
+                }
+            }
+        }
+        self.soft_stale = false;
+        self.shadows = Some(mode);
+        self.samples = samples;
+        self.new_picture();
+        Ok(())
+    }
+
+    /// Kernel files changed (or R/F5): rebuild what the window shows (and with `quad` the
+    /// screen quad's program) from the current sources. On failure the running ones stay and
+    /// the error is returned. The renderer not shown follows when it is shown next.
+    fn reload_kernels(&mut self, quad: bool) -> Result<Duration> {
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
         let start = Instant::now();
         let gl = running.window.gl.clone();
@@ -334,34 +481,36 @@ impl App {
         } else {
             None
         };
-        let tracer = tracer::create(
-            kind,
-            gl.clone(),
-            &running.window.info,
-            &self.scene,
-            &self.shaders,
-            options.clone(),
-        );
-        let tracer = match tracer {
-            Ok(t) => t,
-            Err(e) => {
-                if let Some(p) = program {
-                    // SAFETY: deleting the program we just made.
-                    unsafe { gl.delete_program(p) };
-                }
-                return Err(e);
+        let rebuilt = match (self.shadows, running.soft.as_mut()) {
+            (Some(mode), Some(soft)) => {
+                soft.recompile(&self.shaders, mode, self.samples.0, self.samples.1)
             }
+            _ => tracer::create(
+                self.kind,
+                gl.clone(),
+                &running.window.info,
+                &self.scene,
+                &self.shaders,
+                self.options.clone(),
+            )
+            .map(|t| running.tracer = Some(t)),
         };
+        if let Err(e) = rebuilt {
+            if let Some(p) = program {
+                // SAFETY: deleting the program we just made.
+                unsafe { gl.delete_program(p) };
+            }
+            return Err(e);
+        }
         if let Some(p) = program {
             running.quad.set_program(p);
         }
-        running.tracer = tracer;
-        self.options = options;
-        self.kind = kind;
-        self.has_frame = false;
-        self.last_stats = None;
-        self.render_failed = false;
-        self.dirty = true;
+        if self.shadows.is_some() {
+            running.tracer = None;
+        } else {
+            self.soft_stale = running.soft.is_some();
+        }
+        self.new_picture();
         Ok(start.elapsed())
     }
 
@@ -380,11 +529,11 @@ impl App {
             ),
             None => (true, "all kernels".to_string()),
         };
-        match self.rebuild(quad, self.options.clone(), self.kind) {
+        match self.reload_kernels(quad) {
             Ok(took) => {
                 println!(
-                    "reload ok: {what} ({} tracer rebuilt in {:.0} ms)",
-                    kind_name(self.kind),
+                    "reload ok: {what} ({} rebuilt in {:.0} ms)",
+                    self.shown_name(),
                     took.as_secs_f64() * 1e3
                 );
                 self.notice = None;
@@ -404,10 +553,10 @@ impl App {
         self.update_title(true);
     }
 
-    /// Switch tracer kind or options (keys); on failure keep the running ones.
-    fn change(&mut self, kind: TracerKind, options: RenderOptions, what: String) {
-        match self.rebuild(false, options, kind) {
-            Ok(_) => {
+    /// Print what a key did, or on failure why (also in the title; what runs stays).
+    fn report(&mut self, what: String, result: Result<()>) {
+        match result {
+            Ok(()) => {
                 println!("{what}");
                 self.notice = None;
             }
@@ -420,30 +569,59 @@ impl App {
         self.update_title(true);
     }
 
+    /// New options of the ray tracer (keys). While the soft shadows are shown they are kept
+    /// for it (it is built with them when S shows it again); else it is rebuilt, and on
+    /// failure the running one stays.
+    fn change(&mut self, kind: TracerKind, options: RenderOptions, what: String) {
+        if self.shadows.is_some() {
+            self.kind = kind;
+            self.options = options;
+            if let Some(r) = self.running.as_mut() {
+                r.tracer = None;
+            }
+            println!("{what} (for the ray tracer; soft shadows are shown, S switches)");
+            self.update_title(true);
+            return;
+        }
+        let result = self.show_tracer(kind, options, true);
+        self.report(what, result);
+    }
+
     fn update_title(&mut self, now: bool) {
         if !now && self.title_at.elapsed() < Duration::from_millis(250) {
             return;
         }
         self.title_at = Instant::now();
         let Some(running) = &self.running else { return };
-        let mut t = format!(
-            "gpgpu-rt · {} · {}",
-            self.scene_name(),
-            running.tracer.name()
-        );
-        if self.kind != TracerKind::Base {
-            let g = &self.options.grid;
-            let res = g
-                .resolution
-                .map(|r| r.to_string())
-                .or_else(|| self.grid_resolution_in_use().map(|r| format!("auto={r}")))
-                .unwrap_or_else(|| "auto".into());
-            t += &format!(" {} {res}³", variant_name(g.variant));
+        let mut t = format!("gpgpu-rt · {} · ", self.scene_name());
+        match (self.shadows, running.soft.as_ref()) {
+            (Some(mode), Some(soft)) => {
+                t += &format!(
+                    "soft shadows {} {}×{} · N-tree {}/{}",
+                    mode.name(),
+                    self.samples.0,
+                    self.samples.1,
+                    soft.tree.n,
+                    soft.tree.depth
+                );
+            }
+            _ => {
+                t += &kind_name(self.kind);
+                if self.kind != TracerKind::Base {
+                    let g = &self.options.grid;
+                    let res = g
+                        .resolution
+                        .map(|r| r.to_string())
+                        .or_else(|| self.grid_in_use.map(|r| format!("auto={r}")))
+                        .unwrap_or_else(|| "auto".into());
+                    t += &format!(" {} {res}³", variant_name(g.variant));
+                }
+            }
         }
-        t += &format!(
-            " · {}×{} · refl {}",
-            self.options.width, self.options.height, self.options.refl_depth
-        );
+        t += &format!(" · {}×{}", self.options.width, self.options.height);
+        if self.shadows.is_none() {
+            t += &format!(" · refl {}", self.options.refl_depth);
+        }
         if !self.continuous {
             t += " · paused";
         } else if let Some(fps) = self.fps {
@@ -461,6 +639,9 @@ impl App {
                 kernels.join(", "),
                 group_digits(s.total_triangle_tests())
             );
+            if let Some(n) = s.events.get("linespace_lookups") {
+                t += &format!(" · {} line-space lookups", group_digits(*n));
+            }
         }
         if let Some(n) = &self.notice {
             t += &format!(" · ⚠ {n}");
@@ -468,28 +649,19 @@ impl App {
         running.window.window.set_title(&t);
     }
 
-    /// The grid resolution the running tracer reports using (for `auto`).
-    fn grid_resolution_in_use(&self) -> Option<u32> {
-        self.last_stats
-            .as_ref()?
-            .facts
-            .get("grid_resolution")?
-            .as_u64()
-            .map(|r| r as u32)
-    }
-
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
         if self.finished {
             return;
         }
         let want = (self.continuous || self.dirty) && !self.render_failed;
+        let name = self.shown_name();
         let Some(running) = self.running.as_mut() else {
             return;
         };
         if want {
             self.dirty = false;
             running.window.begin_compute();
-            let rendered = running.tracer.render(&self.camera);
+            let rendered = running.render(self.shadows, &self.camera);
             if let Err(e) = running.window.begin_present() {
                 return self.fail(event_loop, e);
             }
@@ -501,22 +673,32 @@ impl App {
                     if self.counting {
                         self.counted += 1;
                     }
-                    let s = frame.stats;
+                    let s = frame;
                     if self.args.log_frames {
                         let kernels: Vec<String> = s
                             .gpu_ms
                             .iter()
                             .map(|(k, v)| format!("{k}={v:.3}"))
                             .collect();
+                        let lookups = s
+                            .events
+                            .get("linespace_lookups")
+                            .map(|n| format!(", line-space lookups {n}"))
+                            .unwrap_or_default();
                         println!(
-                            "frame {}: {} tracer, wall {:.1} ms, gpu {:.3} ms [{}], triangle tests {}",
+                            "frame {}: {}, wall {:.1} ms, gpu {:.3} ms [{}], triangle tests {}{lookups}",
                             self.frames,
-                            running.tracer.name(),
+                            name,
                             s.wall_ms,
                             s.total_gpu_ms(),
                             kernels.join(" "),
                             s.total_triangle_tests()
                         );
+                    }
+                    if self.shadows.is_none() {
+                        if let Some(r) = s.facts.get("grid_resolution").and_then(|r| r.as_u64()) {
+                            self.grid_in_use = Some(r as u32);
+                        }
                     }
                     self.last_stats = Some(s);
                 }
@@ -533,12 +715,13 @@ impl App {
         }
         let size = running.window.size();
         let viewport = fit_viewport(size, (self.options.width, self.options.height));
-        if self.has_frame {
+        if let Some(texture) = running
+            .output_texture(self.shadows)
+            .filter(|_| self.has_frame)
+        {
             // SAFETY: drawing to the window's default framebuffer.
             unsafe { running.window.gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
-            running
-                .quad
-                .draw(running.tracer.output_texture(), size, viewport);
+            running.quad.draw(texture, size, viewport);
         }
         let target = self.args.frames.unwrap_or(1);
         let done = (self.args.frames.is_some() || self.args.screenshot.is_some())
@@ -571,9 +754,10 @@ impl App {
     /// size, else the quad drawn offscreen at the image size.
     fn save_screenshot(&mut self, path: &Path, viewport: Viewport) -> Result<()> {
         let running = self.running.as_ref().ok_or_else(|| anyhow!("no window"))?;
-        if !self.has_frame {
-            bail!("no frame has been rendered yet");
-        }
+        let texture = running
+            .output_texture(self.shadows)
+            .filter(|_| self.has_frame)
+            .ok_or_else(|| anyhow!("no frame has been rendered yet"))?;
         let (w, h) = (self.options.width, self.options.height);
         let (pixels, from) = if (viewport.width, viewport.height) == (w, h) {
             (
@@ -581,9 +765,7 @@ impl App {
                 "window framebuffer",
             )
         } else {
-            let p = running
-                .quad
-                .draw_offscreen(running.tracer.output_texture(), w, h)?;
+            let p = running.quad.draw_offscreen(texture, w, h)?;
             // the window's framebuffer again for the next draw
             (
                 p,
@@ -634,7 +816,15 @@ impl App {
                 let i = kinds.iter().position(|k| *k == self.kind).unwrap_or(0);
                 let n = kinds.len();
                 let next = kinds[if shift { (i + n - 1) % n } else { (i + 1) % n }];
-                if n == 1 {
+                if self.shadows.is_some() {
+                    // from the soft shadows to the next ray tracer
+                    let rebuild = next != self.kind;
+                    let result = self.show_tracer(next, self.options.clone(), rebuild);
+                    self.report(
+                        format!("tracer {} (soft shadows off)", kind_name(next)),
+                        result,
+                    );
+                } else if n == 1 {
                     self.notice = Some(format!("{} is the only tracer", kind_name(next)));
                     self.update_title(true);
                 } else {
@@ -661,7 +851,7 @@ impl App {
                     .options
                     .grid
                     .resolution
-                    .or_else(|| self.grid_resolution_in_use())
+                    .or(self.grid_in_use)
                     .unwrap_or(16);
                 let next = if shift {
                     current.saturating_sub(GRID_STEP).max(1)
@@ -695,6 +885,67 @@ impl App {
                     let mut o = self.options.clone();
                     o.refl_depth = next;
                     self.change(self.kind, o, format!("reflection depth {next}"));
+                }
+            }
+            Key::Character("s") | Key::Character("S") => {
+                // off (the ray tracer), exact, linespace, linespace-dda
+                let mut cycle = vec![None];
+                cycle.extend(ShadowMode::value_variants().iter().copied().map(Some));
+                let i = cycle.iter().position(|m| *m == self.shadows).unwrap_or(0);
+                let n = cycle.len();
+                let next = cycle[if shift { (i + n - 1) % n } else { (i + 1) % n }];
+                let (what, result) = match next {
+                    _ if self.no_soft.is_some() => {
+                        ("soft shadows".to_string(), Err(self.no_soft_error()))
+                    }
+                    None => (
+                        format!("soft shadows off: {} tracer", kind_name(self.kind)),
+                        self.show_tracer(self.kind, self.options.clone(), false),
+                    ),
+                    Some(mode) => (
+                        format!(
+                            "soft shadows {} {}x{}",
+                            mode.name(),
+                            self.samples.0,
+                            self.samples.1
+                        ),
+                        self.show_soft(mode, self.samples),
+                    ),
+                };
+                self.report(what, result);
+            }
+            Key::Character("l") | Key::Character("L") => {
+                let step = |n: u32| {
+                    if shift {
+                        if n > MIN_LIGHT_SAMPLES {
+                            n - 1
+                        } else {
+                            n
+                        }
+                    } else {
+                        (n + 1).clamp(MIN_LIGHT_SAMPLES, MAX_LIGHT_SAMPLES)
+                    }
+                };
+                let next = (step(self.samples.0), step(self.samples.1));
+                let what = format!("light samples {}x{}", next.0, next.1);
+                if self.no_soft.is_some() {
+                    let e = self.no_soft_error();
+                    self.report("light samples".into(), Err(e));
+                } else if next == self.samples {
+                    self.notice = Some(format!(
+                        "light samples {}x{}: the keys go from {MIN_LIGHT_SAMPLES}x{MIN_LIGHT_SAMPLES} to \
+                         {MAX_LIGHT_SAMPLES}x{MAX_LIGHT_SAMPLES}",
+                        next.0, next.1
+                    ));
+                    self.update_title(true);
+                } else if let Some(mode) = self.shadows {
+                    let result = self.show_soft(mode, next);
+                    self.report(what, result);
+                } else {
+                    self.samples = next;
+                    println!("{what} (for the soft shadows; S shows them)");
+                    self.notice = None;
+                    self.update_title(true);
                 }
             }
             Key::Named(NamedKey::F5) | Key::Character("r") | Key::Character("R") => {
@@ -741,6 +992,14 @@ impl App {
         } else {
             self.change(self.kind, options, what);
         }
+    }
+
+    /// Why S and L do nothing in this scene.
+    fn no_soft_error(&self) -> anyhow::Error {
+        anyhow!(
+            "{} (S and L need a scene with one [[area_light]])",
+            self.no_soft.as_deref().unwrap_or("no area light")
+        )
     }
 
     fn mouse_move(&mut self, x: f64, y: f64) {

@@ -12,7 +12,7 @@ use crate::output;
 use crate::scene::{RenderSettings, Scene};
 use crate::tracer::Frame;
 
-/// The soft-shadow options of `render`.
+/// The soft-shadow options of `render` and `view`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct SoftShadowArgs {
     /// Soft shadows from the scene's [[area_light]] with the Cascaded Line Space (Klee 2016):

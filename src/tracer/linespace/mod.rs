@@ -313,6 +313,71 @@ impl SoftShadowRenderer {
         Ok(())
     }
 
+    /// Recompile every kernel (G-buffer, shadow pass, quad) from `shaders` with a mode and a
+    /// number of samples: the viewer's live reload. The N-tree and the line spaces stay; on
+    /// failure the old programs stay too.
+    pub fn recompile(
+        &mut self,
+        shaders: &ShaderSource,
+        mode: ShadowMode,
+        su: u32,
+        sv: u32,
+    ) -> Result<()> {
+        let gl = self.gl.clone();
+        let shadow = Self::shadow_kernel(&gl, shaders, &self.tree, mode, su, sv)?;
+        let (raster, quad) = match Self::raster_programs(&gl, shaders) {
+            Ok(p) => p,
+            Err(e) => {
+                // SAFETY: deleting the program we just made.
+                unsafe { gl.delete_program(shadow) };
+                return Err(e);
+            }
+        };
+        // SAFETY: deleting our old programs.
+        unsafe {
+            gl.delete_program(self.shadow_program);
+            gl.delete_program(self.raster);
+            gl.delete_program(self.quad_program);
+        }
+        self.shadow_program = shadow;
+        self.raster = raster;
+        self.quad_program = quad;
+        self.options.mode = mode;
+        self.options.samples_u = su;
+        self.options.samples_v = sv;
+        Ok(())
+    }
+
+    /// The G-buffer's and the screen-filling quad's programs.
+    fn raster_programs(gl: &Gl, shaders: &ShaderSource) -> Result<(glow::Program, glow::Program)> {
+        let raster = compile_program(
+            gl,
+            shaders,
+            &[
+                (glow::VERTEX_SHADER, "gbuffer.vert"),
+                (glow::FRAGMENT_SHADER, "gbuffer.frag"),
+            ],
+            &Defines::new(),
+        )?;
+        let quad = compile_program(
+            gl,
+            shaders,
+            &[
+                (glow::VERTEX_SHADER, "linespace_quad.vert"),
+                (glow::FRAGMENT_SHADER, "linespace_quad.frag"),
+            ],
+            &Defines::new(),
+        );
+        match quad {
+            Ok(q) => Ok((raster, q)),
+            Err(e) => {
+                // SAFETY: deleting the program we just made.
+                unsafe { gl.delete_program(raster) };
+                Err(e)
+            }
+        }
+    }
+
     /// Like [`SoftShadowRenderer::new`] with an N-tree built before (over the scene's
     /// world triangles).
     pub fn with_tree(
@@ -362,24 +427,14 @@ impl SoftShadowRenderer {
             options.samples_u,
             options.samples_v,
         )?;
-        let raster = compile_program(
-            &gl,
-            shaders,
-            &[
-                (glow::VERTEX_SHADER, "gbuffer.vert"),
-                (glow::FRAGMENT_SHADER, "gbuffer.frag"),
-            ],
-            &Defines::new(),
-        )?;
-        let quad_program = compile_program(
-            &gl,
-            shaders,
-            &[
-                (glow::VERTEX_SHADER, "linespace_quad.vert"),
-                (glow::FRAGMENT_SHADER, "linespace_quad.frag"),
-            ],
-            &Defines::new(),
-        )?;
+        let (raster, quad_program) = match Self::raster_programs(&gl, shaders) {
+            Ok(p) => p,
+            Err(e) => {
+                // SAFETY: deleting the program we just made.
+                unsafe { gl.delete_program(shadow_program) };
+                return Err(e);
+            }
+        };
         let attrs = scene.world_attributes();
         let pos: Vec<[f32; 3]> = triangles.iter().flatten().map(|v| v.to_array()).collect();
         let nor: Vec<[f32; 3]> = attrs.normals.iter().map(|v| v.to_array()).collect();
@@ -598,8 +653,66 @@ impl SoftShadowRenderer {
         data
     }
 
+    /// The RGBA32F output texture of the last frame (what the screen-filling quad drew), GL
+    /// row order: the viewer shows it through its own screen-filling quad.
+    pub fn output_texture(&self) -> glow::Texture {
+        self.output_texture
+    }
+
     /// Render one frame: G-buffer, shadow pass, screen-filling quad; read everything back.
     pub fn render(&mut self, camera: &Camera) -> Result<SoftShadowFrame> {
+        let t0 = Instant::now();
+        let mut stats = self.draw(camera)?;
+        let gl = self.gl.clone();
+        let (w, h) = (self.options.width, self.options.height);
+        let gb = self.gbuffer;
+        let color = flip_rows(&read_rgba32f(&gl, self.output_texture, w, h), w, h);
+        let shadow: Vec<f32> = flip_rows(&read_rgba32f(&gl, self.shadow_texture, w, h), w, h)
+            .iter()
+            .map(|c| c[0])
+            .collect();
+        let gbuffer_position = flip_rows(&read_rgba32f(&gl, gb[0], w, h), w, h);
+        let gbuffer_normal = flip_rows(&read_rgba32f(&gl, gb[1], w, h), w, h);
+        // the AOVs of the base tracer: primary rays from the camera, hits from the G-buffer
+        let rays = camera.rays(w, h);
+        let mut aovs = Aovs::default();
+        for row in 0..h {
+            let y = h - 1 - row; // GL row of image row `row`
+            for x in 0..w {
+                let (o, d) = rays.primary_ray(x, y);
+                let i = (row * w + x) as usize;
+                let (p, nrm) = (gbuffer_position[i], gbuffer_normal[i]);
+                aovs.ray_origin.push(o.to_array());
+                aovs.ray_direction.push(d.to_array());
+                if p[3] > 0.0 {
+                    aovs.hit_t.push((Vec3::new(p[0], p[1], p[2]) - o).dot(d));
+                    aovs.triangle_id.push(nrm[3] as i32);
+                    aovs.normal.push([nrm[0], nrm[1], nrm[2]]);
+                } else {
+                    aovs.hit_t.push(f32::INFINITY);
+                    aovs.triangle_id.push(-1);
+                    aovs.normal.push([0.0; 3]);
+                }
+            }
+        }
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(SoftShadowFrame {
+            width: w,
+            height: h,
+            color,
+            shadow,
+            gbuffer_position,
+            gbuffer_normal,
+            aovs,
+            stats,
+        })
+    }
+
+    /// Render one frame (G-buffer, shadow pass, screen-filling quad into the output texture)
+    /// and read back only the counters and the timers: the viewer's frame, which shows
+    /// [`SoftShadowRenderer::output_texture`]. A frame that hit llvmpipe's loop limit is
+    /// refused.
+    pub fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
         let gl = self.gl.clone();
         let (w, h) = (self.options.width, self.options.height);
@@ -738,41 +851,12 @@ impl SoftShadowRenderer {
         let gpu_ms = self.timers.resolve(&gl);
         let counters = self.counter_ssbo.read_u32(&gl);
         let count = |i: usize| counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
-        let color = flip_rows(&read_rgba32f(&gl, self.output_texture, w, h), w, h);
-        let shadow: Vec<f32> = flip_rows(&read_rgba32f(&gl, self.shadow_texture, w, h), w, h)
-            .iter()
-            .map(|c| c[0])
-            .collect();
-        let gbuffer_position = flip_rows(&read_rgba32f(&gl, gb[0], w, h), w, h);
-        let gbuffer_normal = flip_rows(&read_rgba32f(&gl, gb[1], w, h), w, h);
         let truncated = count(3);
         if truncated > 0 {
             bail!(
                 "{truncated} pixels of the shadow pass hit the loop budget (llvmpipe ends loops after 65535 \
                  iterations); use fewer --light-samples or the linespace mode"
             );
-        }
-        // the AOVs of the base tracer: primary rays from the camera, hits from the G-buffer
-        let rays = camera.rays(w, h);
-        let mut aovs = Aovs::default();
-        for row in 0..h {
-            let y = h - 1 - row; // GL row of image row `row`
-            for x in 0..w {
-                let (o, d) = rays.primary_ray(x, y);
-                let i = (row * w + x) as usize;
-                let (p, nrm) = (gbuffer_position[i], gbuffer_normal[i]);
-                aovs.ray_origin.push(o.to_array());
-                aovs.ray_direction.push(d.to_array());
-                if p[3] > 0.0 {
-                    aovs.hit_t.push((Vec3::new(p[0], p[1], p[2]) - o).dot(d));
-                    aovs.triangle_id.push(nrm[3] as i32);
-                    aovs.normal.push([nrm[0], nrm[1], nrm[2]]);
-                } else {
-                    aovs.hit_t.push(f32::INFINITY);
-                    aovs.triangle_id.push(-1);
-                    aovs.normal.push([0.0; 3]);
-                }
-            }
         }
         let mut stats = FrameStats {
             gpu_ms,
@@ -783,7 +867,15 @@ impl SoftShadowRenderer {
         stats.events.insert("linespace_lookups".into(), count(1));
         stats.events.insert("nodes_visited".into(), count(2));
         stats.events.insert("packet_failures".into(), count(4));
-        let facts: BTreeMap<String, serde_json::Value> = [
+        stats.facts = self.facts();
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Ok(stats)
+    }
+
+    /// The renderer's facts in the frame statistics (options, N-tree and line-space sizes,
+    /// build times).
+    fn facts(&self) -> BTreeMap<String, serde_json::Value> {
+        [
             ("shadows", json!(self.options.mode)),
             (
                 "light_samples",
@@ -819,19 +911,7 @@ impl SoftShadowRenderer {
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
-        .collect();
-        stats.facts = facts;
-        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok(SoftShadowFrame {
-            width: w,
-            height: h,
-            color,
-            shadow,
-            gbuffer_position,
-            gbuffer_normal,
-            aovs,
-            stats,
-        })
+        .collect()
     }
 
     /// The CPU implementation over the same N-tree and light (src/reference/linespace.rs).
