@@ -86,8 +86,8 @@ enum Command {
     /// Open a window that shows the scene live (orbit, pan, zoom; live-editable kernels with
     /// --glsl-dir); --screenshot FILE.png --frames N saves the N-th frame and exits.
     View(gpgpu_rt::view::ViewArgs),
-    /// Replicate a published evaluation (thesis-5.1, thesis-5.2, thesis-5.3: Müller 2015, ch. 5):
-    /// CSVs, plots and report.md with our numbers beside the published ones.
+    /// Replicate a published evaluation (thesis-5.x: Müller 2015, ch. 5; klee-*: Klee 2016,
+    /// ch. 5): CSVs, plots and report.md with our numbers beside the published ones.
     Bench(gpgpu_rt::bench::BenchArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
     Info {
