@@ -208,14 +208,33 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
     let m = &bench.machine;
     let a = &bench.args;
     let mut s = String::new();
-    let _ = writeln!(s, "# Müller 2015, ch. 5, replicated with gpgpu-rt\n");
+    // the sources whose protocols ran: the Müller-specific settings only where they apply
+    let muller = sections.iter().any(|x| x.protocol.starts_with("thesis-"));
+    let klee = sections.iter().any(|x| x.protocol.starts_with("klee-"));
+    let mut sources = Vec::new();
+    let mut cited = Vec::new();
+    if muller || !klee {
+        sources.push("Müller 2015, ch. 5");
+        cited.push(
+            "Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL 4.5 compute shaders and a per-frame \
+             uniform grid*), ch. 5",
+        );
+    }
+    if klee {
+        sources.push("Klee 2016, ch. 5");
+        cited.push(
+            "Klee 2016 (B.Sc. thesis, *Darstellung von Halbschatten durch Verwendung des \"Cascaded \
+             Linespace\"-Verfahrens*), ch. 5",
+        );
+    }
+    let _ = writeln!(s, "# {}, replicated with gpgpu-rt\n", sources.join("; "));
     let _ = writeln!(
         s,
-        "Our numbers beside the published ones of Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL \
-         4.5 compute shaders and a per-frame uniform grid*), ch. 5. The hardware differs, so absolute FPS are \
-         not comparable: compare the **ratios** (speed-up, test reduction, FPS relative to another scene). \
-         Triangle-test counts do not depend on the hardware, but on the image size, the camera and the scene \
-         files, which the thesis does not fully state.\n"
+        "Our numbers beside the published ones of {}. The hardware differs, so absolute times are not \
+         comparable: compare the **ratios** (speed-up, test reduction, time relative to another scene or \
+         method). Triangle-test counts do not depend on the hardware, but on the image size, the camera and \
+         the scene files, which the theses do not fully state.\n",
+        cited.join(" and ")
     );
     let args: Vec<String> = std::env::args().collect();
     let _ = writeln!(
@@ -253,7 +272,12 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         vec!["OS".into(), m.os.clone(), published::OS.into()],
         vec!["gpgpu-rt".into(), m.gpgpu_rt_version.clone(), "–".into()],
     ];
-    s.push_str(&table(&["", "ours", "Müller 2015 (ch. 5)"], &rows));
+    if muller {
+        s.push_str(&table(&["", "ours", "Müller 2015 (ch. 5)"], &rows));
+    } else {
+        let ours: Vec<Vec<String>> = rows.into_iter().map(|r| r[..2].to_vec()).collect();
+        s.push_str(&table(&["", "ours"], &ours));
+    }
     if m.is_software() {
         let _ = writeln!(
             s,
@@ -264,6 +288,17 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         );
     }
 
+    if muller {
+        muller_settings(&mut s, a);
+    }
+    sections_markdown(&mut s, sections);
+    let path = bench.out.join("report.md");
+    std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}
+
+/// The settings of the Müller 2015 protocols (the Klee sections state their own).
+fn muller_settings(s: &mut String, a: &super::BenchArgs) {
     let _ = writeln!(s, "\n## Settings\n");
     let scale = match a.scale {
         Scale::Quick => "quick (few angles, a small image: minutes on Mesa llvmpipe)",
@@ -342,7 +377,10 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         published::HARDWARE,
         published::MEASURES
     );
+}
 
+/// Every protocol's section with the files it wrote.
+fn sections_markdown(s: &mut String, sections: &[Section]) {
     for sec in sections {
         let _ = writeln!(s, "\n## {}: {}\n", sec.protocol, sec.title);
         s.push_str(&sec.markdown);
@@ -358,9 +396,6 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
             );
         }
     }
-    let path = bench.out.join("report.md");
-    std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(path)
 }
 
 /// Markdown image link for a plot.
