@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context as _, Result};
-use clap::{Parser, Subcommand};
+use clap::parser::ValueSource;
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Subcommand};
 use serde_json::json;
 
 use gpgpu_rt::gl::{GlContext, ShaderSource};
@@ -12,7 +13,7 @@ use gpgpu_rt::output;
 use gpgpu_rt::scene::Scene;
 use gpgpu_rt::tracer::{self, GridArgs, RenderOptions, ShadowFlags, TracerKind};
 
-#[derive(Parser)]
+#[derive(clap::Parser)]
 #[command(
     name = "gpgpu-rt",
     version,
@@ -102,8 +103,12 @@ enum Command {
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
-    match run(cli) {
+    let matches = Cli::command().get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    match run(cli, &matches) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -112,11 +117,21 @@ fn main() -> ExitCode {
     }
 }
 
+/// The options among `ids` (clap ids: the field names) that the command line gave
+/// explicitly, as `--long-name`.
+fn given_options(m: Option<&ArgMatches>, ids: &[&str]) -> Vec<String> {
+    let Some(m) = m else { return Vec::new() };
+    ids.iter()
+        .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
+        .map(|id| format!("--{}", id.replace('_', "-")))
+        .collect()
+}
+
 fn load_scene(path: &Path) -> Result<Scene> {
     Ok(Scene::load(path)?)
 }
 
-fn run(cli: Cli) -> Result<()> {
+fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
     match cli.command {
         Command::Render {
             scene,
@@ -138,7 +153,32 @@ fn run(cli: Cli) -> Result<()> {
             let shaders = ShaderSource::from_dir(gpu.glsl_dir)?;
             let ctx = GlContext::headless(gpu.device)?;
             let soft = soft.with_scene_defaults(&scene.settings);
+            let given = |ids: &[&str]| given_options(matches.subcommand_matches("render"), ids);
             if let Some(mode) = soft.shadows {
+                let ray_tracer_only = given(&[
+                    "tracer",
+                    "refl_depth",
+                    "shadow_flags",
+                    "grid",
+                    "grid_variant",
+                    "voxel_array_length",
+                    "ray_array_length",
+                ]);
+                if !ray_tracer_only.is_empty() {
+                    bail!(
+                        "{} {} not apply: {} of the point-light ray tracers, and this render uses the \
+                         soft-shadow pipeline (`{}`, from {})",
+                        ray_tracer_only.join(", "),
+                        if ray_tracer_only.len() == 1 { "does" } else { "do" },
+                        if ray_tracer_only.len() == 1 { "an option" } else { "options" },
+                        mode.name(),
+                        if given(&["shadows"]).is_empty() {
+                            format!("render.shadows in {}", scene.path.display())
+                        } else {
+                            "--shadows".to_string()
+                        }
+                    );
+                }
                 // Klee 2016: G-buffer, soft-shadow compute pass, screen-filling quad
                 let (w, h) = (
                     width.unwrap_or(scene.settings.width),
@@ -150,9 +190,19 @@ fn run(cli: Cli) -> Result<()> {
                     &scene,
                     &shaders,
                     opts,
+                    frames,
                     &output,
                     aov_dir.as_deref(),
                     stats.as_deref(),
+                );
+            }
+            let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
+            if !soft_only.is_empty() {
+                bail!(
+                    "{} {} not apply without soft shadows: add --shadows exact|linespace|linespace-dda \
+                     (the scene needs an [[area_light]])",
+                    soft_only.join(", "),
+                    if soft_only.len() == 1 { "does" } else { "do" }
                 );
             }
             let options = RenderOptions {

@@ -368,3 +368,40 @@ fn every_shipped_scene_renders() {
         assert!(out.exists());
     }
 }
+
+/// Options of the pipeline a render does not use are refused, not silently ignored: the ray
+/// tracer's options with soft shadows (from `--shadows` or the scene's `render.shadows`), the
+/// soft shadows' options without them.
+#[test]
+fn options_of_the_other_pipeline_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("x.png");
+    let png = png.to_str().unwrap();
+    let area = scene("bunny_area.toml");
+    let small = ["--width", "16", "--height", "16", "-o", png];
+    let with = |extra: &[&str]| {
+        let mut a = vec!["render", area.as_str()];
+        a.extend_from_slice(&small);
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    assert_fails(
+        &with(&["--tracer", "grid"]),
+        &[
+            "--tracer does not apply",
+            "render.shadows in",
+            "bunny_area.toml",
+        ],
+    );
+    assert_fails(
+        &with(&["--shadows", "exact", "--grid", "8", "--refl-depth", "1"]),
+        &["--refl-depth, --grid do not apply", "from --shadows"],
+    );
+    let cow = scene("cow.toml");
+    let mut a = vec!["render", cow.as_str(), "--light-samples", "3x3"];
+    a.extend_from_slice(&small);
+    assert_fails(&run(&a), &["--light-samples does not apply", "--shadows"]);
+    // the defaults of both pipelines' options are not "given": these render
+    let o = with(&["--tile", "64", "--frames", "2", "--light-samples", "2x2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

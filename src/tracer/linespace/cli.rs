@@ -105,18 +105,23 @@ pub fn stats_json(
 }
 
 /// Render `scene` with the soft-shadow pipeline and write the PNG, the AOVs (the base
-/// tracer's plus `shadow.npy`) and the statistics.
+/// tracer's plus `shadow.npy`) and the statistics of the last of `frames` frames.
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     ctx: &GlContext,
     scene: &Scene,
     shaders: &ShaderSource,
     options: SoftShadowOptions,
+    frames: u32,
     out: &Path,
     aov_dir: Option<&Path>,
     stats: Option<&Path>,
 ) -> Result<()> {
     let mut r = SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, scene, shaders, options)?;
+    // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
+    for _ in 1..frames {
+        r.draw(&scene.camera)?;
+    }
     let f = r.render(&scene.camera)?;
     let frame = Frame {
         width: f.width,
