@@ -154,28 +154,34 @@ impl Image2d {
 
     /// Read back RGBA32F texels, row 0 = the bottom row (GL order).
     pub fn read_f32(&self, gl: &Gl) -> Vec<[f32; 4]> {
-        let mut data = vec![[0f32; 4]; (self.width * self.height) as usize];
-        // SAFETY: the slice holds width·height RGBA floats.
-        unsafe {
-            gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT);
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-            gl.get_tex_image(
-                glow::TEXTURE_2D,
-                0,
-                glow::RGBA,
-                glow::FLOAT,
-                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
-            );
-            gl.bind_texture(glow::TEXTURE_2D, None);
-        }
-        data
+        read_texture_rgba32f(gl, self.texture, self.width, self.height)
     }
 
     pub fn delete(&self, gl: &Gl) {
         // SAFETY: deleting our own texture.
         unsafe { gl.delete_texture(self.texture) };
     }
+}
+
+/// Read back a w×h RGBA32F 2D texture (written by image stores or by rendering into it),
+/// row 0 = the bottom row (GL order).
+pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {
+    let mut data = vec![[0f32; 4]; (w * h) as usize];
+    // SAFETY: the slice holds w·h RGBA floats.
+    unsafe {
+        gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT | glow::FRAMEBUFFER_BARRIER_BIT);
+        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+        gl.get_tex_image(
+            glow::TEXTURE_2D,
+            0,
+            glow::RGBA,
+            glow::FLOAT,
+            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
+        );
+        gl.bind_texture(glow::TEXTURE_2D, None);
+    }
+    data
 }
 
 /// GPU time per kernel from GL timer queries: a `GL_TIMESTAMP` query (`glQueryCounter`)

@@ -27,7 +27,7 @@ use glow::HasContext;
 use serde::Serialize;
 use serde_json::json;
 
-use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::resources::{read_texture_rgba32f, GpuTimers, Image2d, Ssbo};
 use crate::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 use crate::scene::{AreaLight, Camera, Scene};
 use crate::tracer::{flip_rows, Aovs, FrameStats};
@@ -210,43 +210,7 @@ pub struct SoftShadowRenderer {
 }
 
 fn rgba32f_texture(gl: &Gl, w: u32, h: u32) -> Result<glow::Texture> {
-    // SAFETY: texture creation on a current context.
-    unsafe {
-        let t = gl.create_texture().map_err(|e| anyhow!(e))?;
-        gl.bind_texture(glow::TEXTURE_2D, Some(t));
-        gl.tex_storage_2d(glow::TEXTURE_2D, 1, glow::RGBA32F, w as i32, h as i32);
-        gl.tex_parameter_i32(
-            glow::TEXTURE_2D,
-            glow::TEXTURE_MIN_FILTER,
-            glow::NEAREST as i32,
-        );
-        gl.tex_parameter_i32(
-            glow::TEXTURE_2D,
-            glow::TEXTURE_MAG_FILTER,
-            glow::NEAREST as i32,
-        );
-        gl.bind_texture(glow::TEXTURE_2D, None);
-        Ok(t)
-    }
-}
-
-fn read_rgba32f(gl: &Gl, t: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {
-    let mut data = vec![[0f32; 4]; (w * h) as usize];
-    // SAFETY: the slice holds w·h RGBA floats.
-    unsafe {
-        gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT | glow::FRAMEBUFFER_BARRIER_BIT);
-        gl.bind_texture(glow::TEXTURE_2D, Some(t));
-        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-        gl.get_tex_image(
-            glow::TEXTURE_2D,
-            0,
-            glow::RGBA,
-            glow::FLOAT,
-            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
-        );
-        gl.bind_texture(glow::TEXTURE_2D, None);
-    }
-    data
+    Ok(Image2d::new(gl, w, h, glow::RGBA32F)?.texture)
 }
 
 impl SoftShadowRenderer {
@@ -666,13 +630,14 @@ impl SoftShadowRenderer {
         let gl = self.gl.clone();
         let (w, h) = (self.options.width, self.options.height);
         let gb = self.gbuffer;
-        let color = flip_rows(&read_rgba32f(&gl, self.output_texture, w, h), w, h);
-        let shadow: Vec<f32> = flip_rows(&read_rgba32f(&gl, self.shadow_texture, w, h), w, h)
-            .iter()
-            .map(|c| c[0])
-            .collect();
-        let gbuffer_position = flip_rows(&read_rgba32f(&gl, gb[0], w, h), w, h);
-        let gbuffer_normal = flip_rows(&read_rgba32f(&gl, gb[1], w, h), w, h);
+        let color = flip_rows(&read_texture_rgba32f(&gl, self.output_texture, w, h), w, h);
+        let shadow: Vec<f32> =
+            flip_rows(&read_texture_rgba32f(&gl, self.shadow_texture, w, h), w, h)
+                .iter()
+                .map(|c| c[0])
+                .collect();
+        let gbuffer_position = flip_rows(&read_texture_rgba32f(&gl, gb[0], w, h), w, h);
+        let gbuffer_normal = flip_rows(&read_texture_rgba32f(&gl, gb[1], w, h), w, h);
         // the AOVs of the base tracer: primary rays from the camera, hits from the G-buffer
         let rays = camera.rays(w, h);
         let mut aovs = Aovs::default();
