@@ -151,8 +151,8 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
         } => {
             let scene = load_scene(&scene)?;
             let shaders = ShaderSource::from_dir(gpu.glsl_dir)?;
-            let ctx = GlContext::headless(gpu.device)?;
             let soft = soft.with_scene_defaults(&scene.settings);
+            // options of the pipeline this render does not use are refused, not ignored
             let given = |ids: &[&str]| given_options(matches.subcommand_matches("render"), ids);
             if let Some(mode) = soft.shadows {
                 let ray_tracer_only = given(&[
@@ -179,6 +179,19 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
                         }
                     );
                 }
+            } else {
+                let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
+                if !soft_only.is_empty() {
+                    bail!(
+                        "{} {} not apply without soft shadows: add --shadows \
+                         exact|linespace|linespace-dda (the scene needs an [[area_light]])",
+                        soft_only.join(", "),
+                        if soft_only.len() == 1 { "does" } else { "do" }
+                    );
+                }
+            }
+            let ctx = GlContext::headless(gpu.device)?;
+            if let Some(mode) = soft.shadows {
                 // Klee 2016: G-buffer, soft-shadow compute pass, screen-filling quad
                 let (w, h) = (
                     width.unwrap_or(scene.settings.width),
@@ -194,15 +207,6 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
                     &output,
                     aov_dir.as_deref(),
                     stats.as_deref(),
-                );
-            }
-            let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
-            if !soft_only.is_empty() {
-                bail!(
-                    "{} {} not apply without soft shadows: add --shadows exact|linespace|linespace-dda \
-                     (the scene needs an [[area_light]])",
-                    soft_only.join(", "),
-                    if soft_only.len() == 1 { "does" } else { "do" }
                 );
             }
             let options = RenderOptions {

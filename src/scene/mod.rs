@@ -8,10 +8,11 @@ pub mod mesh;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::tracer::linespace::{parse_samples, ShadowMode};
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
+
+use crate::tracer::linespace::{parse_samples, ShadowMode};
 
 pub use camera::{Camera, CameraRays};
 pub use mesh::Mesh;
