@@ -306,6 +306,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
                 doc["scene"] = json!(s.path);
                 doc["triangles"] = json!(s.triangle_count());
                 doc["lights"] = json!(s.lights.len());
+                doc["area_lights"] = json!(s.area_lights.len());
                 doc["objects"] = json!(s.objects.len());
                 doc["materials"] = json!(s.materials.len());
                 doc["textures"] = json!(s.textures.len());

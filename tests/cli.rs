@@ -160,6 +160,17 @@ fn info_json_reports_gl_and_scene_counts() {
     let o = run(&["info", &scene("teapot6.toml"), "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["triangles"], 46592, "thesis ch. 5.1: 8192 + 6 × 6400");
+    let o = run(&["info", &scene("bunny_area.toml"), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        v["triangles"],
+        69451 + 2 * 16 * 16,
+        "the bunny and a 16×16-quad floor"
+    );
+    assert_eq!(
+        (v["lights"].as_u64(), v["area_lights"].as_u64()),
+        (Some(0), Some(1))
+    );
 }
 
 fn assert_fails(o: &Output, needles: &[&str]) {
