@@ -109,6 +109,7 @@ impl GlContext {
         let attributes = ContextAttributesBuilder::new()
             .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
             .with_profile(GlProfile::Core)
+            .with_debug(gl_debug_requested())
             .build(None);
         // SAFETY: the config belongs to this display.
         let context = unsafe { display.create_context(&config, &attributes) }
@@ -122,7 +123,8 @@ impl GlContext {
             display.get_proc_address(&name)
         };
         // SAFETY: the context is current; the loader returns this display's GL entry points.
-        let gl = unsafe { Gl::load(load) }?;
+        let mut gl = unsafe { Gl::load(load) }?;
+        gl.enable_debug_output_if_requested();
         let version = gl.version();
         if (version.major, version.minor) < (4, 5) || version.is_embedded {
             bail!(
@@ -204,7 +206,54 @@ impl std::ops::Deref for Gl {
     }
 }
 
+/// `GPGPU_RT_GL_DEBUG=1` (any value but empty or `0`): a debug context whose messages
+/// (GL 4.3 / KHR_debug output) are logged — errors at `error`, the rest at `warn` (performance
+/// and portability notes) or `debug` (notifications; `RUST_LOG=debug` shows them).
+pub fn gl_debug_requested() -> bool {
+    std::env::var("GPGPU_RT_GL_DEBUG").is_ok_and(|v| !v.is_empty() && v != "0")
+}
+
+/// GL debug messages of type error received so far (all contexts of the process).
+static GL_DEBUG_ERRORS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many GL debug messages of type error the debug output has reported (0 without
+/// [`gl_debug_requested`]).
+pub fn gl_debug_errors() -> u64 {
+    GL_DEBUG_ERRORS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 impl Gl {
+    /// With [`gl_debug_requested`], route the context's debug messages to the log,
+    /// synchronously (the message comes from the call that caused it).
+    pub fn enable_debug_output_if_requested(&mut self) {
+        if !gl_debug_requested() {
+            return;
+        }
+        // SAFETY: state changes and a callback registration on the current context.
+        unsafe {
+            self.glow.enable(glow::DEBUG_OUTPUT);
+            self.glow.enable(glow::DEBUG_OUTPUT_SYNCHRONOUS);
+            self.glow
+                .debug_message_callback(|source, kind, id, severity, message| {
+                    let what = format!(
+                        "GL debug (source {source:#x}, type {kind:#x}, id {id}, severity {severity:#x}): \
+                         {message}"
+                    );
+                    if kind == glow::DEBUG_TYPE_ERROR {
+                        GL_DEBUG_ERRORS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    }
+                    match (kind, severity) {
+                        (glow::DEBUG_TYPE_ERROR, _) | (_, glow::DEBUG_SEVERITY_HIGH) => {
+                            log::error!("{what}")
+                        }
+                        (_, glow::DEBUG_SEVERITY_NOTIFICATION) => log::debug!("{what}"),
+                        _ => log::warn!("{what}"),
+                    }
+                });
+        }
+        log::info!("GL debug output enabled (GPGPU_RT_GL_DEBUG)");
+    }
+
     /// # Safety
     /// A GL context must be current and `load` must return its entry points.
     pub unsafe fn load(load: impl Fn(&str) -> *const c_void) -> Result<Gl> {

@@ -85,6 +85,7 @@ impl GlWindow {
         let attributes = ContextAttributesBuilder::new()
             .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
             .with_profile(GlProfile::Core)
+            .with_debug(crate::gl::context::gl_debug_requested())
             .build(Some(handle));
         // SAFETY: the config belongs to this display; the handle is the window's.
         let context = unsafe { display.create_context(&config, &attributes) }
@@ -115,7 +116,8 @@ impl GlWindow {
             display.get_proc_address(&name)
         };
         // SAFETY: the context is current; the loader returns this display's GL entry points.
-        let gl = unsafe { Gl::load(load) }?;
+        let mut gl = unsafe { Gl::load(load) }?;
+        gl.enable_debug_output_if_requested();
         let version = gl.version();
         if (version.major, version.minor) < (4, 5) || version.is_embedded {
             bail!(
