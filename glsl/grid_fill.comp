@@ -15,7 +15,7 @@ layout(std430, binding = 12) coherent buffer VoxelFill { uint voxelFill[]; };
 layout(std430, binding = 15) writeonly buffer VoxelTris { int voxelTris[]; };
 
 uint truncated = 0u;
-int currentTriangle;
+int currentTriangle = -1;
 
 void registerInVoxel(int voxID)
 {

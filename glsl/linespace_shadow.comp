@@ -93,9 +93,9 @@ struct Shaft {
     vec3 ray_direction[NUM_RAYS];
 } shaft;
 
-int active_rays;        // the number of active rays
-vec3 originWorld;       // the shadow rays' common origin in world space
-int k, u, v, dir;       // traversal axis, the other two, direction along k (+1 / -1)
+int active_rays = 0;    // the number of active rays
+vec3 originWorld = vec3(0.0); // the shadow rays' common origin in world space
+int k = 0, u = 1, v = 2, dir = 1; // traversal axis, the other two, direction along k (+1 / -1)
 
 vec3 samplePoint(int r)
 {
@@ -103,6 +103,28 @@ vec3 samplePoint(int r)
     int j = r - i * SAMPLES_V;
     return lightCorner + (float(i) + 0.5) / float(SAMPLES_U) * lightEdgeU
                        + (float(j) + 0.5) / float(SAMPLES_V) * lightEdgeV;
+}
+
+// Algorithm 1 (preparation, first part): the shadow rays of one surface point from the offset
+// origin to the light samples, and the shaft, in the N-tree coordinate system. Sets
+// active_rays to the number of samples in front of the surface. (Before every function that
+// reads the shaft, so the compiler sees it written first.)
+void initShaft(vec3 pos, vec3 normal)
+{
+    originWorld = pos + normal * shadowOffset;
+    active_rays = 0;
+    for (int r = 0; r < NUM_RAYS; r++) {
+        // samples behind the surface are blocked by it (N·L <= 0)
+        vec3 l = samplePoint(r);
+        shaft.active_rays[r] = dot(normal, l - pos) > 0.0;
+        if (shaft.active_rays[r]) active_rays++;
+        shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
+    }
+    // initialise the shaft: transform into the N-tree coordinate system
+    shaft.origin = (originWorld - minBound) * invNodeSize;
+    vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
+    shaft.destination = (centre - minBound) * invNodeSize;
+    shaft.ray_start[0] = shaft.origin;
 }
 
 uvec2 fetchNode(uint group, ivec3 c)
@@ -526,21 +548,9 @@ bool ddaBlocked(int r)
 // Algorithm 1 (preparation): the shadow value of one surface point
 float shadowValue(vec3 pos, vec3 normal)
 {
-    originWorld = pos + normal * shadowOffset;
-    active_rays = 0;
-    for (int r = 0; r < NUM_RAYS; r++) {
-        // samples behind the surface are blocked by it (N·L <= 0)
-        vec3 l = samplePoint(r);
-        shaft.active_rays[r] = dot(normal, l - pos) > 0.0;
-        if (shaft.active_rays[r]) active_rays++;
-        shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
-    }
+    initShaft(pos, normal);
     if (active_rays == 0) return 0.0;
-    // initialise the shaft: transform into the N-tree coordinate system
-    shaft.origin = (originWorld - minBound) * invNodeSize;
     vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
-    shaft.destination = (centre - minBound) * invNodeSize;
-    shaft.ray_start[0] = shaft.origin;
     if (SHADOW_MODE == 2) {
         int lit = 0;
         for (int r = 0; r < NUM_RAYS; r++) {

@@ -23,7 +23,7 @@ layout(std430, binding = 13) writeonly buffer RayContains { int raycontains[]; }
 uniform int traversalMode;
 uniform int lightSource;
 
-int start;              // first position of this ray's list
+int start = 0;          // first position of this ray's list
 int voxelListCounter = 0;
 uint overflows = 0u;
 uint truncated = 0u;

@@ -207,8 +207,8 @@ impl std::ops::Deref for Gl {
 }
 
 /// `GPGPU_RT_GL_DEBUG=1` (any value but empty or `0`): a debug context whose messages
-/// (GL 4.3 / KHR_debug output) are logged — errors at `error`, the rest at `warn` (performance
-/// and portability notes) or `debug` (notifications; `RUST_LOG=debug` shows them).
+/// (GL 4.3 / KHR_debug output) are logged — errors at `error`, the rest at `warn` (compiler,
+/// performance and portability notes) or `debug` (notifications; `RUST_LOG=debug` shows them).
 pub fn gl_debug_requested() -> bool {
     std::env::var("GPGPU_RT_GL_DEBUG").is_ok_and(|v| !v.is_empty() && v != "0")
 }
@@ -243,9 +243,7 @@ impl Gl {
                         GL_DEBUG_ERRORS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     }
                     match (kind, severity) {
-                        (glow::DEBUG_TYPE_ERROR, _) | (_, glow::DEBUG_SEVERITY_HIGH) => {
-                            log::error!("{what}")
-                        }
+                        (glow::DEBUG_TYPE_ERROR, _) => log::error!("{what}"),
                         (_, glow::DEBUG_SEVERITY_NOTIFICATION) => log::debug!("{what}"),
                         _ => log::warn!("{what}"),
                     }

@@ -310,7 +310,17 @@ fn map_line(line: &str, map: &LineMap) -> Option<String> {
     Some(format!("{name}:{origin}{tail}"))
 }
 
+/// Shader stages that compiled with messages (warnings) in their info log, all contexts of the
+/// process. (A stage taken from the driver's shader cache is not compiled and has no log.)
+static COMPILER_MESSAGES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many shader stages compiled with warnings so far (they are logged at `warn`).
+pub fn compiler_messages() -> u64 {
+    COMPILER_MESSAGES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// One stage of a program: kind (glow::COMPUTE_SHADER, ...) and file name below `glsl/`.
+/// Compiler warnings are logged (file and line mapped like errors) and counted.
 pub fn compile_program(
     gl: &Gl,
     source: &ShaderSource,
@@ -333,6 +343,15 @@ pub fn compile_program(
                 bail!(
                     "GLSL compile error in {}:\n{log}",
                     source.display_name(name)
+                );
+            }
+            let log = gl.get_shader_info_log(shader);
+            if !log.trim().is_empty() {
+                COMPILER_MESSAGES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                log::warn!(
+                    "GLSL compiler messages for {}:\n{}",
+                    source.display_name(name),
+                    map_log(&log, &lines).trim_end()
                 );
             }
             gl.attach_shader(program, shader);
