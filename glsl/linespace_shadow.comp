@@ -21,7 +21,11 @@
 // counted and an invocation past LOOP_BUDGET stops; and after the work a sentinel loop of
 // loopSentinel (= 2, a uniform so that it is not unrolled) iterations must run completely —
 // if llvmpipe's limit was reached it ends after one. Either way the pixel is counted as
-// truncated and the host refuses the frame.
+// truncated. The host then renders the frame again with the pixel's rays split into batches
+// (rayBegin..rayEnd, one dispatch each, the lit counts summed in shadowTexture.g), halving
+// the batch until no pixel is truncated; a frame truncated with one ray per batch is refused.
+// A ray's result does not depend on the other rays of its packet, so batches give the same
+// image (ours; the thesis' GPU had no such limit).
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
@@ -36,7 +40,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) uniform readonly image2D positionTexture;  // xyz, w: 1 = geometry
 layout(rgba32f, binding = 1) uniform readonly image2D normalTexture;    // xyz (facing the camera)
 layout(rgba32f, binding = 2) uniform image2D diffuseTexture;            // rgb diffuse colour
-layout(rgba32f, binding = 3) uniform writeonly image2D shadowTexture;   // r: shadow value
+layout(rgba32f, binding = 3) uniform image2D shadowTexture;   // r: shadow value, g: lit rays
 layout(r32ui, binding = 4) uniform readonly uimage3D linespaceTexture;  // Listing 3
 // The node pool (Fig. 8–9): texture buffer, red = flags | child group << 2, green = line space.
 uniform usamplerBuffer nodePool;
@@ -56,6 +60,10 @@ uniform int tex_y_res;
 uniform int ls_y_size;
 uniform ivec2 tileOffset;
 uniform int loopSentinel;
+uniform int rayBegin;        // this dispatch's rays: rayBegin <= r < rayEnd (0, NUM_RAYS: all)
+uniform int rayEnd;
+uniform bool accumulate;     // add to the lit count of the batches before
+uniform bool lastBatch;      // the last batch: write the shaded colour
 
 uint triangleTests = 0u;
 uint linespaceLookups = 0u;
@@ -116,7 +124,7 @@ void initShaft(vec3 pos, vec3 normal)
     for (int r = 0; r < NUM_RAYS; r++) {
         // samples behind the surface are blocked by it (N·L <= 0)
         vec3 l = samplePoint(r);
-        shaft.active_rays[r] = dot(normal, l - pos) > 0.0;
+        shaft.active_rays[r] = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
         if (shaft.active_rays[r]) active_rays++;
         shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
     }
@@ -226,7 +234,7 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
 // the last depth with line spaces (deactivate) the ray is then deactivated.
 bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
 {
-    if (r >= NUM_RAYS || !shaft.active_rays[r]) return false;
+    if (r >= rayEnd || !shaft.active_rays[r]) return false;
     int sf, ef;
     ivec2 sd, ed;
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
@@ -245,7 +253,7 @@ bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 {
     bool found_intersection = false;
     float te = tEnd(level);
-    for (int r = 0; r < NUM_RAYS; r += 4) {
+    for (int r = rayBegin; r < rayEnd; r += 4) {
         if (!loopStep()) return false;
         bool f0 = lineSpaceRay(r, node, childStart, te, deactivate);
         if (f0 && !deactivate) return true;
@@ -281,7 +289,7 @@ bool occludes(uint t, vec3 ro, vec3 rd)
 // the exact triangle tests of a leaf for ray r, four triangles per loop iteration
 void leafRay(int r, uvec2 node, vec3 childStart, float te)
 {
-    if (r >= NUM_RAYS || !shaft.active_rays[r]) return;
+    if (r >= rayEnd || !shaft.active_rays[r]) return;
     int sf, ef;
     ivec2 sd, ed;
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return;
@@ -306,7 +314,7 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
 void leafTests(uvec2 node, vec3 childStart, int level)
 {
     float te = tEnd(level);
-    for (int r = 0; r < NUM_RAYS; r += 4) {
+    for (int r = rayBegin; r < rayEnd; r += 4) {
         if (!loopStep()) return;
         leafRay(r, node, childStart, te);
         leafRay(r + 1, node, childStart, te);
@@ -545,19 +553,20 @@ bool ddaBlocked(int r)
     return false;
 }
 
-// Algorithm 1 (preparation): the shadow value of one surface point
-float shadowValue(vec3 pos, vec3 normal)
+// Algorithm 1 (preparation): how many of this batch's shadow rays of one surface point reach
+// the light
+int litRays(vec3 pos, vec3 normal)
 {
     initShaft(pos, normal);
-    if (active_rays == 0) return 0.0;
+    if (active_rays == 0) return 0;
     vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
     if (SHADOW_MODE == 2) {
         int lit = 0;
-        for (int r = 0; r < NUM_RAYS; r++) {
+        for (int r = rayBegin; r < rayEnd; r++) {
             if (!loopStep()) break;
             if (shaft.active_rays[r] && !ddaBlocked(r)) lit++;
         }
-        return float(lit) / float(NUM_RAYS);
+        return lit;
     }
     vec3 corners[4] = vec3[4](lightCorner, lightCorner + lightEdgeV, lightCorner + lightEdgeU,
                               lightCorner + lightEdgeU + lightEdgeV);
@@ -580,11 +589,14 @@ float shadowValue(vec3 pos, vec3 normal)
         if (a == dominant) { k = a; break; }
         if (m > best) { best = m; k = a; }
     }
-    if (k < 0) { packetFailures++; return 1.0; }
+    if (k < 0) {
+        if (rayBegin == 0) packetFailures++;
+        return rayEnd - rayBegin;
+    }
     ivec2 uvAxes = faceAxes(k);
     u = uvAxes.x; v = uvAxes.y;
     dir = shaft.corner_dir[0][k] > 0.0 ? 1 : -1;
-    return float(traverse()) / float(NUM_RAYS);
+    return traverse();
 }
 
 // false if the GL implementation's loop limit ended loops early (see loopLimit above)
@@ -603,16 +615,20 @@ void main()
         vec4 pos = imageLoad(positionTexture, storePos);
         if (pos.w > 0.0) {
             vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
-            float s = shadowValue(pos.xyz, n);
+            float lit = float(litRays(pos.xyz, n));
             if (!loopsComplete()) truncated = 1u;
-            imageStore(shadowTexture, storePos, vec4(s, 0.0, 0.0, 1.0));
-            // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
-            vec4 diffuse = imageLoad(diffuseTexture, storePos);
-            vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
-            vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
-            imageStore(diffuseTexture, storePos, vec4(c, 1.0));
+            if (accumulate) lit += imageLoad(shadowTexture, storePos).g;
+            float s = lit / float(NUM_RAYS);
+            imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
+            if (lastBatch) {
+                // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
+                vec4 diffuse = imageLoad(diffuseTexture, storePos);
+                vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
+                vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
+                imageStore(diffuseTexture, storePos, vec4(c, 1.0));
+            }
         } else {
-            imageStore(shadowTexture, storePos, vec4(1.0, 0.0, 0.0, 1.0));
+            imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 1.0));
         }
     }
     countAdd(0, triangleTests);

@@ -207,6 +207,10 @@ pub struct SoftShadowRenderer {
     output_fbo: glow::Framebuffer,
     output_texture: glow::Texture,
     timers: GpuTimers,
+    /// Dispatches the shadow rays of a pixel are split into (1: the whole packet at once).
+    /// Doubled when a frame hits llvmpipe's loop limit, kept for the next frames, back to 1
+    /// when the mode or the samples change.
+    ray_batches: u32,
 }
 
 fn rgba32f_texture(gl: &Gl, w: u32, h: u32) -> Result<glow::Texture> {
@@ -274,6 +278,7 @@ impl SoftShadowRenderer {
         self.options.mode = mode;
         self.options.samples_u = su;
         self.options.samples_v = sv;
+        self.ray_batches = 1;
         Ok(())
     }
 
@@ -583,6 +588,7 @@ impl SoftShadowRenderer {
                 output_fbo,
                 output_texture,
                 timers: GpuTimers::default(),
+                ray_batches: 1,
             })
         }
     }
@@ -615,6 +621,12 @@ impl SoftShadowRenderer {
             gl.bind_texture(glow::TEXTURE_3D, None);
         }
         data
+    }
+
+    /// Dispatch the shadow rays of every pixel in `n` batches from the next frame on (normally
+    /// automatic: see [`SoftShadowRenderer::draw`]); clamped to 1..=rays.
+    pub fn set_ray_batches(&mut self, n: u32) {
+        self.ray_batches = n.clamp(1, self.options.samples_u * self.options.samples_v);
     }
 
     /// The RGBA32F output texture of the last frame (what the screen-filling quad drew), GL
@@ -676,9 +688,36 @@ impl SoftShadowRenderer {
     /// Render one frame (G-buffer, shadow pass, screen-filling quad into the output texture)
     /// and read back only the counters and the timers: the viewer's frame, which shows
     /// [`SoftShadowRenderer::output_texture`]. A frame that hit llvmpipe's loop limit is
-    /// refused.
+    /// rendered again with each pixel's shadow rays split into twice as many dispatches
+    /// (`ray_batches` in the facts), until none does; with one ray per dispatch it is refused.
     pub fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
+        let rays = self.options.samples_u * self.options.samples_v;
+        loop {
+            let (mut stats, truncated) = self.draw_once(camera)?;
+            if truncated == 0 {
+                stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+                return Ok(stats);
+            }
+            if self.ray_batches >= rays {
+                bail!(
+                    "{truncated} pixels of the shadow pass hit the loop budget even with one shadow ray per \
+                     dispatch (llvmpipe ends loops after 65535 iterations); use a coarser N-tree or the \
+                     linespace mode"
+                );
+            }
+            // llvmpipe's loop limit: the same frame again with half as many rays per dispatch
+            self.ray_batches = (self.ray_batches * 2).min(rays);
+            log::info!(
+                "{truncated} pixels hit the loop budget: the shadow rays in {} batches per pixel",
+                self.ray_batches
+            );
+        }
+    }
+
+    /// One attempt at a frame with `ray_batches` dispatches of the shadow pass per tile: the
+    /// statistics and the number of truncated pixels (then the image is incomplete).
+    fn draw_once(&mut self, camera: &Camera) -> Result<(FrameStats, u64)> {
         let gl = self.gl.clone();
         let (w, h) = (self.options.width, self.options.height);
         let vp = view_projection(camera, w, h, self.scene_bounds.0, self.scene_bounds.1);
@@ -750,7 +789,7 @@ impl SoftShadowRenderer {
                 0,
                 false,
                 0,
-                glow::WRITE_ONLY,
+                glow::READ_WRITE,
                 glow::RGBA32F,
             );
             gl.bind_image_texture(
@@ -776,21 +815,36 @@ impl SoftShadowRenderer {
             ShadowMode::Linespace => "shadow_linespace",
             ShadowMode::LinespaceDda => "shadow_linespace_dda",
         };
-        for ty in (0..h).step_by(tile as usize) {
-            for tx in (0..w).step_by(tile as usize) {
-                let (tw, th) = (tile.min(w - tx), tile.min(h - ty));
-                self.timers.time(&gl, kernel, || {
-                    // SAFETY: dispatch of our program.
-                    unsafe {
-                        gl.uniform_2_i32(
-                            gl.get_uniform_location(p, "tileOffset").as_ref(),
-                            tx as i32,
-                            ty as i32,
-                        );
-                        gl.dispatch_compute(tw.div_ceil(8), th.div_ceil(8), 1);
-                        gl.memory_barrier(glow::ALL_BARRIER_BITS);
-                    }
-                });
+        // the shadow rays of a pixel in `ray_batches` dispatches (see `draw`)
+        let rays = self.options.samples_u * self.options.samples_v;
+        let batches = self.ray_batches.clamp(1, rays);
+        let per_batch = rays.div_ceil(batches);
+        for begin in (0..rays).step_by(per_batch as usize) {
+            let end = (begin + per_batch).min(rays);
+            // SAFETY: uniforms of our program.
+            unsafe {
+                let loc = |n: &str| gl.get_uniform_location(p, n);
+                gl.uniform_1_i32(loc("rayBegin").as_ref(), begin as i32);
+                gl.uniform_1_i32(loc("rayEnd").as_ref(), end as i32);
+                gl.uniform_1_i32(loc("accumulate").as_ref(), (begin > 0) as i32);
+                gl.uniform_1_i32(loc("lastBatch").as_ref(), (end == rays) as i32);
+            }
+            for ty in (0..h).step_by(tile as usize) {
+                for tx in (0..w).step_by(tile as usize) {
+                    let (tw, th) = (tile.min(w - tx), tile.min(h - ty));
+                    self.timers.time(&gl, kernel, || {
+                        // SAFETY: dispatch of our program.
+                        unsafe {
+                            gl.uniform_2_i32(
+                                gl.get_uniform_location(p, "tileOffset").as_ref(),
+                                tx as i32,
+                                ty as i32,
+                            );
+                            gl.dispatch_compute(tw.div_ceil(8), th.div_ceil(8), 1);
+                            gl.memory_barrier(glow::ALL_BARRIER_BITS);
+                        }
+                    });
+                }
             }
         }
         crate::gl::check_error(&gl, "the shadow pass")?;
@@ -817,12 +871,6 @@ impl SoftShadowRenderer {
         let counters = self.counter_ssbo.read_u32(&gl);
         let count = |i: usize| counters[2 * i] as u64 | ((counters[2 * i + 1] as u64) << 32);
         let truncated = count(3);
-        if truncated > 0 {
-            bail!(
-                "{truncated} pixels of the shadow pass hit the loop budget (llvmpipe ends loops after 65535 \
-                 iterations); use fewer --light-samples or the linespace mode"
-            );
-        }
         let mut stats = FrameStats {
             gpu_ms,
             truncated_rays: truncated,
@@ -833,8 +881,7 @@ impl SoftShadowRenderer {
         stats.events.insert("nodes_visited".into(), count(2));
         stats.events.insert("packet_failures".into(), count(4));
         stats.facts = self.facts();
-        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok(stats)
+        Ok((stats, truncated))
     }
 
     /// The renderer's facts in the frame statistics (options, N-tree and line-space sizes,
@@ -842,6 +889,7 @@ impl SoftShadowRenderer {
     fn facts(&self) -> BTreeMap<String, serde_json::Value> {
         [
             ("shadows", json!(self.options.mode)),
+            ("ray_batches", json!(self.ray_batches)),
             (
                 "light_samples",
                 json!(format!(
