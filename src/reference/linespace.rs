@@ -8,7 +8,7 @@
 //!   Listing 2; at the last stack depth with line spaces, a set line-space bit deactivates the
 //!   ray (a hit, without triangle tests — the thesis' approximation).
 //! * [`ShadowMode::LinespaceDda`]: every ray alone through the same N-tree with a hierarchical
-//!   3D-DDA [AW87] and the same line-space termination (Table 3's DDA).
+//!   3D-DDA \[AW87\] and the same line-space termination (Table 3's DDA).
 //! * [`ShadowMode::Exact`]: the packet traversal of `Linespace` with the line spaces used only
 //!   to skip empty shafts, down to the leaves, where the rays are tested against the leaves'
 //!   triangles (Table 2's "Schnitttests mit Dreiecken"); the reference.

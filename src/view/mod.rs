@@ -91,7 +91,7 @@ pub struct ViewArgs {
     /// the variant).
     #[command(flatten)]
     pub grid: tracer::GridArgs,
-    /// The soft-shadow options, as for `render` (scenes with an [[area_light]]; S cycles the
+    /// The soft-shadow options, as for `render` (scenes with an `[[area_light]]`; S cycles the
     /// mode, L / shift+L the samples).
     #[command(flatten)]
     pub soft: SoftShadowArgs,

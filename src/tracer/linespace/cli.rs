@@ -15,7 +15,7 @@ use crate::tracer::Frame;
 /// The soft-shadow options of `render` and `view`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct SoftShadowArgs {
-    /// Soft shadows from the scene's [[area_light]] with the Cascaded Line Space (Klee 2016):
+    /// Soft shadows from the scene's `[[area_light]]` with the Cascaded Line Space (Klee 2016):
     /// G-buffer, shadow compute pass, screen-filling quad. `exact`: triangle tests (the
     /// reference); `linespace`: packet traversal, the line-space bit decides a hit;
     /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination.

@@ -1,5 +1,5 @@
 //! Soft shadows from a rectangular area light with the Cascaded Line Space — Klee 2016
-//! (B.Sc. thesis), ch. 3.3, 4 and 5, after Keul et al. [KLM].
+//! (B.Sc. thesis), ch. 3.3, 4 and 5, after Keul et al. \[KLM\].
 //!
 //! The pipeline of Fig. 7, as [`SoftShadowRenderer::render`] runs it:
 //! 1. **G-buffer**: the scene rasterised into an FBO with position, normal and diffuse

@@ -1,5 +1,5 @@
 //! The N-tree with a line space per inner node — Klee 2016, ch. 3.3 and 4.2 (Fig. 4, 5, 8, 9,
-//! Listing 3), after Keul et al. [KLM].
+//! Listing 3), after Keul et al. \[KLM\].
 //!
 //! * **N-tree**: an octree with N cells per axis (N = 10 in the thesis). Levels: the root (level
 //!   0), its N³ children (level 1), ..., the leaves at level `depth − 1`, which store triangles.
