@@ -217,6 +217,43 @@ fn bad_input_fails_with_file_and_line() {
     )
     .unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["m.obj:5"]);
+    // non-finite numbers (TOML has nan and inf) and absurd procedural sizes name their line
+    let head = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n";
+    for (body, line, needle) in [
+        (
+            "[[light]]\nposition = [nan, 1, 1]\n[[object]]\ntype = \"floor\"\n",
+            4,
+            "finite",
+        ),
+        (
+            "[[object]]\ntype = \"floor\"\ntranslate = [inf, 0, 0]\n",
+            5,
+            "finite",
+        ),
+        (
+            "[[object]]\ntype = \"floor\"\nquads = 100000\n",
+            5,
+            "at most",
+        ),
+        (
+            "[render]\nambient = [nan, 0, 0]\n[[object]]\ntype = \"floor\"\n",
+            4,
+            "finite",
+        ),
+    ] {
+        std::fs::write(&bad, format!("{head}{body}")).unwrap();
+        let at = format!("bad.toml:{line}");
+        assert_fails(&run(&["info", bad.to_str().unwrap()]), &[&at, needle]);
+    }
+    std::fs::write(
+        &bad,
+        "[camera]\nposition = [0, nan, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"floor\"\n",
+    )
+    .unwrap();
+    assert_fails(
+        &run(&["info", bad.to_str().unwrap()]),
+        &["bad.toml:1", "finite"],
+    );
     // missing OBJ
     std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"gone.obj\"\n").unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["gone.obj"]);

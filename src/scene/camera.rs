@@ -47,6 +47,9 @@ impl Camera {
         let p = Vec3::from(self.position);
         let l = Vec3::from(self.look_at);
         let up = Vec3::from(self.up);
+        if !(p.is_finite() && l.is_finite() && up.is_finite() && self.fov_y.is_finite()) {
+            return Err("camera: position, look_at, up and fov_y must be finite".into());
+        }
         if (l - p).length() <= 0.0 {
             return Err("camera.look_at equals camera.position".into());
         }

@@ -267,21 +267,37 @@ impl Scene {
                 "render.width and render.height must be positive".into(),
             ));
         }
-        if settings.shadow_offset.is_nan() || settings.shadow_offset < 0.0 {
+        if !settings
+            .background
+            .iter()
+            .chain(&settings.ambient)
+            .all(|v| v.is_finite())
+        {
             return Err(SceneError::at(
                 path,
                 render_line,
-                "render.shadow_offset must be >= 0".into(),
+                "render.background and render.ambient must be finite".into(),
             ));
         }
-        let lights = file
-            .light
-            .into_iter()
-            .map(|l| Light {
+        if !settings.shadow_offset.is_finite() || settings.shadow_offset < 0.0 {
+            return Err(SceneError::at(
+                path,
+                render_line,
+                "render.shadow_offset must be finite and >= 0".into(),
+            ));
+        }
+        let mut lights = Vec::new();
+        for l in file.light {
+            let span = l.span();
+            let l = l.into_inner();
+            if !l.position.iter().chain(&l.color).all(|v| v.is_finite()) {
+                return Err(at(span, "light: position and color must be finite".into()));
+            }
+            lights.push(Light {
                 position: Vec3::from(l.position),
                 color: Vec3::from(l.color),
-            })
-            .collect();
+            });
+        }
         let mut area_lights = Vec::new();
         for l in file.area_light {
             let span = l.span();
@@ -429,7 +445,13 @@ impl Scene {
             }
             "teapot" => {
                 let path = need_path("models/teapot.bpt")?;
-                let mut mesh = mesh::teapot(&path, def.tessellation.unwrap_or(10)).map_err(ObjectError::File)?;
+                let n = def.tessellation.unwrap_or(10);
+                if n == 0 {
+                    return Err(ObjectError::Here("tessellation must be positive".into()));
+                }
+                // Newell's teapot has 32 patches (checked when they are read)
+                procedural_limit("tessellation", n, 32 * 2 * n as u64 * n as u64)?;
+                let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
                 let c = color.unwrap_or(Vec3::new(0.8, 0.3, 0.2));
                 mesh.colors.iter_mut().for_each(|x| *x = c);
                 let id = self.add_material(Material { texture, ..base });
@@ -441,6 +463,7 @@ impl Scene {
                 if quads == 0 {
                     return Err(ObjectError::Here("quads must be positive".into()));
                 }
+                procedural_limit("quads", quads, 2 * quads as u64 * quads as u64)?;
                 let checker = match (def.checker, color) {
                     (Some([a, b]), _) => [Vec3::from(a), Vec3::from(b)],
                     (None, Some(c)) => [c, c],
@@ -470,6 +493,30 @@ impl Scene {
             Scale::Uniform(s) => Vec3::splat(s),
             Scale::Axes(a) => Vec3::from(a),
         };
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        let scale_values: Vec<f32> = match def.scale {
+            Scale::Uniform(s) => vec![s],
+            Scale::Axes(a) => a.to_vec(),
+        };
+        if !(finite(&def.translate)
+            && finite(&def.rotate)
+            && finite(&scale_values)
+            && def.fit.is_none_or(|f| f.is_finite() && f > 0.0)
+            && def.size.is_none_or(|s| s.is_finite() && s > 0.0))
+        {
+            return Err(ObjectError::Here(
+                "translate, rotate and scale must be finite, fit and size finite and positive"
+                    .into(),
+            ));
+        }
+        if !(finite(&def.color.unwrap_or_default())
+            && finite(def.checker.unwrap_or_default().as_flattened())
+            && finite(&[def.specular, def.shininess]))
+        {
+            return Err(ObjectError::Here(
+                "color, checker, specular and shininess must be finite".into(),
+            ));
+        }
         let r = def.rotate.map(f32::to_radians);
         let model = Mat4::from_scale_rotation_translation(
             scale,
@@ -487,6 +534,21 @@ impl Scene {
             model,
         })
     }
+}
+
+/// The most triangles a procedural object (`teapot`, `floor`) may have: far beyond what the GL
+/// buffers of any device hold (those limits are checked when the scene is uploaded), but it
+/// keeps a mistyped `quads` or `tessellation` from exhausting the memory first.
+pub const MAX_PROCEDURAL_TRIANGLES: u64 = 1 << 26;
+
+fn procedural_limit(key: &str, value: u32, triangles: u64) -> Result<(), ObjectError> {
+    if triangles > MAX_PROCEDURAL_TRIANGLES {
+        return Err(ObjectError::Here(format!(
+            "{key} = {value} gives {triangles} triangles; a procedural object may have at most \
+             {MAX_PROCEDURAL_TRIANGLES}"
+        )));
+    }
+    Ok(())
 }
 
 /// World-space vertex attributes of the whole scene.
@@ -513,7 +575,7 @@ struct SceneFile {
     camera: Spanned<Camera>,
     render: Option<Spanned<RenderSettings>>,
     #[serde(default)]
-    light: Vec<LightDef>,
+    light: Vec<Spanned<LightDef>>,
     #[serde(default)]
     area_light: Vec<Spanned<AreaLightDef>>,
     #[serde(default)]
