@@ -254,6 +254,13 @@ fn bad_input_fails_with_file_and_line() {
         &run(&["info", bad.to_str().unwrap()]),
         &["bad.toml:1", "finite"],
     );
+    // a vertex with nan
+    std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"m.obj\"\n").unwrap();
+    assert_fails(
+        &run(&["info", bad.to_str().unwrap()]),
+        &["m.obj:2", "non-finite"],
+    );
     // missing OBJ
     std::fs::write(&bad, "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"obj\"\npath = \"gone.obj\"\n").unwrap();
     assert_fails(&run(&["info", bad.to_str().unwrap()]), &["gone.obj"]);

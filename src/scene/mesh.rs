@@ -176,6 +176,18 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
             "the OBJ file has no faces".into(),
         ));
     }
+    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+    if !(finite(bytemuck::cast_slice(&mesh.positions))
+        && finite(bytemuck::cast_slice(&mesh.normals))
+        && finite(bytemuck::cast_slice(&mesh.texcoords)))
+    {
+        let (line, what) = locate_obj_error(path);
+        return Err(SceneError::at(
+            path,
+            line,
+            format!("a vertex has a non-finite number (nan or inf){what}"),
+        ));
+    }
     Ok(LoadedObj {
         mesh,
         materials,
@@ -194,8 +206,12 @@ fn locate_obj_error(path: &Path) -> (Option<usize>, String) {
         let mut it = line.split_whitespace();
         let Some(tag) = it.next() else { continue };
         let rest: Vec<&str> = it.collect();
-        let floats_ok =
-            |min: usize| rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok());
+        let floats_ok = |min: usize| {
+            rest.len() >= min
+                && rest
+                    .iter()
+                    .all(|s| s.parse::<f32>().is_ok_and(f32::is_finite))
+        };
         let bad = match tag {
             "v" => {
                 nv += 1;
@@ -268,12 +284,14 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
     for (i, v) in vertices.iter().enumerate() {
         let c = ["x", "y", "z"].map(|k| scalar(v.get(k)));
         match c {
-            [Some(x), Some(y), Some(z)] => pos.push(Vec3::new(x as f32, y as f32, z as f32)),
+            [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|c| (*c as f32).is_finite()) => {
+                pos.push(Vec3::new(x as f32, y as f32, z as f32))
+            }
             _ => {
                 return Err(SceneError::at(
                     path,
                     None,
-                    format!("vertex {i} lacks numeric x, y, z"),
+                    format!("vertex {i} lacks finite numeric x, y, z"),
                 ))
             }
         }
