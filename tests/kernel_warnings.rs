@@ -1,7 +1,9 @@
 //! Every kernel of every design compiles without a compiler warning on Mesa (a warning such as
-//! "`x` used uninitialized" can hide a real bug). Its own test binary: the driver's shader
-//! cache is switched off for the process, so that every stage is really compiled and its log
-//! is seen.
+//! "`x` used uninitialized" can hide a real bug), and its assembled source is valid GLSL 4.50
+//! for Khronos' reference compiler, glslangValidator (stricter than Mesa in places, so a
+//! kernel that passes is more likely to compile on other drivers too). Its own test binary:
+//! the driver's shader cache is switched off for the process, so that every stage is really
+//! compiled and its log is seen, and the assembled sources are dumped (GPGPU_RT_DUMP_GLSL).
 
 mod common;
 
@@ -13,6 +15,8 @@ use gpgpu_rt::tracer::{self, GridOptions, GridVariant, ShadowFlags, TracerKind};
 #[test]
 fn every_kernel_compiles_without_warnings() {
     std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true");
+    let dump = tempfile::tempdir().unwrap();
+    std::env::set_var("GPGPU_RT_DUMP_GLSL", dump.path());
     let ctx = common::context();
     let shaders = ShaderSource::default();
 
@@ -80,4 +84,73 @@ fn every_kernel_compiles_without_warnings() {
         0,
         "kernels compiled with warnings (run with RUST_LOG=warn to see them)"
     );
+    validate_with_glslang(dump.path());
+}
+
+/// Every dumped stage through `glslangValidator` (Debian: glslang-tools; `.ci/run` installs
+/// it). Skipped with a message where it is missing, unless `CI` is set.
+fn validate_with_glslang(dir: &std::path::Path) {
+    let in_ci = std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && v != "false");
+    if std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        assert!(
+            !in_ci,
+            "glslangValidator is missing, but CI is set (.ci/run installs glslang-tools)"
+        );
+        eprintln!("SKIPPED: glslangValidator not found (Debian: apt-get install glslang-tools)");
+        return;
+    }
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    // every kernel file of glsl/ was compiled at least once
+    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl")).unwrap() {
+        let name = entry.unwrap().file_name();
+        if entry_is_kernel(&name) {
+            assert!(
+                dir.join(&name).exists(),
+                "{name:?} was not compiled by the test"
+            );
+        }
+    }
+    let mut failures = Vec::new();
+    for f in &files {
+        let name = f.file_name().unwrap().to_string_lossy().to_string();
+        let stage = ["comp", "vert", "frag"]
+            .into_iter()
+            .find(|s| name.contains(&format!(".{s}")))
+            .unwrap_or_else(|| panic!("unknown stage of {name}"));
+        let out = std::process::Command::new("glslangValidator")
+            .args(["-S", stage])
+            .arg(f)
+            .output()
+            .unwrap();
+        if !out.status.success() {
+            failures.push(format!(
+                "{name}:\n{}",
+                String::from_utf8_lossy(&out.stdout).trim()
+            ));
+        }
+    }
+    assert!(files.len() >= 20, "only {} stages dumped", files.len());
+    eprintln!(
+        "glslangValidator: {} assembled stages, {} rejected",
+        files.len(),
+        failures.len()
+    );
+    assert!(
+        failures.is_empty(),
+        "glslangValidator:\n{}",
+        failures.join("\n")
+    );
+}
+
+fn entry_is_kernel(name: &std::ffi::OsStr) -> bool {
+    let n = name.to_string_lossy();
+    n.ends_with(".comp") || n.ends_with(".vert") || n.ends_with(".frag")
 }

@@ -310,6 +310,32 @@ fn map_line(line: &str, map: &LineMap) -> Option<String> {
     Some(format!("{name}:{origin}{tail}"))
 }
 
+/// `GPGPU_RT_DUMP_GLSL=DIR`: every stage's assembled source (includes expanded, defines
+/// injected: what the driver compiles, so its line numbers are the driver's) is written to
+/// DIR/NAME, a second version of the same file as NAME.2, and so on.
+fn dump_source(name: &str, text: &str) {
+    let Some(dir) = std::env::var_os("GPGPU_RT_DUMP_GLSL") else {
+        return;
+    };
+    let dir = Path::new(&dir);
+    let file = Path::new(name)
+        .file_name()
+        .unwrap_or_default()
+        .to_string_lossy();
+    let mut path = dir.join(file.as_ref());
+    let mut k = 2;
+    while path.exists() {
+        if std::fs::read_to_string(&path).is_ok_and(|t| t == text) {
+            return;
+        }
+        path = dir.join(format!("{file}.{k}"));
+        k += 1;
+    }
+    if let Err(e) = std::fs::create_dir_all(dir).and_then(|_| std::fs::write(&path, text)) {
+        log::warn!("GPGPU_RT_DUMP_GLSL: cannot write {}: {e}", path.display());
+    }
+}
+
 /// Shader stages that compiled with messages (warnings) in their info log, all contexts of the
 /// process. (A stage taken from the driver's shader cache is not compiled and has no log.)
 static COMPILER_MESSAGES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -333,6 +359,7 @@ pub fn compile_program(
         let mut shaders = Vec::new();
         for &(kind, name) in stages {
             let (text, lines) = source.assemble(name, defines)?;
+            dump_source(name, &text);
             let shader = gl.create_shader(kind).map_err(|e| anyhow!(e))?;
             gl.shader_source(shader, &text);
             gl.compile_shader(shader);
