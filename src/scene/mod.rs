@@ -449,7 +449,7 @@ impl Scene {
                 if n == 0 {
                     return Err(ObjectError::Here("tessellation must be positive".into()));
                 }
-                // the limit for the 32 patches of Newell's teapot (a .bpt with more patches gives more)
+                // 32 patches in Newell's teapot (a .bpt with more patches gives more)
                 procedural_limit("tessellation", n, 32 * 2 * n as u64 * n as u64)?;
                 let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
                 let c = color.unwrap_or(Vec3::new(0.8, 0.3, 0.2));
