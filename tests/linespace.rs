@@ -340,20 +340,8 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     // 100 rays per pixel (the thesis' largest packet): GPU and CPU still agree
     r.reconfigure(&shaders, ShadowMode::Linespace, 10, 10)
         .unwrap();
-    let f = r.render(&scene.camera).unwrap();
-    let cpu = r.cpu();
-    let off = hit
-        .iter()
-        .filter(|&&i| {
-            let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
-            let (s, _) = cpu.shadow(
-                ShadowMode::Linespace,
-                Vec3::new(p[0], p[1], p[2]),
-                Vec3::new(n[0], n[1], n[2]).normalize(),
-            );
-            (s - f.shadow[i]).abs() > 1e-6
-        })
-        .count();
+    let ls10 = r.render(&scene.camera).unwrap();
+    let off = cpu_mismatches(&r, &ls10, ShadowMode::Linespace, &hit);
     assert!(
         off * 100 <= hit.len(),
         "10x10: {off} pixels differ between GPU and CPU"
@@ -371,36 +359,43 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         "exact 10x10: {batches} ray batches per pixel on {}",
         ctx.info.renderer
     );
-    let cpu = r.cpu();
-    let off = hit
-        .iter()
-        .filter(|&&i| {
-            let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
-            let (s, _) = cpu.shadow(
-                ShadowMode::Exact,
-                Vec3::new(p[0], p[1], p[2]),
-                Vec3::new(n[0], n[1], n[2]).normalize(),
-            );
-            (s - f.shadow[i]).abs() > 1e-6
-        })
-        .count();
+    let off = cpu_mismatches(&r, &f, ShadowMode::Exact, &hit);
     assert!(
         off * 100 <= hit.len(),
         "exact 10x10 in {batches} batches: {off} pixels differ between GPU and CPU"
     );
     // batches are only a way of dispatching: forced on a frame that needs none, the image is
-    // the same (linespace, 10x10, each pixel's 100 rays in 4 dispatches)
+    // the same as the whole packet's frame above (linespace, 10x10, each pixel's 100 rays in
+    // 4 dispatches)
     r.reconfigure(&shaders, ShadowMode::Linespace, 10, 10)
         .unwrap();
-    let whole = r.render(&scene.camera).unwrap();
     r.set_ray_batches(4);
     let split = r.render(&scene.camera).unwrap();
     assert_eq!(split.stats.facts["ray_batches"], 4);
-    assert_eq!(
-        whole.shadow, split.shadow,
-        "ray batches changed the shadows"
-    );
-    assert_eq!(whole.color, split.color, "ray batches changed the image");
+    assert_eq!(ls10.shadow, split.shadow, "ray batches changed the shadows");
+    assert_eq!(ls10.color, split.color, "ray batches changed the image");
+}
+
+/// Hit pixels (indices into the frame) whose GPU shadow value differs from the CPU
+/// implementation's for the same G-buffer point.
+fn cpu_mismatches(
+    r: &SoftShadowRenderer,
+    f: &gpgpu_rt::tracer::linespace::SoftShadowFrame,
+    mode: ShadowMode,
+    hit: &[usize],
+) -> usize {
+    let cpu = r.cpu();
+    hit.iter()
+        .filter(|&&i| {
+            let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
+            let (s, _) = cpu.shadow(
+                mode,
+                Vec3::new(p[0], p[1], p[2]),
+                Vec3::new(n[0], n[1], n[2]).normalize(),
+            );
+            (s - f.shadow[i]).abs() > 1e-6
+        })
+        .count()
 }
 
 #[test]

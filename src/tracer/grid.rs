@@ -125,32 +125,9 @@ impl GridStages {
         self.scale = 2.0 / extent;
     }
 
+    /// GPU memory of the grid buffers (`grid_bytes`).
     fn bytes(&self) -> usize {
-        match &self.variant {
-            Variant::Thesis {
-                voxelslist,
-                voxelcontains,
-                rayslist,
-                raycontains,
-                ..
-            } => voxelslist.bytes + voxelcontains.bytes + rayslist.bytes + raycontains.bytes,
-            Variant::Exact {
-                voxel_count,
-                voxel_start,
-                voxel_fill,
-                block_sums,
-                grid_total,
-                voxel_tris,
-                ..
-            } => {
-                voxel_count.bytes
-                    + voxel_start.bytes
-                    + voxel_fill.bytes
-                    + block_sums.bytes
-                    + grid_total.bytes
-                    + voxel_tris.bytes
-            }
-        }
+        self.buffers().iter().map(|b| b.bytes).sum()
     }
 
     fn programs(&self) -> Vec<glow::Program> {

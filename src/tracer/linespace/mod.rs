@@ -293,27 +293,23 @@ impl SoftShadowRenderer {
         sv: u32,
     ) -> Result<()> {
         let gl = self.gl.clone();
-        let shadow = Self::shadow_kernel(&gl, shaders, &self.tree, mode, su, sv)?;
-        let (raster, quad) = match Self::raster_programs(&gl, shaders) {
-            Ok(p) => p,
-            Err(e) => {
-                // SAFETY: deleting the program we just made.
-                unsafe { gl.delete_program(shadow) };
-                return Err(e);
+        let (raster, quad) = Self::raster_programs(&gl, shaders)?;
+        // the shadow kernel as `reconfigure` makes it (which keeps the old one on failure)
+        if let Err(e) = self.reconfigure(shaders, mode, su, sv) {
+            // SAFETY: deleting the programs we just made.
+            unsafe {
+                gl.delete_program(raster);
+                gl.delete_program(quad);
             }
-        };
+            return Err(e);
+        }
         // SAFETY: deleting our old programs.
         unsafe {
-            gl.delete_program(self.shadow_program);
             gl.delete_program(self.raster);
             gl.delete_program(self.quad_program);
         }
-        self.shadow_program = shadow;
         self.raster = raster;
         self.quad_program = quad;
-        self.options.mode = mode;
-        self.options.samples_u = su;
-        self.options.samples_v = sv;
         Ok(())
     }
 
@@ -819,6 +815,8 @@ impl SoftShadowRenderer {
         let rays = self.options.samples_u * self.options.samples_v;
         let batches = self.ray_batches.clamp(1, rays);
         let per_batch = rays.div_ceil(batches);
+        // SAFETY: a uniform query of our program.
+        let tile_offset = unsafe { gl.get_uniform_location(p, "tileOffset") };
         for begin in (0..rays).step_by(per_batch as usize) {
             let end = (begin + per_batch).min(rays);
             // SAFETY: uniforms of our program.
@@ -835,11 +833,7 @@ impl SoftShadowRenderer {
                     self.timers.time(&gl, kernel, || {
                         // SAFETY: dispatch of our program.
                         unsafe {
-                            gl.uniform_2_i32(
-                                gl.get_uniform_location(p, "tileOffset").as_ref(),
-                                tx as i32,
-                                ty as i32,
-                            );
+                            gl.uniform_2_i32(tile_offset.as_ref(), tx as i32, ty as i32);
                             gl.dispatch_compute(tw.div_ceil(8), th.div_ceil(8), 1);
                             gl.memory_barrier(glow::ALL_BARRIER_BITS);
                         }
