@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod mesh;
+pub mod shadows;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -12,7 +13,7 @@ use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::tracer::linespace::{parse_samples, ShadowMode};
+pub use shadows::{parse_samples, ShadowMode};
 
 pub use camera::{Camera, CameraRays};
 pub use mesh::Mesh;

@@ -14,7 +14,6 @@
 //! The N-tree and the line spaces are built on the CPU once; the node pool goes into a texture
 //! buffer (RG32UI), the line spaces into a 3D R32UI texture laid out as Listing 3.
 
-pub mod cli;
 pub mod ntree;
 
 use std::collections::BTreeMap;
@@ -24,7 +23,6 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Result};
 use glam::{Mat4, Vec3};
 use glow::HasContext;
-use serde::Serialize;
 use serde_json::json;
 
 use crate::gl::resources::{read_texture_rgba32f, GpuTimers, Image2d, Ssbo};
@@ -32,60 +30,8 @@ use crate::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 use crate::scene::{AreaLight, Camera, Scene};
 use crate::tracer::{flip_rows, Aovs, FrameStats};
 
+pub use crate::scene::shadows::{parse_samples, ShadowMode};
 pub use ntree::{NTree, PackedLinespaces};
-
-/// `render --shadows`: how the shadow rays are answered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ShadowMode {
-    /// The packet traversal down to the leaves with real triangle tests (line spaces only
-    /// skip empty shafts): the reference (Table 2, "Schnitttests mit Dreiecken").
-    Exact,
-    /// The packet traversal (coherent grid traversal, Algorithm 1–4); at the last depth with
-    /// line spaces the bit decides a hit (the thesis' approximation).
-    Linespace,
-    /// Every ray alone with a 3D-DDA through the N-tree, same line-space termination (Table 3).
-    LinespaceDda,
-}
-
-impl ShadowMode {
-    /// SHADOW_MODE of the kernel.
-    pub fn kernel_mode(self) -> u32 {
-        match self {
-            ShadowMode::Exact => 0,
-            ShadowMode::Linespace => 1,
-            ShadowMode::LinespaceDda => 2,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            ShadowMode::Exact => "exact",
-            ShadowMode::Linespace => "linespace",
-            ShadowMode::LinespaceDda => "linespace-dda",
-        }
-    }
-}
-
-/// Parse `UxV` (e.g. `5x5`) light samples.
-pub fn parse_samples(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}`: expected UxV, e.g. 5x5"))?;
-    let a: u32 = a
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
-    let b: u32 = b
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
-    if !(1..=10).contains(&a) || !(1..=10).contains(&b) {
-        return Err(format!(
-            "`{s}`: 1x1 to 10x10 samples (the thesis uses 2x2 to 10x10)"
-        ));
-    }
-    Ok((a, b))
-}
 
 /// Options of the soft-shadow renderer.
 #[derive(Debug, Clone)]

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::gl::GlInfo;
+use gpgpu_rt::gl::GlInfo;
 
 /// What `report.md` states about the machine.
 #[derive(Debug, Clone, Serialize)]

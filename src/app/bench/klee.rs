@@ -23,8 +23,8 @@ use super::plots::{self, Chart, Series, Style, BLACK_INDEX};
 use super::report::{self, num, ratio, Section};
 use super::runner::{Bench, Sizing};
 use super::{Protocol, FULL_SIZE, QUICK_SIZE};
-use crate::scene::Scene;
-use crate::tracer::linespace::{
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::linespace::{
     ShadowMode, SoftShadowFrame, SoftShadowOptions, SoftShadowRenderer,
 };
 
@@ -184,7 +184,7 @@ impl Setup {
         let mut times = Vec::new();
         let mut counts = Default::default();
         for _ in 0..frames.max(1) {
-            counts = crate::reference::linespace::ShadowCounts::default();
+            counts = gpgpu_rt::reference::linespace::ShadowCounts::default();
             let t = Instant::now();
             for (p, n) in f.gbuffer_position.iter().zip(&f.gbuffer_normal) {
                 if p[3] > 0.0 {
@@ -207,7 +207,7 @@ impl Setup {
         let (w, h) = (self.sizing.width, self.sizing.height);
         let rays = self.scene.camera.rays(w, h);
         let mut times = Vec::new();
-        let mut counts = crate::reference::linespace::ShadowCounts::default();
+        let mut counts = gpgpu_rt::reference::linespace::ShadowCounts::default();
         for _ in 0..frames.max(1) {
             counts = Default::default();
             let t = Instant::now();

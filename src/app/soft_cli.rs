@@ -6,11 +6,13 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use serde_json::json;
 
-use super::{parse_samples, ShadowMode, SoftShadowFrame, SoftShadowOptions, SoftShadowRenderer};
-use crate::gl::{GlContext, ShaderSource};
-use crate::output;
-use crate::scene::{RenderSettings, Scene};
-use crate::tracer::Frame;
+use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::output;
+use gpgpu_rt::scene::{RenderSettings, Scene};
+use gpgpu_rt::tracer::linespace::{
+    parse_samples, ShadowMode, SoftShadowFrame, SoftShadowOptions, SoftShadowRenderer,
+};
+use gpgpu_rt::tracer::Frame;
 
 /// The soft-shadow options of `render` and `view`.
 #[derive(clap::Args, Debug, Clone)]

@@ -23,8 +23,8 @@ use winit::dpi::PhysicalSize;
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
-use crate::gl::context::query_info;
-use crate::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
+use gpgpu_rt::gl::context::query_info;
+use gpgpu_rt::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 
 /// A window with a current GL 4.5 core context. Drop GL objects made on `gl` first.
 pub struct GlWindow {
@@ -85,7 +85,7 @@ impl GlWindow {
         let attributes = ContextAttributesBuilder::new()
             .with_context_api(ContextApi::OpenGl(Some(Version::new(4, 5))))
             .with_profile(GlProfile::Core)
-            .with_debug(crate::gl::context::gl_debug_requested())
+            .with_debug(gpgpu_rt::gl::context::gl_debug_requested())
             .build(Some(handle));
         // SAFETY: the config belongs to this display; the handle is the window's.
         let context = unsafe { display.create_context(&config, &attributes) }

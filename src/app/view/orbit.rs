@@ -9,7 +9,7 @@
 
 use glam::{Quat, Vec3};
 
-use crate::scene::Camera;
+use gpgpu_rt::scene::Camera;
 
 /// The smallest angle, in degrees, between the viewing direction and the up axis that orbiting
 /// keeps (looking straight up or down would leave the image orientation undefined).

@@ -30,11 +30,11 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::WindowId;
 
-use crate::gl::ShaderSource;
-use crate::scene::{Camera, Scene};
-use crate::tracer::linespace::cli::SoftShadowArgs;
-use crate::tracer::linespace::{scene_light, ShadowMode, SoftShadowRenderer};
-use crate::tracer::{
+use crate::soft_cli::SoftShadowArgs;
+use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::scene::{Camera, Scene};
+use gpgpu_rt::tracer::linespace::{scene_light, ShadowMode, SoftShadowRenderer};
+use gpgpu_rt::tracer::{
     self, FrameStats, GridVariant, RenderOptions, ShadowFlags, Tracer, TracerKind,
 };
 
@@ -772,7 +772,7 @@ impl App {
                 "offscreen framebuffer (the window is not the image's size)",
             )
         };
-        crate::gl::check_error(&running.window.gl, "reading the frame back")?;
+        gpgpu_rt::gl::check_error(&running.window.gl, "reading the frame back")?;
         save_png(path, w, h, &pixels)?;
         println!(
             "screenshot: {} ({w}x{h}, frame {}, {from})",

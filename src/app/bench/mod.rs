@@ -53,9 +53,9 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 
 pub use report::Section;
-pub use runner::{Bench, Config, Outcome, Sizing, TracerSpec};
+pub use runner::Bench;
 
-use crate::tracer::GridVariant;
+use gpgpu_rt::tracer::GridVariant;
 
 /// Default image size at `--scale quick`: small enough for Mesa llvmpipe.
 pub const QUICK_SIZE: (u32, u32) = (64, 64);

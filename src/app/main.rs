@@ -1,4 +1,9 @@
-//! The `gpgpu-rt` command line.
+//! The `gpgpu-rt` command line: the application (CLI, viewer, bench protocols) on top of the
+//! `gpgpu_rt` library.
+
+mod bench;
+mod soft_cli;
+mod view;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -74,7 +79,7 @@ enum Command {
         #[command(flatten)]
         grid: GridArgs,
         #[command(flatten)]
-        soft: gpgpu_rt::tracer::linespace::cli::SoftShadowArgs,
+        soft: soft_cli::SoftShadowArgs,
         #[command(flatten)]
         gpu: GpuArgs,
     },
@@ -86,10 +91,10 @@ enum Command {
     },
     /// Open a window that shows the scene live (orbit, pan, zoom; live-editable kernels with
     /// --glsl-dir); --screenshot FILE.png --frames N saves the N-th frame and exits.
-    View(gpgpu_rt::view::ViewArgs),
+    View(view::ViewArgs),
     /// Replicate a published evaluation (thesis-5.x: Müller 2015, ch. 5; klee-*: Klee 2016,
     /// ch. 5): CSVs, plots and report.md with our numbers beside the published ones.
-    Bench(gpgpu_rt::bench::BenchArgs),
+    Bench(bench::BenchArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
     Info {
         scene: Option<PathBuf>,
@@ -198,7 +203,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
                     height.unwrap_or(scene.settings.height),
                 );
                 let opts = soft.options(mode, w, h, tile);
-                return gpgpu_rt::tracer::linespace::cli::render(
+                return soft_cli::render(
                     &ctx,
                     &scene,
                     &shaders,
@@ -283,8 +288,8 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
             );
             Ok(())
         }
-        Command::View(args) => gpgpu_rt::view::run(args),
-        Command::Bench(args) => gpgpu_rt::bench::run(args),
+        Command::View(args) => view::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::ExportTriangles { scene, output } => {
             let scene = load_scene(&scene)?;
             let tris = scene.world_triangles();

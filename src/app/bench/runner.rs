@@ -14,9 +14,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::machine::Machine;
 use super::stats::Stats;
 use super::{BenchArgs, Rotation, Scale};
-use crate::gl::{GlContext, ShaderSource};
-use crate::scene::Scene;
-use crate::tracer::{
+use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::tracer::{
     self, FrameStats, GridOptions, GridVariant, RenderOptions, ShadowFlags, TracerKind,
 };
 
@@ -284,11 +284,6 @@ impl Bench {
             .unwrap_or_else(|| vec![GridVariant::Thesis, GridVariant::Exact])
     }
 
-    /// Whether this build has the grid tracer.
-    pub fn has_grid(&self) -> bool {
-        <TracerKind as clap::ValueEnum>::from_str("grid", true).is_ok()
-    }
-
     /// Load a scene of the scenes folder (once).
     pub fn scene(&mut self, name: &str) -> Result<&Scene> {
         if !self.scenes.contains_key(name) {
@@ -441,7 +436,7 @@ impl Bench {
                     c.scene_name(),
                     c.tracer.slug()
                 ));
-                crate::output::write_png(&self.out.join(&rel), &frame)?;
+                gpgpu_rt::output::write_png(&self.out.join(&rel), &frame)?;
                 out.image = Some(rel);
             }
             out.frames.push(FrameRecord {

@@ -150,8 +150,8 @@ impl Protocol for Thesis52 {
                 .join("; ")
         };
         let monotone = [
-            crate::tracer::GridVariant::Thesis,
-            crate::tracer::GridVariant::Exact,
+            gpgpu_rt::tracer::GridVariant::Thesis,
+            gpgpu_rt::tracer::GridVariant::Exact,
         ]
         .into_iter()
         .filter_map(|v| {

@@ -1,0 +1,58 @@
+//! The soft-shadow settings a scene file may give (`[render] shadows`, `light_samples`) and
+//! `render --shadows`/`--light-samples` take: how the shadow rays of Klee 2016's pipeline are
+//! answered, and how many. GPU-free, so the scene parser and the renderer share them.
+
+use serde::Serialize;
+
+/// `render --shadows`: how the shadow rays are answered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowMode {
+    /// The packet traversal down to the leaves with real triangle tests (line spaces only
+    /// skip empty shafts): the reference (Table 2, "Schnitttests mit Dreiecken").
+    Exact,
+    /// The packet traversal (coherent grid traversal, Algorithm 1–4); at the last depth with
+    /// line spaces the bit decides a hit (the thesis' approximation).
+    Linespace,
+    /// Every ray alone with a 3D-DDA through the N-tree, same line-space termination (Table 3).
+    LinespaceDda,
+}
+
+impl ShadowMode {
+    /// SHADOW_MODE of the kernel.
+    pub fn kernel_mode(self) -> u32 {
+        match self {
+            ShadowMode::Exact => 0,
+            ShadowMode::Linespace => 1,
+            ShadowMode::LinespaceDda => 2,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadowMode::Exact => "exact",
+            ShadowMode::Linespace => "linespace",
+            ShadowMode::LinespaceDda => "linespace-dda",
+        }
+    }
+}
+
+/// Parse `UxV` (e.g. `5x5`) light samples.
+pub fn parse_samples(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    let a: u32 = a
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    let b: u32 = b
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}`: expected UxV, e.g. 5x5"))?;
+    if !(1..=10).contains(&a) || !(1..=10).contains(&b) {
+        return Err(format!(
+            "`{s}`: 1x1 to 10x10 samples (the thesis uses 2x2 to 10x10)"
+        ));
+    }
+    Ok((a, b))
+}
