@@ -1,8 +1,10 @@
 //! gpgpu-rt: GPU ray tracing in OpenGL 4.5 compute shaders, after Müller 2015 (the base
 //! tracer and the per-frame uniform grid) and related designs. See the README.
 
+pub mod accel;
+pub mod frame;
 pub mod gl;
 pub mod output;
+pub mod pipeline;
 pub mod reference;
 pub mod scene;
-pub mod tracer;

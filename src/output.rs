@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{Context as _, Result};
 use npyz::WriterBuilder;
 
-use crate::tracer::{Aovs, Frame};
+use crate::frame::{Aovs, Frame};
 
 /// The colour as an 8-bit PNG (clamped to [0, 1], no gamma, as the thesis displays it).
 pub fn write_png(path: &Path, frame: &Frame) -> Result<()> {
@@ -37,7 +37,8 @@ pub fn write_npy<T: npyz::AutoSerialize + Copy>(
 }
 
 /// The AOVs of the GUIDE: ray_origin, ray_direction (f32 `[H,W,3]`), hit_t (f32 `[H,W]`, +inf on
-/// a miss), triangle_id (i32 `[H,W]`, -1 on a miss), normal (f32 `[H,W,3]`); row 0 = top.
+/// a miss), triangle_id (i32 `[H,W]`, -1 on a miss), normal (f32 `[H,W,3]`), and with soft
+/// shadows shadow (f32 `[H,W]`, the fraction of unblocked shadow rays); row 0 = top.
 pub fn write_aovs(dir: &Path, width: u32, height: u32, aovs: &Aovs) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (h, w) = (height as u64, width as u64);
@@ -59,5 +60,8 @@ pub fn write_aovs(dir: &Path, width: u32, height: u32, aovs: &Aovs) -> Result<()
         aovs.triangle_id.iter().copied(),
     )?;
     write_npy(&dir.join("normal.npy"), &[h, w, 3], flat3(&aovs.normal))?;
+    if let Some(shadow) = &aovs.shadow {
+        write_npy(&dir.join("shadow.npy"), &[h, w], shadow.iter().copied())?;
+    }
     Ok(())
 }

@@ -6,9 +6,9 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{Light, Scene};
-use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::{ShadowFlags, Tracer};
 
 #[test]
 fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
@@ -99,12 +99,12 @@ fn more_than_four_lights_with_bitwise_shadow_flags() {
     let cpu = render_cpu(&scene, &opts);
     assert_close(&gpu, &cpu, "cow with 37 lights");
     // the thesis' RGBA flags hold 4 lights: a clear error, not a silent drop
-    let err = BaseTracer::new(
+    let err = RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         &scene,
         &ShaderSource::default(),
-        gpgpu_rt::tracer::RenderOptions {
+        RenderOptions {
             shadow_flags: ShadowFlags::Rgba,
             ..opts.clone()
         },
@@ -123,7 +123,7 @@ fn thesis_rgba_flags_equal_bitwise_flags_for_four_lights() {
     let rgba = render_gpu(
         &ctx,
         &scene,
-        gpgpu_rt::tracer::RenderOptions {
+        RenderOptions {
             shadow_flags: ShadowFlags::Rgba,
             ..options(48, 40, 1)
         },
@@ -140,7 +140,7 @@ fn tiling_does_not_change_the_image() {
     let whole = render_gpu(
         &ctx,
         &scene,
-        gpgpu_rt::tracer::RenderOptions {
+        RenderOptions {
             tile: 0,
             ..options(72, 40, 1)
         },
@@ -148,7 +148,7 @@ fn tiling_does_not_change_the_image() {
     let tiled = render_gpu(
         &ctx,
         &scene,
-        gpgpu_rt::tracer::RenderOptions {
+        RenderOptions {
             tile: 16,
             ..options(72, 40, 1)
         },
@@ -162,7 +162,7 @@ fn moving_an_object_needs_only_its_model_matrix() {
     let ctx = context();
     let mut scene = load("teapot1.toml");
     let opts = options(48, 48, 1);
-    let mut tracer = BaseTracer::new(
+    let mut tracer = RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         &scene,
@@ -175,7 +175,7 @@ fn moving_an_object_needs_only_its_model_matrix() {
     let moved = Mat4::from_translation(Vec3::new(0.6, 0.0, -0.4))
         * Mat4::from_rotation_y(0.7)
         * scene.objects[1].model;
-    tracer.set_model(1, moved);
+    tracer.set_model(1, moved).unwrap();
     let after = tracer.render(&scene.camera).unwrap();
     assert_ne!(before.color, after.color);
     scene.objects[1].model = moved;

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use gpgpu_rt::tracer::TracerKind;
+use gpgpu_rt::accel::TracerKind;
 
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 

@@ -1,6 +1,10 @@
 //! The command line as other tools use it: render with AOVs and statistics, export-triangles,
 //! info --json, and clear errors with a non-zero exit on bad input.
 
+mod common;
+
+use common::copy_dir;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -358,7 +362,7 @@ fn bad_input_fails_with_file_and_line() {
     // a GLSL error in an edited kernel names the file and line
     let glsl = d.join("glsl");
     copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"), &glsl);
-    let shading = glsl.join("shading.comp");
+    let shading = glsl.join("mueller2015/shading.comp");
     let src = std::fs::read_to_string(&shading).unwrap();
     let line = src.lines().position(|l| l.contains("void main()")).unwrap() + 1;
     std::fs::write(
@@ -385,19 +389,6 @@ fn bad_input_fails_with_file_and_line() {
         ]),
         &[&format!("shading.comp:{line}")],
     );
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let p = e.path();
-        if p.is_dir() {
-            copy_dir(&p, &to.join(e.file_name()));
-        } else {
-            std::fs::copy(&p, to.join(e.file_name())).unwrap();
-        }
-    }
 }
 
 #[test]

@@ -7,12 +7,15 @@ mod common;
 
 use common::*;
 use glam::{IVec3, Mat4, Vec3};
+use gpgpu_rt::accel::exact_grid::ExactGrid;
+use gpgpu_rt::accel::thesis_grid::ThesisGrid;
+use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
+use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::grid::{tri_box_overlap, GridSpace};
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::grid::GridTracer;
-use gpgpu_rt::tracer::{GridOptions, GridVariant, RenderOptions, Tracer};
 
 /// A small deterministic generator (no dependency needed for test data).
 struct Lcg(u64);
@@ -180,6 +183,7 @@ fn triangle_box_overlap_matches_dense_sampling() {
 
 fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
     RenderOptions {
+        tracer: TracerKind::Grid,
         grid: GridOptions {
             variant,
             resolution: Some(n),
@@ -189,8 +193,8 @@ fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
     }
 }
 
-fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions) -> GridTracer {
-    GridTracer::new(
+fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions) -> RayTracer {
+    RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         scene,
@@ -200,11 +204,25 @@ fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions
     .expect("grid tracer")
 }
 
+/// The grid's voxel lists of the last frame and its scene-to-grid mapping (centre, scale).
+fn read_lists(t: &RayTracer) -> (Vec<Vec<i32>>, Vec3, f32) {
+    let a = t.accelerator().as_any();
+    let (lists, m) = match (
+        a.downcast_ref::<ThesisGrid>(),
+        a.downcast_ref::<ExactGrid>(),
+    ) {
+        (Some(g), _) => g.read_lists(t.gl()),
+        (_, Some(g)) => g.read_lists(t.gl()),
+        _ => panic!("not a grid: {}", t.entry().label),
+    };
+    (lists, m.center, m.scale)
+}
+
 /// The GPU's voxel lists equal the CPU reference's, as sets per voxel.
 fn check_lists(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, variant: GridVariant, n: u32) {
     let mut t = grid_tracer(ctx, scene, grid_options(16, 16, variant, n));
     t.render(&scene.camera).unwrap();
-    let (lists, center, scale) = t.read_lists();
+    let (lists, center, scale) = read_lists(&t);
     let g = GridSpace { n };
     let mut expected = vec![Vec::new(); (n * n * n) as usize];
     for (id, tri) in scene.world_triangles().iter().enumerate() {
@@ -324,7 +342,7 @@ fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
     let scene = big_triangle_scene(dir.path());
     let ctx = context();
     let base = render_gpu(&ctx, &scene, options(48, 48, 0));
-    let hits = |f: &gpgpu_rt::tracer::Frame| {
+    let hits = |f: &Frame| {
         f.aovs
             .as_ref()
             .unwrap()
@@ -373,6 +391,7 @@ fn thesis_grid_counts_what_its_fixed_lists_drop() {
     let ctx = context();
     let scene = load("bunny.toml");
     let opts = RenderOptions {
+        tracer: TracerKind::Grid,
         grid: GridOptions {
             variant: GridVariant::Thesis,
             resolution: Some(8),
@@ -389,7 +408,7 @@ fn thesis_grid_counts_what_its_fixed_lists_drop() {
     assert!(dropped > 50_000, "dropped {dropped}");
     assert!(overflows > 0, "ray list overflows {overflows}");
     // the references kept are exactly what the lists hold
-    let (lists, _, _) = t.read_lists();
+    let (lists, _, _) = read_lists(&t);
     assert!(lists.iter().all(|l| l.len() <= 16));
 }
 
@@ -399,12 +418,15 @@ fn moving_object_is_rebuilt_every_frame() {
     let mut scene = load("teapot1.toml");
     let opts = grid_options(40, 40, GridVariant::Exact, 16);
     let mut grid = grid_tracer(&ctx, &scene, opts.clone());
-    let mut base = BaseTracer::new(
+    let mut base = RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         &scene,
         &ShaderSource::default(),
-        opts,
+        RenderOptions {
+            tracer: TracerKind::Base,
+            ..opts
+        },
     )
     .unwrap();
     let first = grid.render(&scene.camera).unwrap();
@@ -412,8 +434,8 @@ fn moving_object_is_rebuilt_every_frame() {
     let moved = Mat4::from_translation(Vec3::new(0.5, 1.5, -0.5))
         * Mat4::from_rotation_y(1.0)
         * scene.objects[1].model;
-    grid.set_model(1, moved);
-    base.set_model(1, moved);
+    grid.set_model(1, moved).unwrap();
+    base.set_model(1, moved).unwrap();
     let (g, b) = (
         grid.render(&scene.camera).unwrap(),
         base.render(&scene.camera).unwrap(),

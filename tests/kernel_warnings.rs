@@ -7,10 +7,13 @@
 
 mod common;
 
+use gpgpu_rt::accel::{GridOptions, REGISTRY};
 use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, ShaderSource};
-use gpgpu_rt::tracer::linespace::{ShadowMode, SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::tracer::{self, GridOptions, GridVariant, ShadowFlags, TracerKind};
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::scene::ShadowMode;
 
 #[test]
 fn every_kernel_compiles_without_warnings() {
@@ -20,29 +23,24 @@ fn every_kernel_compiles_without_warnings() {
     let ctx = common::context();
     let shaders = ShaderSource::default();
 
-    // the ray tracers: base (both shadow-flag layouts), grid (both variants)
+    // the ray tracer with every accelerator of the registry, both shadow-flag layouts
     let scene = common::load("teapot1.toml");
-    let mut configs = Vec::new();
-    for flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
-        configs.push((TracerKind::Base, GridOptions::default(), flags));
-    }
-    for variant in [GridVariant::Thesis, GridVariant::Exact] {
-        let grid = GridOptions {
-            variant,
-            resolution: Some(8),
-            ..GridOptions::default()
-        };
-        configs.push((TracerKind::Grid, grid, ShadowFlags::Bits));
-    }
-    for (kind, grid, shadow_flags) in configs {
-        let opts = gpgpu_rt::tracer::RenderOptions {
-            grid,
-            shadow_flags,
-            ..common::options(8, 8, 1)
-        };
-        let mut t = tracer::create(kind, ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
-            .expect("tracer");
-        t.render(&scene.camera).expect("frame");
+    for entry in REGISTRY {
+        for shadow_flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
+            let opts = RenderOptions {
+                tracer: entry.tracer,
+                grid: GridOptions {
+                    variant: entry.grid_variant.unwrap_or_default(),
+                    resolution: Some(8),
+                    ..GridOptions::default()
+                },
+                shadow_flags,
+                ..common::options(8, 8, 1)
+            };
+            let mut t =
+                RayTracer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts).expect("tracer");
+            t.render(&scene.camera).expect("frame");
+        }
     }
 
     // the soft shadows: G-buffer, the three shadow modes, the quad
@@ -72,8 +70,8 @@ fn every_kernel_compiles_without_warnings() {
         &ctx.gl,
         &shaders,
         &[
-            (glow::VERTEX_SHADER, "screen_quad.vert"),
-            (glow::FRAGMENT_SHADER, "screen_quad.frag"),
+            (glow::VERTEX_SHADER, "common/screen_quad.vert"),
+            (glow::FRAGMENT_SHADER, "common/screen_quad.frag"),
         ],
         &Defines::new(),
     )
@@ -108,13 +106,12 @@ fn validate_with_glslang(dir: &std::path::Path) {
         .map(|e| e.unwrap().path())
         .collect();
     files.sort();
-    // every kernel file of glsl/ was compiled at least once
-    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl")).unwrap() {
-        let name = entry.unwrap().file_name();
-        if entry_is_kernel(&name) {
+    // every kernel file of glsl/ was compiled at least once (dumped as `folder.file.comp`)
+    for (name, _) in gpgpu_rt::gl::program::EMBEDDED {
+        if is_kernel(name) {
             assert!(
-                dir.join(&name).exists(),
-                "{name:?} was not compiled by the test"
+                dir.join(name.replace('/', ".")).exists(),
+                "{name} was not compiled by the test"
             );
         }
     }
@@ -150,7 +147,6 @@ fn validate_with_glslang(dir: &std::path::Path) {
     );
 }
 
-fn entry_is_kernel(name: &std::ffi::OsStr) -> bool {
-    let n = name.to_string_lossy();
+fn is_kernel(n: &str) -> bool {
     n.ends_with(".comp") || n.ends_with(".vert") || n.ends_with(".frag")
 }

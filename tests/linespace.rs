@@ -4,13 +4,41 @@
 mod common;
 
 use glam::Vec3;
+use gpgpu_rt::frame::{Aovs, FrameStats};
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::linespace::ntree::{
+use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::reference::ntree::{
     self, build_linespace, build_linespace_brute_force, entry_index, face_rect, get_bit,
     pack_linespaces, shaft_hits_box, Aabb, NTree,
 };
-use gpgpu_rt::tracer::linespace::{ShadowMode, SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::scene::Scene;
+use gpgpu_rt::scene::{Camera, ShadowMode};
+
+/// A soft-shadow frame as the tests read it: the renderer's frame, its shadow values and the
+/// G-buffer it was shaded from (row 0 = the top image row everywhere).
+struct SoftFrame {
+    color: Vec<[f32; 4]>,
+    shadow: Vec<f32>,
+    gbuffer_position: Vec<[f32; 4]>,
+    gbuffer_normal: Vec<[f32; 4]>,
+    aovs: Aovs,
+    stats: FrameStats,
+}
+
+fn render(r: &mut SoftShadowRenderer, camera: &Camera) -> anyhow::Result<SoftFrame> {
+    let f = r.render(camera)?;
+    let (gbuffer_position, gbuffer_normal) = r.read_gbuffer();
+    let mut aovs = f.aovs.expect("the soft-shadow renderer keeps its AOVs");
+    Ok(SoftFrame {
+        color: f.color,
+        shadow: aovs.shadow.take().expect("shadow values"),
+        gbuffer_position,
+        gbuffer_normal,
+        aovs,
+        stats: f.stats,
+    })
+}
 
 /// A small deterministic generator (xorshift).
 struct Rng(u64);
@@ -218,7 +246,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     )
     .unwrap();
     // the 3D texture holds exactly the packed layout
-    assert_eq!(r.read_linespace_texture(), r.packed.texels);
+    assert_eq!(r.read_linespace_texture(), r.scene.packed.texels);
     let mut shadows = Vec::new();
     for mode in [
         ShadowMode::Exact,
@@ -226,7 +254,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         ShadowMode::LinespaceDda,
     ] {
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
-        let f = r.render(&scene.camera).unwrap();
+        let f = render(&mut r, &scene.camera).unwrap();
         let cpu = r.cpu();
         let (mut hits, mut off, mut cpu_tests) = (0usize, 0usize, 0u64);
         for (i, p) in f.gbuffer_position.iter().enumerate() {
@@ -265,7 +293,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         ));
     }
     // the CPU's primary rays (Table 1: ray traced on the CPU) find what the G-buffer rasterised
-    let f = r.render(&scene.camera).unwrap();
+    let f = render(&mut r, &scene.camera).unwrap();
     let cpu = r.cpu();
     let rays = scene.camera.rays(64, 64);
     let (mut same, mut hit_px) = (0, 0);
@@ -340,7 +368,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     // 100 rays per pixel (the thesis' largest packet): GPU and CPU still agree
     r.reconfigure(&shaders, ShadowMode::Linespace, 10, 10)
         .unwrap();
-    let ls10 = r.render(&scene.camera).unwrap();
+    let ls10 = render(&mut r, &scene.camera).unwrap();
     let off = cpu_mismatches(&r, &ls10, ShadowMode::Linespace, &hit);
     assert!(
         off * 100 <= hit.len(),
@@ -350,9 +378,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     // bunny reaches that there (8-lane vectors); the frame is then rendered again with the rays
     // in batches — whatever the GL implementation, the frame comes out right
     r.reconfigure(&shaders, ShadowMode::Exact, 10, 10).unwrap();
-    let f = r
-        .render(&scene.camera)
-        .expect("exact 10x10 renders, in ray batches if need be");
+    let f = render(&mut r, &scene.camera).expect("exact 10x10 renders, in ray batches if need be");
     assert_eq!(f.stats.truncated_rays, 0);
     let batches = f.stats.facts["ray_batches"].as_u64().unwrap();
     eprintln!(
@@ -370,7 +396,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     r.reconfigure(&shaders, ShadowMode::Linespace, 10, 10)
         .unwrap();
     r.set_ray_batches(4);
-    let split = r.render(&scene.camera).unwrap();
+    let split = render(&mut r, &scene.camera).unwrap();
     assert_eq!(split.stats.facts["ray_batches"], 4);
     assert_eq!(ls10.shadow, split.shadow, "ray batches changed the shadows");
     assert_eq!(ls10.color, split.color, "ray batches changed the image");
@@ -378,12 +404,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
 
 /// Hit pixels (indices into the frame) whose GPU shadow value differs from the CPU
 /// implementation's for the same G-buffer point.
-fn cpu_mismatches(
-    r: &SoftShadowRenderer,
-    f: &gpgpu_rt::tracer::linespace::SoftShadowFrame,
-    mode: ShadowMode,
-    hit: &[usize],
-) -> usize {
+fn cpu_mismatches(r: &SoftShadowRenderer, f: &SoftFrame, mode: ShadowMode, hit: &[usize]) -> usize {
     let cpu = r.cpu();
     hit.iter()
         .filter(|&&i| {

@@ -7,6 +7,10 @@
 //! The tests start the binary through `xvfb-run -a`. Without `xvfb-run` they are skipped with
 //! a message, except in CI (`CI` set), where they fail: `.ci/run` installs `xvfb`.
 
+mod common;
+
+use common::copy_dir;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -305,19 +309,6 @@ fn spawn_lines(mut cmd: Command) -> (Running, Lines, std::thread::JoinHandle<Str
     (child, lines, stderr)
 }
 
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let target = to.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), target).unwrap();
-        }
-    }
-}
-
 /// Replace a file the way editors save: write a sibling, rename it over the original.
 fn save(path: &Path, contents: &str) {
     let tmp = path.with_file_name(".edit.tmp");
@@ -331,7 +322,7 @@ fn kernel_edit_reloads_live() {
     let dir = tempfile::tempdir().unwrap();
     let glsl = dir.path().join("glsl");
     copy_dir(&root().join("glsl"), &glsl);
-    let shading = glsl.join("shading.comp");
+    let shading = glsl.join("mueller2015/shading.comp");
     let original = std::fs::read_to_string(&shading).unwrap();
 
     // a compile error on a known line: a line of garbage before `void main()`
@@ -421,7 +412,7 @@ fn soft_shadow_kernel_edit_reloads_live() {
     let dir = tempfile::tempdir().unwrap();
     let glsl = dir.path().join("glsl");
     copy_dir(&root().join("glsl"), &glsl);
-    let quad = glsl.join("linespace_quad.frag");
+    let quad = glsl.join("klee2016/linespace_quad.frag");
     let original = std::fs::read_to_string(&quad).unwrap();
     let store = "fragColor = vec4(texture(colorTexture, texCoord).rgb, 1.0);";
     assert_eq!(

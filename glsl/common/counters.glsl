@@ -3,7 +3,7 @@
 // carry: atomicAdd returns the old low word, and an addition that wraps it adds 1 to the high
 // word. Each work group first sums its invocations' counts in shared memory, so there is one
 // global atomic per work group and counter. The host clears the buffer every frame.
-layout(std430, binding = 8) coherent buffer CounterBuffer { uint counters[]; };
+layout(std430, binding = SSBO_COUNTERS) coherent buffer CounterBuffer { uint counters[]; };
 
 shared uint groupCount[COUNTER_SLOTS_PER_KERNEL];
 

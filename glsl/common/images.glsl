@@ -8,17 +8,17 @@
 //   finalTex    rgb: output colour,           a: accumulated weight (Listing 16)
 // primaryHit is ours (not in the thesis): the first hit's t and triangle id for the AOVs.
 
-layout(rgba32f, binding = 0) uniform image2D rayOriginTexture;
-layout(rgba32f, binding = 1) uniform image2D rayDirTexture;
-layout(rgba32f, binding = 2) uniform image2D normalTexture;
-layout(rgba32f, binding = 3) uniform image2D colorBufferTexture;
+layout(rgba32f, binding = IMAGE_RAY_ORIGIN) uniform image2D rayOriginTexture;
+layout(rgba32f, binding = IMAGE_RAY_DIR) uniform image2D rayDirTexture;
+layout(rgba32f, binding = IMAGE_NORMAL) uniform image2D normalTexture;
+layout(rgba32f, binding = IMAGE_COLOR_BUFFER) uniform image2D colorBufferTexture;
 #if SHADOW_BITS
-layout(rgba32ui, binding = 4) uniform uimage2D shadowTexture;
+layout(rgba32ui, binding = IMAGE_SHADOW) uniform uimage2D shadowTexture;
 #else
-layout(rgba32f, binding = 4) uniform image2D shadowTexture;
+layout(rgba32f, binding = IMAGE_SHADOW) uniform image2D shadowTexture;
 #endif
-layout(rgba32f, binding = 5) uniform image2D finalTexture;
-layout(rgba32f, binding = 6) uniform image2D primaryHitTexture;
+layout(rgba32f, binding = IMAGE_FINAL) uniform image2D finalTexture;
+layout(rgba32f, binding = IMAGE_PRIMARY_HIT) uniform image2D primaryHitTexture;
 
 // Tiles: a frame is dispatched in tiles so that no single dispatch runs long enough for a
 // driver watchdog to kill it; tileOffset is the tile's lower-left pixel.

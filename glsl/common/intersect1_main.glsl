@@ -14,7 +14,7 @@
 uniform vec4 backgroundColor;
 // 1 in the first pass (primary rays): the first hit is also stored for the AOVs.
 uniform int storePrimaryHit;
-layout(binding = 0) uniform sampler2DArray textures;
+layout(binding = SAMPLER_TEXTURES) uniform sampler2DArray textures;
 
 void trace(ivec2 storePos)
 {

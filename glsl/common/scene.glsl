@@ -3,17 +3,17 @@
 // and the lights; the kernels only read them. Triangles are stored as a triangle soup:
 // the vertices of triangle k are vertex[3k], vertex[3k+1], vertex[3k+2] (Listing 12).
 
-layout(std430, binding = 0) SCENE_QUALIFIER buffer VertexBuffer { vec4 vertex[]; };
-layout(std430, binding = 1) SCENE_QUALIFIER buffer NormalBuffer { vec4 normals[]; };
-layout(std430, binding = 2) SCENE_QUALIFIER buffer ColorBuffer { vec4 colors[]; };
-layout(std430, binding = 3) SCENE_QUALIFIER buffer TexCoordBuffer { vec2 texcoords[]; };
+layout(std430, binding = SSBO_VERTEX) SCENE_QUALIFIER buffer VertexBuffer { vec4 vertex[]; };
+layout(std430, binding = SSBO_NORMAL) SCENE_QUALIFIER buffer NormalBuffer { vec4 normals[]; };
+layout(std430, binding = SSBO_COLOR) SCENE_QUALIFIER buffer ColorBuffer { vec4 colors[]; };
+layout(std430, binding = SSBO_TEXCOORD) SCENE_QUALIFIER buffer TexCoordBuffer { vec2 texcoords[]; };
 // Material id of every triangle (written by the transform pass from the object's materials).
-layout(std430, binding = 4) SCENE_QUALIFIER buffer TriMaterialBuffer { int triMaterial[]; };
+layout(std430, binding = SSBO_TRI_MATERIAL) SCENE_QUALIFIER buffer TriMaterialBuffer { int triMaterial[]; };
 // Per material: x = reflection coefficient (refl), y = specular, z = shininess,
 // w = texture layer in the sampler2DArray (-1: vertex colours).
-layout(std430, binding = 5) readonly buffer MaterialBuffer { vec4 material[]; };
-layout(std430, binding = 6) SCENE_QUALIFIER buffer LightPosBuffer { vec4 lightPos[]; };
-layout(std430, binding = 7) SCENE_QUALIFIER buffer LightColorBuffer { vec4 lightColor[]; };
+layout(std430, binding = SSBO_MATERIAL) readonly buffer MaterialBuffer { vec4 material[]; };
+layout(std430, binding = SSBO_LIGHT_POS) SCENE_QUALIFIER buffer LightPosBuffer { vec4 lightPos[]; };
+layout(std430, binding = SSBO_LIGHT_COLOR) SCENE_QUALIFIER buffer LightColorBuffer { vec4 lightColor[]; };
 
 // Number of triangles in the scene (vertex.length() / 3).
 int triangleCount() { return vertex.length() / 3; }

@@ -1,8 +1,11 @@
 //! OpenGL plumbing: the headless context, program loading, and small resource helpers.
 
 pub mod context;
+pub mod kernel;
 pub mod program;
 pub mod resources;
+pub mod slots;
 
 pub use context::{check_error, Gl, GlContext, GlInfo};
+pub use kernel::{Kernel, PixelGrid};
 pub use program::{compile_program, Defines, ShaderSource};

@@ -15,117 +15,9 @@ use glow::HasContext;
 
 use super::context::Gl;
 
-/// The kernel files compiled into the binary, keyed by their path below `glsl/`.
-pub const EMBEDDED: &[(&str, &str)] = &[
-    (
-        "common/scene.glsl",
-        include_str!("../../glsl/common/scene.glsl"),
-    ),
-    (
-        "common/images.glsl",
-        include_str!("../../glsl/common/images.glsl"),
-    ),
-    (
-        "common/intersect.glsl",
-        include_str!("../../glsl/common/intersect.glsl"),
-    ),
-    (
-        "common/counters.glsl",
-        include_str!("../../glsl/common/counters.glsl"),
-    ),
-    (
-        "common/intersect_head.glsl",
-        include_str!("../../glsl/common/intersect_head.glsl"),
-    ),
-    (
-        "common/intersect1_main.glsl",
-        include_str!("../../glsl/common/intersect1_main.glsl"),
-    ),
-    (
-        "common/intersect2_main.glsl",
-        include_str!("../../glsl/common/intersect2_main.glsl"),
-    ),
-    (
-        "common/grid.glsl",
-        include_str!("../../glsl/common/grid.glsl"),
-    ),
-    (
-        "common/voxelwalk.glsl",
-        include_str!("../../glsl/common/voxelwalk.glsl"),
-    ),
-    (
-        "common/tribox.glsl",
-        include_str!("../../glsl/common/tribox.glsl"),
-    ),
-    (
-        "common/grid_overlap.glsl",
-        include_str!("../../glsl/common/grid_overlap.glsl"),
-    ),
-    (
-        "common/dda.glsl",
-        include_str!("../../glsl/common/dda.glsl"),
-    ),
-    (
-        "eye_ray_generation.comp",
-        include_str!("../../glsl/eye_ray_generation.comp"),
-    ),
-    (
-        "intersect1.comp",
-        include_str!("../../glsl/intersect1.comp"),
-    ),
-    (
-        "intersect2.comp",
-        include_str!("../../glsl/intersect2.comp"),
-    ),
-    ("shading.comp", include_str!("../../glsl/shading.comp")),
-    ("build.comp", include_str!("../../glsl/build.comp")),
-    ("traversal.comp", include_str!("../../glsl/traversal.comp")),
-    (
-        "intersect1_grid.comp",
-        include_str!("../../glsl/intersect1_grid.comp"),
-    ),
-    (
-        "intersect2_grid.comp",
-        include_str!("../../glsl/intersect2_grid.comp"),
-    ),
-    (
-        "grid_count.comp",
-        include_str!("../../glsl/grid_count.comp"),
-    ),
-    ("grid_scan.comp", include_str!("../../glsl/grid_scan.comp")),
-    ("grid_fill.comp", include_str!("../../glsl/grid_fill.comp")),
-    (
-        "intersect1_dda.comp",
-        include_str!("../../glsl/intersect1_dda.comp"),
-    ),
-    (
-        "intersect2_dda.comp",
-        include_str!("../../glsl/intersect2_dda.comp"),
-    ),
-    ("transform.vert", include_str!("../../glsl/transform.vert")),
-    ("gbuffer.vert", include_str!("../../glsl/gbuffer.vert")),
-    ("gbuffer.frag", include_str!("../../glsl/gbuffer.frag")),
-    (
-        "linespace_shadow.comp",
-        include_str!("../../glsl/linespace_shadow.comp"),
-    ),
-    (
-        "linespace_quad.vert",
-        include_str!("../../glsl/linespace_quad.vert"),
-    ),
-    (
-        "linespace_quad.frag",
-        include_str!("../../glsl/linespace_quad.frag"),
-    ),
-    (
-        "screen_quad.vert",
-        include_str!("../../glsl/screen_quad.vert"),
-    ),
-    (
-        "screen_quad.frag",
-        include_str!("../../glsl/screen_quad.frag"),
-    ),
-];
+/// The kernel files compiled into the binary, keyed by their path below `glsl/` (every file
+/// of the folder: see `build.rs`).
+pub const EMBEDDED: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/embedded_glsl.rs"));
 
 /// Where kernel sources come from.
 #[derive(Debug, Clone, Default)]
@@ -167,14 +59,18 @@ impl ShaderSource {
         }
     }
 
-    /// Assemble `name` with its includes and the given defines. Returns the text and, for
+    /// Assemble `name` with its includes, the binding slots of [`super::slots`] and the given
+    /// defines. Returns the text and, for
     /// every line of it, the file and line it came from.
     pub fn assemble(&self, name: &str, defines: &Defines) -> Result<(String, LineMap)> {
         let mut map = LineMap::default();
         let mut out = String::new();
         map.push("<generated header>", 1);
         out.push_str("#version 450 core\n");
-        for (i, (k, v)) in defines.0.iter().enumerate() {
+        // the binding slots of gl::slots, then the program's own defines
+        let mut all = super::slots::defines();
+        all.0.extend(defines.0.clone());
+        for (i, (k, v)) in all.0.iter().enumerate() {
             out.push_str(&format!("#define {k} {v}\n"));
             map.push("<generated header>", i + 2);
         }
@@ -318,11 +214,9 @@ fn dump_source(name: &str, text: &str) {
         return;
     };
     let dir = Path::new(&dir);
-    let file = Path::new(name)
-        .file_name()
-        .unwrap_or_default()
-        .to_string_lossy();
-    let mut path = dir.join(file.as_ref());
+    // `thesis_grid/intersect1.comp` -> `thesis_grid.intersect1.comp`
+    let file = name.replace(['/', '\\'], ".");
+    let mut path = dir.join(&file);
     let mut k = 2;
     while path.exists() {
         if std::fs::read_to_string(&path).is_ok_and(|t| t == text) {
@@ -428,7 +322,7 @@ mod tests {
     fn includes_are_resolved_and_numbered() {
         let src = ShaderSource::default();
         let (text, map) = src
-            .assemble("intersect1.comp", &Defines::new().set("FOO", 3))
+            .assemble("brute_force/intersect1.comp", &Defines::new().set("FOO", 3))
             .unwrap();
         assert!(text.starts_with("#version 450 core\n#define FOO 3\n"));
         assert!(map.files().any(|f| f == "glsl/common/intersect.glsl"));

@@ -152,6 +152,30 @@ impl Image2d {
         }
     }
 
+    /// Copy the texels of `src` (same size and format) into this image, on the GPU.
+    pub fn copy_from(&self, gl: &Gl, src: &Image2d) {
+        // SAFETY: glCopyImageSubData between two of our textures of the same size and format.
+        unsafe {
+            gl.copy_image_sub_data(
+                src.texture,
+                glow::TEXTURE_2D,
+                0,
+                0,
+                0,
+                0,
+                self.texture,
+                glow::TEXTURE_2D,
+                0,
+                0,
+                0,
+                0,
+                self.width as i32,
+                self.height as i32,
+                1,
+            )
+        };
+    }
+
     /// Read back RGBA32F texels, row 0 = the bottom row (GL order).
     pub fn read_f32(&self, gl: &Gl) -> Vec<[f32; 4]> {
         read_texture_rgba32f(gl, self.texture, self.width, self.height)

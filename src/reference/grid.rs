@@ -1,9 +1,147 @@
 //! CPU reference of the uniform grid (Müller 2015, ch. 3.2): Algorithms 2 and 3 with the
 //! special cases of Fig. 13, the thesis' edge-walk registration of triangles, and the exact
-//! variant's triangle/box overlap registration — the same arithmetic as the GLSL in
-//! `glsl/common/voxelwalk.glsl`, `glsl/build.comp` and `glsl/common/tribox.glsl`, in f32.
+//! variant's triangle/box overlap registration and 3D-DDA — the same arithmetic as the GLSL in
+//! `glsl/common/grid.glsl`, `glsl/thesis_grid/` and `glsl/exact_grid/`, in f32. Shared by
+//! the CPU twins of both grids (`thesis_grid.rs`, `exact_grid.rs`).
 
-use glam::{IVec3, Vec3};
+use glam::{IVec3, Mat4, Vec3};
+
+/// The scene-to-grid mapping of `glsl/common/grid.glsl`: grid = (p − centre) · scale, which
+/// puts the scene's current bounds onto [-1, 1)³ with one scale (so ray parameters are the
+/// same in scene and grid space).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridMapping {
+    pub center: Vec3,
+    pub scale: f32,
+}
+
+impl GridMapping {
+    /// The mapping for the objects' object-space bounds under their model matrices, slightly
+    /// enlarged so the far faces stay inside — what the GPU grids compute every frame.
+    pub fn of_objects(object_bounds: &[(Vec3, Vec3)], models: &[Mat4]) -> GridMapping {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for ((olo, ohi), m) in object_bounds.iter().zip(models) {
+            for k in 0..8 {
+                let c = Vec3::new(
+                    if k & 1 == 0 { olo.x } else { ohi.x },
+                    if k & 2 == 0 { olo.y } else { ohi.y },
+                    if k & 4 == 0 { olo.z } else { ohi.z },
+                );
+                let w = m.transform_point3(c);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        let extent = (hi - lo).max_element().max(1e-6) * 1.001;
+        GridMapping {
+            center: (lo + hi) * 0.5,
+            scale: 2.0 / extent,
+        }
+    }
+
+    /// The mapping of a scene as loaded (every object at its model matrix).
+    pub fn of_scene(scene: &crate::scene::Scene) -> GridMapping {
+        let bounds: Vec<_> = scene.objects.iter().map(|o| o.mesh.bounds()).collect();
+        let models: Vec<_> = scene.objects.iter().map(|o| o.model).collect();
+        Self::of_objects(&bounds, &models)
+    }
+
+    /// toGridSpace
+    pub fn to_grid(&self, p: Vec3) -> Vec3 {
+        (p - self.center) * self.scale
+    }
+
+    /// A scene-space triangle in grid space.
+    pub fn triangle(&self, t: &[Vec3; 3]) -> [Vec3; 3] {
+        t.map(|p| self.to_grid(p))
+    }
+}
+
+/// clipToGrid: the parameter interval [enter, exit] of ro + t·rd (grid space) inside the grid
+/// box [-1, 1]³ (empty when enter > exit).
+pub fn clip_to_grid(ro: Vec3, rd: Vec3) -> (f32, f32) {
+    let inv = Vec3::ONE / rd;
+    let t0 = (Vec3::NEG_ONE - ro) * inv;
+    let t1 = (Vec3::ONE - ro) * inv;
+    let (tn, tf) = (t0.min(t1), t0.max(t1));
+    (tn.max_element(), tf.min_element())
+}
+
+/// The 3D-DDA of `glsl/exact_grid/dda.glsl` (Amanatides & Woo 1987).
+#[derive(Debug, Clone, Copy)]
+pub struct Walk {
+    pub voxel: IVec3,
+    step: IVec3,
+    t_max: Vec3,
+    t_delta: Vec3,
+    t_end: f32,
+}
+
+impl Walk {
+    /// beginWalk: a walk of rog + t·rdg (grid space) for t in [0, t_end]; `None` if the ray
+    /// misses the grid.
+    pub fn begin(space: &GridSpace, rog: Vec3, rdg: Vec3, t_end: f32) -> Option<Walk> {
+        let (enter, exit) = clip_to_grid(rog, rdg);
+        let t0 = enter.max(0.0);
+        let t_end = exit.min(t_end);
+        if t0 > t_end {
+            return None;
+        }
+        let voxel = space.clamp(space.get_voxel(rog + t0 * rdg));
+        let step = IVec3::new(sgn(rdg.x), sgn(rdg.y), sgn(rdg.z));
+        let up = Vec3::select(rdg.cmpgt(Vec3::ZERO), Vec3::ONE, Vec3::ZERO);
+        let next_face = (voxel.as_vec3() + up) * space.vx_edge() - 1.0;
+        let inv = Vec3::ONE / rdg;
+        let t_max = Vec3::select(
+            rdg.cmpeq(Vec3::ZERO),
+            Vec3::INFINITY,
+            (next_face - rog) * inv,
+        );
+        let t_delta = (space.vx_edge() * inv).abs();
+        Some(Walk {
+            voxel,
+            step,
+            t_max,
+            t_delta,
+            t_end,
+        })
+    }
+
+    /// voxelExit: the parameter at which the ray leaves the current voxel.
+    pub fn exit(&self) -> f32 {
+        self.t_max.min_element()
+    }
+
+    /// stepWalk: into the next voxel; false when the walk has ended.
+    pub fn step(&mut self, space: &GridSpace) -> bool {
+        let exit = self.exit();
+        if exit > self.t_end {
+            return false;
+        }
+        let d = if self.t_max.x == exit {
+            0
+        } else if self.t_max.y == exit {
+            1
+        } else {
+            2
+        };
+        self.voxel[d] += self.step[d];
+        self.t_max[d] += self.t_delta[d];
+        space.voxel_id(self.voxel).is_some()
+    }
+}
+
+/// GLSL's sign() as an int.
+fn sgn(x: f32) -> i32 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
 
 /// A uniform grid of `n`³ voxels over [-1, 1)³ (the thesis' scene space).
 #[derive(Debug, Clone, Copy)]

@@ -1,5 +1,5 @@
 //! The CPU implementation of Klee 2016's soft shadows (ch. 4.3, Algorithms 1–4, Listings
-//! 1–3): the same N-tree, line spaces and traversals as `glsl/linespace_shadow.comp`, in plain
+//! 1–3): the same N-tree, line spaces and traversals as `glsl/klee2016/linespace_shadow.comp`, in plain
 //! Rust, step by step like the kernel — the oracle of the tests and the CPU side of the
 //! thesis' CPU/GPU comparison (Fig. 12, Table 3).
 //!
@@ -21,11 +21,11 @@
 use glam::{IVec3, Vec3};
 
 use crate::reference::intersect_triangle;
-use crate::scene::AreaLight;
-use crate::tracer::linespace::ntree::{
+use crate::reference::ntree::{
     entry_index, face_axes, NTree, PackedLinespaces, CHILDREN_BIT, GEOMETRY_BIT,
 };
-use crate::tracer::linespace::ShadowMode;
+use crate::scene::AreaLight;
+use crate::scene::ShadowMode;
 
 /// Exact event counts of one pixel or frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

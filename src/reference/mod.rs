@@ -3,19 +3,50 @@
 //! arithmetic and the same pass structure as the kernels. It is the oracle of the tests: the
 //! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
 
-pub mod linespace;
-
+pub mod brute_force;
+pub mod exact_grid;
 pub mod grid;
+pub mod linespace;
+pub mod ntree;
+pub mod thesis_grid;
 
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
+use crate::frame::Aovs;
 use crate::scene::{Camera, Scene, WorldAttributes};
-use crate::tracer::Aovs;
+
+/// A closest hit: ray parameter, triangle id and barycentric (u, v).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub id: usize,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// The CPU twin of an accelerator (`crate::accel`): the same searches as its intersect1 and
+/// intersect2 kernels, in f32 with the same arithmetic, so the tests can hold every GPU
+/// accelerator against its twin. Each returns the number of ray–triangle tests it made.
+pub trait CpuAccelerator: Send + Sync {
+    /// The closest hit of ro + t·rd (t > 0) other than triangle `last`; equal distances go to
+    /// the lower triangle id.
+    fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64);
+    /// Whether a triangle other than `last` is hit with `offset` < t < `light_distance` (the
+    /// shadow feeler of Listing 15).
+    fn occluded(
+        &self,
+        ro: Vec3,
+        rd: Vec3,
+        light_distance: f32,
+        offset: f32,
+        last: i32,
+    ) -> (bool, u64);
+}
 
 /// The scene prepared for tracing on the CPU.
 pub struct Reference {
-    triangles: Vec<[Vec3; 3]>,
+    accel: Box<dyn CpuAccelerator>,
     attributes: WorldAttributes,
     materials: Vec<Vec4>,
     lights: Vec<(Vec3, Vec3)>,
@@ -68,9 +99,18 @@ fn reflect(i: Vec3, n: Vec3) -> Vec3 {
 }
 
 impl Reference {
+    /// The base tracer's reference: every ray against every triangle.
     pub fn new(scene: &Scene) -> Reference {
+        Self::with_accelerator(
+            scene,
+            Box::new(brute_force::BruteForce::new(scene.world_triangles())),
+        )
+    }
+
+    /// The reference with the closest-hit and any-hit searches of `accel`.
+    pub fn with_accelerator(scene: &Scene, accel: Box<dyn CpuAccelerator>) -> Reference {
         Reference {
-            triangles: scene.world_triangles(),
+            accel,
             attributes: scene.world_attributes(),
             materials: scene
                 .materials
@@ -112,24 +152,6 @@ impl Reference {
         top.lerp(bottom, fy)
     }
 
-    /// Closest hit skipping `last`; (t, id, u, v) and the number of tests.
-    fn closest(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<(f32, usize, f32, f32)>, u64) {
-        let mut best: Option<(f32, usize, f32, f32)> = None;
-        let mut tests = 0;
-        for (i, t) in self.triangles.iter().enumerate() {
-            if i as i32 == last {
-                continue;
-            }
-            tests += 1;
-            if let Some((tt, u, v)) = intersect_triangle(ro, rd, t[0], t[1], t[2]) {
-                if best.is_none_or(|b| tt < b.0) {
-                    best = Some((tt, i, u, v));
-                }
-            }
-        }
-        (best, tests)
-    }
-
     /// The shadow feeler of Listing 15: (in shadow, tests).
     fn shadowed(&self, p: Vec3, n: Vec3, last: usize, light: Vec3) -> (bool, u64) {
         let to_light = light - p;
@@ -138,19 +160,8 @@ impl Reference {
         if n.dot(rd) <= 0.0 {
             return (true, 0);
         }
-        let mut tests = 0;
-        for (i, t) in self.triangles.iter().enumerate() {
-            if i == last {
-                continue;
-            }
-            tests += 1;
-            if let Some((tt, _, _)) = intersect_triangle(p, rd, t[0], t[1], t[2]) {
-                if tt > self.shadow_offset && tt < dist {
-                    return (true, tests);
-                }
-            }
-        }
-        (false, tests)
+        self.accel
+            .occluded(p, rd, dist, self.shadow_offset, last as i32)
     }
 
     /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.
@@ -170,14 +181,14 @@ impl Reference {
             if ray_state <= 0.0 {
                 break;
             }
-            let (hit, tests) = self.closest(ro, rd, last);
+            let (hit, tests) = self.accel.closest_hit(ro, rd, last);
             out.tests1 += tests;
             let (temp, weight_in) = match hit {
                 None => {
                     ray_state = 0.0;
                     (self.background, 1.0)
                 }
-                Some((t, id, u, v)) => {
+                Some(Hit { t, id, u, v }) => {
                     let w = 1.0 - u - v;
                     let k = 3 * id;
                     let mut n = (w * a.normals[k] + u * a.normals[k + 1] + v * a.normals[k + 2])

@@ -4,11 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
+use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::base::BaseTracer;
-use gpgpu_rt::tracer::{Frame, RenderOptions, ShadowFlags, Tracer};
 
 pub fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -26,6 +28,7 @@ pub fn context() -> GlContext {
 
 pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
     RenderOptions {
+        tracer: TracerKind::Base,
         width: w,
         height: h,
         refl_depth,
@@ -37,7 +40,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
 }
 
 pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
-    let mut t = BaseTracer::new(
+    let mut t = RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         scene,
@@ -129,4 +132,18 @@ pub fn assert_close(gpu: &Frame, cpu: &ReferenceFrame, what: &str) -> Comparison
     assert!(c.mean_color_diff < 0.005, "{what}: colours differ: {c:?}");
     assert!(c.color_outliers < 0.01, "{what}: colours differ: {c:?}");
     c
+}
+
+/// Copy a folder tree (e.g. `glsl/` for `--glsl-dir`).
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let target = to.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), target).unwrap();
+        }
+    }
 }

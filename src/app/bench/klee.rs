@@ -23,10 +23,19 @@ use super::plots::{self, Chart, Series, Style, BLACK_INDEX};
 use super::report::{self, num, ratio, Section};
 use super::runner::{Bench, Sizing};
 use super::{Protocol, FULL_SIZE, QUICK_SIZE};
+use gpgpu_rt::frame::FrameStats;
+use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::linespace::{
-    ShadowMode, SoftShadowFrame, SoftShadowOptions, SoftShadowRenderer,
-};
+use gpgpu_rt::scene::ShadowMode;
+
+/// A soft-shadow frame's statistics and the G-buffer it was shaded from (the CPU
+/// implementation shades the same points).
+pub struct SoftShadowFrame {
+    pub stats: FrameStats,
+    pub gbuffer_position: Vec<[f32; 4]>,
+    pub gbuffer_normal: Vec<[f32; 4]>,
+}
 
 pub const BUNNY: &str = "bunny_area.toml";
 pub const DRAGON: &str = "dragon_area.toml";
@@ -138,12 +147,18 @@ impl Setup {
     ) -> Result<(Meas, Meas, SoftShadowFrame)> {
         self.renderer.reconfigure(&bench.shaders, mode, su, sv)?;
         for _ in 0..self.sizing.warmup {
-            self.renderer.render(&self.scene.camera)?;
+            self.renderer.draw(&self.scene.camera)?;
         }
         let (mut shadow, mut gbuf) = (Vec::new(), Vec::new());
         let mut last = None;
         for _ in 0..self.sizing.angles.max(1) {
-            let f = self.renderer.render(&self.scene.camera)?;
+            let stats = self.renderer.draw(&self.scene.camera)?;
+            let (gbuffer_position, gbuffer_normal) = self.renderer.read_gbuffer();
+            let f = SoftShadowFrame {
+                stats,
+                gbuffer_position,
+                gbuffer_normal,
+            };
             shadow.push(
                 f.stats
                     .gpu_ms

@@ -55,7 +55,7 @@ use anyhow::{bail, Result};
 pub use report::Section;
 pub use runner::Bench;
 
-use gpgpu_rt::tracer::GridVariant;
+use gpgpu_rt::accel::GridVariant;
 
 /// Default image size at `--scale quick`: small enough for Mesa llvmpipe.
 pub const QUICK_SIZE: (u32, u32) = (64, 64);

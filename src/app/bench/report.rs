@@ -360,7 +360,7 @@ fn muller_settings(s: &mut String, a: &super::BenchArgs) {
         a.tile,
         if a.tile == 0 { "one dispatch per kernel and pass, as the thesis" } else { "tiles of at most this many pixels squared" }
     );
-    let d = gpgpu_rt::tracer::GridOptions::default();
+    let d = gpgpu_rt::accel::GridOptions::default();
     let _ = writeln!(
         s,
         "- Grid list lengths of the thesis variant: voxel_array_length {}, ray_array_length {} \

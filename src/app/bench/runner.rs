@@ -14,11 +14,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::machine::Machine;
 use super::stats::Stats;
 use super::{BenchArgs, Rotation, Scale};
+use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
+use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
-use gpgpu_rt::tracer::{
-    self, FrameStats, GridOptions, GridVariant, RenderOptions, ShadowFlags, TracerKind,
-};
 
 /// Which tracer a configuration measures.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -386,6 +387,7 @@ impl Bench {
             grid.ray_array_length = Some(r);
         }
         let options = RenderOptions {
+            tracer: kind,
             width: c.width,
             height: c.height,
             refl_depth: c.refl_depth,
@@ -395,8 +397,7 @@ impl Bench {
             grid,
         };
         let start = Instant::now();
-        let mut tracer = tracer::create(
-            kind,
+        let mut tracer = RayTracer::new(
             self.ctx.gl.clone(),
             &self.ctx.info,
             scene,
@@ -407,26 +408,28 @@ impl Bench {
         let center = rotation_center(scene);
         let base_models: Vec<Mat4> = scene.objects.iter().map(|o| o.model).collect();
         let rotate = self.args.rotate;
-        let place = |tracer: &mut Box<dyn tracer::Tracer>, angle: f64| match rotate {
-            Rotation::Objects => {
-                let r = Mat4::from_translation(center)
-                    * Mat4::from_rotation_y((angle as f32).to_radians())
-                    * Mat4::from_translation(-center);
-                for (i, m) in base_models.iter().enumerate() {
-                    tracer.set_model(i, r * *m);
+        let place = |tracer: &mut RayTracer, angle: f64| -> Result<gpgpu_rt::scene::Camera> {
+            match rotate {
+                Rotation::Objects => {
+                    let r = Mat4::from_translation(center)
+                        * Mat4::from_rotation_y((angle as f32).to_radians())
+                        * Mat4::from_translation(-center);
+                    for (i, m) in base_models.iter().enumerate() {
+                        tracer.set_model(i, r * *m)?;
+                    }
+                    Ok(scene.camera)
                 }
-                scene.camera
+                // orbiting the camera by −θ shows the objects turned by θ; the light stays put
+                Rotation::Camera => Ok(scene.camera.orbited(center, -(angle as f32))),
             }
-            // orbiting the camera by −θ shows the objects turned by θ; the light stays put
-            Rotation::Camera => scene.camera.orbited(center, -(angle as f32)),
         };
         for _ in 0..c.warmup {
-            let cam = place(&mut tracer, c.angles[0]);
+            let cam = place(&mut tracer, c.angles[0])?;
             tracer.render(&cam).context("warm-up frame")?;
             pb.inc(1);
         }
         for (i, &angle) in c.angles.iter().enumerate() {
-            let cam = place(&mut tracer, angle);
+            let cam = place(&mut tracer, angle)?;
             let frame = tracer
                 .render(&cam)
                 .with_context(|| format!("frame at {angle}°"))?;

@@ -4,7 +4,7 @@
 use super::plots::{Series, Style};
 use super::report::{self, int, mmm, num, ratio};
 use super::runner::{variant_name, Config, Outcome, Sizing, TracerSpec};
-use gpgpu_rt::tracer::GridVariant;
+use gpgpu_rt::accel::GridVariant;
 
 /// Grid configurations for every variant × resolution of `scene`.
 pub fn grid_configs(

@@ -150,8 +150,8 @@ impl Protocol for Thesis52 {
                 .join("; ")
         };
         let monotone = [
-            gpgpu_rt::tracer::GridVariant::Thesis,
-            gpgpu_rt::tracer::GridVariant::Exact,
+            gpgpu_rt::accel::GridVariant::Thesis,
+            gpgpu_rt::accel::GridVariant::Exact,
         ]
         .into_iter()
         .filter_map(|v| {

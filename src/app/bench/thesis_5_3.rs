@@ -15,7 +15,7 @@ use super::report::{self, int, num, ratio, Section};
 use super::runner::{rotation_angles, variant_name, Bench, Config, Sizing, TracerSpec};
 use super::sweep;
 use super::{Protocol, Scale, FULL_SIZE, QUICK_SIZE};
-use gpgpu_rt::tracer::GridVariant;
+use gpgpu_rt::accel::GridVariant;
 
 pub struct Thesis53;
 

@@ -30,13 +30,32 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::WindowId;
 
-use crate::soft_cli::SoftShadowArgs;
+use crate::args::SoftShadowArgs;
+use gpgpu_rt::accel::{GridVariant, TracerKind};
+use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::gl::{Gl, GlInfo};
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::softshadow::{scene_light, SoftShadowRenderer};
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::scene::ShadowMode;
 use gpgpu_rt::scene::{Camera, Scene};
-use gpgpu_rt::tracer::linespace::{scene_light, ShadowMode, SoftShadowRenderer};
-use gpgpu_rt::tracer::{
-    self, FrameStats, GridVariant, RenderOptions, ShadowFlags, Tracer, TracerKind,
-};
+
+/// The ray tracer with the accelerator `kind`.
+fn create_tracer(
+    kind: TracerKind,
+    gl: std::sync::Arc<Gl>,
+    info: &GlInfo,
+    scene: &Scene,
+    shaders: &ShaderSource,
+    options: RenderOptions,
+) -> Result<Box<dyn Renderer>> {
+    let options = RenderOptions {
+        tracer: kind,
+        ..options
+    };
+    Ok(Box::new(RayTracer::new(gl, info, scene, shaders, options)?))
+}
 
 use watch::GlslWatcher;
 use window::{
@@ -90,7 +109,7 @@ pub struct ViewArgs {
     /// The grid tracer's options, as for `render` (G / shift+G / A change the resolution, V
     /// the variant).
     #[command(flatten)]
-    pub grid: tracer::GridArgs,
+    pub grid: crate::args::GridArgs,
     /// The soft-shadow options, as for `render` (scenes with an `[[area_light]]`; S cycles the
     /// mode, L / shift+L the samples).
     #[command(flatten)]
@@ -145,6 +164,7 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     }
     let shaders = ShaderSource::from_dir(args.glsl_dir.clone())?;
     let options = RenderOptions {
+        tracer: args.tracer,
         width: args.width.unwrap_or(scene.settings.width),
         height: args.height.unwrap_or(scene.settings.height),
         refl_depth: args.refl_depth.unwrap_or(scene.settings.refl_depth),
@@ -178,7 +198,7 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
 struct Running {
     /// The ray tracer (`App::kind`, `App::options`); `None` until it is first shown, and after
     /// a change or a reload while the soft shadows are shown (built again when shown).
-    tracer: Option<Box<dyn Tracer>>,
+    tracer: Option<Box<dyn Renderer>>,
     /// The soft-shadow renderer, built when first shown and kept while the ray tracer is shown
     /// (its N-tree is built once).
     soft: Option<SoftShadowRenderer>,
@@ -192,7 +212,7 @@ impl Running {
     fn render(&mut self, shadows: Option<ShadowMode>, camera: &Camera) -> Result<FrameStats> {
         match (shadows, self.soft.as_mut(), self.tracer.as_mut()) {
             (Some(_), Some(soft), _) => soft.draw(camera),
-            (None, _, Some(tracer)) => tracer.render(camera).map(|f| f.stats),
+            (None, _, Some(tracer)) => tracer.draw(camera),
             _ => bail!("no renderer is built"),
         }
     }
@@ -200,7 +220,7 @@ impl Running {
     /// The output texture of what is shown (the soft shadows or the ray tracer).
     fn output_texture(&self, shadows: Option<ShadowMode>) -> Option<glow::Texture> {
         match shadows {
-            Some(_) => self.soft.as_ref().map(SoftShadowRenderer::output_texture),
+            Some(_) => self.soft.as_ref().map(|s| s.output_texture()),
             None => self.tracer.as_ref().map(|t| t.output_texture()),
         }
     }
@@ -411,7 +431,7 @@ impl App {
     ) -> Result<()> {
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
         if rebuild || running.tracer.is_none() {
-            let tracer = tracer::create(
+            let tracer = create_tracer(
                 kind,
                 running.window.gl.clone(),
                 &running.window.info,
@@ -485,7 +505,7 @@ impl App {
             (Some(mode), Some(soft)) => {
                 soft.recompile(&self.shaders, mode, self.samples.0, self.samples.1)
             }
-            _ => tracer::create(
+            _ => create_tracer(
                 self.kind,
                 gl.clone(),
                 &running.window.info,
@@ -601,8 +621,8 @@ impl App {
                     mode.name(),
                     self.samples.0,
                     self.samples.1,
-                    soft.tree.n,
-                    soft.tree.depth
+                    soft.scene.tree.n,
+                    soft.scene.tree.depth
                 );
             }
             _ => {

@@ -1,0 +1,644 @@
+// linespace_shadow kernel — Klee 2016, ch. 4.1 (Fig. 7, second phase) and ch. 4.3:
+// Algorithm 1 (preparation and traversal), Algorithm 2 (isIntersection), Algorithm 3
+// (isNodeIntersection, after Kay–Kajiya), Algorithm 4 with Listing 3 (getEntry: the bit in the
+// 3D R32UI line-space texture), Listing 1 (struct Stack) and Listing 2 (struct Shaft).
+// One invocation per pixel: the pixel's position and normal come from the G-buffer; its
+// SAMPLES_U × SAMPLES_V shadow rays towards the rectangular light form one packet that walks
+// the N-tree slice by slice along the axis k (coherent grid traversal [WIK+06, KWH09]).
+//   SHADOW_MODE 0 (exact):     line spaces only skip empty shafts; the leaves' triangles are
+//                              tested (Table 2, "Schnitttests mit Dreiecken").
+//   SHADOW_MODE 1 (linespace): at the last depth with line spaces, a set bit is a hit (the
+//                              thesis' approximation, Table 2 "Linespace-Abfrage").
+//   SHADOW_MODE 2 (linespace-dda): every ray alone with a hierarchical 3D-DDA [AW87] and the
+//                              same line-space termination (Table 3).
+// The node containing the rays' common origin has no entry side, hence no line-space entry:
+// it is always descended and its leaves are tested exactly (not said in the thesis; without
+// it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it. The shadow value (fraction of unblocked rays) goes to
+// shadowTexture and, multiplied into the diffuse colour, back into the diffuse texture.
+// loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total — and it
+// runs 8 invocations as one SIMD vector whose loops iterate while any lane is active, so the
+// budget is spent by the vector, not by one pixel. Two guards: every loop iteration here is
+// counted and an invocation past LOOP_BUDGET stops; and after the work a sentinel loop of
+// loopSentinel (= 2, a uniform so that it is not unrolled) iterations must run completely —
+// if llvmpipe's limit was reached it ends after one. Either way the pixel is counted as
+// truncated. The host then renders the frame again with the pixel's rays split into batches
+// (rayBegin..rayEnd, one dispatch each, the lit counts summed in shadowTexture.g), halving
+// the batch until no pixel is truncated; a frame truncated with one ray per batch is refused.
+// A ray's result does not depend on the other rays of its packet, so batches give the same
+// image (ours; the thesis' GPU had no such limit).
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#define N NTREE_N
+#define COUNTER_SLOTS_PER_KERNEL 5
+#include "../common/counters.glsl"
+
+#define GEOMETRY_BIT 1u
+#define CHILDREN_BIT 2u
+#define LOOP_BUDGET 60000u
+#define INF uintBitsToFloat(0x7F800000u)
+
+layout(rgba32f, binding = IMAGE_GBUFFER_POSITION) uniform readonly image2D positionTexture;  // xyz, w: 1 = geometry
+layout(rgba32f, binding = IMAGE_GBUFFER_NORMAL) uniform readonly image2D normalTexture;    // xyz (facing the camera)
+layout(rgba32f, binding = IMAGE_GBUFFER_DIFFUSE) uniform image2D diffuseTexture;            // rgb diffuse colour
+layout(rgba32f, binding = IMAGE_SHADOW_VALUE) uniform image2D shadowTexture;   // r: shadow value, g: lit rays
+layout(r32ui, binding = IMAGE_LINESPACE) uniform readonly uimage3D linespaceTexture;  // Listing 3
+// The node pool (Fig. 8–9): texture buffer, red = flags | child group << 2, green = line space.
+layout(binding = SAMPLER_NODE_POOL) uniform usamplerBuffer nodePool;
+layout(std430, binding = SSBO_TRI_VERTEX) readonly buffer TriangleBuffer { vec4 triVertex[]; };
+layout(std430, binding = SSBO_LEAF_TRIANGLES) readonly buffer LeafTriangleBuffer { uint leafTriangles[]; };
+
+uniform vec3 minBound;       // ntree.minBound
+uniform float invNodeSize;   // ntree.invNodeSize (1 / edge of a child of the root)
+uniform vec3 lightCorner;
+uniform vec3 lightEdgeU;
+uniform vec3 lightEdgeV;
+uniform vec3 lightColor;
+uniform vec3 ambient;
+uniform float shadowOffset;
+uniform int tex_x_res;
+uniform int tex_y_res;
+uniform int ls_y_size;
+uniform ivec2 tileOffset;
+uniform int loopSentinel;
+uniform int rayBegin;        // this dispatch's rays: rayBegin <= r < rayEnd (0, NUM_RAYS: all)
+uniform int rayEnd;
+uniform bool accumulate;     // add to the lit count of the batches before
+uniform bool lastBatch;      // the last batch: write the shaded colour
+
+uint triangleTests = 0u;
+uint linespaceLookups = 0u;
+uint nodesVisited = 0u;
+uint truncated = 0u;
+uint packetFailures = 0u;
+uint loopIterations = 0u;
+
+// false once the invocation has used up its loop budget
+bool loopStep()
+{
+    loopIterations++;
+    if (loopIterations > LOOP_BUDGET) { truncated = 1u; return false; }
+    return true;
+}
+
+struct Stack
+{
+    uvec2 parent_node;
+    uvec2 nodelist[N * N];
+    ivec2 offset[N * N];
+    int nodelist_index;
+    bool traverse_chilids;
+    int current_slice;
+    int last_slice;
+    float u_min, u_max, v_min, v_max;
+} stack[NUM_MAX_DEPTH];
+
+struct Shaft {
+    vec3 origin;
+    vec3 destination;
+    vec3 corner_dir[4];
+    bool active_rays[NUM_RAYS];
+    vec3 ray_start[NUM_MAX_DEPTH + 1];
+    vec3 ray_direction[NUM_RAYS];
+} shaft;
+
+int active_rays = 0;    // the number of active rays
+vec3 originWorld = vec3(0.0); // the shadow rays' common origin in world space
+int k = 0, u = 1, v = 2, dir = 1; // traversal axis, the other two, direction along k (+1 / -1)
+
+vec3 samplePoint(int r)
+{
+    int i = r / SAMPLES_V;
+    int j = r - i * SAMPLES_V;
+    return lightCorner + (float(i) + 0.5) / float(SAMPLES_U) * lightEdgeU
+                       + (float(j) + 0.5) / float(SAMPLES_V) * lightEdgeV;
+}
+
+// Algorithm 1 (preparation, first part): the shadow rays of one surface point from the offset
+// origin to the light samples, and the shaft, in the N-tree coordinate system. Sets
+// active_rays to the number of samples in front of the surface. (Before every function that
+// reads the shaft, so the compiler sees it written first.)
+void initShaft(vec3 pos, vec3 normal)
+{
+    originWorld = pos + normal * shadowOffset;
+    active_rays = 0;
+    for (int r = 0; r < NUM_RAYS; r++) {
+        // samples behind the surface are blocked by it (N·L <= 0)
+        vec3 l = samplePoint(r);
+        shaft.active_rays[r] = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
+        if (shaft.active_rays[r]) active_rays++;
+        shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
+    }
+    // initialise the shaft: transform into the N-tree coordinate system
+    shaft.origin = (originWorld - minBound) * invNodeSize;
+    vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
+    shaft.destination = (centre - minBound) * invNodeSize;
+    shaft.ray_start[0] = shaft.origin;
+}
+
+uvec2 fetchNode(uint group, ivec3 c)
+{
+    nodesVisited++;
+    return texelFetch(nodePool, int(group) * N * N * N + c.x + N * (c.y + N * c.z)).rg;
+}
+
+// t of the light sample in the coordinates of a node at `level` (1 in the root's)
+float tEnd(int level)
+{
+    float n = float(N);
+    return level == 0 ? 1.0 : (level == 1 ? n : (level == 2 ? n * n : n * n * n));
+}
+
+// the two axes of a side's cells
+ivec2 faceAxes(int axis) { return axis == 0 ? ivec2(1, 2) : (axis == 1 ? ivec2(0, 2) : ivec2(0, 1)); }
+
+// one slab of Kay–Kajiya: false when the ray runs parallel outside it
+bool slab(int a, vec3 startPoint, vec3 direction, inout float tnear, inout float tfar,
+          inout int nearAxis, inout int farAxis)
+{
+    float fN = float(N);
+    if (direction[a] == 0.0) return !(startPoint[a] < 0.0 || startPoint[a] > fN);
+    float inv = 1.0 / direction[a];
+    float t0 = (0.0 - startPoint[a]) * inv;
+    float t1 = (fN - startPoint[a]) * inv;
+    if (t0 > t1) { float tmp = t0; t0 = t1; t1 = tmp; }
+    if (t0 > tnear) { tnear = t0; nearAxis = a; }
+    if (t1 < tfar) { tfar = t1; farAxis = a; }
+    return true;
+}
+
+// Algorithm 3: isNodeIntersection — Kay–Kajiya on the node [0, N]^3. Sides are numbered
+// 2·axis + (0 at coordinate 0, 1 at N) (the thesis: ±1, ±2, ±3).
+bool isNodeIntersection(vec3 startPoint, vec3 direction, float t_end,
+                        out int startFace, out ivec2 startDim, out int endFace, out ivec2 endDim)
+{
+    float fN = float(N);
+    float tnear = -INF, tfar = INF;
+    int nearAxis = 0, farAxis = 0;
+    startFace = 0; endFace = 0; startDim = ivec2(0); endDim = ivec2(0);
+    // the three slabs, written out (no loop: see loopLimit)
+    if (!slab(0, startPoint, direction, tnear, tfar, nearAxis, farAxis)) return false;
+    if (!slab(1, startPoint, direction, tnear, tfar, nearAxis, farAxis)) return false;
+    if (!slab(2, startPoint, direction, tnear, tfar, nearAxis, farAxis)) return false;
+    if (tnear > tfar || tfar < 0.0 || tnear > t_end) return false;
+    vec3 startVec = startPoint + tnear * direction;
+    vec3 endVec = startPoint + tfar * direction;
+    startFace = 2 * nearAxis + (direction[nearAxis] > 0.0 ? 0 : 1);
+    endFace = 2 * farAxis + (direction[farAxis] > 0.0 ? 1 : 0);
+    ivec2 sa = faceAxes(nearAxis), ea = faceAxes(farAxis);
+    startDim = clamp(ivec2(floor(vec2(startVec[sa.x], startVec[sa.y]))), ivec2(0), ivec2(N - 1));
+    endDim = clamp(ivec2(floor(vec2(endVec[ea.x], endVec[ea.y]))), ivec2(0), ivec2(N - 1));
+    return true;
+}
+
+// Ours: a node whose box, grown by NEAR_MARGIN child cells, holds the rays' origin is
+// descended instead of asking its line space (rays starting just beside a node boundary would
+// otherwise enter the neighbour through the side cell next to their own surface, whose shaft
+// holds that surface: thin dark lines along every node boundary).
+#define NEAR_MARGIN 1.0
+bool nearOrigin(vec3 childStart)
+{
+    return all(greaterThanEqual(childStart, vec3(-NEAR_MARGIN))) && all(lessThanEqual(childStart, vec3(float(N) + NEAR_MARGIN)));
+}
+
+// Algorithm 4 and Listing 3: getEntry — the bit of the shaft between two boundary cells.
+// Symmetric entries are stored once (sides s < e); two cells of one side have no shaft:
+// true, conservatively (only a grazing ray gets there).
+bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endDim)
+{
+    if (startFace == endFace) return true;
+    int s = startFace, e = endFace;
+    int cs = startDim.x + N * startDim.y, ce = endDim.x + N * endDim.y;
+    if (s > e) { int t = s; s = e; e = t; t = cs; cs = ce; ce = t; }
+    int pair = s * (11 - s) / 2 + (e - s - 1);
+    int entry_num = pair * N * N * N * N + cs * N * N + ce;
+    linespaceLookups++;
+    uint ls_index = node.g;
+
+    /* x-position in the linespace */
+    int entry_num_compressed = entry_num / 32;
+    int bit_position = entry_num - 32 * entry_num_compressed;
+
+    /* y-position in the linespace */
+    int y_position = (int(ls_index) * ls_y_size) + entry_num_compressed / tex_x_res;
+
+    /* coordinates in the linespace_buffer */
+    int y_coord = y_position % tex_y_res;
+    int x_coord = entry_num_compressed % tex_x_res;
+    int z_coord = y_position / tex_y_res;
+
+    uint entry = imageLoad(linespaceTexture, ivec3(x_coord, y_coord, z_coord)).r;
+    return ((entry >> uint(bit_position)) & 1u) != 0u;
+}
+
+// Algorithm 2, one ray: true if the ray crosses the node and its line-space bit is set; at
+// the last depth with line spaces (deactivate) the ray is then deactivated.
+bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
+{
+    if (r >= rayEnd || !shaft.active_rays[r]) return false;
+    int sf, ef;
+    ivec2 sd, ed;
+    if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
+    if (!getEntry(node, sf, sd, ef, ed)) return false;
+    if (deactivate) {
+        shaft.active_rays[r] = false;
+        active_rays--;
+    }
+    return true;
+}
+
+// Algorithm 2: isIntersection. deactivate: at the last depth with line spaces a set bit is a
+// hit and deactivates the ray; elsewhere the first set bit returns true (descend). Four rays
+// per loop iteration (see loopLimit).
+bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
+{
+    bool found_intersection = false;
+    float te = tEnd(level);
+    for (int r = rayBegin; r < rayEnd; r += 4) {
+        if (!loopStep()) return false;
+        bool f0 = lineSpaceRay(r, node, childStart, te, deactivate);
+        if (f0 && !deactivate) return true;
+        bool f1 = lineSpaceRay(r + 1, node, childStart, te, deactivate);
+        if (f1 && !deactivate) return true;
+        bool f2 = lineSpaceRay(r + 2, node, childStart, te, deactivate);
+        if (f2 && !deactivate) return true;
+        bool f3 = lineSpaceRay(r + 3, node, childStart, te, deactivate);
+        if (f3 && !deactivate) return true;
+        found_intersection = found_intersection || f0 || f1 || f2 || f3;
+    }
+    return found_intersection;
+}
+
+// Algorithm 1 of Müller 2015 (Möller–Trumbore), hit for 0 < t < 1 (up to the light sample).
+bool occludes(uint t, vec3 ro, vec3 rd)
+{
+    triangleTests++;
+    vec3 v0 = triVertex[3u * t].xyz, v1 = triVertex[3u * t + 1u].xyz, v2 = triVertex[3u * t + 2u].xyz;
+    vec3 edge1 = v1 - v0;
+    vec3 edge2 = v2 - v0;
+    vec3 pvec = cross(rd, edge2);
+    float det = dot(edge1, pvec);
+    float invDet = 1.0 / det;
+    vec3 tvec = ro - v0;
+    float uu = invDet * dot(tvec, pvec);
+    vec3 qvec = cross(tvec, edge1);
+    float vv = invDet * dot(rd, qvec);
+    float tt = invDet * dot(edge2, qvec);
+    return uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < 1.0;
+}
+
+// the exact triangle tests of a leaf for ray r, four triangles per loop iteration
+void leafRay(int r, uvec2 node, vec3 childStart, float te)
+{
+    if (r >= rayEnd || !shaft.active_rays[r]) return;
+    int sf, ef;
+    ivec2 sd, ed;
+    if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return;
+    vec3 rd = samplePoint(r) - originWorld;
+    uint off = node.r >> 2;
+    uint count = node.g;
+    for (uint i = 0u; i < count; i += 4u) {
+        if (!loopStep()) return;
+        if (occludes(leafTriangles[off + i], originWorld, rd)
+            || (i + 1u < count && occludes(leafTriangles[off + i + 1u], originWorld, rd))
+            || (i + 2u < count && occludes(leafTriangles[off + i + 2u], originWorld, rd))
+            || (i + 3u < count && occludes(leafTriangles[off + i + 3u], originWorld, rd))) {
+            shaft.active_rays[r] = false;
+            active_rays--;
+            return;
+        }
+    }
+}
+
+// the exact triangle tests of a leaf for every active ray crossing it, four rays per loop
+// iteration (see loopLimit)
+void leafTests(uvec2 node, vec3 childStart, int level)
+{
+    float te = tEnd(level);
+    for (int r = rayBegin; r < rayEnd; r += 4) {
+        if (!loopStep()) return;
+        leafRay(r, node, childStart, te);
+        leafRay(r + 1, node, childStart, te);
+        leafRay(r + 2, node, childStart, te);
+        leafRay(r + 3, node, childStart, te);
+    }
+}
+
+// the slices [first, last] the packet crosses in a node at stack depth d
+bool sliceRange(int d, out int first, out int last)
+{
+    float fN = float(N);
+    float ko = shaft.ray_start[d][k];
+    float te = tEnd(d);
+    first = 0; last = 0;
+    if (dir > 0) {
+        float kfar = -INF;
+        for (int c = 0; c < 4; c++) kfar = max(kfar, ko + shaft.corner_dir[c][k] * te);
+        kfar = min(kfar, fN);
+        float knear = max(ko, 0.0);
+        if (knear >= fN || kfar <= 0.0 || knear > kfar) return false;
+        first = clamp(int(floor(knear)), 0, N - 1);
+        last = max(clamp(int(ceil(kfar)) - 1, 0, N - 1), first);
+    } else {
+        float kfar = INF;
+        for (int c = 0; c < 4; c++) kfar = min(kfar, ko + shaft.corner_dir[c][k] * te);
+        kfar = max(kfar, 0.0);
+        float knear = min(ko, fN);
+        if (knear <= 0.0 || kfar >= fN || knear < kfar) return false;
+        first = clamp(int(ceil(knear)) - 1, 0, N - 1);
+        last = min(clamp(int(floor(kfar)), 0, N - 1), first);
+    }
+    return true;
+}
+
+// u_min/u_max/v_min/v_max of the packet in slice j at depth d (Fig. 10(b)–(c)): the corner
+// rays where they enter and leave the slice (the thesis adds the constant delta_uv per slice;
+// computing it from the slice's bounds gives the same range)
+void sliceUV(int d, int j)
+{
+    float ko = shaft.ray_start[d][k];
+    float te = tEnd(d);
+    float a = float(j), b = float(j) + 1.0;
+    stack[d].u_min = INF; stack[d].u_max = -INF;
+    stack[d].v_min = INF; stack[d].v_max = -INF;
+    for (int c = 0; c < 4; c++) {
+        vec3 cd = shaft.corner_dir[c];
+        float kend = ko + cd[k] * te;
+        float lo = dir > 0 ? ko : kend, hi = dir > 0 ? kend : ko;
+        for (int q = 0; q < 2; q++) {
+            float kk = clamp(q == 0 ? a : b, lo, hi);
+            float lambda = (kk - ko) / cd[k];
+            float pu = shaft.ray_start[d][u] + lambda * cd[u];
+            float pv = shaft.ray_start[d][v] + lambda * cd[v];
+            stack[d].u_min = min(stack[d].u_min, pu);
+            stack[d].u_max = max(stack[d].u_max, pu);
+            stack[d].v_min = min(stack[d].v_min, pv);
+            stack[d].v_max = max(stack[d].v_max, pv);
+        }
+    }
+}
+
+bool initLevel(int d, uvec2 parent)
+{
+    int first, last;
+    if (!sliceRange(d, first, last)) return false;
+    stack[d].parent_node = parent;
+    stack[d].nodelist_index = 0;
+    stack[d].traverse_chilids = false;
+    stack[d].current_slice = first;
+    stack[d].last_slice = last;
+    return true;
+}
+
+// Algorithm 1 (continuation): returns the number of rays still active
+int traverse()
+{
+    float fN = float(N);
+    if (!initLevel(0, uvec2(GEOMETRY_BIT | CHILDREN_BIT, 0u))) return active_rays;
+    int depth = 0;
+    while (depth >= 0) {
+        if (!loopStep()) return active_rays;
+        bool next_depth = false;
+        int slice = stack[depth].current_slice;
+        for (;;) {
+            if (!loopStep()) return active_rays;
+            if (!stack[depth].traverse_chilids) {
+                sliceUV(depth, slice);
+                int cu0 = max(int(floor(stack[depth].u_min)), 0);
+                int cu1 = min(int(floor(stack[depth].u_max)), N - 1);
+                int cv0 = max(int(floor(stack[depth].v_min)), 0);
+                int cv1 = min(int(floor(stack[depth].v_max)), N - 1);
+                stack[depth].nodelist_index = 0;
+                for (int cu = cu0; cu <= cu1; cu++) {
+                    for (int cv = cv0; cv <= cv1; cv++) {
+                        if (!loopStep()) return active_rays;
+                        ivec3 c;
+                        c[k] = slice; c[u] = cu; c[v] = cv;
+                        uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
+                        if ((node.r & GEOMETRY_BIT) != 0u) {
+                            int i = stack[depth].nodelist_index++;
+                            stack[depth].nodelist[i] = node;
+                            stack[depth].offset[i] = ivec2(cu, cv);
+                        }
+                    }
+                }
+            }
+            while (stack[depth].nodelist_index > 0) {
+                if (!loopStep()) return active_rays;
+                int i = --stack[depth].nodelist_index;
+                uvec2 node = stack[depth].nodelist[i];
+                ivec3 uvk_offset;
+                uvk_offset[k] = slice; uvk_offset[u] = stack[depth].offset[i].x; uvk_offset[v] = stack[depth].offset[i].y;
+                // ray_start[depth + 1] = n × (ray_start[depth] − uvk_offset)
+                vec3 childStart = (shaft.ray_start[depth] - vec3(uvk_offset)) * fN;
+                if ((node.r & CHILDREN_BIT) == 0u) {
+                    leafTests(node, childStart, depth + 1);
+                } else {
+                    bool inside = nearOrigin(childStart);
+                    bool descend;
+                    if (inside) {
+                        descend = true;
+                    } else if (SHADOW_MODE == 1 && depth == LAST_LS_DEPTH) {
+                        isIntersection(node, childStart, depth + 1, true);
+                        descend = false;
+                    } else {
+                        descend = isIntersection(node, childStart, depth + 1, false);
+                    }
+                    if (descend && depth + 1 < NUM_MAX_DEPTH) {
+                        shaft.ray_start[depth + 1] = childStart;
+                        if (initLevel(depth + 1, node)) {
+                            stack[depth].traverse_chilids = true;
+                            stack[depth].current_slice = slice;
+                            next_depth = true;
+                        }
+                    }
+                }
+                if (active_rays == 0) return 0;
+                if (next_depth) break;
+            }
+            if (next_depth) break;
+            stack[depth].traverse_chilids = false;
+            if (slice == stack[depth].last_slice) break;
+            slice += dir;
+        }
+        // the thesis adds 2 and subtracts 1 at the end of the while loop
+        depth += next_depth ? 1 : -1;
+    }
+    return active_rays;
+}
+
+// Table 3's DDA: one ray with a hierarchical 3D-DDA and the same line-space termination.
+// True: blocked.
+struct Dda { uint group; vec3 start; ivec3 cell; vec3 t_max; float t; float t_end; };
+Dda dstack[NUM_MAX_DEPTH];
+
+bool ddaInit(int d, uint group, vec3 start, float t_end, vec3 direction)
+{
+    float fN = float(N);
+    bool inside = all(greaterThanEqual(start, vec3(0.0))) && all(lessThan(start, vec3(fN)));
+    float t0 = 0.0;
+    if (!inside) {
+        float tnear = 0.0, tfar = INF;
+        for (int a = 0; a < 3; a++) {
+            if (direction[a] == 0.0) {
+                if (start[a] < 0.0 || start[a] > fN) return false;
+                continue;
+            }
+            float ta = -start[a] / direction[a];
+            float tb = (fN - start[a]) / direction[a];
+            tnear = max(tnear, min(ta, tb));
+            tfar = min(tfar, max(ta, tb));
+        }
+        if (tnear > tfar || tnear > t_end) return false;
+        t0 = tnear;
+    }
+    vec3 p = start + t0 * direction;
+    ivec3 cell = clamp(ivec3(floor(p)), ivec3(0), ivec3(N - 1));
+    vec3 tm = vec3(INF);
+    for (int a = 0; a < 3; a++) {
+        if (direction[a] > 0.0) tm[a] = (float(cell[a]) + 1.0 - start[a]) / direction[a];
+        else if (direction[a] < 0.0) tm[a] = (float(cell[a]) - start[a]) / direction[a];
+    }
+    dstack[d].group = group; dstack[d].start = start; dstack[d].cell = cell;
+    dstack[d].t_max = tm; dstack[d].t = t0; dstack[d].t_end = t_end;
+    return true;
+}
+
+bool ddaBlocked(int r)
+{
+    float fN = float(N);
+    vec3 direction = shaft.ray_direction[r];
+    ivec3 stp = ivec3(direction.x > 0.0 ? 1 : -1, direction.y > 0.0 ? 1 : -1, direction.z > 0.0 ? 1 : -1);
+    vec3 t_delta = 1.0 / abs(direction);
+    if (!ddaInit(0, 0u, shaft.origin, 1.0, direction)) return false;
+    vec3 rd = samplePoint(r) - originWorld;
+    int depth = 0;
+    while (depth >= 0) {
+        if (!loopStep()) return false;
+        ivec3 cell = dstack[depth].cell;
+        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(N))) || dstack[depth].t > dstack[depth].t_end) {
+            depth--;
+            continue;
+        }
+        vec3 tm = dstack[depth].t_max;
+        int a = (tm.x <= tm.y && tm.x <= tm.z) ? 0 : (tm.y <= tm.z ? 1 : 2);
+        dstack[depth].t = tm[a];
+        dstack[depth].cell[a] += stp[a];
+        dstack[depth].t_max[a] += t_delta[a];
+        uvec2 node = fetchNode(dstack[depth].group, cell);
+        if ((node.r & GEOMETRY_BIT) == 0u) continue;
+        vec3 childStart = (dstack[depth].start - vec3(cell)) * fN;
+        float te = tEnd(depth + 1);
+        if ((node.r & CHILDREN_BIT) == 0u) {
+            uint off = node.r >> 2;
+            for (uint i = 0u; i < node.g; i++) {
+                if (!loopStep()) return false;
+                if (occludes(leafTriangles[off + i], originWorld, rd)) return true;
+            }
+            continue;
+        }
+        bool inside = nearOrigin(childStart);
+        bool descend = inside;
+        if (!inside) {
+            int sf, ef;
+            ivec2 sd, ed;
+            if (isNodeIntersection(childStart, direction, te, sf, sd, ef, ed) && getEntry(node, sf, sd, ef, ed)) {
+                if (depth == LAST_LS_DEPTH) return true;
+                descend = true;
+            }
+        }
+        if (descend && depth + 1 < NUM_MAX_DEPTH) {
+            if (ddaInit(depth + 1, node.r >> 2, childStart, te, direction)) depth++;
+        }
+    }
+    return false;
+}
+
+// Algorithm 1 (preparation): how many of this batch's shadow rays of one surface point reach
+// the light
+int litRays(vec3 pos, vec3 normal)
+{
+    initShaft(pos, normal);
+    if (active_rays == 0) return 0;
+    vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
+    if (SHADOW_MODE == 2) {
+        int lit = 0;
+        for (int r = rayBegin; r < rayEnd; r++) {
+            if (!loopStep()) break;
+            if (shaft.active_rays[r] && !ddaBlocked(r)) lit++;
+        }
+        return lit;
+    }
+    vec3 corners[4] = vec3[4](lightCorner, lightCorner + lightEdgeV, lightCorner + lightEdgeU,
+                              lightCorner + lightEdgeU + lightEdgeV);
+    for (int c = 0; c < 4; c++) shaft.corner_dir[c] = (corners[c] - originWorld) * invNodeSize;
+    // the traversal axis k: the dominant axis of the light vector, if all four corner rays go
+    // the same way along it; else the axis along which they do with the largest minimum
+    vec3 lv = abs(centre - originWorld);
+    int dominant = (lv.x >= lv.y && lv.x >= lv.z) ? 0 : (lv.y >= lv.z ? 1 : 2);
+    k = -1;
+    float best = -1.0;
+    for (int a = 0; a < 3; a++) {
+        bool allPos = true, allNeg = true;
+        float m = INF;
+        for (int c = 0; c < 4; c++) {
+            allPos = allPos && shaft.corner_dir[c][a] > 0.0;
+            allNeg = allNeg && shaft.corner_dir[c][a] < 0.0;
+            m = min(m, abs(shaft.corner_dir[c][a]));
+        }
+        if (!(allPos || allNeg)) continue;
+        if (a == dominant) { k = a; break; }
+        if (m > best) { best = m; k = a; }
+    }
+    if (k < 0) {
+        if (rayBegin == 0) packetFailures++;
+        return rayEnd - rayBegin;
+    }
+    ivec2 uvAxes = faceAxes(k);
+    u = uvAxes.x; v = uvAxes.y;
+    dir = shaft.corner_dir[0][k] > 0.0 ? 1 : -1;
+    return traverse();
+}
+
+// false if the GL implementation's loop limit ended loops early (see loopLimit above)
+bool loopsComplete()
+{
+    int c = 0;
+    for (int i = 0; i < loopSentinel; i++) c++;
+    return c == loopSentinel;
+}
+
+void main()
+{
+    countersBegin();
+    ivec2 storePos = ivec2(gl_GlobalInvocationID.xy) + tileOffset;
+    if (all(lessThan(storePos, imageSize(positionTexture)))) {
+        vec4 pos = imageLoad(positionTexture, storePos);
+        if (pos.w > 0.0) {
+            vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
+            float lit = float(litRays(pos.xyz, n));
+            if (!loopsComplete()) truncated = 1u;
+            if (accumulate) lit += imageLoad(shadowTexture, storePos).g;
+            float s = lit / float(NUM_RAYS);
+            imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
+            if (lastBatch) {
+                // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
+                vec4 diffuse = imageLoad(diffuseTexture, storePos);
+                vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
+                vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
+                imageStore(diffuseTexture, storePos, vec4(c, 1.0));
+            }
+        } else {
+            imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 1.0));
+        }
+    }
+    countAdd(0, triangleTests);
+    countAdd(1, linespaceLookups);
+    countAdd(2, nodesVisited);
+    countAdd(3, truncated);
+    countAdd(4, packetFailures);
+    countersEnd(0, COUNTER_TRIANGLE_TESTS);
+    countersEnd(1, COUNTER_LINESPACE_LOOKUPS);
+    countersEnd(2, COUNTER_NODES_VISITED);
+    countersEnd(3, COUNTER_TRUNCATED);
+    countersEnd(4, COUNTER_PACKET_FAILURES);
+}

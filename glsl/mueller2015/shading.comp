@@ -1,0 +1,68 @@
+// shading kernel — Müller 2015, ch. 3.1.1 and 4.1.3, Listing 16.
+// One invocation per pixel. The shadow flags say which lights reach the hit point; for those
+// the Phong model (diffuse + specular, with the ambient light) lights the colour of
+// colorBuffer. The lit colour is added to the output texture with the weights of Listing 16:
+//     final = weight * final + (1 - weight) * temp;   final.w = weight + (1 - weight) * pColor.w
+// A ray that missed (rayState 0, colour buffer not empty) adds the background the same way.
+// Finally the rayState is decremented.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#define SCENE_QUALIFIER readonly
+#include "../common/scene.glsl"
+#include "../common/images.glsl"
+
+uniform vec4 camPosition;
+uniform vec4 ambientColor;
+uniform int lightCount;
+
+bool inShadow(ivec2 storePos, int l)
+{
+#if SHADOW_BITS
+    uvec4 flags = imageLoad(shadowTexture, storePos);
+    return (flags[l >> 5] & (1u << uint(l & 31))) != 0u;
+#else
+    return imageLoad(shadowTexture, storePos)[l] > 0.5;
+#endif
+}
+
+void main()
+{
+    ivec2 storePos = pixelPosition();
+    if (!insideImage(storePos)) return;
+    vec4 pColor = imageLoad(colorBufferTexture, storePos);
+    // empty colour buffer (weight -1): the ray was inactive in this pass
+    if (pColor.w < 0.0) return;
+    vec4 originState = imageLoad(rayOriginTexture, storePos);
+    float rayState = originState.w;
+
+    vec3 temp_color;
+    if (rayState > 0.0) {
+        vec3 p = originState.xyz;
+        vec3 n = imageLoad(normalTexture, storePos).xyz;
+        int triID = int(imageLoad(rayDirTexture, storePos).w);
+        vec4 mat = material[triMaterial[triID]];
+        vec3 view = normalize(camPosition.xyz - p);
+        temp_color = ambientColor.rgb * pColor.rgb;
+        for (int l = 0; l < lightCount; l++) {
+            if (inShadow(storePos, l)) continue;
+            vec3 L = normalize(lightPos[l].xyz - p);
+            float diffuse = max(dot(n, L), 0.0);
+            vec3 R = reflect(-L, n);
+            float specular = mat.y * pow(max(dot(R, view), 0.0), mat.z);
+            temp_color += lightColor[l].rgb * (diffuse * pColor.rgb + vec3(specular));
+        }
+    } else {
+        // the ray left the scene in this pass: the background colour
+        temp_color = pColor.rgb;
+    }
+
+    // Listing 16: weighted addition of the colour to the output colour
+    vec4 final_color = imageLoad(finalTexture, storePos);
+    float weight = final_color.w;
+    final_color.rgb = weight * final_color.rgb + (1.0 - weight) * temp_color;
+    final_color.w = weight + (1.0 - weight) * pColor.w;
+    imageStore(finalTexture, storePos, final_color);
+
+    if (rayState > 0.0)
+        imageStore(rayOriginTexture, storePos, vec4(originState.xyz, rayState - 1.0));
+}

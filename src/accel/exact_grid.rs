@@ -1,0 +1,227 @@
+//! The exact uniform grid — ours, after Müller 2015 ch. 3.2 and 4.2, rebuilt on the GPU every
+//! frame: triangle/box overlap registration, compact lists built by a count pass, a prefix sum
+//! and a fill pass, and a 3D-DDA inside the intersection kernels that ends only at a hit inside
+//! the current voxel (`glsl/exact_grid/`). Its image equals the base tracer's. CPU twin:
+//! `reference::exact_grid`.
+
+use std::any::Any;
+use std::sync::Arc;
+
+use anyhow::Result;
+use serde_json::json;
+
+use super::grid_frame::{lists_of, resolution, GridFrame};
+use super::TracerKind;
+use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
+use crate::frame::FrameStats;
+use crate::gl::resources::Ssbo;
+use crate::gl::slots::ssbo;
+use crate::gl::{Gl, Kernel};
+use crate::reference::{self, grid::GridMapping, CpuAccelerator};
+use crate::scene::Scene;
+
+/// Largest resolution: the prefix sum handles 2048 blocks of 1024 voxels.
+pub const MAX_RESOLUTION: u32 = 128;
+
+pub const ENTRY: Entry = Entry {
+    tracer: TracerKind::Grid,
+    grid_variant: Some(GridVariant::Exact),
+    label: "grid-exact",
+    gpu: ExactGrid::create,
+    cpu: |scene, options, _| -> Result<Box<dyn CpuAccelerator>> {
+        let n = resolution(scene, options, MAX_RESOLUTION)?;
+        Ok(Box::new(reference::exact_grid::ExactGrid::new(
+            scene.world_triangles(),
+            n,
+            GridMapping::of_scene(scene),
+        )))
+    },
+};
+
+/// The compact lists: voxelCount (references per voxel), voxelStart (their prefix sum),
+/// voxelFill (the fill pass's cursor), blockSums and gridTotal (the prefix sum's), voxelTris
+/// (the references, grown to the count of every build).
+struct Lists {
+    voxel_count: Ssbo,
+    voxel_start: Ssbo,
+    voxel_fill: Ssbo,
+    block_sums: Ssbo,
+    grid_total: Ssbo,
+    voxel_tris: Ssbo,
+}
+
+impl Lists {
+    fn all(&self) -> [(&Ssbo, u32); 6] {
+        [
+            (&self.voxel_count, ssbo::VOXEL_COUNT),
+            (&self.voxel_start, ssbo::VOXEL_START),
+            (&self.voxel_fill, ssbo::VOXEL_FILL),
+            (&self.block_sums, ssbo::BLOCK_SUMS),
+            (&self.grid_total, ssbo::GRID_TOTAL),
+            (&self.voxel_tris, ssbo::VOXEL_TRIS),
+        ]
+    }
+
+    fn bind(&self, gl: &Gl) {
+        for (b, slot) in self.all() {
+            b.bind(gl, slot);
+        }
+    }
+}
+
+pub struct ExactGrid {
+    gl: Arc<Gl>,
+    frame: GridFrame,
+    triangles: usize,
+    count: Kernel,
+    scan: Kernel,
+    fill: Kernel,
+    intersect1: Kernel,
+    intersect2: Kernel,
+    lists: Lists,
+    max_ssbo: i64,
+    /// triangle references of the last build
+    refs: u64,
+}
+
+impl ExactGrid {
+    fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        let frame = GridFrame::new(scene, resolution(scene, o, MAX_RESOLUTION)?);
+        let n3 = frame.voxels();
+        let defs = [frame.define()];
+        let max_ssbo = b.info.max_ssbo_block_size;
+        let ssbo = |name, bytes| Ssbo::new(b.gl, name, bytes, None, max_ssbo);
+        let lists = Lists {
+            voxel_count: ssbo("voxelCount", 4 * n3)?,
+            voxel_start: ssbo("voxelStart", 4 * n3)?,
+            voxel_fill: ssbo("voxelFill", 4 * n3)?,
+            block_sums: ssbo("blockSums", 4 * n3.div_ceil(1024))?,
+            grid_total: ssbo("gridTotal", 16)?,
+            // grown to the number of references on the first build
+            voxel_tris: ssbo("voxelTris", 4 * scene.triangle_count())?,
+        };
+        Ok(Box::new(ExactGrid {
+            gl: b.gl.clone(),
+            triangles: scene.triangle_count(),
+            count: b.kernel("exact_grid/count.comp", &defs, "grid_count")?,
+            scan: b.kernel("exact_grid/scan.comp", &defs, "grid_scan")?,
+            fill: b.kernel("exact_grid/fill.comp", &defs, "grid_fill")?,
+            intersect1: b.kernel("exact_grid/intersect1.comp", &defs, "intersect1")?,
+            intersect2: b.kernel("exact_grid/intersect2.comp", &defs, "intersect2")?,
+            lists,
+            max_ssbo,
+            refs: 0,
+            frame,
+        }))
+    }
+
+    /// The prefix sum over the voxel counts, in three phases (block sums, their sum, offsets).
+    fn scan(&self, f: &mut FrameContext) {
+        let n3 = self.frame.voxels() as u32;
+        let blocks = n3.div_ceil(1024);
+        let k = &self.scan;
+        k.use_program();
+        k.set_i32("voxelTotal", n3 as i32);
+        k.set_i32("blockCount", blocks as i32);
+        for (phase, groups) in [(0, blocks), (1, 1), (2, blocks)] {
+            k.set_i32("scanPhase", phase);
+            k.dispatch_1d(f.timers, groups);
+        }
+    }
+
+    /// Make room for `total` references (half again as many, so a moving scene rarely
+    /// reallocates).
+    fn reserve(&mut self, total: usize) -> Result<()> {
+        if 4 * total > self.lists.voxel_tris.bytes {
+            let bytes = (4 * total + 4 * total / 2).max(16);
+            self.lists.voxel_tris.delete(&self.gl);
+            self.lists.voxel_tris = Ssbo::new(&self.gl, "voxelTris", bytes, None, self.max_ssbo)?;
+        }
+        Ok(())
+    }
+
+    /// The voxel lists of the last build read back (triangle ids in storage order) and the
+    /// mapping used. For tests and inspection.
+    pub fn read_lists(&self, gl: &Gl) -> (Vec<Vec<i32>>, GridMapping) {
+        let count = self.lists.voxel_count.read_u32(gl);
+        let start = self.lists.voxel_start.read_u32(gl);
+        let tris = self.lists.voxel_tris.read_u32(gl);
+        let lists = lists_of(self.frame.voxels(), &tris, |v| {
+            (start[v] as usize, count[v] as usize)
+        });
+        (lists, self.frame.mapping)
+    }
+
+    pub fn resolution(&self) -> u32 {
+        self.frame.n
+    }
+}
+
+impl Accelerator for ExactGrid {
+    fn build(&mut self, f: &mut FrameContext) -> Result<()> {
+        self.frame.update(f.models);
+        let tri_groups = (self.triangles as u32).div_ceil(128);
+        let (gl, l) = (f.gl, &self.lists);
+        f.timers.time(gl, "grid_clear", || {
+            l.voxel_count.clear_u32(gl, 0);
+            l.voxel_fill.clear_u32(gl, 0);
+        });
+        self.lists.bind(gl);
+        self.count.use_program();
+        self.frame.set_uniforms(&self.count);
+        self.count.dispatch_1d(f.timers, tri_groups);
+        self.scan(f);
+        // the number of references sizes the compact lists
+        let total = self.lists.grid_total.read_u32(gl)[0] as usize;
+        self.refs = total as u64;
+        self.reserve(total)?;
+        self.lists.voxel_tris.bind(gl, ssbo::VOXEL_TRIS);
+        self.fill.use_program();
+        self.frame.set_uniforms(&self.fill);
+        self.fill.dispatch_1d(f.timers, tri_groups);
+        Ok(())
+    }
+
+    fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
+        self.lists.bind(f.gl);
+        self.intersect1.use_program();
+        self.frame.set_uniforms(&self.intersect1);
+        &self.intersect1
+    }
+
+    fn any_hit(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+        self.lists.bind(f.gl);
+        self.intersect2.use_program();
+        self.frame.set_uniforms(&self.intersect2);
+        &self.intersect2
+    }
+
+    fn stats(&self, stats: &mut FrameStats) {
+        let build: f64 = ["grid_clear", "grid_count", "grid_scan", "grid_fill"]
+            .iter()
+            .filter_map(|k| stats.gpu_ms.get(*k))
+            .sum();
+        let bytes: usize = self.lists.all().iter().map(|(b, _)| b.bytes).sum();
+        let f = &mut stats.facts;
+        f.insert("grid_resolution".into(), json!(self.frame.n));
+        f.insert("grid_bytes".into(), json!(bytes));
+        f.insert("grid_build_ms".into(), json!(build));
+        f.insert("grid_variant".into(), json!("exact"));
+        f.insert("grid_triangle_refs".into(), json!(self.refs));
+        // the exact grid loses nothing
+        stats.events.insert("dropped_triangle_refs".into(), 0);
+        stats.events.insert("ray_list_overflows".into(), 0);
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl Drop for ExactGrid {
+    fn drop(&mut self) {
+        for (b, _) in self.lists.all() {
+            b.delete(&self.gl);
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! The acceleration structures of Müller 2015's four-kernel pipeline, one type each, with a
+//! GPU side here and a CPU twin in [`crate::reference`]:
+//!
+//! | `--tracer` | GPU side | GLSL | CPU twin |
+//! |---|---|---|---|
+//! | `base` | [`brute_force::BruteForce`] | `glsl/brute_force/` | `reference::brute_force` |
+//! | `grid --grid-variant thesis` | [`thesis_grid::ThesisGrid`] | `glsl/thesis_grid/` | `reference::thesis_grid` |
+//! | `grid --grid-variant exact` | [`exact_grid::ExactGrid`] | `glsl/exact_grid/` | `reference::exact_grid` |
+//!
+//! An accelerator answers the pipeline's two questions — the closest hit of every ray
+//! (intersect1) and whether a shadow feeler is blocked (intersect2) — and may rebuild itself
+//! every frame from the freshly transformed scene. In the GLSL, its intersect1 kernel defines
+//! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
+//! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). [`REGISTRY`] lists
+//! every accelerator once.
+
+pub mod brute_force;
+pub mod exact_grid;
+pub mod grid_frame;
+pub mod thesis_grid;
+
+use std::any::Any;
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
+use glam::Mat4;
+use serde::Serialize;
+
+use crate::frame::FrameStats;
+use crate::gl::resources::GpuTimers;
+use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+use crate::reference::CpuAccelerator;
+use crate::scene::Scene;
+
+/// The GPU side of an accelerator.
+pub trait Accelerator {
+    /// Rebuild from the freshly transformed scene, before the eye rays (the grids: every
+    /// frame, Fig. 15; brute force: nothing).
+    fn build(&mut self, f: &mut FrameContext) -> Result<()>;
+    /// Prepare intersect1 of reflection pass `pass` (0: primary rays): run any kernel that
+    /// must come first, bind the design's buffers, put its intersect1 kernel in use with the
+    /// design's uniforms set, and return it. The pipeline sets the shared uniforms and
+    /// dispatches it over the image.
+    fn closest_hit(&mut self, f: &mut FrameContext, pass: u32) -> &Kernel;
+    /// The same for intersect2, the shadow feelers towards light `light` (any hit).
+    fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel;
+    /// Add the design's facts (sizes, build time, settings) and events to the statistics.
+    fn stats(&self, stats: &mut FrameStats);
+    /// For tests and inspection: the concrete type.
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// What an accelerator gets from the pipeline during a frame.
+pub struct FrameContext<'a> {
+    pub gl: &'a Arc<Gl>,
+    pub timers: &'a mut GpuTimers,
+    /// The image and its tiling, for per-pixel kernels.
+    pub pixels: PixelGrid,
+    /// The model matrix of every object this frame.
+    pub models: &'a [Mat4],
+}
+
+/// What an accelerator gets when it is made: the GL context, the kernels' sources and the
+/// pipeline's `#define`s, the image size.
+pub struct BuildContext<'a> {
+    pub gl: &'a Arc<Gl>,
+    pub info: &'a GlInfo,
+    pub shaders: &'a ShaderSource,
+    /// The `#define`s every kernel of the pipeline gets (counters, shadow flags, offset).
+    pub defines: &'a Defines,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl BuildContext<'_> {
+    /// Compile one of the accelerator's compute kernels with the pipeline's defines plus
+    /// `extra`, timed under `timer`.
+    pub fn kernel(
+        &self,
+        file: &str,
+        extra: &[(&str, String)],
+        timer: &'static str,
+    ) -> Result<Kernel> {
+        let mut d = self.defines.clone();
+        for (k, v) in extra {
+            d = d.set(k, v);
+        }
+        Kernel::compute(self.gl, self.shaders, file, &d, timer)
+    }
+}
+
+/// The `--tracer` choices of the four-kernel pipeline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TracerKind {
+    /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
+    Base,
+    /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
+    Grid,
+}
+
+/// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum GridVariant {
+    /// Faithful: triangles registered along their edges into fixed-size voxel lists, per-ray
+    /// voxel lists from the traversal kernel (Listings 17–22).
+    Thesis,
+    /// Exact: triangle/box overlap, compact lists (count, prefix sum, fill), 3D-DDA in the
+    /// intersection kernels.
+    #[default]
+    Exact,
+}
+
+/// Options of the accelerators (today: the grids').
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GridOptions {
+    pub variant: GridVariant,
+    /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
+    pub resolution: Option<u32>,
+    /// The thesis variant's fixed list lengths: voxel_array_length (triangle ids per voxel,
+    /// Listing 17: 512) and ray_array_length (voxel ids per ray; `None`: 3·N as Listing 17).
+    pub voxel_array_length: u32,
+    pub ray_array_length: Option<u32>,
+}
+
+impl Default for GridOptions {
+    fn default() -> Self {
+        GridOptions {
+            variant: GridVariant::Exact,
+            resolution: None,
+            voxel_array_length: 512,
+            ray_array_length: None,
+        }
+    }
+}
+
+/// `--grid auto`: N = cbrt(T / 5), i.e. about five triangles per voxel if the triangles filled
+/// the box evenly, within 4..=64. It gives 24 for the 69451-triangle bunny, the resolution the
+/// thesis found fastest (ch. 5.3).
+pub fn auto_resolution(triangles: usize) -> u32 {
+    ((triangles as f64 / 5.0).cbrt().round() as u32).clamp(4, 64)
+}
+
+/// One accelerator: how the command line names it, and how its GPU side and CPU twin are made.
+pub struct Entry {
+    /// The `--tracer` value.
+    pub tracer: TracerKind,
+    /// The `--grid-variant` it answers to (`None`: any; the option is then ignored).
+    pub grid_variant: Option<GridVariant>,
+    /// A name for reports: "base", "grid-thesis", "grid-exact".
+    pub label: &'static str,
+    pub gpu: fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>,
+    /// The CPU twin over the scene as loaded.
+    pub cpu: fn(&Scene, &GridOptions, (u32, u32)) -> Result<Box<dyn CpuAccelerator>>,
+}
+
+/// Every accelerator of the four-kernel pipeline.
+pub const REGISTRY: &[Entry] = &[brute_force::ENTRY, thesis_grid::ENTRY, exact_grid::ENTRY];
+
+/// The accelerator `--tracer tracer` with `options` selects.
+pub fn entry(tracer: TracerKind, options: &GridOptions) -> Result<&'static Entry> {
+    REGISTRY
+        .iter()
+        .find(|e| e.tracer == tracer && e.grid_variant.is_none_or(|v| v == options.variant))
+        .ok_or_else(|| anyhow!("no accelerator for --tracer {tracer:?} with {options:?}"))
+}

@@ -1,0 +1,204 @@
+//! The thesis' uniform grid (Müller 2015, ch. 2.1.1, 3.2, 4.2), rebuilt on the GPU every frame
+//! so that scenes may move — faithful: the build kernel registers each triangle along its
+//! edges into fixed-size voxel lists (`voxelslist`, `voxelcontains`, cleared with
+//! glClearBufferData), the traversal kernel writes each ray's non-empty voxels into
+//! `rayslist`/`raycontains`, and the intersection kernels walk those lists (Listings 17–22,
+//! Algorithms 2–3; `glsl/thesis_grid/`). What it loses is counted: `dropped_triangle_refs` (a
+//! voxel list was full), `ray_list_overflows` (a ray list was full); what it cannot see
+//! (triangle interiors away from the edges) shows in the image. CPU twin:
+//! `reference::thesis_grid`.
+
+use std::any::Any;
+use std::sync::Arc;
+
+use anyhow::{bail, Result};
+use serde_json::json;
+
+use super::grid_frame::{lists_of, resolution, GridFrame};
+use super::TracerKind;
+use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
+use crate::frame::FrameStats;
+use crate::gl::resources::Ssbo;
+use crate::gl::slots::ssbo;
+use crate::gl::{Gl, Kernel};
+use crate::reference::{self, grid::GridMapping, CpuAccelerator};
+use crate::scene::Scene;
+
+/// Largest resolution: the per-ray lists sort up to 3N crossings with BubbleSort (and
+/// llvmpipe's loop limit).
+pub const MAX_RESOLUTION: u32 = 64;
+
+pub const ENTRY: Entry = Entry {
+    tracer: TracerKind::Grid,
+    grid_variant: Some(GridVariant::Thesis),
+    label: "grid-thesis",
+    gpu: ThesisGrid::create,
+    cpu: |scene, options, _| -> Result<Box<dyn CpuAccelerator>> {
+        let n = resolution(scene, options, MAX_RESOLUTION)?;
+        Ok(Box::new(reference::thesis_grid::ThesisGrid::new(
+            scene.world_triangles(),
+            n,
+            GridMapping::of_scene(scene),
+            options.voxel_array_length as usize,
+            options.ray_array_length.unwrap_or(3 * n) as usize,
+        )))
+    },
+};
+
+pub struct ThesisGrid {
+    gl: Arc<Gl>,
+    frame: GridFrame,
+    triangles: usize,
+    build: Kernel,
+    traversal: Kernel,
+    intersect1: Kernel,
+    intersect2: Kernel,
+    /// VerticesInVoxel in the thesis' GLSL, though it holds triangle ids (Listing 19)
+    voxelslist: Ssbo,
+    /// ContainedVertices in the thesis' GLSL: the fill level of every voxel list
+    voxelcontains: Ssbo,
+    rayslist: Ssbo,
+    raycontains: Ssbo,
+    voxel_array_length: u32,
+    ray_array_length: u32,
+}
+
+impl ThesisGrid {
+    fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        let frame = GridFrame::new(scene, resolution(scene, o, MAX_RESOLUTION)?);
+        let (n, n3) = (frame.n, frame.voxels());
+        let l = o.voxel_array_length;
+        let r = o.ray_array_length.unwrap_or(3 * n);
+        if l == 0 || r == 0 {
+            bail!("voxel_array_length and ray_array_length must be positive");
+        }
+        let defs = [
+            frame.define(),
+            ("voxel_array_length", l.to_string()),
+            ("ray_array_length", r.to_string()),
+        ];
+        let pixels = (b.width * b.height) as usize;
+        let ssbo = |name, bytes| Ssbo::new(b.gl, name, bytes, None, b.info.max_ssbo_block_size);
+        Ok(Box::new(ThesisGrid {
+            gl: b.gl.clone(),
+            triangles: scene.triangle_count(),
+            build: b.kernel("thesis_grid/build.comp", &defs, "build")?,
+            traversal: b.kernel("thesis_grid/traversal.comp", &defs, "traversal")?,
+            intersect1: b.kernel("thesis_grid/intersect1.comp", &defs, "intersect1")?,
+            intersect2: b.kernel("thesis_grid/intersect2.comp", &defs, "intersect2")?,
+            voxelslist: ssbo("voxelslist", 4 * n3 * l as usize)?,
+            voxelcontains: ssbo("voxelcontains", 4 * n3)?,
+            rayslist: ssbo("rayslist", 4 * pixels * r as usize)?,
+            raycontains: ssbo("raycontains", 4 * pixels)?,
+            voxel_array_length: l,
+            ray_array_length: r,
+            frame,
+        }))
+    }
+
+    fn bind(&self, f: &FrameContext) {
+        self.voxelslist.bind(f.gl, ssbo::VOXELSLIST);
+        self.voxelcontains.bind(f.gl, ssbo::VOXELCONTAINS);
+        self.rayslist.bind(f.gl, ssbo::RAYSLIST);
+        self.raycontains.bind(f.gl, ssbo::RAYCONTAINS);
+    }
+
+    /// The traversal kernel (Listing 21): every ray's non-empty voxels into `rayslist` — the
+    /// primary or reflected rays (mode 0) or the shadow feelers towards `light` (mode 1).
+    fn traverse(&self, f: &mut FrameContext, light: Option<usize>) {
+        self.bind(f);
+        let k = &self.traversal;
+        k.use_program();
+        self.frame.set_uniforms(k);
+        k.set_i32("traversalMode", light.is_some() as i32);
+        k.set_i32("lightSource", light.unwrap_or(0) as i32);
+        k.dispatch_pixels(f.timers, f.pixels);
+    }
+
+    /// The voxel lists of the last build read back (triangle ids in storage order) and the
+    /// mapping used. For tests and inspection.
+    pub fn read_lists(&self, gl: &Gl) -> (Vec<Vec<i32>>, GridMapping) {
+        let l = self.voxel_array_length as usize;
+        let fill = self.voxelcontains.read_u32(gl);
+        let lists = lists_of(self.frame.voxels(), &self.voxelslist.read_u32(gl), |v| {
+            (v * l, fill[v] as usize)
+        });
+        (lists, self.frame.mapping)
+    }
+
+    pub fn resolution(&self) -> u32 {
+        self.frame.n
+    }
+}
+
+impl Accelerator for ThesisGrid {
+    fn build(&mut self, f: &mut FrameContext) -> Result<()> {
+        self.frame.update(f.models);
+        // Fig. 15: empty the lists, then the build kernel, every frame
+        let (gl, list, contains) = (f.gl, &self.voxelslist, &self.voxelcontains);
+        f.timers.time(gl, "grid_clear", || {
+            list.clear_u32(gl, u32::MAX); // -1
+            contains.clear_u32(gl, 0);
+        });
+        self.bind(f);
+        self.build.use_program();
+        self.frame.set_uniforms(&self.build);
+        self.build
+            .dispatch_1d(f.timers, (self.triangles as u32).div_ceil(128));
+        Ok(())
+    }
+
+    fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
+        self.traverse(f, None);
+        self.intersect1.use_program();
+        self.frame.set_uniforms(&self.intersect1);
+        &self.intersect1
+    }
+
+    fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
+        self.traverse(f, Some(light));
+        self.intersect2.use_program();
+        self.frame.set_uniforms(&self.intersect2);
+        &self.intersect2
+    }
+
+    fn stats(&self, stats: &mut FrameStats) {
+        let build: f64 = ["grid_clear", "build"]
+            .iter()
+            .filter_map(|k| stats.gpu_ms.get(*k))
+            .sum();
+        let bytes: usize = [
+            &self.voxelslist,
+            &self.voxelcontains,
+            &self.rayslist,
+            &self.raycontains,
+        ]
+        .iter()
+        .map(|b| b.bytes)
+        .sum();
+        let f = &mut stats.facts;
+        f.insert("grid_resolution".into(), json!(self.frame.n));
+        f.insert("grid_bytes".into(), json!(bytes));
+        f.insert("grid_build_ms".into(), json!(build));
+        f.insert("grid_variant".into(), json!("thesis"));
+        f.insert("voxel_array_length".into(), json!(self.voxel_array_length));
+        f.insert("ray_array_length".into(), json!(self.ray_array_length));
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl Drop for ThesisGrid {
+    fn drop(&mut self) {
+        for b in [
+            &self.voxelslist,
+            &self.voxelcontains,
+            &self.rayslist,
+            &self.raycontains,
+        ] {
+            b.delete(&self.gl);
+        }
+    }
+}

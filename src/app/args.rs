@@ -1,0 +1,128 @@
+//! Command-line options shared by `render`, `view` and `bench`: the GL device, the kernels'
+//! folder, the grid's options and the soft-shadow options.
+
+use std::path::PathBuf;
+
+use gpgpu_rt::accel::{GridOptions, GridVariant};
+use gpgpu_rt::pipeline::softshadow::SoftShadowOptions;
+use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
+
+#[derive(clap::Args)]
+pub struct GpuArgs {
+    /// EGL device index (default: the first that gives an OpenGL 4.5 core context).
+    #[arg(long)]
+    pub device: Option<usize>,
+    /// Load the GLSL kernels from this directory instead of the copies built into the binary.
+    #[arg(long, value_name = "DIR")]
+    pub glsl_dir: Option<PathBuf>,
+}
+
+/// `--grid N|auto`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridResolution {
+    Auto,
+    N(u32),
+}
+
+impl std::str::FromStr for GridResolution {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(GridResolution::Auto);
+        }
+        match s.parse::<u32>() {
+            Ok(n) if n > 0 => Ok(GridResolution::N(n)),
+            _ => Err(format!(
+                "`{s}` is neither `auto` nor a positive voxel count per axis"
+            )),
+        }
+    }
+}
+
+/// The grid tracer's command-line options (`render`, `view`, `bench`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct GridArgs {
+    /// Grid resolution N (N³ voxels), or `auto`: N = cbrt(triangles / 5), within 4..=64.
+    #[arg(long, default_value = "auto", value_name = "N|auto")]
+    pub grid: GridResolution,
+    /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
+    /// compact lists, 3D-DDA.
+    #[arg(long, value_enum, default_value = "exact")]
+    pub grid_variant: GridVariant,
+    /// Thesis variant: triangle ids per voxel list (Listing 17: 512).
+    #[arg(long, default_value_t = 512, value_name = "L")]
+    pub voxel_array_length: u32,
+    /// Thesis variant: voxel ids per ray list (default 3·N, as Listing 17).
+    #[arg(long, value_name = "R")]
+    pub ray_array_length: Option<u32>,
+}
+
+impl GridArgs {
+    pub fn options(&self) -> GridOptions {
+        GridOptions {
+            variant: self.grid_variant,
+            resolution: match self.grid {
+                GridResolution::Auto => None,
+                GridResolution::N(n) => Some(n),
+            },
+            voxel_array_length: self.voxel_array_length,
+            ray_array_length: self.ray_array_length,
+        }
+    }
+}
+
+/// The soft-shadow options of `render` and `view`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SoftShadowArgs {
+    /// Soft shadows from the scene's `[[area_light]]` with the Cascaded Line Space (Klee 2016):
+    /// G-buffer, shadow compute pass, screen-filling quad. `exact`: triangle tests (the
+    /// reference); `linespace`: packet traversal, the line-space bit decides a hit;
+    /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination.
+    /// [default: the scene's render.shadows, else the point-light ray tracer]
+    #[arg(long, value_enum)]
+    pub shadows: Option<ShadowMode>,
+    /// Uniform samples of the area light, UxV (2x2 … 10x10 in the thesis) [default: the
+    /// scene's render.light_samples, else 4x4].
+    #[arg(long, value_parser = parse_samples, value_name = "UxV")]
+    pub light_samples: Option<(u32, u32)>,
+    /// Cells per axis of every N-tree node (N; 10 in the thesis).
+    #[arg(long, default_value_t = 10, value_name = "N")]
+    pub ntree_n: u32,
+    /// Levels of the N-tree including the root (3 in the thesis; 3 or 4).
+    #[arg(long, default_value_t = 3, value_name = "D")]
+    pub ntree_depth: u32,
+}
+
+impl SoftShadowArgs {
+    /// The scene file's `render.shadows` and `render.light_samples` where the command line
+    /// gives none.
+    pub fn with_scene_defaults(mut self, settings: &RenderSettings) -> SoftShadowArgs {
+        self.shadows = self.shadows.or(settings.shadows);
+        self.light_samples = self.light_samples.or(settings.light_samples);
+        self
+    }
+
+    /// The light samples: the option, else 4x4.
+    pub fn samples(&self) -> (u32, u32) {
+        self.light_samples.unwrap_or((4, 4))
+    }
+
+    pub fn options(
+        &self,
+        mode: ShadowMode,
+        width: u32,
+        height: u32,
+        tile: u32,
+    ) -> SoftShadowOptions {
+        SoftShadowOptions {
+            mode,
+            samples_u: self.samples().0,
+            samples_v: self.samples().1,
+            ntree_n: self.ntree_n,
+            ntree_depth: self.ntree_depth,
+            width,
+            height,
+            tile,
+        }
+    }
+}

@@ -1,0 +1,289 @@
+//! `gpgpu-rt render`: one scene, one renderer (the ray tracer with an accelerator, or the
+//! soft-shadow pipeline), the PNG, the AOVs and the statistics of the last frame.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context as _, Result};
+use clap::parser::ValueSource;
+use clap::ArgMatches;
+use serde_json::json;
+
+use crate::args::{GpuArgs, GridArgs, SoftShadowArgs};
+use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::frame::Frame;
+use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::output;
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::softshadow::SoftShadowRenderer;
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::scene::{Scene, ShadowMode};
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML), e.g. scenes/teapot1.toml.
+    scene: PathBuf,
+    /// Output PNG.
+    #[arg(short, long, default_value = "out.png")]
+    output: PathBuf,
+    /// Image width (default: the scene's render.width).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height (default: the scene's render.height).
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long, value_enum, default_value = "base")]
+    tracer: TracerKind,
+    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
+    #[arg(long)]
+    refl_depth: Option<u32>,
+    /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
+    #[arg(long, value_enum, default_value = "bits")]
+    shadow_flags: ShadowFlags,
+    /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling),
+    /// so that no dispatch runs long enough for a driver watchdog.
+    #[arg(long, default_value_t = 256, value_name = "N")]
+    tile: u32,
+    /// Write NumPy AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal) here.
+    #[arg(long, value_name = "DIR")]
+    aov_dir: Option<PathBuf>,
+    /// Write the statistics of the frame as JSON.
+    #[arg(long, value_name = "FILE.json")]
+    stats: Option<PathBuf>,
+    /// Render the frame this many times and report the last (the first ones warm up:
+    /// shader compilation on first use, caches).
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    frames: u32,
+    #[command(flatten)]
+    grid: GridArgs,
+    #[command(flatten)]
+    soft: SoftShadowArgs,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+/// The options among `ids` (clap ids: the field names) that the command line gave
+/// explicitly, as `--long-name`.
+fn given_options(m: Option<&ArgMatches>, ids: &[&str]) -> Vec<String> {
+    let Some(m) = m else { return Vec::new() };
+    ids.iter()
+        .filter(|id| m.value_source(id) == Some(ValueSource::CommandLine))
+        .map(|id| format!("--{}", id.replace('_', "-")))
+        .collect()
+}
+
+/// "does"/"do" and "an option"/"options" for a list of options.
+fn verb(options: &[String]) -> (&'static str, &'static str) {
+    match options.len() {
+        1 => ("does", "an option"),
+        _ => ("do", "options"),
+    }
+}
+
+/// Options of the pipeline this render does not use are refused, not ignored.
+fn refuse_other_pipeline(
+    args: &RenderArgs,
+    scene: &Scene,
+    matches: Option<&ArgMatches>,
+) -> Result<()> {
+    let given = |ids: &[&str]| given_options(matches, ids);
+    if let Some(mode) = args.soft.shadows {
+        let ray_tracer_only = given(&[
+            "tracer",
+            "refl_depth",
+            "shadow_flags",
+            "grid",
+            "grid_variant",
+            "voxel_array_length",
+            "ray_array_length",
+        ]);
+        if !ray_tracer_only.is_empty() {
+            let (does, an_option) = verb(&ray_tracer_only);
+            bail!(
+                "{} {does} not apply: {an_option} of the point-light ray tracers, and this render uses the \
+                 soft-shadow pipeline (`{}`, from {})",
+                ray_tracer_only.join(", "),
+                mode.name(),
+                if given(&["shadows"]).is_empty() {
+                    format!("render.shadows in {}", scene.path.display())
+                } else {
+                    "--shadows".to_string()
+                }
+            );
+        }
+    } else {
+        let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
+        if !soft_only.is_empty() {
+            bail!(
+                "{} {} not apply without soft shadows: add --shadows \
+                 exact|linespace|linespace-dda (the scene needs an [[area_light]])",
+                soft_only.join(", "),
+                verb(&soft_only).0
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The renderer the options choose: Klee 2016's soft shadows with `--shadows` (or the scene's
+/// render.shadows), else Müller 2015's ray tracer with the `--tracer` accelerator.
+fn make_renderer(
+    ctx: &GlContext,
+    scene: &Scene,
+    shaders: &ShaderSource,
+    args: &RenderArgs,
+) -> Result<Box<dyn Renderer>> {
+    let width = args.width.unwrap_or(scene.settings.width);
+    let height = args.height.unwrap_or(scene.settings.height);
+    if let Some(mode) = args.soft.shadows {
+        let opts = args.soft.options(mode, width, height, args.tile);
+        let r = SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, scene, shaders, opts)?;
+        return Ok(Box::new(r));
+    }
+    let options = RenderOptions {
+        tracer: args.tracer,
+        width,
+        height,
+        refl_depth: args.refl_depth.unwrap_or(scene.settings.refl_depth),
+        tile: args.tile,
+        shadow_flags: args.shadow_flags,
+        aovs: args.aov_dir.is_some(),
+        grid: args.grid.options(),
+    };
+    Ok(Box::new(RayTracer::new(
+        ctx.gl.clone(),
+        &ctx.info,
+        scene,
+        shaders,
+        options,
+    )?))
+}
+
+/// The statistics document of a frame (the keys of `render --stats`).
+pub fn stats_doc(ctx: &GlContext, scene: &Scene, r: &dyn Renderer, f: &Frame) -> serde_json::Value {
+    let s = &f.stats;
+    let mut doc = json!({
+        "scene": scene.path,
+        "renderer": ctx.info.renderer,
+        "gl_version": ctx.info.version,
+        "vendor": ctx.info.vendor,
+        "tracer": r.name(),
+        "width": f.width,
+        "height": f.height,
+        "triangles": scene.triangle_count(),
+        "triangle_tests": s.triangle_tests,
+        "triangle_tests_total": s.total_triangle_tests(),
+        "events": s.events,
+        "truncated_rays": s.truncated_rays,
+        "gpu_ms": s.gpu_ms,
+        "gpu_ms_total": s.total_gpu_ms(),
+        "wall_ms": s.wall_ms,
+    });
+    for (k, v) in r.settings() {
+        doc[k] = v;
+    }
+    for (k, v) in &s.facts {
+        doc[k] = v.clone();
+    }
+    for (k, v) in &s.events {
+        doc[k] = json!(v);
+    }
+    doc
+}
+
+/// The PNG, the AOVs (`--aov-dir`) and the statistics (`--stats`) of `frame`.
+fn write_outputs(
+    args: &RenderArgs,
+    ctx: &GlContext,
+    scene: &Scene,
+    r: &dyn Renderer,
+    frame: &Frame,
+) -> Result<()> {
+    output::write_png(&args.output, frame)?;
+    if let (Some(dir), Some(aovs)) = (&args.aov_dir, &frame.aovs) {
+        output::write_aovs(dir, frame.width, frame.height, aovs)?;
+    }
+    if let Some(path) = &args.stats {
+        let doc = stats_doc(ctx, scene, r, frame);
+        std::fs::write(path, serde_json::to_string_pretty(&doc)? + "\n")
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// What was rendered, in one line on stderr.
+fn summary(
+    ctx: &GlContext,
+    scene: &Scene,
+    mode: Option<ShadowMode>,
+    args: &RenderArgs,
+    f: &Frame,
+) -> String {
+    let s = &f.stats;
+    let what = match mode {
+        Some(mode) => {
+            let (u, v) = args.soft.samples();
+            format!("soft shadows `{}` with {u}x{v} samples", mode.name())
+        }
+        None => format!(
+            "{} lights, {} tracer",
+            scene.lights.len(),
+            args.tracer_name()
+        ),
+    };
+    let mut line = format!(
+        "{}: {}x{}, {} triangles, {what} on {}: {:.1} GPU ms, {} triangle tests",
+        scene.path.display(),
+        f.width,
+        f.height,
+        scene.triangle_count(),
+        ctx.info.renderer,
+        s.total_gpu_ms(),
+        s.total_triangle_tests(),
+    );
+    if let Some(n) = s.events.get("linespace_lookups") {
+        line += &format!(", {n} line-space lookups");
+    }
+    line + &format!(" -> {}", args.output.display())
+}
+
+impl RenderArgs {
+    fn tracer_name(&self) -> &'static str {
+        match self.tracer {
+            TracerKind::Base => "base",
+            TracerKind::Grid => "grid",
+        }
+    }
+}
+
+/// `render`: load, check the options, render `--frames` frames, write the last.
+pub fn run(mut args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
+    let scene = Scene::load(&args.scene)?;
+    let shaders = ShaderSource::from_dir(args.gpu.glsl_dir.clone())?;
+    args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
+    refuse_other_pipeline(&args, &scene, matches)?;
+    let ctx = GlContext::headless(args.gpu.device)?;
+    let mut r = make_renderer(&ctx, &scene, &shaders, &args)?;
+    // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
+    for _ in 1..args.frames {
+        r.draw(&scene.camera)?;
+    }
+    let frame = r.render(&scene.camera)?;
+    write_outputs(&args, &ctx, &scene, r.as_ref(), &frame)?;
+    eprintln!(
+        "{}",
+        summary(&ctx, &scene, args.soft.shadows, &args, &frame)
+    );
+    Ok(())
+}
+
+/// `export-triangles`: the scene's world-space triangles as f32 [T,3,3].
+pub fn export_triangles(scene: &Path, out: &Path) -> Result<()> {
+    let scene = Scene::load(scene)?;
+    let tris = scene.world_triangles();
+    output::write_npy(
+        out,
+        &[tris.len() as u64, 3, 3],
+        tris.iter()
+            .flat_map(|t| t.iter().flat_map(|v| v.to_array())),
+    )
+}

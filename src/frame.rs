@@ -1,0 +1,75 @@
+//! What a renderer hands back: the frame's colour, its per-pixel outputs (AOVs) and its
+//! statistics. GPU-free, shared by the pipelines, the accelerators, the CPU reference and the
+//! output writers.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// Statistics of one frame.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct FrameStats {
+    /// Ray–triangle tests per kernel (exact 64-bit counts).
+    pub triangle_tests: BTreeMap<String, u64>,
+    /// GPU time per kernel in milliseconds (GL timer queries, summed over tiles and passes).
+    pub gpu_ms: BTreeMap<String, f64>,
+    /// Rays whose loop the GL implementation ended early (llvmpipe's loop limit); a frame
+    /// with any is refused by the host.
+    pub truncated_rays: u64,
+    /// Other exact event counts of the design (grid: voxels_visited, dropped_triangle_refs,
+    /// ray_list_overflows, ...).
+    pub events: BTreeMap<String, u64>,
+    /// Design-specific facts (grid: grid_resolution, grid_bytes, grid_build_ms, ...).
+    pub facts: BTreeMap<String, serde_json::Value>,
+    /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
+    pub wall_ms: f64,
+}
+
+impl FrameStats {
+    pub fn total_gpu_ms(&self) -> f64 {
+        self.gpu_ms.values().sum()
+    }
+    pub fn total_triangle_tests(&self) -> u64 {
+        self.triangle_tests.values().sum()
+    }
+}
+
+/// Per-pixel outputs beside the colour, row 0 = the top image row.
+#[derive(Debug, Clone, Default)]
+pub struct Aovs {
+    pub ray_origin: Vec<[f32; 3]>,
+    pub ray_direction: Vec<[f32; 3]>,
+    pub hit_t: Vec<f32>,
+    pub triangle_id: Vec<i32>,
+    pub normal: Vec<[f32; 3]>,
+    /// Soft shadows (Klee 2016): the fraction of unblocked shadow rays per pixel (1 where no
+    /// geometry was hit); `shadow.npy`.
+    pub shadow: Option<Vec<f32>>,
+}
+
+/// A rendered frame: RGBA colour (rgb: colour, a: accumulated weight), row 0 = top.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub color: Vec<[f32; 4]>,
+    pub aovs: Option<Aovs>,
+    pub stats: FrameStats,
+}
+
+/// Flip GL row order (row 0 = bottom) to image order (row 0 = top).
+pub fn flip_rows<T: Clone>(data: &[T], width: u32, height: u32) -> Vec<T> {
+    let w = width as usize;
+    (0..height as usize)
+        .rev()
+        .flat_map(|r| data[r * w..(r + 1) * w].iter().cloned())
+        .collect()
+}
+
+/// The xyz of every RGBA texel, GL rows flipped to image rows.
+pub fn flip_xyz(data: &[[f32; 4]], width: u32, height: u32) -> Vec<[f32; 3]> {
+    flip_rows(data, width, height)
+        .iter()
+        .map(|v| [v[0], v[1], v[2]])
+        .collect()
+}

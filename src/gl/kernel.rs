@@ -1,0 +1,218 @@
+//! A kernel: one GLSL program with its uniforms looked up once, the name its GPU time is
+//! recorded under, and the dispatch helpers every design shares (over the image in tiles, or
+//! one-dimensional). Resources are bound by the named slots of [`super::slots`], never by bare
+//! numbers.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use anyhow::{bail, Result};
+use glow::HasContext;
+
+use super::resources::GpuTimers;
+use super::{compile_program, Defines, Gl, ShaderSource};
+
+/// The work group size of the per-pixel kernels (`local_size_x = local_size_y = 8`).
+pub const PIXEL_GROUP: u32 = 8;
+
+/// One GLSL program: a compute kernel, or a vertex + fragment program of a raster pass.
+pub struct Kernel {
+    gl: Arc<Gl>,
+    program: glow::Program,
+    /// The name its dispatches are timed under (the key of `gpu_ms`).
+    timer: &'static str,
+    uniforms: HashMap<String, glow::UniformLocation>,
+}
+
+/// The image size and tiling of a per-pixel dispatch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PixelGrid {
+    pub width: u32,
+    pub height: u32,
+    /// Dispatches cover at most tile×tile pixels (0: the whole image in one dispatch).
+    pub tile: u32,
+}
+
+impl PixelGrid {
+    /// Check the tile size: a multiple of the work group size, or 0.
+    pub fn new(width: u32, height: u32, tile: u32) -> Result<PixelGrid> {
+        if !tile.is_multiple_of(PIXEL_GROUP) {
+            bail!(
+                "--tile {tile} must be a multiple of {PIXEL_GROUP} (the kernels' work group size)"
+            );
+        }
+        Ok(PixelGrid {
+            width,
+            height,
+            tile,
+        })
+    }
+
+    /// The tiles as (x, y, width, height), row by row.
+    pub fn tiles(&self) -> Vec<(u32, u32, u32, u32)> {
+        let (w, h) = (self.width, self.height);
+        let tile = if self.tile == 0 { w.max(h) } else { self.tile } as usize;
+        let mut out = Vec::new();
+        for ty in (0..h).step_by(tile) {
+            for tx in (0..w).step_by(tile) {
+                out.push((tx, ty, (tile as u32).min(w - tx), (tile as u32).min(h - ty)));
+            }
+        }
+        out
+    }
+}
+
+impl Kernel {
+    /// Compile `file` (below `glsl/`) as a compute kernel timed under `timer`.
+    pub fn compute(
+        gl: &Arc<Gl>,
+        shaders: &ShaderSource,
+        file: &str,
+        defines: &Defines,
+        timer: &'static str,
+    ) -> Result<Kernel> {
+        Self::program(gl, shaders, &[(glow::COMPUTE_SHADER, file)], defines, timer)
+    }
+
+    /// Compile and link the stages `(kind, file)` into one program timed under `timer`.
+    pub fn program(
+        gl: &Arc<Gl>,
+        shaders: &ShaderSource,
+        stages: &[(u32, &str)],
+        defines: &Defines,
+        timer: &'static str,
+    ) -> Result<Kernel> {
+        let program = compile_program(gl, shaders, stages, defines)?;
+        // SAFETY: queries of the program we just linked.
+        let uniforms = unsafe {
+            (0..gl.get_active_uniforms(program))
+                .filter_map(|i| gl.get_active_uniform(program, i))
+                .filter_map(|u| {
+                    let name = u.name.trim_end_matches("[0]").to_string();
+                    gl.get_uniform_location(program, &name).map(|l| (name, l))
+                })
+                .collect()
+        };
+        Ok(Kernel {
+            gl: gl.clone(),
+            program,
+            timer,
+            uniforms,
+        })
+    }
+
+    pub fn timer(&self) -> &'static str {
+        self.timer
+    }
+
+    /// Make this program current.
+    pub fn use_program(&self) {
+        // SAFETY: binding our own program.
+        unsafe { self.gl.use_program(Some(self.program)) };
+    }
+
+    /// The location of `name`; `None` where the program has no such active uniform (the
+    /// compiler may remove an unused one: setting it is then a no-op, as in GL).
+    fn loc(&self, name: &str) -> Option<&glow::UniformLocation> {
+        self.uniforms.get(name)
+    }
+
+    // The setters act on the program in use (call `use_program` first).
+    pub fn set_i32(&self, name: &str, v: i32) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_1_i32(self.loc(name), v) };
+    }
+    pub fn set_f32(&self, name: &str, v: f32) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_1_f32(self.loc(name), v) };
+    }
+    pub fn set_ivec2(&self, name: &str, v: [i32; 2]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_2_i32(self.loc(name), v[0], v[1]) };
+    }
+    pub fn set_vec3(&self, name: &str, v: [f32; 3]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_3_f32_slice(self.loc(name), &v) };
+    }
+    pub fn set_vec4(&self, name: &str, v: [f32; 3], w: f32) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_4_f32(self.loc(name), v[0], v[1], v[2], w) };
+    }
+    pub fn set_mat3(&self, name: &str, m: &[f32; 9]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_matrix_3_f32_slice(self.loc(name), false, m) };
+    }
+    pub fn set_mat4(&self, name: &str, m: &[f32; 16]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_matrix_4_f32_slice(self.loc(name), false, m) };
+    }
+
+    /// Dispatch this kernel (in use) over the image in tiles of `grid`, each dispatch timed,
+    /// the tile's origin in the uniform `tileOffset`, followed by a barrier.
+    pub fn dispatch_pixels(&self, timers: &mut GpuTimers, grid: PixelGrid) {
+        let gl = &self.gl;
+        for (tx, ty, tw, th) in grid.tiles() {
+            self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
+            timers.time(gl, self.timer, || {
+                // SAFETY: dispatch of the program in use.
+                unsafe {
+                    gl.dispatch_compute(tw.div_ceil(PIXEL_GROUP), th.div_ceil(PIXEL_GROUP), 1)
+                }
+            });
+        }
+        barrier(gl);
+    }
+
+    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, followed
+    /// by a barrier.
+    pub fn dispatch_1d(&self, timers: &mut GpuTimers, groups: u32) {
+        let gl = &self.gl;
+        if groups > 0 {
+            // SAFETY: dispatch of the program in use.
+            timers.time(gl, self.timer, || unsafe {
+                gl.dispatch_compute(groups, 1, 1)
+            });
+        }
+        barrier(gl);
+    }
+}
+
+impl Drop for Kernel {
+    fn drop(&mut self) {
+        // SAFETY: deleting our own program.
+        unsafe { self.gl.delete_program(self.program) };
+    }
+}
+
+/// A barrier so the next kernel or draw sees this kernel's image and buffer writes.
+pub fn barrier(gl: &Gl) {
+    // SAFETY: glMemoryBarrier on a current context.
+    unsafe {
+        gl.memory_barrier(
+            glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
+                | glow::SHADER_STORAGE_BARRIER_BIT
+                | glow::BUFFER_UPDATE_BARRIER_BIT
+                | glow::TEXTURE_FETCH_BARRIER_BIT,
+        )
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_image_once() {
+        let g = PixelGrid::new(100, 37, 32).unwrap();
+        let tiles = g.tiles();
+        let area: u32 = tiles.iter().map(|t| t.2 * t.3).sum();
+        assert_eq!(area, 100 * 37);
+        assert_eq!(tiles.len(), 4 * 2);
+        assert_eq!(tiles.last(), Some(&(96, 32, 4, 5)));
+        assert_eq!(
+            PixelGrid::new(100, 37, 0).unwrap().tiles(),
+            vec![(0, 0, 100, 37)]
+        );
+        assert!(PixelGrid::new(8, 8, 12).is_err());
+    }
+}

@@ -1,0 +1,109 @@
+//! The binding slots of every GPU resource, in one table shared by the Rust side and the GLSL
+//! side: each constant here is injected into every kernel as a `#define` (`SSBO_VOXELSLIST`,
+//! `IMAGE_RAY_ORIGIN`, `SAMPLER_TEXTURES`, ...), and the kernels name their
+//! `layout(binding = ...)` by it. No binding or unit number is written anywhere else.
+//!
+//! Slots of different designs may share a number (a program binds one design's resources);
+//! the names say whose they are.
+
+use super::program::Defines;
+
+macro_rules! slot_table {
+    ($(#[$doc:meta])* $module:ident, $prefix:literal { $($(#[$d:meta])* $name:ident = $value:expr,)* }) => {
+        $(#[$doc])*
+        pub mod $module {
+            $($(#[$d])* pub const $name: u32 = $value;)*
+            /// (GLSL `#define` name, slot) of every slot of this kind.
+            pub const TABLE: &[(&str, u32)] = &[$((concat!($prefix, stringify!($name)), $value),)*];
+        }
+    };
+}
+
+slot_table! {
+    /// Shader storage buffer bindings (`layout(std430, binding = SSBO_...)`).
+    ssbo, "SSBO_" {
+        // the scene SSBOs of Müller 2015 ch. 3.1.2 (glsl/common/scene.glsl)
+        VERTEX = 0,
+        NORMAL = 1,
+        COLOR = 2,
+        TEXCOORD = 3,
+        TRI_MATERIAL = 4,
+        MATERIAL = 5,
+        LIGHT_POS = 6,
+        LIGHT_COLOR = 7,
+        /// the 64-bit counters of every design (glsl/common/counters.glsl)
+        COUNTERS = 8,
+        // the thesis grid, Listings 17–22 (glsl/thesis_grid/); the thesis' names
+        VOXELSLIST = 10,
+        VOXELCONTAINS = 11,
+        RAYSLIST = 12,
+        RAYCONTAINS = 13,
+        // the exact grid (glsl/exact_grid/)
+        VOXEL_COUNT = 10,
+        VOXEL_START = 11,
+        VOXEL_FILL = 12,
+        BLOCK_SUMS = 13,
+        GRID_TOTAL = 14,
+        VOXEL_TRIS = 15,
+        // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
+        TRI_VERTEX = 0,
+        LEAF_TRIANGLES = 1,
+    }
+}
+
+slot_table! {
+    /// Image units (`layout(rgba32f, binding = IMAGE_...) uniform image2D`).
+    image, "IMAGE_" {
+        // the ray-state textures of Müller 2015 ch. 3.1.2 (glsl/common/images.glsl)
+        RAY_ORIGIN = 0,
+        RAY_DIR = 1,
+        NORMAL = 2,
+        COLOR_BUFFER = 3,
+        SHADOW = 4,
+        FINAL = 5,
+        PRIMARY_HIT = 6,
+        // Klee 2016's shadow pass: the G-buffer, the shadow values, the line spaces
+        GBUFFER_POSITION = 0,
+        GBUFFER_NORMAL = 1,
+        GBUFFER_DIFFUSE = 2,
+        SHADOW_VALUE = 3,
+        LINESPACE = 4,
+    }
+}
+
+slot_table! {
+    /// Texture units of samplers (`layout(binding = SAMPLER_...) uniform sampler...`).
+    sampler, "SAMPLER_" {
+        /// the scene's texture array (intersect1)
+        TEXTURES = 0,
+        /// Klee 2016's node pool (a texture buffer)
+        NODE_POOL = 1,
+        /// the texture a screen-filling quad shows
+        QUAD_COLOR = 0,
+    }
+}
+
+/// The `#define`s of every slot, which every program gets.
+pub fn defines() -> Defines {
+    let mut d = Defines::new();
+    for (name, slot) in ssbo::TABLE.iter().chain(image::TABLE).chain(sampler::TABLE) {
+        d = d.set(name, slot);
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_within_a_kind() {
+        for table in [ssbo::TABLE, image::TABLE, sampler::TABLE] {
+            let mut names: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
+            names.sort();
+            let n = names.len();
+            names.dedup();
+            assert_eq!(names.len(), n);
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! The pipelines — how rays flow through the GPU — behind one [`Renderer`] interface that
+//! `render`, `view` and `bench` drive the same way, whatever the design:
+//!
+//! | pipeline | source | module | kernels | accelerators |
+//! |---|---|---|---|---|
+//! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`raytrace`] | `glsl/mueller2015/` | every one of [`crate::accel::REGISTRY`] |
+//! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`softshadow`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
+
+pub mod raytrace;
+pub mod softshadow;
+
+use anyhow::Result;
+use glam::Mat4;
+
+use crate::frame::{Frame, FrameStats};
+use crate::scene::Camera;
+
+/// A pipeline with its scene on the GPU, ready to render frames.
+pub trait Renderer {
+    /// The design's name in the statistics: "base", "grid", "linespace".
+    fn name(&self) -> &'static str;
+    /// The image size (width, height).
+    fn size(&self) -> (u32, u32);
+    /// Render one frame seen from `camera` into the output texture. Only the counters and
+    /// the timers are read back: the viewer's frame.
+    fn draw(&mut self, camera: &Camera) -> Result<FrameStats>;
+    /// Read the last drawn frame back: colour, the AOVs the renderer was made to keep, and
+    /// the statistics [`Renderer::draw`] returned.
+    fn read_back(&mut self) -> Result<Frame>;
+    /// The RGBA32F output texture of the last frame (rgb colour, a weight), GL row order, for
+    /// showing it through a screen-filling quad (Müller 2015, ch. 3.1.3).
+    fn output_texture(&self) -> glow::Texture;
+    /// Move object `object` (index in the scene's objects): its model matrix for the next
+    /// frames. An error where the design's structure is static (the N-tree of Klee 2016).
+    fn set_model(&mut self, object: usize, model: Mat4) -> Result<()>;
+    /// The renderer's settings for the statistics document (`render --stats`), beside the
+    /// statistics of the frame.
+    fn settings(&self) -> serde_json::Map<String, serde_json::Value>;
+
+    /// Draw a frame and read it back.
+    fn render(&mut self, camera: &Camera) -> Result<Frame> {
+        self.draw(camera)?;
+        self.read_back()
+    }
+}

@@ -1,0 +1,326 @@
+//! The scene on the GPU, as Müller 2015 ch. 3.1.2 keeps it: the object-space vertex
+//! attributes in VBOs (uploaded once), and the SSBOs the kernels read, filled every frame by
+//! the transform pass (`glsl/transform.vert`, rasterizer discarded) from the VBOs and each
+//! object's model and normal matrices. Materials, lights and textures live beside them.
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use glam::{Mat3, Mat4};
+use glow::HasContext;
+
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
+use crate::scene::Scene;
+
+/// SSBO binding points of the scene, shared with `glsl/common/scene.glsl`.
+pub use crate::gl::slots::ssbo as binding;
+
+pub struct GpuScene {
+    vao: glow::VertexArray,
+    light_vao: glow::VertexArray,
+    vbos: Vec<glow::Buffer>,
+    /// (first vertex, vertex count) of every object in the VBOs and SSBOs.
+    ranges: Vec<(i32, i32)>,
+    light_count: i32,
+    ssbos: Vec<(u32, Ssbo)>,
+    transform: glow::Program,
+    /// An FBO with a 1×1 renderbuffer: a surfaceless context has no default framebuffer to
+    /// draw the (discarded) points into.
+    fbo: glow::Framebuffer,
+    rbo: glow::Renderbuffer,
+    pub textures: glow::Texture,
+    pub triangles: usize,
+}
+
+fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
+    // SAFETY: buffer creation with data on a current context.
+    unsafe {
+        let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
+        gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, data, glow::STATIC_DRAW);
+        Ok(b)
+    }
+}
+
+impl GpuScene {
+    pub fn new(gl: &Gl, info: &GlInfo, scene: &Scene, shaders: &ShaderSource) -> Result<GpuScene> {
+        let triangles = scene.triangle_count();
+        let vertices = 3 * triangles;
+        let max = info.max_ssbo_block_size;
+        if scene.lights.is_empty() {
+            log::warn!(
+                "{}: the scene has no lights; only ambient light",
+                scene.path.display()
+            );
+        }
+        if info.max_vertex_shader_storage_blocks < 8 {
+            bail!(
+                "the transform pass writes 7 shader storage blocks from a vertex shader, \
+                 GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is {}",
+                info.max_vertex_shader_storage_blocks
+            );
+        }
+        // object-space attributes, one VBO each, as the thesis' RTObject keeps them
+        let mut pos = Vec::with_capacity(vertices);
+        let mut nor = Vec::with_capacity(vertices);
+        let mut col = Vec::with_capacity(vertices);
+        let mut tex = Vec::with_capacity(vertices);
+        let mut mat: Vec<i32> = Vec::with_capacity(vertices);
+        let mut ranges = Vec::new();
+        for o in &scene.objects {
+            ranges.push((pos.len() as i32, o.mesh.positions.len() as i32));
+            pos.extend(o.mesh.positions.iter().map(|v| v.to_array()));
+            nor.extend(o.mesh.normals.iter().map(|v| v.to_array()));
+            col.extend(o.mesh.colors.iter().map(|v| v.to_array()));
+            tex.extend(o.mesh.texcoords.iter().map(|v| v.to_array()));
+            mat.extend(o.mesh.triangle_material.iter().flat_map(|m| [*m as i32; 3]));
+        }
+        let program = compile_program(
+            gl,
+            shaders,
+            &[(glow::VERTEX_SHADER, "mueller2015/transform.vert")],
+            &Defines::new(),
+        )?;
+        // SAFETY: VAO/VBO setup on a current context.
+        unsafe {
+            let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
+            gl.bind_vertex_array(Some(vao));
+            let mut vbos = Vec::new();
+            for (loc, data, n) in [
+                (0u32, bytemuck::cast_slice::<_, u8>(&pos), 3),
+                (1, bytemuck::cast_slice(&nor), 3),
+                (2, bytemuck::cast_slice(&col), 3),
+                (3, bytemuck::cast_slice(&tex), 2),
+            ] {
+                let b = upload_vbo(gl, data)?;
+                gl.enable_vertex_attrib_array(loc);
+                gl.vertex_attrib_pointer_f32(loc, n, glow::FLOAT, false, 0, 0);
+                vbos.push(b);
+            }
+            let b = upload_vbo(gl, bytemuck::cast_slice(&mat))?;
+            gl.enable_vertex_attrib_array(4);
+            gl.vertex_attrib_pointer_i32(4, 1, glow::INT, 0, 0);
+            vbos.push(b);
+
+            let light_vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
+            gl.bind_vertex_array(Some(light_vao));
+            let lp: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.position.to_array()).collect();
+            let lc: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.color.to_array()).collect();
+            for (loc, data) in [(0u32, &lp), (2, &lc)] {
+                let b = upload_vbo(gl, bytemuck::cast_slice(&data[..]))?;
+                gl.enable_vertex_attrib_array(loc);
+                gl.vertex_attrib_pointer_f32(loc, 3, glow::FLOAT, false, 0, 0);
+                vbos.push(b);
+            }
+            gl.bind_vertex_array(None);
+            gl.bind_buffer(glow::ARRAY_BUFFER, None);
+
+            let materials: Vec<[f32; 4]> = scene
+                .materials
+                .iter()
+                .map(|m| {
+                    [
+                        m.reflection,
+                        m.specular,
+                        m.shininess,
+                        m.texture.map(|t| t as f32).unwrap_or(-1.0),
+                    ]
+                })
+                .collect();
+            let lights = scene.lights.len().max(1);
+            let ssbos = vec![
+                (
+                    binding::VERTEX,
+                    Ssbo::new(gl, "vertex", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::NORMAL,
+                    Ssbo::new(gl, "normals", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::COLOR,
+                    Ssbo::new(gl, "colors", 16 * vertices, None, max)?,
+                ),
+                (
+                    binding::TEXCOORD,
+                    Ssbo::new(gl, "texcoords", 8 * vertices, None, max)?,
+                ),
+                (
+                    binding::TRI_MATERIAL,
+                    Ssbo::new(gl, "triMaterial", 4 * triangles, None, max)?,
+                ),
+                (
+                    binding::MATERIAL,
+                    Ssbo::new(
+                        gl,
+                        "material",
+                        16 * materials.len(),
+                        Some(bytemuck::cast_slice(&materials)),
+                        max,
+                    )?,
+                ),
+                (
+                    binding::LIGHT_POS,
+                    Ssbo::new(gl, "lightPos", 16 * lights, None, max)?,
+                ),
+                (
+                    binding::LIGHT_COLOR,
+                    Ssbo::new(gl, "lightColor", 16 * lights, None, max)?,
+                ),
+            ];
+
+            let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
+            let rbo = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo));
+            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 1, 1);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::RENDERBUFFER,
+                Some(rbo),
+            );
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+
+            let textures = upload_textures(gl, info, scene)?;
+            crate::gl::check_error(gl, "uploading the scene")?;
+            Ok(GpuScene {
+                vao,
+                light_vao,
+                vbos,
+                ranges,
+                light_count: scene.lights.len() as i32,
+                ssbos,
+                transform: program,
+                fbo,
+                rbo,
+                textures,
+                triangles,
+            })
+        }
+    }
+
+    /// Bytes of GPU memory in the scene SSBOs.
+    pub fn ssbo_bytes(&self) -> usize {
+        self.ssbos.iter().map(|(_, s)| s.bytes).sum()
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        for (b, s) in &self.ssbos {
+            s.bind(gl, *b);
+        }
+        // SAFETY: binding our texture array to unit 0 (sampler `textures`).
+        unsafe {
+            gl.active_texture(glow::TEXTURE0 + crate::gl::slots::sampler::TEXTURES);
+            gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.textures));
+        }
+    }
+
+    /// The transform pass: every object's vertices through its model matrix into the SSBOs,
+    /// then the lights. `models[i]` is object i's model matrix.
+    pub fn transform(&self, gl: &Gl, timers: &mut GpuTimers, models: &[Mat4]) {
+        self.bind(gl);
+        timers.time(gl, "transform", || {
+            // SAFETY: draws with our program and VAOs; rasterization is discarded.
+            unsafe {
+                gl.use_program(Some(self.transform));
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+                gl.enable(glow::RASTERIZER_DISCARD);
+                let loc = |n: &str| gl.get_uniform_location(self.transform, n);
+                gl.uniform_1_i32(loc("transformLights").as_ref(), 0);
+                gl.bind_vertex_array(Some(self.vao));
+                for (&(first, count), model) in self.ranges.iter().zip(models) {
+                    let normal = Mat3::from_mat4(*model).inverse().transpose();
+                    gl.uniform_matrix_4_f32_slice(
+                        loc("modelMatrix").as_ref(),
+                        false,
+                        &model.to_cols_array(),
+                    );
+                    gl.uniform_matrix_3_f32_slice(
+                        loc("normalMatrix").as_ref(),
+                        false,
+                        &normal.to_cols_array(),
+                    );
+                    gl.draw_arrays(glow::POINTS, first, count);
+                }
+                if self.light_count > 0 {
+                    gl.uniform_1_i32(loc("transformLights").as_ref(), 1);
+                    gl.uniform_matrix_4_f32_slice(
+                        loc("modelMatrix").as_ref(),
+                        false,
+                        &Mat4::IDENTITY.to_cols_array(),
+                    );
+                    gl.bind_vertex_array(Some(self.light_vao));
+                    gl.draw_arrays(glow::POINTS, 0, self.light_count);
+                }
+                gl.bind_vertex_array(None);
+                gl.disable(glow::RASTERIZER_DISCARD);
+                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+                gl.memory_barrier(glow::SHADER_STORAGE_BARRIER_BIT);
+            }
+        });
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own objects.
+        unsafe {
+            gl.delete_vertex_array(self.vao);
+            gl.delete_vertex_array(self.light_vao);
+            for b in &self.vbos {
+                gl.delete_buffer(*b);
+            }
+            for (_, s) in &self.ssbos {
+                s.delete(gl);
+            }
+            gl.delete_program(self.transform);
+            gl.delete_framebuffer(self.fbo);
+            gl.delete_renderbuffer(self.rbo);
+            gl.delete_texture(self.textures);
+        }
+    }
+}
+
+/// All textures as layers of one RGBA8 2D array texture (bilinear, repeat), sampled by
+/// intersect1 with the material's layer. A scene without textures gets one white texel.
+fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Texture> {
+    let (w, h, layers) = scene.texture_layers(info.max_texture_size as u32);
+    if layers.len() > info.max_array_texture_layers.max(1) as usize {
+        bail!(
+            "{} textures, more than GL_MAX_ARRAY_TEXTURE_LAYERS = {}",
+            layers.len(),
+            info.max_array_texture_layers
+        );
+    }
+    let mut data = Vec::with_capacity((w * h * 4) as usize * layers.len());
+    for l in &layers {
+        data.extend_from_slice(l.as_raw());
+    }
+    // SAFETY: texture upload of w·h·layers RGBA8 texels.
+    unsafe {
+        let t = gl.create_texture().map_err(|e| anyhow!(e))?;
+        gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(t));
+        gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+        gl.tex_image_3d(
+            glow::TEXTURE_2D_ARRAY,
+            0,
+            glow::RGBA8 as i32,
+            w as i32,
+            h as i32,
+            layers.len() as i32,
+            0,
+            glow::RGBA,
+            glow::UNSIGNED_BYTE,
+            glow::PixelUnpackData::Slice(Some(&data)),
+        );
+        for (p, v) in [
+            (glow::TEXTURE_MIN_FILTER, glow::LINEAR),
+            (glow::TEXTURE_MAG_FILTER, glow::LINEAR),
+            (glow::TEXTURE_WRAP_S, glow::REPEAT),
+            (glow::TEXTURE_WRAP_T, glow::REPEAT),
+        ] {
+            gl.tex_parameter_i32(glow::TEXTURE_2D_ARRAY, p, v as i32);
+        }
+        gl.bind_texture(glow::TEXTURE_2D_ARRAY, None);
+        crate::gl::check_error(gl, "uploading the textures").context("texture upload")?;
+        Ok(t)
+    }
+}

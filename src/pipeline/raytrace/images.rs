@@ -1,0 +1,121 @@
+//! The ray-state textures of Müller 2015 ch. 3.1.2, bound to the image units of
+//! `glsl/common/images.glsl` ([`crate::gl::slots::image`]) and cleared every frame — and the
+//! copies of the primary rays and normals kept for the AOVs.
+
+use anyhow::Result;
+
+use super::ShadowFlags;
+use crate::frame::{flip_rows, flip_xyz, Aovs};
+use crate::gl::resources::Image2d;
+use crate::gl::slots::image;
+use crate::gl::Gl;
+
+/// The textures of ch. 3.1.2.
+pub struct RayImages {
+    pub ray_origin: Image2d,
+    pub ray_dir: Image2d,
+    pub normal: Image2d,
+    pub color_buffer: Image2d,
+    pub shadow: Image2d,
+    pub final_color: Image2d,
+    /// ours: (t, triangle id, u, v) of the first hit, written in the first pass (AOVs)
+    pub primary_hit: Image2d,
+}
+
+impl RayImages {
+    pub fn new(gl: &Gl, w: u32, h: u32, flags: ShadowFlags) -> Result<RayImages> {
+        let f = glow::RGBA32F;
+        let shadow = match flags {
+            ShadowFlags::Rgba => glow::RGBA32F,
+            ShadowFlags::Bits => glow::RGBA32UI,
+        };
+        Ok(RayImages {
+            ray_origin: Image2d::new(gl, w, h, f)?,
+            ray_dir: Image2d::new(gl, w, h, f)?,
+            normal: Image2d::new(gl, w, h, f)?,
+            color_buffer: Image2d::new(gl, w, h, f)?,
+            shadow: Image2d::new(gl, w, h, shadow)?,
+            final_color: Image2d::new(gl, w, h, f)?,
+            primary_hit: Image2d::new(gl, w, h, f)?,
+        })
+    }
+
+    fn all(&self) -> [(&Image2d, u32); 7] {
+        [
+            (&self.ray_origin, image::RAY_ORIGIN),
+            (&self.ray_dir, image::RAY_DIR),
+            (&self.normal, image::NORMAL),
+            (&self.color_buffer, image::COLOR_BUFFER),
+            (&self.shadow, image::SHADOW),
+            (&self.final_color, image::FINAL),
+            (&self.primary_hit, image::PRIMARY_HIT),
+        ]
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        for (img, unit) in self.all() {
+            img.bind_image(gl, unit);
+        }
+    }
+
+    pub fn clear(&self, gl: &Gl) {
+        for (img, _) in self.all() {
+            img.clear(gl);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        for (img, _) in self.all() {
+            img.delete(gl);
+        }
+    }
+}
+
+/// The primary rays and the first hits' normals, copied on the GPU while a frame runs (the
+/// ray-state textures are overwritten by the reflection passes), read back on demand.
+pub struct AovImages {
+    ray_origin: Image2d,
+    ray_dir: Image2d,
+    normal: Image2d,
+}
+
+impl AovImages {
+    pub fn new(gl: &Gl, w: u32, h: u32) -> Result<AovImages> {
+        Ok(AovImages {
+            ray_origin: Image2d::new(gl, w, h, glow::RGBA32F)?,
+            ray_dir: Image2d::new(gl, w, h, glow::RGBA32F)?,
+            normal: Image2d::new(gl, w, h, glow::RGBA32F)?,
+        })
+    }
+
+    /// After the eye rays: keep them.
+    pub fn keep_rays(&self, gl: &Gl, images: &RayImages) {
+        self.ray_origin.copy_from(gl, &images.ray_origin);
+        self.ray_dir.copy_from(gl, &images.ray_dir);
+    }
+
+    /// After the first pass: keep the normals of the first hits.
+    pub fn keep_normals(&self, gl: &Gl, images: &RayImages) {
+        self.normal.copy_from(gl, &images.normal);
+    }
+
+    /// The AOVs of the last frame, row 0 = the top image row.
+    pub fn read(&self, gl: &Gl, primary_hit: &Image2d) -> Aovs {
+        let (w, h) = (self.normal.width, self.normal.height);
+        let hit = flip_rows(&primary_hit.read_f32(gl), w, h);
+        Aovs {
+            ray_origin: flip_xyz(&self.ray_origin.read_f32(gl), w, h),
+            ray_direction: flip_xyz(&self.ray_dir.read_f32(gl), w, h),
+            hit_t: hit.iter().map(|v| v[0]).collect(),
+            triangle_id: hit.iter().map(|v| v[1].to_bits() as i32).collect(),
+            normal: flip_xyz(&self.normal.read_f32(gl), w, h),
+            shadow: None,
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        for img in [&self.ray_origin, &self.ray_dir, &self.normal] {
+            img.delete(gl);
+        }
+    }
+}

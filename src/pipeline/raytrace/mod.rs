@@ -1,0 +1,406 @@
+//! The ray tracer of Müller 2015 (ch. 3.1, 4.1): four compute kernels — eye-ray generation,
+//! intersect1, intersect2 and shading — that communicate through the ray-state textures, run in
+//! the render loop of Fig. 8 (Fig. 15 with the uniform grid). The scene is transformed into
+//! SSBOs at the start of every frame ([`gpu_scene`]); the closest-hit and any-hit searches are
+//! the accelerator's ([`crate::accel`]), everything else is here.
+
+pub mod gpu_scene;
+pub mod images;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Result};
+use glam::Mat4;
+use serde::Serialize;
+use serde_json::json;
+
+use self::gpu_scene::GpuScene;
+use self::images::{AovImages, RayImages};
+use super::Renderer;
+use crate::accel::{self, Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
+use crate::frame::{flip_rows, Frame, FrameStats};
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::slots::ssbo;
+use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+use crate::scene::{Camera, CameraRays, Scene};
+
+/// How the shadow flags of intersect2 are stored (Müller 2015, Listing 15 and ch. 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowFlags {
+    /// The thesis: one channel of an RGBA32F texture per light, so at most 4 lights.
+    Rgba,
+    /// The bitwise flags proposed in ch. 5: one bit per light in an RGBA32UI texture, so at
+    /// most 128 lights.
+    Bits,
+}
+
+impl ShadowFlags {
+    pub fn max_lights(self) -> usize {
+        match self {
+            ShadowFlags::Rgba => 4,
+            ShadowFlags::Bits => 128,
+        }
+    }
+}
+
+/// Options of one render.
+#[derive(Debug, Clone)]
+pub struct RenderOptions {
+    /// The accelerator (`--tracer`, with `grid.variant` for the grid).
+    pub tracer: TracerKind,
+    pub width: u32,
+    pub height: u32,
+    /// REFL_DEPTH: reflection passes after the primary pass (Fig. 8).
+    pub refl_depth: u32,
+    /// Dispatches cover at most tile×tile pixels (0: the whole image in one dispatch).
+    pub tile: u32,
+    pub shadow_flags: ShadowFlags,
+    /// Keep the primary rays and first hits for the AOVs.
+    pub aovs: bool,
+    /// Grid options (ignored by the other accelerators).
+    pub grid: GridOptions,
+}
+
+/// Global counter slots, shared with the kernels through `#define COUNTER_*`.
+pub const COUNTERS: &[&str] = &[
+    "intersect1",
+    "intersect2",
+    "truncated_rays",
+    "voxels_visited",
+    "dropped_triangle_refs",
+    "ray_list_overflows",
+];
+
+/// The counters that count ray–triangle tests (the rest count events).
+pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
+
+/// `#define`s every kernel gets: counter slots and the shadow-flag layout.
+pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
+    let mut d = Defines::new()
+        .set(
+            "SHADOW_BITS",
+            (options.shadow_flags == ShadowFlags::Bits) as i32,
+        )
+        .set(
+            "SHADOW_OFFSET",
+            format!("{:?}", scene.settings.shadow_offset),
+        );
+    for (i, c) in COUNTERS.iter().enumerate() {
+        d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
+    }
+    d
+}
+
+/// The pipeline's own kernels (Listings 11 and 16).
+struct Kernels {
+    eye_ray_generation: Kernel,
+    shading: Kernel,
+}
+
+/// The scene's lighting and background, as the kernels' uniforms take them.
+struct Lighting {
+    lights: usize,
+    background: [f32; 3],
+    ambient: [f32; 3],
+}
+
+/// The ray tracer: Müller 2015's pipeline with one accelerator.
+pub struct RayTracer {
+    gl: Arc<Gl>,
+    scene: GpuScene,
+    images: RayImages,
+    aov_images: Option<AovImages>,
+    kernels: Kernels,
+    counters: Ssbo,
+    timers: GpuTimers,
+    options: RenderOptions,
+    pixels: PixelGrid,
+    lighting: Lighting,
+    renderer: String,
+    /// Model matrix per object, applied by the transform pass every frame.
+    models: Vec<Mat4>,
+    entry: &'static Entry,
+    accel: Box<dyn Accelerator>,
+    last: Option<FrameStats>,
+}
+
+/// Refuse options the pipeline cannot honour, before anything is allocated.
+fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Result<PixelGrid> {
+    if scene.lights.len() > options.shadow_flags.max_lights() {
+        bail!(
+            "{}: {} lights, but --shadow-flags {} holds at most {} (use --shadow-flags bits)",
+            scene.path.display(),
+            scene.lights.len(),
+            match options.shadow_flags {
+                ShadowFlags::Rgba => "rgba",
+                ShadowFlags::Bits => "bits",
+            },
+            options.shadow_flags.max_lights()
+        );
+    }
+    let max_tex = info.max_texture_size as u32;
+    let (w, h) = (options.width, options.height);
+    if w == 0 || h == 0 || w > max_tex || h > max_tex {
+        bail!("image size {w}x{h} outside 1..={max_tex} (GL_MAX_TEXTURE_SIZE)");
+    }
+    PixelGrid::new(w, h, options.tile)
+}
+
+impl RayTracer {
+    /// The pipeline for `scene` with the accelerator `options` selects, on the current context.
+    pub fn new(
+        gl: Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+        options: RenderOptions,
+    ) -> Result<RayTracer> {
+        let pixels = check_options(info, scene, &options)?;
+        let entry = accel::entry(options.tracer, &options.grid)?;
+        let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
+        let defines = kernel_defines(scene, &options);
+        let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
+        let kernels = Kernels {
+            eye_ray_generation: compute(
+                "mueller2015/eye_ray_generation.comp",
+                "eye_ray_generation",
+            )?,
+            shading: compute("mueller2015/shading.comp", "shading")?,
+        };
+        let (w, h) = (options.width, options.height);
+        let build = BuildContext {
+            gl: &gl,
+            info,
+            shaders,
+            defines: &defines,
+            width: w,
+            height: h,
+        };
+        let accel = (entry.gpu)(&build, scene, &options.grid)?;
+        let counters = Ssbo::new(
+            &gl,
+            "counters",
+            8 * COUNTERS.len(),
+            None,
+            info.max_ssbo_block_size,
+        )?;
+        let t = RayTracer {
+            images: RayImages::new(&gl, w, h, options.shadow_flags)?,
+            aov_images: options
+                .aovs
+                .then(|| AovImages::new(&gl, w, h))
+                .transpose()?,
+            scene: gpu_scene,
+            kernels,
+            counters,
+            timers: GpuTimers::default(),
+            lighting: Lighting {
+                lights: scene.lights.len(),
+                background: scene.settings.background,
+                ambient: scene.settings.ambient,
+            },
+            models: scene.objects.iter().map(|o| o.model).collect(),
+            options,
+            pixels,
+            renderer: info.renderer.clone(),
+            entry,
+            accel,
+            last: None,
+            gl,
+        };
+        check_error(&t.gl, "creating the ray tracer")?;
+        Ok(t)
+    }
+
+    pub fn options(&self) -> &RenderOptions {
+        &self.options
+    }
+
+    /// The accelerator (for tests and inspection: downcast with `as_any`).
+    pub fn accelerator(&self) -> &dyn Accelerator {
+        self.accel.as_ref()
+    }
+
+    /// The accelerator's registry entry.
+    pub fn entry(&self) -> &'static Entry {
+        self.entry
+    }
+
+    pub fn gl(&self) -> &Gl {
+        &self.gl
+    }
+
+    /// The eye rays (Listing 11).
+    fn eye_rays(&mut self, cam: &CameraRays) {
+        let k = &self.kernels.eye_ray_generation;
+        k.use_program();
+        k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
+        k.set_vec4("camImgPosition", cam.cam_img_position.into(), 1.0);
+        k.set_vec4("camWidth", cam.cam_width.into(), 0.0);
+        k.set_vec4("camHeight", cam.cam_height.into(), 0.0);
+        k.dispatch_pixels(&mut self.timers, self.pixels);
+    }
+
+    /// One pass of Fig. 8's loop: intersect1, intersect2 per light, shading.
+    fn pass(&mut self, cam: &CameraRays, pass: u32) {
+        let mut f = FrameContext {
+            gl: &self.gl,
+            timers: &mut self.timers,
+            pixels: self.pixels,
+            models: &self.models,
+        };
+        let k = self.accel.closest_hit(&mut f, pass);
+        k.set_vec4("backgroundColor", self.lighting.background, 1.0);
+        k.set_i32("storePrimaryHit", (pass == 0) as i32);
+        k.dispatch_pixels(f.timers, f.pixels);
+        // the shadow flags of this pass
+        self.images.shadow.clear(&self.gl);
+        for light in 0..self.lighting.lights {
+            let k = self.accel.any_hit(&mut f, light);
+            k.set_i32("lightSource", light as i32);
+            k.dispatch_pixels(f.timers, f.pixels);
+        }
+        let k = &self.kernels.shading;
+        k.use_program();
+        k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
+        k.set_vec4("ambientColor", self.lighting.ambient, 1.0);
+        k.set_i32("lightCount", self.lighting.lights as i32);
+        k.dispatch_pixels(&mut self.timers, self.pixels);
+    }
+
+    /// The counters and timers of the frame, with the accelerator's facts.
+    fn frame_stats(&mut self) -> FrameStats {
+        let raw = self.counters.read_u32(&self.gl);
+        let mut stats = FrameStats {
+            gpu_ms: self.timers.resolve(&self.gl),
+            ..Default::default()
+        };
+        for (i, name) in COUNTERS.iter().enumerate() {
+            let v = raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32);
+            if TRIANGLE_TEST_COUNTERS.contains(name) {
+                stats.triangle_tests.insert(name.to_string(), v);
+            } else if *name == "truncated_rays" {
+                stats.truncated_rays = v;
+            } else {
+                stats.events.insert(name.to_string(), v);
+            }
+        }
+        self.accel.stats(&mut stats);
+        stats
+    }
+}
+
+impl Renderer for RayTracer {
+    fn name(&self) -> &'static str {
+        match self.options.tracer {
+            TracerKind::Base => "base",
+            TracerKind::Grid => "grid",
+        }
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.options.width, self.options.height)
+    }
+
+    /// The render loop of Fig. 8 / Fig. 15.
+    fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
+        let start = Instant::now();
+        let gl = self.gl.clone();
+        // the scene data is transformed into the SSBOs at the start of every frame
+        self.scene.transform(&gl, &mut self.timers, &self.models);
+        self.scene.bind(&gl);
+        self.counters.bind(&gl, ssbo::COUNTERS);
+        self.counters.clear_u32(&gl, 0);
+        self.accel.build(&mut FrameContext {
+            gl: &self.gl,
+            timers: &mut self.timers,
+            pixels: self.pixels,
+            models: &self.models,
+        })?;
+        self.images.clear(&gl);
+        self.images.bind(&gl);
+        let cam = camera.rays(self.options.width, self.options.height);
+        self.eye_rays(&cam);
+        if let Some(a) = &self.aov_images {
+            a.keep_rays(&gl, &self.images);
+        }
+        for pass in 0..=self.options.refl_depth {
+            self.pass(&cam, pass);
+            if let (0, Some(a)) = (pass, &self.aov_images) {
+                a.keep_normals(&gl, &self.images);
+            }
+        }
+        let mut stats = self.frame_stats();
+        if stats.truncated_rays > 0 {
+            bail!(
+                "{} shader loops stopped early: this GL implementation ({}) ends long shader loops \
+                 (Mesa llvmpipe: 65535 iterations per invocation); the frame would be wrong",
+                stats.truncated_rays,
+                self.renderer
+            );
+        }
+        check_error(&gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
+        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.last = Some(stats.clone());
+        Ok(stats)
+    }
+
+    fn read_back(&mut self) -> Result<Frame> {
+        let stats = self
+            .last
+            .clone()
+            .ok_or_else(|| anyhow!("no frame drawn yet"))?;
+        let (w, h) = self.size();
+        Ok(Frame {
+            width: w,
+            height: h,
+            color: flip_rows(&self.images.final_color.read_f32(&self.gl), w, h),
+            aovs: self
+                .aov_images
+                .as_ref()
+                .map(|a| a.read(&self.gl, &self.images.primary_hit)),
+            stats,
+        })
+    }
+
+    fn output_texture(&self) -> glow::Texture {
+        self.images.final_color.texture
+    }
+
+    fn set_model(&mut self, object: usize, model: Mat4) -> Result<()> {
+        let n = self.models.len();
+        *self
+            .models
+            .get_mut(object)
+            .ok_or_else(|| anyhow!("object {object} of {n}"))? = model;
+        Ok(())
+    }
+
+    fn settings(&self) -> serde_json::Map<String, serde_json::Value> {
+        let o = &self.options;
+        [
+            ("lights", json!(self.lighting.lights)),
+            ("refl_depth", json!(o.refl_depth)),
+            ("shadow_flags", json!(o.shadow_flags)),
+            ("tile", json!(o.tile)),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect()
+    }
+}
+
+impl Drop for RayTracer {
+    fn drop(&mut self) {
+        let gl = self.gl.clone();
+        self.scene.delete(&gl);
+        self.images.delete(&gl);
+        if let Some(a) = &self.aov_images {
+            a.delete(&gl);
+        }
+        self.counters.delete(&gl);
+        self.timers.delete(&gl);
+    }
+}

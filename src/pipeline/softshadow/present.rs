@@ -1,0 +1,108 @@
+//! Phase 3 of Klee 2016's pipeline (Fig. 7): the shaded diffuse texture drawn by a
+//! screen-filling quad (`glsl/klee2016/linespace_quad.*`, one triangle that covers the
+//! viewport) into the output texture — headless, an FBO read back into the PNG; in the viewer,
+//! the texture it shows.
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Result};
+use glow::HasContext;
+
+use super::gbuffer::rgba32f_texture;
+use crate::gl::resources::GpuTimers;
+use crate::gl::slots::sampler;
+use crate::gl::{Defines, Gl, Kernel, ShaderSource};
+
+pub struct Present {
+    gl: Arc<Gl>,
+    quad: Kernel,
+    vao: glow::VertexArray,
+    fbo: glow::Framebuffer,
+    pub output: glow::Texture,
+    width: u32,
+    height: u32,
+}
+
+/// The screen-filling quad's program.
+pub fn quad_kernel(gl: &Arc<Gl>, shaders: &ShaderSource) -> Result<Kernel> {
+    Kernel::program(
+        gl,
+        shaders,
+        &[
+            (glow::VERTEX_SHADER, "klee2016/linespace_quad.vert"),
+            (glow::FRAGMENT_SHADER, "klee2016/linespace_quad.frag"),
+        ],
+        &Defines::new(),
+        "present",
+    )
+}
+
+impl Present {
+    pub fn new(gl: &Arc<Gl>, shaders: &ShaderSource, w: u32, h: u32) -> Result<Present> {
+        let quad = quad_kernel(gl, shaders)?;
+        let output = rgba32f_texture(gl, w, h)?;
+        // SAFETY: FBO and VAO creation on a current context.
+        unsafe {
+            let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(output),
+                0,
+            );
+            let complete =
+                gl.check_framebuffer_status(glow::FRAMEBUFFER) == glow::FRAMEBUFFER_COMPLETE;
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            if !complete {
+                bail!("the output FBO is incomplete");
+            }
+            Ok(Present {
+                gl: gl.clone(),
+                quad,
+                vao: gl.create_vertex_array().map_err(|e| anyhow!(e))?,
+                fbo,
+                output,
+                width: w,
+                height: h,
+            })
+        }
+    }
+
+    /// Replace the program (the viewer's live reload).
+    pub fn set_kernel(&mut self, quad: Kernel) {
+        self.quad = quad;
+    }
+
+    /// Draw `color` through the quad into the output texture.
+    pub fn draw(&self, timers: &mut GpuTimers, color: glow::Texture) {
+        let gl = &self.gl;
+        self.quad.use_program();
+        timers.time(gl, self.quad.timer(), || {
+            // SAFETY: drawing the quad with our program into our FBO.
+            unsafe {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+                gl.viewport(0, 0, self.width as i32, self.height as i32);
+                gl.active_texture(glow::TEXTURE0 + sampler::QUAD_COLOR);
+                gl.bind_texture(glow::TEXTURE_2D, Some(color));
+                gl.bind_vertex_array(Some(self.vao));
+                gl.draw_arrays(glow::TRIANGLES, 0, 3);
+                gl.bind_vertex_array(None);
+                gl.bind_texture(glow::TEXTURE_2D, None);
+                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            }
+        });
+    }
+}
+
+impl Drop for Present {
+    fn drop(&mut self) {
+        // SAFETY: deleting our own objects.
+        unsafe {
+            self.gl.delete_vertex_array(self.vao);
+            self.gl.delete_framebuffer(self.fbo);
+            self.gl.delete_texture(self.output);
+        }
+    }
+}

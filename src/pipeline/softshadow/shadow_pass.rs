@@ -1,0 +1,296 @@
+//! Phase 2 of Klee 2016's pipeline (Fig. 7, ch. 4.3): `glsl/klee2016/linespace_shadow.comp`
+//! gives every pixel of the G-buffer its shadow value by walking the N-tree with its line
+//! spaces, and multiplies it into the diffuse texture. Its data: the node pool in a texture
+//! buffer of (red, green) texels (Fig. 8–9), the line spaces in a 3D R32UI texture laid out as
+//! Listing 3, the triangles and the leaves' triangle lists in SSBOs.
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Result};
+use glam::Vec3;
+use glow::HasContext;
+
+use super::gbuffer::rgba32f_texture;
+use super::SoftShadowOptions;
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::slots::{image, sampler, ssbo};
+use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+use crate::reference::ntree::{NTree, PackedLinespaces};
+use crate::scene::{AreaLight, ShadowMode};
+
+/// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`.
+pub const COUNTERS: [&str; 5] = [
+    "triangle_tests",
+    "linespace_lookups",
+    "nodes_visited",
+    "truncated",
+    "packet_failures",
+];
+
+/// The shadow kernel for a mode and a number of samples (the defines of Algorithm 1).
+pub fn shadow_kernel(
+    gl: &Arc<Gl>,
+    shaders: &ShaderSource,
+    tree: &NTree,
+    mode: ShadowMode,
+    (su, sv): (u32, u32),
+) -> Result<Kernel> {
+    if !(1..=10).contains(&su) || !(1..=10).contains(&sv) {
+        bail!("{su}x{sv} light samples: 1x1 to 10x10");
+    }
+    let mut defines = Defines::new()
+        .set("NTREE_N", tree.n)
+        .set("NUM_MAX_DEPTH", tree.depth - 1)
+        .set("LAST_LS_DEPTH", tree.last_linespace_depth())
+        .set("SAMPLES_U", su)
+        .set("SAMPLES_V", sv)
+        .set("NUM_RAYS", su * sv)
+        .set("SHADOW_MODE", mode.kernel_mode());
+    for (i, c) in COUNTERS.iter().enumerate() {
+        defines = defines.set(&format!("COUNTER_{}", c.to_uppercase()), i);
+    }
+    let timer = match mode {
+        ShadowMode::Exact => "shadow_exact",
+        ShadowMode::Linespace => "shadow_linespace",
+        ShadowMode::LinespaceDda => "shadow_linespace_dda",
+    };
+    Kernel::compute(
+        gl,
+        shaders,
+        "klee2016/linespace_shadow.comp",
+        &defines,
+        timer,
+    )
+}
+
+/// The counts of one shadow pass.
+pub struct ShadowCounts(pub [u64; 5]);
+
+impl ShadowCounts {
+    pub fn get(&self, name: &str) -> u64 {
+        COUNTERS
+            .iter()
+            .position(|c| *c == name)
+            .map_or(0, |i| self.0[i])
+    }
+}
+
+/// The uniforms of the shadow kernel that stay from frame to frame.
+pub struct ShadowUniforms {
+    pub light: AreaLight,
+    pub ambient: [f32; 3],
+    pub shadow_offset: f32,
+}
+
+pub struct ShadowPass {
+    gl: Arc<Gl>,
+    pub kernel: Kernel,
+    /// r: shadow value, g: lit rays (summed over batches)
+    pub shadow_texture: glow::Texture,
+    node_buffer: glow::Buffer,
+    node_texture: glow::Texture,
+    linespace_texture: glow::Texture,
+    /// triVertex, leafTriangles, counters
+    buffers: [Ssbo; 3],
+    min_bound: Vec3,
+    inv_node_size: f32,
+    texture_layout: [u32; 3],
+}
+
+/// The node pool as a texture buffer of RG32UI texels (Fig. 8–9).
+fn node_pool(gl: &Gl, tree: &NTree) -> Result<(glow::Buffer, glow::Texture)> {
+    // SAFETY: buffer and texture creation on a current context.
+    unsafe {
+        let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
+        gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
+        let data = bytemuck::cast_slice(&tree.nodes);
+        gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, data, glow::STATIC_DRAW);
+        gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+        let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
+        gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
+        gl.tex_buffer(glow::RG32UI, buffer);
+        gl.bind_texture(glow::TEXTURE_BUFFER, None);
+        Ok((buffer, texture))
+    }
+}
+
+/// The line spaces as a 3D R32UI texture laid out as Listing 3.
+fn linespace_texture(gl: &Gl, packed: &PackedLinespaces) -> Result<glow::Texture> {
+    let (x, y, z) = (
+        packed.tex_x_res as i32,
+        packed.tex_y_res as i32,
+        packed.tex_z_res as i32,
+    );
+    // SAFETY: texture creation and upload; the slice holds x·y·z texels.
+    unsafe {
+        let t = gl.create_texture().map_err(|e| anyhow!(e))?;
+        gl.bind_texture(glow::TEXTURE_3D, Some(t));
+        gl.tex_storage_3d(glow::TEXTURE_3D, 1, glow::R32UI, x, y, z);
+        gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
+        let texels = glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(&packed.texels)));
+        let (red, uint) = (glow::RED_INTEGER, glow::UNSIGNED_INT);
+        gl.tex_sub_image_3d(glow::TEXTURE_3D, 0, 0, 0, 0, x, y, z, red, uint, texels);
+        for p in [glow::TEXTURE_MIN_FILTER, glow::TEXTURE_MAG_FILTER] {
+            gl.tex_parameter_i32(glow::TEXTURE_3D, p, glow::NEAREST as i32);
+        }
+        gl.bind_texture(glow::TEXTURE_3D, None);
+        Ok(t)
+    }
+}
+
+impl ShadowPass {
+    pub fn new(
+        gl: &Arc<Gl>,
+        info: &GlInfo,
+        kernel: Kernel,
+        tree: &NTree,
+        packed: &PackedLinespaces,
+        triangles: &[[Vec3; 3]],
+        options: &SoftShadowOptions,
+    ) -> Result<ShadowPass> {
+        let max = info.max_ssbo_block_size;
+        let tri4: Vec<[f32; 4]> = triangles
+            .iter()
+            .flatten()
+            .map(|v| [v.x, v.y, v.z, 1.0])
+            .collect();
+        let buffers = [
+            Ssbo::new(
+                gl,
+                "triVertex",
+                16 * tri4.len(),
+                Some(bytemuck::cast_slice(&tri4)),
+                max,
+            )?,
+            Ssbo::new(
+                gl,
+                "leafTriangles",
+                4 * tree.leaf_triangles.len(),
+                Some(bytemuck::cast_slice(&tree.leaf_triangles)),
+                max,
+            )?,
+            Ssbo::new(gl, "counters", 8 * COUNTERS.len(), None, max)?,
+        ];
+        let (node_buffer, node_texture) = node_pool(gl, tree)?;
+        let pass = ShadowPass {
+            gl: gl.clone(),
+            kernel,
+            shadow_texture: rgba32f_texture(gl, options.width, options.height)?,
+            node_buffer,
+            node_texture,
+            linespace_texture: linespace_texture(gl, packed)?,
+            buffers,
+            min_bound: tree.min_bound,
+            inv_node_size: tree.inv_node_size(),
+            texture_layout: [packed.tex_x_res, packed.tex_y_res, packed.ls_y_size],
+        };
+        crate::gl::check_error(gl, "uploading the N-tree and the line spaces")?;
+        Ok(pass)
+    }
+
+    /// Bind the G-buffer, the shadow texture, the line spaces, the node pool and the buffers
+    /// to their slots, and set the uniforms that stay for the frame.
+    fn bind(&self, gbuffer: &[glow::Texture; 3], u: &ShadowUniforms) {
+        let gl = &self.gl;
+        let k = &self.kernel;
+        k.use_program();
+        k.set_vec3("minBound", self.min_bound.to_array());
+        k.set_f32("invNodeSize", self.inv_node_size);
+        k.set_vec3("lightCorner", u.light.corner.to_array());
+        k.set_vec3("lightEdgeU", u.light.edge_u.to_array());
+        k.set_vec3("lightEdgeV", u.light.edge_v.to_array());
+        k.set_vec3("lightColor", u.light.color.to_array());
+        k.set_vec3("ambient", u.ambient);
+        k.set_f32("shadowOffset", u.shadow_offset);
+        let [x, y, ls_y] = self.texture_layout;
+        k.set_i32("tex_x_res", x as i32);
+        k.set_i32("tex_y_res", y as i32);
+        k.set_i32("ls_y_size", ls_y as i32);
+        k.set_i32("loopSentinel", 2);
+        let (rw, ro, f) = (glow::READ_WRITE, glow::READ_ONLY, glow::RGBA32F);
+        // SAFETY: binding our textures to their units.
+        unsafe {
+            gl.active_texture(glow::TEXTURE0 + sampler::NODE_POOL);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.node_texture));
+            gl.active_texture(glow::TEXTURE0);
+            let img = |unit, t, access, format| {
+                gl.bind_image_texture(unit, Some(t), 0, false, 0, access, format)
+            };
+            img(image::GBUFFER_POSITION, gbuffer[0], ro, f);
+            img(image::GBUFFER_NORMAL, gbuffer[1], ro, f);
+            img(image::GBUFFER_DIFFUSE, gbuffer[2], rw, f);
+            img(image::SHADOW_VALUE, self.shadow_texture, rw, f);
+            let ls = Some(self.linespace_texture);
+            gl.bind_image_texture(image::LINESPACE, ls, 0, true, 0, ro, glow::R32UI);
+        }
+        let [tris, leaves, counters] = &self.buffers;
+        tris.bind(gl, ssbo::TRI_VERTEX);
+        leaves.bind(gl, ssbo::LEAF_TRIANGLES);
+        counters.bind(gl, ssbo::COUNTERS);
+    }
+
+    /// The shadow pass over the image, each pixel's `rays` shadow rays in `batches`
+    /// dispatches per tile (llvmpipe's loop limit: see `SoftShadowRenderer::draw`).
+    pub fn run(
+        &self,
+        timers: &mut GpuTimers,
+        pixels: PixelGrid,
+        gbuffer: &[glow::Texture; 3],
+        uniforms: &ShadowUniforms,
+        (rays, batches): (u32, u32),
+    ) -> ShadowCounts {
+        let counters = &self.buffers[2];
+        counters.clear_u32(&self.gl, 0);
+        self.bind(gbuffer, uniforms);
+        let k = &self.kernel;
+        let per_batch = rays.div_ceil(batches.clamp(1, rays));
+        for begin in (0..rays).step_by(per_batch as usize) {
+            let end = (begin + per_batch).min(rays);
+            k.set_i32("rayBegin", begin as i32);
+            k.set_i32("rayEnd", end as i32);
+            k.set_i32("accumulate", (begin > 0) as i32);
+            k.set_i32("lastBatch", (end == rays) as i32);
+            k.dispatch_pixels(timers, pixels);
+        }
+        let raw = counters.read_u32(&self.gl);
+        ShadowCounts(std::array::from_fn(|i| {
+            raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32)
+        }))
+    }
+
+    /// Read the 3D line-space texture back (`texels` of them; the round-trip test).
+    pub fn read_linespace_texture(&self, texels: usize) -> Vec<u32> {
+        let gl = &self.gl;
+        let mut data = vec![0u32; texels];
+        // SAFETY: the slice holds all texels of the texture.
+        unsafe {
+            gl.bind_texture(glow::TEXTURE_3D, Some(self.linespace_texture));
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
+            gl.get_tex_image(
+                glow::TEXTURE_3D,
+                0,
+                glow::RED_INTEGER,
+                glow::UNSIGNED_INT,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
+            );
+            gl.bind_texture(glow::TEXTURE_3D, None);
+        }
+        data
+    }
+}
+
+impl Drop for ShadowPass {
+    fn drop(&mut self) {
+        let gl = &self.gl;
+        // SAFETY: deleting our own objects.
+        unsafe {
+            gl.delete_texture(self.shadow_texture);
+            gl.delete_texture(self.node_texture);
+            gl.delete_texture(self.linespace_texture);
+            gl.delete_buffer(self.node_buffer);
+        }
+        for b in &self.buffers {
+            b.delete(gl);
+        }
+    }
+}

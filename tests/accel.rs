@@ -1,0 +1,66 @@
+//! Every accelerator of the registry (`accel::REGISTRY`) against its CPU twin, through the same
+//! interface: the GPU's ray tracer with the accelerator and the CPU reference with the twin
+//! trace the same frame (primary rays, one reflection pass, shadow feelers), and their first
+//! hits, hit distances and triangle-test counts are compared.
+
+mod common;
+
+use common::*;
+use gpgpu_rt::accel::{GridOptions, REGISTRY};
+use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::reference::Reference;
+
+#[test]
+fn every_accelerator_agrees_with_its_cpu_twin() {
+    let ctx = context();
+    let scene = load("cow.toml");
+    let (w, h) = (64, 48);
+    for entry in REGISTRY {
+        let grid = GridOptions {
+            variant: entry.grid_variant.unwrap_or_default(),
+            resolution: Some(12),
+            ..GridOptions::default()
+        };
+        let opts = RenderOptions {
+            tracer: entry.tracer,
+            grid,
+            ..options(w, h, 1)
+        };
+        let mut t = RayTracer::new(
+            ctx.gl.clone(),
+            &ctx.info,
+            &scene,
+            &ShaderSource::default(),
+            opts,
+        )
+        .expect("tracer");
+        assert_eq!(t.entry().label, entry.label);
+        let gpu = t.render(&scene.camera).expect("frame");
+        // the twin sees the same lists only where the GPU lost nothing
+        for lost in ["dropped_triangle_refs", "ray_list_overflows"] {
+            assert_eq!(
+                gpu.stats.events.get(lost).copied().unwrap_or(0),
+                0,
+                "{}",
+                entry.label
+            );
+        }
+        let twin = (entry.cpu)(&scene, &grid, (w, h)).expect("CPU twin");
+        let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
+        let c = compare(&gpu, &cpu);
+        eprintln!("{}: {c:?}", entry.label);
+        assert!(c.hits > 400, "{}: {} hits", entry.label, c.hits);
+        assert_eq!(c.id_mismatches, 0, "{}: first hits differ", entry.label);
+        assert!(c.max_t_rel < 1e-5, "{}: hit distances differ", entry.label);
+        let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
+        let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
+        eprintln!(
+            "{}: intersect1 {g1} / {c1}, intersect2 {g2} / {c2}",
+            entry.label
+        );
+        assert_eq!(g1, c1, "{}: intersect1 tests", entry.label);
+        assert_eq!(g2, c2, "{}: intersect2 tests", entry.label);
+    }
+}
