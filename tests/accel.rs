@@ -54,6 +54,8 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
         assert!(c.hits > 400, "{}: {} hits", entry.label, c.hits);
         assert_eq!(c.id_mismatches, 0, "{}: first hits differ", entry.label);
         assert!(c.max_t_rel < 1e-5, "{}: hit distances differ", entry.label);
+        // same shadows, same colours
+        assert_eq!(c.color_outliers, 0.0, "{}: colours differ", entry.label);
         let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
         let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
         eprintln!(
@@ -61,6 +63,14 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
             entry.label
         );
         assert_eq!(g1, c1, "{}: intersect1 tests", entry.label);
-        assert_eq!(g2, c2, "{}: intersect2 tests", entry.label);
+        if entry.grid_variant.is_none() {
+            assert_eq!(g2, c2, "{}: intersect2 tests", entry.label);
+        } else {
+            // the grids fill a voxel's list in the order their atomics give, so a shadow feeler
+            // meets its first occluder after more or fewer tests than the twin's ascending lists
+            // (measured on this frame: 52,793 vs 52,741, 0.1 %); the answers are the same
+            let d = (g2 as f64 - c2 as f64).abs() / c2 as f64;
+            assert!(d < 0.005, "{}: intersect2 tests {g2} vs {c2}", entry.label);
+        }
     }
 }
