@@ -273,12 +273,8 @@ impl Scene {
         };
         let render_error = |m: &str| SceneError::at(path, render_line, m.into());
         settings.validate().map_err(render_error)?;
-        let lights: Vec<Light> = (file.light.into_iter())
-            .map(|l| src.check(l, LightDef::light))
-            .collect::<Result<_, _>>()?;
-        let area_lights: Vec<AreaLight> = (file.area_light.into_iter())
-            .map(|l| src.check(l, AreaLightDef::area_light))
-            .collect::<Result<_, _>>()?;
+        let lights = src.check_all(file.light, LightDef::light)?;
+        let area_lights = src.check_all(file.area_light, AreaLightDef::area_light)?;
         if settings.shadows.is_some() && area_lights.is_empty() {
             return Err(render_error(
                 "render.shadows needs an [[area_light]] in the scene",
@@ -595,6 +591,15 @@ impl SceneText<'_> {
     ) -> Result<U, SceneError> {
         let start = item.span().start;
         convert(item.into_inner()).map_err(|m| self.error_at(start, m))
+    }
+
+    /// Every item through `convert`, as [`SceneText::check`].
+    fn check_all<T, U>(
+        &self,
+        items: Vec<Spanned<T>>,
+        convert: impl Fn(T) -> Result<U, String>,
+    ) -> Result<Vec<U>, SceneError> {
+        items.into_iter().map(|i| self.check(i, &convert)).collect()
     }
 }
 
