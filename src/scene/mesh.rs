@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Ply, Property};
 
 use super::SceneError;
 
@@ -64,110 +66,12 @@ pub struct LoadedObj {
 /// Load an OBJ file (triangulated) with its MTL materials. Material index
 /// `materials.len()` in `triangle_material` means "no material".
 pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| {
-        if !path.exists() {
-            return SceneError::at(path, None, format!("cannot open OBJ file: {e}"));
-        }
-        let (line, what) = locate_obj_error(path);
-        SceneError::at(path, line, format!("malformed OBJ file ({e}){what}"))
-    })?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let materials: Vec<ObjMaterial> = match mtl {
-        Ok(ms) => ms
-            .into_iter()
-            .map(|m| ObjMaterial {
-                name: m.name.clone(),
-                diffuse: m.diffuse.map(Vec3::from),
-                texture: m.diffuse_texture.as_ref().map(|t| dir.join(t)),
-                shininess: m.shininess,
-            })
-            .collect(),
-        Err(tobj::LoadError::OpenFileFailed) => Vec::new(),
-        Err(e) => {
-            return Err(SceneError::at(
-                path,
-                None,
-                format!("cannot load its MTL file: {e}"),
-            ))
-        }
-    };
-    let none = materials.len() as u32;
+    let (models, mtl) = read_obj(path)?;
+    let materials = obj_materials(path, mtl)?;
     let mut mesh = Mesh::default();
     let mut has_vertex_colors = false;
     for model in &models {
-        let m = &model.mesh;
-        let count = m.positions.len() / 3;
-        let pos = |i: usize| {
-            Vec3::new(
-                m.positions[3 * i],
-                m.positions[3 * i + 1],
-                m.positions[3 * i + 2],
-            )
-        };
-        // smooth normals (area weighted) when the file has none
-        let normals: Vec<Vec3> = if m.normals.len() == m.positions.len() {
-            (0..count)
-                .map(|i| {
-                    Vec3::new(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2])
-                        .normalize_or_zero()
-                })
-                .collect()
-        } else {
-            let mut acc = vec![Vec3::ZERO; count];
-            for f in m.indices.chunks_exact(3) {
-                let (a, b, c) = (f[0] as usize, f[1] as usize, f[2] as usize);
-                let n = (pos(b) - pos(a)).cross(pos(c) - pos(a));
-                acc[a] += n;
-                acc[b] += n;
-                acc[c] += n;
-            }
-            acc.into_iter().map(|n| n.normalize_or_zero()).collect()
-        };
-        let vcol = m.vertex_color.len() == m.positions.len();
-        has_vertex_colors |= vcol;
-        let mat = m.material_id.map(|i| i as u32).unwrap_or(none);
-        let diffuse = m
-            .material_id
-            .and_then(|i| materials.get(i))
-            .and_then(|mm| mm.diffuse)
-            .unwrap_or(Vec3::splat(0.8));
-        for f in m.indices.chunks_exact(3) {
-            let idx = [f[0] as usize, f[1] as usize, f[2] as usize];
-            let p = idx.map(pos);
-            // a face whose normals are all zero (degenerate) gets its geometric normal
-            let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-            let n = idx.map(|i| {
-                if normals[i] == Vec3::ZERO {
-                    geo
-                } else {
-                    normals[i]
-                }
-            });
-            let c = idx.map(|i| {
-                if vcol {
-                    Vec3::new(
-                        m.vertex_color[3 * i],
-                        m.vertex_color[3 * i + 1],
-                        m.vertex_color[3 * i + 2],
-                    )
-                } else {
-                    diffuse
-                }
-            });
-            let t = idx.map(|i| {
-                if m.texcoords.len() >= 2 * count {
-                    Vec2::new(m.texcoords[2 * i], m.texcoords[2 * i + 1])
-                } else {
-                    Vec2::ZERO
-                }
-            });
-            mesh.push_triangle(p, n, c, t, mat);
-        }
+        has_vertex_colors |= append_obj_model(&mut mesh, &model.mesh, &materials);
     }
     if mesh.positions.is_empty() {
         return Err(SceneError::at(
@@ -176,23 +80,151 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
             "the OBJ file has no faces".into(),
         ));
     }
-    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
-    if !(finite(bytemuck::cast_slice(&mesh.positions))
-        && finite(bytemuck::cast_slice(&mesh.normals))
-        && finite(bytemuck::cast_slice(&mesh.texcoords)))
-    {
-        let (line, what) = locate_obj_error(path);
-        return Err(SceneError::at(
-            path,
-            line,
-            format!("a vertex has a non-finite number (nan or inf){what}"),
-        ));
-    }
+    check_obj_finite(path, &mesh)?;
     Ok(LoadedObj {
         mesh,
         materials,
         has_vertex_colors,
     })
+}
+
+/// The models and the MTL materials as tobj reads them; its errors name the file and, where
+/// [`locate_obj_error`] finds it, the line.
+fn read_obj(path: &Path) -> Result<(Vec<tobj::Model>, ObjMtl), SceneError> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    tobj::load_obj(path, &opts).map_err(|e| {
+        if !path.exists() {
+            return SceneError::at(path, None, format!("cannot open OBJ file: {e}"));
+        }
+        let (line, what) = locate_obj_error(path);
+        SceneError::at(path, line, format!("malformed OBJ file ({e}){what}"))
+    })
+}
+
+/// tobj's result for the MTL file an OBJ file names.
+type ObjMtl = Result<Vec<tobj::Material>, tobj::LoadError>;
+
+/// The MTL materials, texture paths relative to the OBJ file; none when the MTL file is
+/// missing (or none is named), an error when it is malformed.
+fn obj_materials(path: &Path, mtl: ObjMtl) -> Result<Vec<ObjMaterial>, SceneError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    match mtl {
+        Ok(ms) => Ok(ms
+            .into_iter()
+            .map(|m| ObjMaterial {
+                name: m.name.clone(),
+                diffuse: m.diffuse.map(Vec3::from),
+                texture: m.diffuse_texture.as_ref().map(|t| dir.join(t)),
+                shininess: m.shininess,
+            })
+            .collect()),
+        Err(tobj::LoadError::OpenFileFailed) => Ok(Vec::new()),
+        Err(e) => Err(SceneError::at(
+            path,
+            None,
+            format!("cannot load its MTL file: {e}"),
+        )),
+    }
+}
+
+/// Append the faces of one tobj model: normals from the file, or smooth (area weighted) when
+/// it has none; colours per vertex, or the material's diffuse colour; texture coordinates
+/// where the file has them. Returns whether the model has per-vertex colours.
+fn append_obj_model(mesh: &mut Mesh, m: &tobj::Mesh, materials: &[ObjMaterial]) -> bool {
+    let count = m.positions.len() / 3;
+    let pos: Vec<Vec3> = (0..count).map(|i| vec3_at(&m.positions, i)).collect();
+    let faces: Vec<[usize; 3]> = m
+        .indices
+        .chunks_exact(3)
+        .map(|f| [f[0] as usize, f[1] as usize, f[2] as usize])
+        .collect();
+    let normals: Vec<Vec3> = if m.normals.len() == m.positions.len() {
+        (0..count)
+            .map(|i| vec3_at(&m.normals, i).normalize_or_zero())
+            .collect()
+    } else {
+        smooth_normals(&pos, &faces)
+    };
+    let vcol = m.vertex_color.len() == m.positions.len();
+    let has_texcoords = m.texcoords.len() >= 2 * count;
+    let mat = m
+        .material_id
+        .map(|i| i as u32)
+        .unwrap_or(materials.len() as u32);
+    let diffuse = m
+        .material_id
+        .and_then(|i| materials.get(i))
+        .and_then(|mm| mm.diffuse)
+        .unwrap_or(Vec3::splat(0.8));
+    for idx in faces {
+        let p = idx.map(|i| pos[i]);
+        let c = idx.map(|i| {
+            if vcol {
+                vec3_at(&m.vertex_color, i)
+            } else {
+                diffuse
+            }
+        });
+        let t = idx.map(|i| {
+            if has_texcoords {
+                Vec2::new(m.texcoords[2 * i], m.texcoords[2 * i + 1])
+            } else {
+                Vec2::ZERO
+            }
+        });
+        mesh.push_triangle(p, corner_normals(p, idx, &normals), c, t, mat);
+    }
+    vcol
+}
+
+/// Entry `i` of a flat `x y z x y z …` array.
+fn vec3_at(v: &[f32], i: usize) -> Vec3 {
+    Vec3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2])
+}
+
+/// Area-weighted vertex normals of an indexed triangle list: unit length, or zero for a
+/// vertex of degenerate triangles only.
+fn smooth_normals(pos: &[Vec3], triangles: &[[usize; 3]]) -> Vec<Vec3> {
+    let mut acc = vec![Vec3::ZERO; pos.len()];
+    for t in triangles {
+        let n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
+        t.iter().for_each(|&k| acc[k] += n);
+    }
+    acc.into_iter().map(Vec3::normalize_or_zero).collect()
+}
+
+/// The normals at the corners `idx` (positions `p`) of a triangle; a zero vertex normal
+/// (degenerate geometry) gives way to the triangle's geometric normal.
+fn corner_normals(p: [Vec3; 3], idx: [usize; 3], normals: &[Vec3]) -> [Vec3; 3] {
+    let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+    idx.map(|i| {
+        if normals[i] == Vec3::ZERO {
+            geo
+        } else {
+            normals[i]
+        }
+    })
+}
+
+/// tobj reads `nan` and `inf`; a vertex with one is an error naming its line.
+fn check_obj_finite(path: &Path, mesh: &Mesh) -> Result<(), SceneError> {
+    let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+    if finite(bytemuck::cast_slice(&mesh.positions))
+        && finite(bytemuck::cast_slice(&mesh.normals))
+        && finite(bytemuck::cast_slice(&mesh.texcoords))
+    {
+        return Ok(());
+    }
+    let (line, what) = locate_obj_error(path);
+    Err(SceneError::at(
+        path,
+        line,
+        format!("a vertex has a non-finite number (nan or inf){what}"),
+    ))
 }
 
 /// Find the first line tobj could not have parsed: numbers of `v`/`vn`/`vt` lines and the
@@ -253,8 +285,29 @@ fn locate_obj_error(path: &Path) -> (Option<usize>, String) {
 /// `vertex` x/y/z and `face` vertex_indices (polygons are fanned into triangles). Vertex
 /// normals are the area-weighted face normals.
 pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
-    use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
+    let ply = read_ply(path)?;
+    let empty = Vec::new();
+    let pos = ply_positions(path, ply.payload.get("vertex").unwrap_or(&empty))?;
+    let faces = ply.payload.get("face").unwrap_or(&empty);
+    let tris = ply_triangles(path, faces, pos.len())?;
+    if tris.is_empty() {
+        return Err(SceneError::at(
+            path,
+            None,
+            "the PLY file has no faces".into(),
+        ));
+    }
+    let normals = smooth_normals(&pos, &tris);
+    let mut mesh = Mesh::default();
+    for t in tris {
+        let p = t.map(|k| pos[k]);
+        let n = corner_normals(p, t, &normals);
+        mesh.push_triangle(p, n, [Vec3::splat(0.8); 3], [Vec2::ZERO; 3], 0);
+    }
+    Ok(mesh)
+}
+
+fn read_ply(path: &Path) -> Result<Ply<DefaultElement>, SceneError> {
     let file = std::fs::File::open(path)
         .map_err(|e| SceneError::at(path, None, format!("cannot open PLY file: {e}")))?;
     let mut reader: Box<dyn std::io::Read> = if path.extension().is_some_and(|e| e == "gz") {
@@ -262,27 +315,16 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
     } else {
         Box::new(std::io::BufReader::new(file))
     };
-    let ply = Parser::<DefaultElement>::new()
+    Parser::<DefaultElement>::new()
         .read_ply(&mut reader)
-        .map_err(|e| SceneError::at(path, None, format!("malformed PLY file: {e}")))?;
-    let scalar = |p: Option<&Property>| -> Option<f64> {
-        Some(match p? {
-            Property::Float(v) => *v as f64,
-            Property::Double(v) => *v,
-            Property::Int(v) => *v as f64,
-            Property::UInt(v) => *v as f64,
-            Property::Short(v) => *v as f64,
-            Property::UShort(v) => *v as f64,
-            Property::Char(v) => *v as f64,
-            Property::UChar(v) => *v as f64,
-            _ => return None,
-        })
-    };
-    let empty = Vec::new();
-    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+        .map_err(|e| SceneError::at(path, None, format!("malformed PLY file: {e}")))
+}
+
+/// The `x y z` of every vertex element, each finite.
+fn ply_positions(path: &Path, vertices: &[DefaultElement]) -> Result<Vec<Vec3>, SceneError> {
     let mut pos = Vec::with_capacity(vertices.len());
     for (i, v) in vertices.iter().enumerate() {
-        let c = ["x", "y", "z"].map(|k| scalar(v.get(k)));
+        let c = ["x", "y", "z"].map(|k| ply_scalar(v.get(k)));
         match c {
             [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|c| (*c as f32).is_finite()) => {
                 pos.push(Vec3::new(x as f32, y as f32, z as f32))
@@ -296,30 +338,41 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
             }
         }
     }
-    let faces = ply.payload.get("face").unwrap_or(&empty);
+    Ok(pos)
+}
+
+/// A scalar property as f64; `None` for a missing property or a list.
+fn ply_scalar(p: Option<&Property>) -> Option<f64> {
+    Some(match p? {
+        Property::Float(v) => *v as f64,
+        Property::Double(v) => *v,
+        Property::Int(v) => *v as f64,
+        Property::UInt(v) => *v as f64,
+        Property::Short(v) => *v as f64,
+        Property::UShort(v) => *v as f64,
+        Property::Char(v) => *v as f64,
+        Property::UChar(v) => *v as f64,
+        _ => return None,
+    })
+}
+
+/// The faces fanned into triangles, every index checked against the `vertices` count.
+fn ply_triangles(
+    path: &Path,
+    faces: &[DefaultElement],
+    vertices: usize,
+) -> Result<Vec<[usize; 3]>, SceneError> {
     let mut tris: Vec<[usize; 3]> = Vec::with_capacity(faces.len());
     for (i, f) in faces.iter().enumerate() {
-        let idx: Vec<i64> = match f.get("vertex_indices").or_else(|| f.get("vertex_index")) {
-            Some(Property::ListInt(v)) => v.iter().map(|x| *x as i64).collect(),
-            Some(Property::ListUInt(v)) => v.iter().map(|x| *x as i64).collect(),
-            Some(Property::ListShort(v)) => v.iter().map(|x| *x as i64).collect(),
-            Some(Property::ListUShort(v)) => v.iter().map(|x| *x as i64).collect(),
-            Some(Property::ListUChar(v)) => v.iter().map(|x| *x as i64).collect(),
-            _ => {
-                return Err(SceneError::at(
-                    path,
-                    None,
-                    format!("face {i} lacks a vertex_indices list"),
-                ))
-            }
-        };
-        if idx.len() < 3 || idx.iter().any(|&k| k < 0 || k as usize >= pos.len()) {
+        let idx = ply_face_indices(f).ok_or_else(|| {
+            SceneError::at(path, None, format!("face {i} lacks a vertex_indices list"))
+        })?;
+        if idx.len() < 3 || idx.iter().any(|&k| k < 0 || k as usize >= vertices) {
             return Err(SceneError::at(
                 path,
                 None,
                 format!(
-                    "face {i} has indices {idx:?}: needs at least 3, each below {} vertices",
-                    pos.len()
+                    "face {i} has indices {idx:?}: needs at least 3, each below {vertices} vertices"
                 ),
             ));
         }
@@ -327,33 +380,22 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
             tris.push([idx[0] as usize, idx[k] as usize, idx[k + 1] as usize]);
         }
     }
-    if tris.is_empty() {
-        return Err(SceneError::at(
-            path,
-            None,
-            "the PLY file has no faces".into(),
-        ));
+    Ok(tris)
+}
+
+/// A face's `vertex_indices` (or `vertex_index`) list of any integer type.
+fn ply_face_indices(f: &DefaultElement) -> Option<Vec<i64>> {
+    fn widen<T: Copy + Into<i64>>(v: &[T]) -> Vec<i64> {
+        v.iter().map(|x| (*x).into()).collect()
     }
-    let mut acc = vec![Vec3::ZERO; pos.len()];
-    for t in &tris {
-        let n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
-        t.iter().for_each(|&k| acc[k] += n);
+    match f.get("vertex_indices").or_else(|| f.get("vertex_index"))? {
+        Property::ListInt(v) => Some(widen(v)),
+        Property::ListUInt(v) => Some(widen(v)),
+        Property::ListShort(v) => Some(widen(v)),
+        Property::ListUShort(v) => Some(widen(v)),
+        Property::ListUChar(v) => Some(widen(v)),
+        _ => None,
     }
-    let mut mesh = Mesh::default();
-    for t in &tris {
-        let p = t.map(|k| pos[k]);
-        let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        let n = t.map(|k| {
-            let n = acc[k].normalize_or_zero();
-            if n == Vec3::ZERO {
-                geo
-            } else {
-                n
-            }
-        });
-        mesh.push_triangle(p, n, [Vec3::splat(0.8); 3], [Vec2::ZERO; 3], 0);
-    }
-    Ok(mesh)
 }
 
 /// Newell's teapot: 32 bicubic Bézier patches in the `.bpt` format (a line with the patch

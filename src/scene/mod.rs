@@ -9,7 +9,7 @@ pub mod shadows;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
+use glam::{Mat3, Mat4, Quat, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -123,6 +123,27 @@ fn light_samples<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, 
         .map_err(serde::de::Error::custom)
 }
 
+impl RenderSettings {
+    /// Sizes positive, colours finite, the shadow offset finite and >= 0.
+    fn validate(&self) -> Result<(), &'static str> {
+        if self.width == 0 || self.height == 0 {
+            return Err("render.width and render.height must be positive");
+        }
+        if !self
+            .background
+            .iter()
+            .chain(&self.ambient)
+            .all(|v| v.is_finite())
+        {
+            return Err("render.background and render.ambient must be finite");
+        }
+        if !self.shadow_offset.is_finite() || self.shadow_offset < 0.0 {
+            return Err("render.shadow_offset must be finite and >= 0");
+        }
+        Ok(())
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
@@ -180,12 +201,18 @@ impl Scene {
         out
     }
 
-    /// World-space per-vertex data (normals, colours, texture coordinates) and per-triangle
-    /// material ids, in the order of [`Scene::world_triangles`].
+    /// World-space per-vertex data (positions, normals, colours, texture coordinates) and
+    /// per-triangle material ids, in the order of [`Scene::world_triangles`].
     pub fn world_attributes(&self) -> WorldAttributes {
         let mut a = WorldAttributes::default();
         for o in &self.objects {
             let nm = o.normal_matrix();
+            a.positions.extend(
+                o.mesh
+                    .positions
+                    .iter()
+                    .map(|p| o.model.transform_point3(*p)),
+            );
             a.normals
                 .extend(o.mesh.normals.iter().map(|n| (nm * *n).normalize_or_zero()));
             a.colors.extend_from_slice(&o.mesh.colors);
@@ -208,20 +235,11 @@ impl Scene {
                 vec![image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]))],
             );
         }
-        let w = self
-            .textures
-            .iter()
-            .map(|(_, t)| t.width())
-            .max()
-            .unwrap_or(1)
-            .min(max_size);
-        let h = self
-            .textures
-            .iter()
-            .map(|(_, t)| t.height())
-            .max()
-            .unwrap_or(1)
-            .min(max_size);
+        let largest = |side: fn(&image::RgbaImage) -> u32| {
+            let most = self.textures.iter().map(|(_, t)| side(t)).max();
+            most.unwrap_or(1).min(max_size)
+        };
+        let (w, h) = (largest(|t| t.width()), largest(|t| t.height()));
         let layers = self
             .textures
             .iter()
@@ -246,87 +264,20 @@ impl Scene {
     }
 
     fn parse(path: &Path, text: &str) -> Result<Scene, SceneError> {
-        let file: SceneFile = toml::from_str(text).map_err(|e| {
-            let line = e.span().map(|s| line_of(text, s.start));
-            SceneError::at(path, line, e.message().to_string())
-        })?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let at = |span: std::ops::Range<usize>, msg: String| {
-            SceneError::at(path, Some(line_of(text, span.start)), msg)
-        };
-        let cam_span = file.camera.span();
-        let camera = file.camera.into_inner();
-        camera.validate().map_err(|m| at(cam_span.clone(), m))?;
+        let src = SceneText { path, text };
+        let file = src.deserialize()?;
+        let camera = src.check(file.camera, |c| c.validate().map(|()| c))?;
         let (settings, render_line) = match file.render {
             Some(r) => (*r.get_ref(), Some(line_of(text, r.span().start))),
             None => (RenderSettings::default(), None),
         };
-        if settings.width == 0 || settings.height == 0 {
-            return Err(SceneError::at(
-                path,
-                render_line,
-                "render.width and render.height must be positive".into(),
-            ));
-        }
-        if !settings
-            .background
-            .iter()
-            .chain(&settings.ambient)
-            .all(|v| v.is_finite())
-        {
-            return Err(SceneError::at(
-                path,
-                render_line,
-                "render.background and render.ambient must be finite".into(),
-            ));
-        }
-        if !settings.shadow_offset.is_finite() || settings.shadow_offset < 0.0 {
-            return Err(SceneError::at(
-                path,
-                render_line,
-                "render.shadow_offset must be finite and >= 0".into(),
-            ));
-        }
-        let mut lights = Vec::new();
-        for l in file.light {
-            let span = l.span();
-            let l = l.into_inner();
-            if !l.position.iter().chain(&l.color).all(|v| v.is_finite()) {
-                return Err(at(span, "light: position and color must be finite".into()));
-            }
-            lights.push(Light {
-                position: Vec3::from(l.position),
-                color: Vec3::from(l.color),
-            });
-        }
-        let mut area_lights = Vec::new();
-        for l in file.area_light {
-            let span = l.span();
-            let l = l.into_inner();
-            let a = AreaLight {
-                corner: Vec3::from(l.corner),
-                edge_u: Vec3::from(l.edge_u),
-                edge_v: Vec3::from(l.edge_v),
-                color: Vec3::from(l.color),
-            };
-            let finite = [a.corner, a.edge_u, a.edge_v, a.color]
-                .iter()
-                .all(|v| v.is_finite());
-            if !finite || a.edge_u.cross(a.edge_v).length() <= 1e-12 {
-                return Err(at(
-                    span,
-                    "area_light: corner, edge_u, edge_v and color must be finite, and edge_u and \
-                     edge_v must span a rectangle (non-zero, not parallel)"
-                        .into(),
-                ));
-            }
-            area_lights.push(a);
-        }
+        let render_error = |m: &str| SceneError::at(path, render_line, m.into());
+        settings.validate().map_err(render_error)?;
+        let lights = src.check_all(file.light, LightDef::light)?;
+        let area_lights = src.check_all(file.area_light, AreaLightDef::area_light)?;
         if settings.shadows.is_some() && area_lights.is_empty() {
-            return Err(SceneError::at(
-                path,
-                render_line,
-                "render.shadows needs an [[area_light]] in the scene".into(),
+            return Err(render_error(
+                "render.shadows needs an [[area_light]] in the scene",
             ));
         }
         let mut scene = Scene {
@@ -346,11 +297,12 @@ impl Scene {
                 "the scene has no [[object]]".into(),
             ));
         }
+        let dir = path.parent().unwrap_or(Path::new("."));
         for (k, def) in file.object.into_iter().enumerate() {
-            let span = def.kind.span();
+            let type_line = def.kind.span().start;
             let object = scene.build_object(dir, k, def).map_err(|e| match e {
                 // errors about the object itself point at its `type` line
-                ObjectError::Here(m) => at(span.clone(), m),
+                ObjectError::Here(m) => src.error_at(type_line, m),
                 ObjectError::File(e) => e,
             })?;
             scene.objects.push(object);
@@ -383,157 +335,192 @@ impl Scene {
         index: usize,
         def: ObjectDef,
     ) -> Result<Object, ObjectError> {
-        let kind = def.kind.get_ref().as_str();
-        let base = Material {
-            reflection: def.reflection,
-            specular: def.specular,
-            shininess: def.shininess,
-            texture: None,
-        };
-        if !(0.0..=1.0).contains(&def.reflection) {
-            return Err(ObjectError::Here(format!(
-                "reflection = {} must lie in [0, 1]",
-                def.reflection
-            )));
-        }
-        let color = def.color.map(Vec3::from);
+        let base = def.base_material()?;
         let texture = match &def.texture {
             Some(t) => Some(self.load_texture(&dir.join(t.get_ref()))?),
             None => None,
         };
-        let need_path = |what: &str| {
-            def.path
-                .as_ref()
-                .map(|p| dir.join(p.get_ref()))
-                .ok_or_else(|| {
-                    ObjectError::Here(format!(
-                        "an object of type \"{kind}\" needs path = \"{what}\""
-                    ))
-                })
-        };
-        let mut mesh = match kind {
-            "obj" => {
-                let path = need_path("model.obj")?;
-                let obj = mesh::load_obj(&path).map_err(ObjectError::File)?;
-                // one scene material per MTL material, plus one for faces without
-                let mut ids = Vec::new();
-                for m in &obj.materials {
-                    let tex = match (&texture, &m.texture) {
-                        (Some(t), _) => Some(*t),
-                        (None, Some(p)) => Some(self.load_texture(p)?),
-                        (None, None) => None,
-                    };
-                    ids.push(self.add_material(Material { texture: tex, ..base }));
-                }
-                ids.push(self.add_material(Material { texture, ..base }));
-                let mut mesh = obj.mesh;
-                for m in mesh.triangle_material.iter_mut() {
-                    *m = ids[*m as usize];
-                }
-                if let Some(c) = color {
-                    mesh.colors.iter_mut().for_each(|x| *x = c);
-                }
-                mesh
-            }
-            "ply" => {
-                let path = need_path("model.ply.gz")?;
-                let mut mesh = mesh::load_ply(&path).map_err(ObjectError::File)?;
-                let c = color.unwrap_or(Vec3::splat(0.8));
-                mesh.colors.iter_mut().for_each(|x| *x = c);
-                let id = self.add_material(Material { texture, ..base });
-                mesh.triangle_material.iter_mut().for_each(|m| *m = id);
-                mesh
-            }
-            "teapot" => {
-                let path = need_path("models/teapot.bpt")?;
-                let n = def.tessellation.unwrap_or(10);
-                if n == 0 {
-                    return Err(ObjectError::Here("tessellation must be positive".into()));
-                }
-                // 32 patches in Newell's teapot (a .bpt with more patches gives more)
-                procedural_limit("tessellation", n, 32 * 2 * n as u64 * n as u64)?;
-                let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
-                let c = color.unwrap_or(Vec3::new(0.8, 0.3, 0.2));
-                mesh.colors.iter_mut().for_each(|x| *x = c);
-                let id = self.add_material(Material { texture, ..base });
-                mesh.triangle_material.iter_mut().for_each(|m| *m = id);
-                mesh
-            }
-            "floor" => {
-                let quads = def.quads.unwrap_or(64);
-                if quads == 0 {
-                    return Err(ObjectError::Here("quads must be positive".into()));
-                }
-                procedural_limit("quads", quads, 2 * quads as u64 * quads as u64)?;
-                let checker = match (def.checker, color) {
-                    (Some([a, b]), _) => [Vec3::from(a), Vec3::from(b)],
-                    (None, Some(c)) => [c, c],
-                    (None, None) => [Vec3::splat(0.75), Vec3::splat(0.35)],
-                };
-                let mut mesh = mesh::floor(def.size.unwrap_or(4.0), quads, checker);
-                let id = self.add_material(Material { texture, ..base });
-                mesh.triangle_material.iter_mut().for_each(|m| *m = id);
-                mesh
-            }
+        let mut mesh = self.object_mesh(dir, &def, Material { texture, ..base })?;
+        if let Some(size) = def.fit {
+            fit(&mut mesh, size);
+        }
+        def.check_numbers()?;
+        let model = def.model_matrix()?;
+        let kind = def.kind.get_ref();
+        Ok(Object {
+            name: def.name.unwrap_or_else(|| format!("{kind}#{index}")),
+            mesh,
+            model,
+        })
+    }
+
+    /// The object's mesh by its type, its triangles with the scene material id of `material`
+    /// (an OBJ file's: one per MTL material).
+    fn object_mesh(
+        &mut self,
+        dir: &Path,
+        def: &ObjectDef,
+        material: Material,
+    ) -> Result<Mesh, ObjectError> {
+        let mut mesh = match def.kind.get_ref().as_str() {
+            "obj" => return self.obj_mesh(&def.model_path(dir, "model.obj")?, material, def),
+            "ply" => def.ply_mesh(dir)?,
+            "teapot" => def.teapot_mesh(dir)?,
+            "floor" => def.floor_mesh()?,
             other => {
                 return Err(ObjectError::Here(format!(
                     "unknown object type \"{other}\" (expected \"obj\", \"ply\", \"teapot\" or \"floor\")"
                 )))
             }
         };
-        if let Some(fit) = def.fit {
-            let (lo, hi) = mesh.bounds();
-            let extent = (hi - lo).max_element();
-            let center = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
-            let s = fit / extent;
-            mesh.positions
-                .iter_mut()
-                .for_each(|p| *p = (*p - center) * s);
+        let id = self.add_material(material);
+        mesh.triangle_material.fill(id);
+        Ok(mesh)
+    }
+
+    /// An OBJ model with one scene material per MTL material (with the MTL texture unless
+    /// `material` has one) plus `material` for faces without; the object's `color`, if given,
+    /// replaces the file's colours.
+    fn obj_mesh(
+        &mut self,
+        path: &Path,
+        material: Material,
+        def: &ObjectDef,
+    ) -> Result<Mesh, ObjectError> {
+        let obj = mesh::load_obj(path).map_err(ObjectError::File)?;
+        let mut ids = Vec::new();
+        for m in &obj.materials {
+            let texture = match (material.texture, &m.texture) {
+                (Some(t), _) => Some(t),
+                (None, Some(p)) => Some(self.load_texture(p)?),
+                (None, None) => None,
+            };
+            ids.push(self.add_material(Material {
+                texture,
+                ..material
+            }));
         }
-        let scale = match def.scale {
-            Scale::Uniform(s) => Vec3::splat(s),
-            Scale::Axes(a) => Vec3::from(a),
+        ids.push(self.add_material(material));
+        let mut mesh = obj.mesh;
+        for m in mesh.triangle_material.iter_mut() {
+            *m = ids[*m as usize];
+        }
+        if let Some(c) = def.color {
+            mesh.colors.fill(Vec3::from(c));
+        }
+        Ok(mesh)
+    }
+}
+
+/// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`.
+fn fit(mesh: &mut Mesh, size: f32) {
+    let (lo, hi) = mesh.bounds();
+    let extent = (hi - lo).max_element();
+    let center = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
+    let s = size / extent;
+    mesh.positions
+        .iter_mut()
+        .for_each(|p| *p = (*p - center) * s);
+}
+
+impl ObjectDef {
+    /// The material the object gives, without a texture.
+    fn base_material(&self) -> Result<Material, ObjectError> {
+        if !(0.0..=1.0).contains(&self.reflection) {
+            return Err(ObjectError::Here(format!(
+                "reflection = {} must lie in [0, 1]",
+                self.reflection
+            )));
+        }
+        Ok(Material {
+            reflection: self.reflection,
+            specular: self.specular,
+            shininess: self.shininess,
+            texture: None,
+        })
+    }
+
+    /// `path` relative to the scene file's folder; `example` shows it in the error when the
+    /// object has none.
+    fn model_path(&self, dir: &Path, example: &str) -> Result<PathBuf, ObjectError> {
+        let path = self.path.as_ref().map(|p| dir.join(p.get_ref()));
+        path.ok_or_else(|| {
+            ObjectError::Here(format!(
+                "an object of type \"{}\" needs path = \"{example}\"",
+                self.kind.get_ref()
+            ))
+        })
+    }
+
+    fn ply_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
+        let path = self.model_path(dir, "model.ply.gz")?;
+        let mut mesh = mesh::load_ply(&path).map_err(ObjectError::File)?;
+        mesh.colors.fill(self.color_or(Vec3::splat(0.8)));
+        Ok(mesh)
+    }
+
+    fn teapot_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
+        let path = self.model_path(dir, "models/teapot.bpt")?;
+        // 32 patches in Newell's teapot (a .bpt with more patches gives more)
+        let n = procedural_size("tessellation", self.tessellation, 10, |n| 32 * 2 * n * n)?;
+        let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
+        mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
+        Ok(mesh)
+    }
+
+    fn floor_mesh(&self) -> Result<Mesh, ObjectError> {
+        let quads = procedural_size("quads", self.quads, 64, |q| 2 * q * q)?;
+        let checker = match (self.checker, self.color) {
+            (Some([a, b]), _) => [Vec3::from(a), Vec3::from(b)],
+            (None, Some(c)) => [Vec3::from(c); 2],
+            (None, None) => [Vec3::splat(0.75), Vec3::splat(0.35)],
         };
+        Ok(mesh::floor(self.size.unwrap_or(4.0), quads, checker))
+    }
+
+    fn color_or(&self, default: Vec3) -> Vec3 {
+        self.color.map(Vec3::from).unwrap_or(default)
+    }
+
+    /// Every number finite, `fit` and `size` also positive.
+    fn check_numbers(&self) -> Result<(), ObjectError> {
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
-        let scale_values: Vec<f32> = match def.scale {
-            Scale::Uniform(s) => vec![s],
-            Scale::Axes(a) => a.to_vec(),
-        };
-        if !(finite(&def.translate)
-            && finite(&def.rotate)
-            && finite(&scale_values)
-            && def.fit.is_none_or(|f| f.is_finite() && f > 0.0)
-            && def.size.is_none_or(|s| s.is_finite() && s > 0.0))
+        if !(finite(&self.translate)
+            && finite(&self.rotate)
+            && self.scale.vector().is_finite()
+            && self.fit.is_none_or(|f| f.is_finite() && f > 0.0)
+            && self.size.is_none_or(|s| s.is_finite() && s > 0.0))
         {
             return Err(ObjectError::Here(
                 "translate, rotate and scale must be finite, fit and size finite and positive"
                     .into(),
             ));
         }
-        if !(finite(&def.color.unwrap_or_default())
-            && finite(def.checker.unwrap_or_default().as_flattened())
-            && finite(&[def.specular, def.shininess]))
+        if !(finite(&self.color.unwrap_or_default())
+            && finite(self.checker.unwrap_or_default().as_flattened())
+            && finite(&[self.specular, self.shininess]))
         {
             return Err(ObjectError::Here(
                 "color, checker, specular and shininess must be finite".into(),
             ));
         }
-        let r = def.rotate.map(f32::to_radians);
+        Ok(())
+    }
+
+    /// Scale, then rotate (y, then x, then z), then translate; an error when singular.
+    fn model_matrix(&self) -> Result<Mat4, ObjectError> {
+        let r = self.rotate.map(f32::to_radians);
         let model = Mat4::from_scale_rotation_translation(
-            scale,
+            self.scale.vector(),
             Quat::from_euler(glam::EulerRot::YXZ, r[1], r[0], r[2]),
-            Vec3::from(def.translate),
+            Vec3::from(self.translate),
         );
         if Mat3::from_mat4(model).determinant().abs() < 1e-12 {
             return Err(ObjectError::Here(
                 "the transform is singular (a zero scale)".into(),
             ));
         }
-        Ok(Object {
-            name: def.name.unwrap_or_else(|| format!("{kind}#{index}")),
-            mesh,
-            model,
-        })
+        Ok(model)
     }
 }
 
@@ -542,24 +529,31 @@ impl Scene {
 /// keeps a mistyped `quads` or `tessellation` from exhausting the memory first.
 pub const MAX_PROCEDURAL_TRIANGLES: u64 = 1 << 26;
 
-fn procedural_limit(key: &str, value: u32, triangles: u64) -> Result<(), ObjectError> {
+/// The size `key` of a procedural object (`default` when not given): positive, and giving at
+/// most [`MAX_PROCEDURAL_TRIANGLES`] by `triangles`.
+fn procedural_size(
+    key: &str,
+    value: Option<u32>,
+    default: u32,
+    triangles: fn(u64) -> u64,
+) -> Result<u32, ObjectError> {
+    let value = value.unwrap_or(default);
+    if value == 0 {
+        return Err(ObjectError::Here(format!("{key} must be positive")));
+    }
+    let triangles = triangles(value as u64);
     if triangles > MAX_PROCEDURAL_TRIANGLES {
         return Err(ObjectError::Here(format!(
             "{key} = {value} gives {triangles} triangles; a procedural object may have at most \
              {MAX_PROCEDURAL_TRIANGLES}"
         )));
     }
-    Ok(())
+    Ok(value)
 }
 
-/// World-space vertex attributes of the whole scene.
-#[derive(Debug, Clone, Default)]
-pub struct WorldAttributes {
-    pub normals: Vec<Vec3>,
-    pub colors: Vec<Vec3>,
-    pub texcoords: Vec<Vec2>,
-    pub triangle_material: Vec<u32>,
-}
+/// World-space vertex attributes of the whole scene: one triangle soup whose
+/// `triangle_material` holds scene material ids.
+pub type WorldAttributes = Mesh;
 
 enum ObjectError {
     Here(String),
@@ -568,6 +562,45 @@ enum ObjectError {
 
 fn line_of(text: &str, byte: usize) -> usize {
     text[..byte.min(text.len())].matches('\n').count() + 1
+}
+
+/// A scene file's path and text, for errors that name a line.
+struct SceneText<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl SceneText<'_> {
+    fn deserialize(&self) -> Result<SceneFile, SceneError> {
+        toml::from_str(self.text).map_err(|e| {
+            let line = e.span().map(|s| line_of(self.text, s.start));
+            SceneError::at(self.path, line, e.message().to_string())
+        })
+    }
+
+    /// An error at the line of byte `byte`.
+    fn error_at(&self, byte: usize, message: String) -> SceneError {
+        SceneError::at(self.path, Some(line_of(self.text, byte)), message)
+    }
+
+    /// `item` through `convert`; its error names the line where the item starts.
+    fn check<T, U>(
+        &self,
+        item: Spanned<T>,
+        convert: impl FnOnce(T) -> Result<U, String>,
+    ) -> Result<U, SceneError> {
+        let start = item.span().start;
+        convert(item.into_inner()).map_err(|m| self.error_at(start, m))
+    }
+
+    /// Every item through `convert`, as [`SceneText::check`].
+    fn check_all<T, U>(
+        &self,
+        items: Vec<Spanned<T>>,
+        convert: impl Fn(T) -> Result<U, String>,
+    ) -> Result<Vec<U>, SceneError> {
+        items.into_iter().map(|i| self.check(i, &convert)).collect()
+    }
 }
 
 #[derive(Deserialize)]
@@ -601,6 +634,45 @@ struct AreaLightDef {
     color: [f32; 3],
 }
 
+impl LightDef {
+    fn light(self) -> Result<Light, String> {
+        if !self
+            .position
+            .iter()
+            .chain(&self.color)
+            .all(|v| v.is_finite())
+        {
+            return Err("light: position and color must be finite".into());
+        }
+        Ok(Light {
+            position: Vec3::from(self.position),
+            color: Vec3::from(self.color),
+        })
+    }
+}
+
+impl AreaLightDef {
+    fn area_light(self) -> Result<AreaLight, String> {
+        let a = AreaLight {
+            corner: Vec3::from(self.corner),
+            edge_u: Vec3::from(self.edge_u),
+            edge_v: Vec3::from(self.edge_v),
+            color: Vec3::from(self.color),
+        };
+        let finite = [a.corner, a.edge_u, a.edge_v, a.color]
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite || a.edge_u.cross(a.edge_v).length() <= 1e-12 {
+            return Err(
+                "area_light: corner, edge_u, edge_v and color must be finite, and edge_u and \
+                 edge_v must span a rectangle (non-zero, not parallel)"
+                    .into(),
+            );
+        }
+        Ok(a)
+    }
+}
+
 fn white() -> [f32; 3] {
     [1.0, 1.0, 1.0]
 }
@@ -610,6 +682,15 @@ fn white() -> [f32; 3] {
 enum Scale {
     Uniform(f32),
     Axes([f32; 3]),
+}
+
+impl Scale {
+    fn vector(&self) -> Vec3 {
+        match *self {
+            Scale::Uniform(s) => Vec3::splat(s),
+            Scale::Axes(a) => Vec3::from(a),
+        }
+    }
 }
 
 #[derive(Deserialize)]

@@ -41,162 +41,195 @@ fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
     }
 }
 
+/// A VBO of `size`-component float vectors as vertex attribute `loc` of the bound VAO.
+fn float_attribute(gl: &Gl, loc: u32, data: &[u8], size: i32) -> Result<glow::Buffer> {
+    let b = upload_vbo(gl, data)?;
+    // SAFETY: attribute setup of the bound VAO from the bound buffer `b`.
+    unsafe {
+        gl.enable_vertex_attrib_array(loc);
+        gl.vertex_attrib_pointer_f32(loc, size, glow::FLOAT, false, 0, 0);
+    }
+    Ok(b)
+}
+
+/// Object-space vertex attributes of all objects, one array per VBO, as the thesis' RTObject
+/// keeps them.
+struct VertexData {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    colors: Vec<[f32; 3]>,
+    texcoords: Vec<[f32; 2]>,
+    /// The material id of each vertex's triangle.
+    materials: Vec<i32>,
+    /// (first vertex, vertex count) of every object.
+    ranges: Vec<(i32, i32)>,
+}
+
+impl VertexData {
+    fn of(scene: &Scene) -> VertexData {
+        let vertices = scene.vertex_count();
+        let mut d = VertexData {
+            positions: Vec::with_capacity(vertices),
+            normals: Vec::with_capacity(vertices),
+            colors: Vec::with_capacity(vertices),
+            texcoords: Vec::with_capacity(vertices),
+            materials: Vec::with_capacity(vertices),
+            ranges: Vec::new(),
+        };
+        for o in &scene.objects {
+            let m = &o.mesh;
+            d.ranges
+                .push((d.positions.len() as i32, m.positions.len() as i32));
+            d.positions.extend(m.positions.iter().map(|v| v.to_array()));
+            d.normals.extend(m.normals.iter().map(|v| v.to_array()));
+            d.colors.extend(m.colors.iter().map(|v| v.to_array()));
+            d.texcoords.extend(m.texcoords.iter().map(|v| v.to_array()));
+            d.materials
+                .extend(m.triangle_material.iter().flat_map(|m| [*m as i32; 3]));
+        }
+        d
+    }
+}
+
+/// What the transform pass needs of the device, and a warning for a scene without lights.
+fn check_device(info: &GlInfo, scene: &Scene) -> Result<()> {
+    if scene.lights.is_empty() {
+        log::warn!(
+            "{}: the scene has no lights; only ambient light",
+            scene.path.display()
+        );
+    }
+    if info.max_vertex_shader_storage_blocks < 8 {
+        bail!(
+            "the transform pass writes 7 shader storage blocks from a vertex shader, \
+             GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is {}",
+            info.max_vertex_shader_storage_blocks
+        );
+    }
+    Ok(())
+}
+
+/// The transform pass' VAOs, objects and lights, and all their VBOs.
+fn vertex_arrays(
+    gl: &Gl,
+    scene: &Scene,
+    data: &VertexData,
+) -> Result<(glow::VertexArray, glow::VertexArray, Vec<glow::Buffer>)> {
+    let mut vbos = Vec::new();
+    // SAFETY: VAO/VBO setup on a current context.
+    unsafe {
+        let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
+        gl.bind_vertex_array(Some(vao));
+        for (loc, bytes, n) in [
+            (0u32, bytemuck::cast_slice::<_, u8>(&data.positions), 3),
+            (1, bytemuck::cast_slice(&data.normals), 3),
+            (2, bytemuck::cast_slice(&data.colors), 3),
+            (3, bytemuck::cast_slice(&data.texcoords), 2),
+        ] {
+            vbos.push(float_attribute(gl, loc, bytes, n)?);
+        }
+        let b = upload_vbo(gl, bytemuck::cast_slice(&data.materials))?;
+        gl.enable_vertex_attrib_array(4);
+        gl.vertex_attrib_pointer_i32(4, 1, glow::INT, 0, 0);
+        vbos.push(b);
+
+        let light_vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
+        gl.bind_vertex_array(Some(light_vao));
+        let lp: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.position.to_array()).collect();
+        let lc: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.color.to_array()).collect();
+        for (loc, v) in [(0u32, lp), (2, lc)] {
+            vbos.push(float_attribute(gl, loc, bytemuck::cast_slice(&v), 3)?);
+        }
+        gl.bind_vertex_array(None);
+        gl.bind_buffer(glow::ARRAY_BUFFER, None);
+        Ok((vao, light_vao, vbos))
+    }
+}
+
+/// The SSBOs the kernels read: per vertex and per light, filled by the transform pass, and the
+/// materials (reflection, specular, shininess, texture layer or -1), uploaded here.
+fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
+    let triangles = scene.triangle_count();
+    let vertices = 3 * triangles;
+    let lights = scene.lights.len().max(1);
+    let materials: Vec<[f32; 4]> = scene
+        .materials
+        .iter()
+        .map(|m| {
+            let texture = m.texture.map(|t| t as f32).unwrap_or(-1.0);
+            [m.reflection, m.specular, m.shininess, texture]
+        })
+        .collect();
+    let material_bytes: &[u8] = bytemuck::cast_slice(&materials);
+    let buffers = [
+        (binding::VERTEX, "vertex", 16 * vertices, None),
+        (binding::NORMAL, "normals", 16 * vertices, None),
+        (binding::COLOR, "colors", 16 * vertices, None),
+        (binding::TEXCOORD, "texcoords", 8 * vertices, None),
+        (binding::TRI_MATERIAL, "triMaterial", 4 * triangles, None),
+        (
+            binding::MATERIAL,
+            "material",
+            material_bytes.len(),
+            Some(material_bytes),
+        ),
+        (binding::LIGHT_POS, "lightPos", 16 * lights, None),
+        (binding::LIGHT_COLOR, "lightColor", 16 * lights, None),
+    ];
+    buffers
+        .into_iter()
+        .map(|(b, name, bytes, data)| Ok((b, Ssbo::new(gl, name, bytes, data, max)?)))
+        .collect()
+}
+
+/// An FBO with a 1×1 renderbuffer for the transform pass' (discarded) points.
+fn point_target(gl: &Gl) -> Result<(glow::Framebuffer, glow::Renderbuffer)> {
+    // SAFETY: framebuffer setup on a current context.
+    unsafe {
+        let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
+        let rbo = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo));
+        gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 1, 1);
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            glow::COLOR_ATTACHMENT0,
+            glow::RENDERBUFFER,
+            Some(rbo),
+        );
+        gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+        Ok((fbo, rbo))
+    }
+}
+
 impl GpuScene {
     pub fn new(gl: &Gl, info: &GlInfo, scene: &Scene, shaders: &ShaderSource) -> Result<GpuScene> {
-        let triangles = scene.triangle_count();
-        let vertices = 3 * triangles;
-        let max = info.max_ssbo_block_size;
-        if scene.lights.is_empty() {
-            log::warn!(
-                "{}: the scene has no lights; only ambient light",
-                scene.path.display()
-            );
-        }
-        if info.max_vertex_shader_storage_blocks < 8 {
-            bail!(
-                "the transform pass writes 7 shader storage blocks from a vertex shader, \
-                 GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is {}",
-                info.max_vertex_shader_storage_blocks
-            );
-        }
-        // object-space attributes, one VBO each, as the thesis' RTObject keeps them
-        let mut pos = Vec::with_capacity(vertices);
-        let mut nor = Vec::with_capacity(vertices);
-        let mut col = Vec::with_capacity(vertices);
-        let mut tex = Vec::with_capacity(vertices);
-        let mut mat: Vec<i32> = Vec::with_capacity(vertices);
-        let mut ranges = Vec::new();
-        for o in &scene.objects {
-            ranges.push((pos.len() as i32, o.mesh.positions.len() as i32));
-            pos.extend(o.mesh.positions.iter().map(|v| v.to_array()));
-            nor.extend(o.mesh.normals.iter().map(|v| v.to_array()));
-            col.extend(o.mesh.colors.iter().map(|v| v.to_array()));
-            tex.extend(o.mesh.texcoords.iter().map(|v| v.to_array()));
-            mat.extend(o.mesh.triangle_material.iter().flat_map(|m| [*m as i32; 3]));
-        }
+        check_device(info, scene)?;
+        let data = VertexData::of(scene);
         let program = compile_program(
             gl,
             shaders,
             &[(glow::VERTEX_SHADER, "mueller2015/transform.vert")],
             &Defines::new(),
         )?;
-        // SAFETY: VAO/VBO setup on a current context.
-        unsafe {
-            let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-            gl.bind_vertex_array(Some(vao));
-            let mut vbos = Vec::new();
-            for (loc, data, n) in [
-                (0u32, bytemuck::cast_slice::<_, u8>(&pos), 3),
-                (1, bytemuck::cast_slice(&nor), 3),
-                (2, bytemuck::cast_slice(&col), 3),
-                (3, bytemuck::cast_slice(&tex), 2),
-            ] {
-                let b = upload_vbo(gl, data)?;
-                gl.enable_vertex_attrib_array(loc);
-                gl.vertex_attrib_pointer_f32(loc, n, glow::FLOAT, false, 0, 0);
-                vbos.push(b);
-            }
-            let b = upload_vbo(gl, bytemuck::cast_slice(&mat))?;
-            gl.enable_vertex_attrib_array(4);
-            gl.vertex_attrib_pointer_i32(4, 1, glow::INT, 0, 0);
-            vbos.push(b);
-
-            let light_vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-            gl.bind_vertex_array(Some(light_vao));
-            let lp: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.position.to_array()).collect();
-            let lc: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.color.to_array()).collect();
-            for (loc, data) in [(0u32, &lp), (2, &lc)] {
-                let b = upload_vbo(gl, bytemuck::cast_slice(&data[..]))?;
-                gl.enable_vertex_attrib_array(loc);
-                gl.vertex_attrib_pointer_f32(loc, 3, glow::FLOAT, false, 0, 0);
-                vbos.push(b);
-            }
-            gl.bind_vertex_array(None);
-            gl.bind_buffer(glow::ARRAY_BUFFER, None);
-
-            let materials: Vec<[f32; 4]> = scene
-                .materials
-                .iter()
-                .map(|m| {
-                    [
-                        m.reflection,
-                        m.specular,
-                        m.shininess,
-                        m.texture.map(|t| t as f32).unwrap_or(-1.0),
-                    ]
-                })
-                .collect();
-            let lights = scene.lights.len().max(1);
-            let ssbos = vec![
-                (
-                    binding::VERTEX,
-                    Ssbo::new(gl, "vertex", 16 * vertices, None, max)?,
-                ),
-                (
-                    binding::NORMAL,
-                    Ssbo::new(gl, "normals", 16 * vertices, None, max)?,
-                ),
-                (
-                    binding::COLOR,
-                    Ssbo::new(gl, "colors", 16 * vertices, None, max)?,
-                ),
-                (
-                    binding::TEXCOORD,
-                    Ssbo::new(gl, "texcoords", 8 * vertices, None, max)?,
-                ),
-                (
-                    binding::TRI_MATERIAL,
-                    Ssbo::new(gl, "triMaterial", 4 * triangles, None, max)?,
-                ),
-                (
-                    binding::MATERIAL,
-                    Ssbo::new(
-                        gl,
-                        "material",
-                        16 * materials.len(),
-                        Some(bytemuck::cast_slice(&materials)),
-                        max,
-                    )?,
-                ),
-                (
-                    binding::LIGHT_POS,
-                    Ssbo::new(gl, "lightPos", 16 * lights, None, max)?,
-                ),
-                (
-                    binding::LIGHT_COLOR,
-                    Ssbo::new(gl, "lightColor", 16 * lights, None, max)?,
-                ),
-            ];
-
-            let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-            let rbo = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo));
-            gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 1, 1);
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
-                glow::COLOR_ATTACHMENT0,
-                glow::RENDERBUFFER,
-                Some(rbo),
-            );
-            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-
-            let textures = upload_textures(gl, info, scene)?;
-            crate::gl::check_error(gl, "uploading the scene")?;
-            Ok(GpuScene {
-                vao,
-                light_vao,
-                vbos,
-                ranges,
-                light_count: scene.lights.len() as i32,
-                ssbos,
-                transform: program,
-                fbo,
-                rbo,
-                textures,
-                triangles,
-            })
-        }
+        let (vao, light_vao, vbos) = vertex_arrays(gl, scene, &data)?;
+        let ssbos = scene_ssbos(gl, scene, info.max_ssbo_block_size)?;
+        let (fbo, rbo) = point_target(gl)?;
+        let textures = upload_textures(gl, info, scene)?;
+        crate::gl::check_error(gl, "uploading the scene")?;
+        Ok(GpuScene {
+            vao,
+            light_vao,
+            vbos,
+            ranges: data.ranges,
+            light_count: scene.lights.len() as i32,
+            ssbos,
+            transform: program,
+            fbo,
+            rbo,
+            textures,
+            triangles: scene.triangle_count(),
+        })
     }
 
     /// Bytes of GPU memory in the scene SSBOs.
