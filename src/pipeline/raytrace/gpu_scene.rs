@@ -1,6 +1,6 @@
 //! The scene on the GPU, as Müller 2015 ch. 3.1.2 keeps it: the object-space vertex
 //! attributes in VBOs (uploaded once), and the SSBOs the kernels read, filled every frame by
-//! the transform pass (`glsl/transform.vert`, rasterizer discarded) from the VBOs and each
+//! the transform pass (`glsl/mueller2015/transform.vert`, rasterizer discarded) from the VBOs and each
 //! object's model and normal matrices. Materials, lights and textures live beside them.
 
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -8,7 +8,7 @@ use glam::{Mat3, Mat4};
 use glow::HasContext;
 
 use crate::gl::resources::{GpuTimers, Ssbo};
-use crate::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
+use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
 use crate::scene::Scene;
 
 /// SSBO binding points of the scene, shared with `glsl/common/scene.glsl`.
@@ -22,7 +22,7 @@ pub struct GpuScene {
     ranges: Vec<(i32, i32)>,
     light_count: i32,
     ssbos: Vec<(u32, Ssbo)>,
-    transform: glow::Program,
+    transform: Kernel,
     /// An FBO with a 1×1 renderbuffer: a surfaceless context has no default framebuffer to
     /// draw the (discarded) points into.
     fbo: glow::Framebuffer,
@@ -203,14 +203,20 @@ fn point_target(gl: &Gl) -> Result<(glow::Framebuffer, glow::Renderbuffer)> {
 }
 
 impl GpuScene {
-    pub fn new(gl: &Gl, info: &GlInfo, scene: &Scene, shaders: &ShaderSource) -> Result<GpuScene> {
+    pub fn new(
+        gl: &std::sync::Arc<Gl>,
+        info: &GlInfo,
+        scene: &Scene,
+        shaders: &ShaderSource,
+    ) -> Result<GpuScene> {
         check_device(info, scene)?;
         let data = VertexData::of(scene);
-        let program = compile_program(
+        let program = Kernel::program(
             gl,
             shaders,
             &[(glow::VERTEX_SHADER, "mueller2015/transform.vert")],
             &Defines::new(),
+            "transform",
         )?;
         let (vao, light_vao, vbos) = vertex_arrays(gl, scene, &data)?;
         let ssbos = scene_ssbos(gl, scene, info.max_ssbo_block_size)?;
@@ -241,7 +247,7 @@ impl GpuScene {
         for (b, s) in &self.ssbos {
             s.bind(gl, *b);
         }
-        // SAFETY: binding our texture array to unit 0 (sampler `textures`).
+        // SAFETY: binding our texture array to its unit (sampler `textures`).
         unsafe {
             gl.active_texture(glow::TEXTURE0 + crate::gl::slots::sampler::TEXTURES);
             gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.textures));
@@ -252,36 +258,24 @@ impl GpuScene {
     /// then the lights. `models[i]` is object i's model matrix.
     pub fn transform(&self, gl: &Gl, timers: &mut GpuTimers, models: &[Mat4]) {
         self.bind(gl);
-        timers.time(gl, "transform", || {
+        let k = &self.transform;
+        k.use_program();
+        timers.time(gl, k.timer(), || {
             // SAFETY: draws with our program and VAOs; rasterization is discarded.
             unsafe {
-                gl.use_program(Some(self.transform));
                 gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
                 gl.enable(glow::RASTERIZER_DISCARD);
-                let loc = |n: &str| gl.get_uniform_location(self.transform, n);
-                gl.uniform_1_i32(loc("transformLights").as_ref(), 0);
+                k.set_i32("transformLights", 0);
                 gl.bind_vertex_array(Some(self.vao));
                 for (&(first, count), model) in self.ranges.iter().zip(models) {
                     let normal = Mat3::from_mat4(*model).inverse().transpose();
-                    gl.uniform_matrix_4_f32_slice(
-                        loc("modelMatrix").as_ref(),
-                        false,
-                        &model.to_cols_array(),
-                    );
-                    gl.uniform_matrix_3_f32_slice(
-                        loc("normalMatrix").as_ref(),
-                        false,
-                        &normal.to_cols_array(),
-                    );
+                    k.set_mat4("modelMatrix", &model.to_cols_array());
+                    k.set_mat3("normalMatrix", &normal.to_cols_array());
                     gl.draw_arrays(glow::POINTS, first, count);
                 }
                 if self.light_count > 0 {
-                    gl.uniform_1_i32(loc("transformLights").as_ref(), 1);
-                    gl.uniform_matrix_4_f32_slice(
-                        loc("modelMatrix").as_ref(),
-                        false,
-                        &Mat4::IDENTITY.to_cols_array(),
-                    );
+                    k.set_i32("transformLights", 1);
+                    k.set_mat4("modelMatrix", &Mat4::IDENTITY.to_cols_array());
                     gl.bind_vertex_array(Some(self.light_vao));
                     gl.draw_arrays(glow::POINTS, 0, self.light_count);
                 }
@@ -304,7 +298,6 @@ impl GpuScene {
             for (_, s) in &self.ssbos {
                 s.delete(gl);
             }
-            gl.delete_program(self.transform);
             gl.delete_framebuffer(self.fbo);
             gl.delete_renderbuffer(self.rbo);
             gl.delete_texture(self.textures);
