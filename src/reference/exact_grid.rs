@@ -5,9 +5,8 @@
 
 use glam::Vec3;
 
-use super::brute_force::{closer_hit, occludes};
 use super::grid::{GridMapping, GridSpace, Walk};
-use super::{CpuAccelerator, Hit};
+use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 pub struct ExactGrid {
     triangles: Vec<[Vec3; 3]>,
@@ -53,50 +52,23 @@ impl ExactGrid {
 
 impl CpuAccelerator for ExactGrid {
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
-        let mut best: Option<Hit> = None;
-        let mut tests = 0;
+        let (mut best, mut tests): (Option<Hit>, u64) = (None, 0);
         self.walk(ro, rd, f32::INFINITY, |list, exit| {
-            for &tri in list.iter().filter(|&&t| t as i32 != last) {
-                tests += 1;
-                closer_hit(
-                    &mut best,
-                    &self.triangles[tri as usize],
-                    tri as usize,
-                    ro,
-                    rd,
-                );
-            }
+            let ids = list.iter().map(|&t| t as usize);
+            closest_among(&mut best, &self.triangles, ids, (ro, rd, last), &mut tests);
             // a hit inside this voxel is the closest
             best.is_some_and(|b| b.t <= exit)
         });
         (best, tests)
     }
 
-    fn occluded(
-        &self,
-        ro: Vec3,
-        rd: Vec3,
-        light_distance: f32,
-        offset: f32,
-        last: i32,
-    ) -> (bool, u64) {
-        let (mut shadow, mut tests) = (false, 0);
-        self.walk(ro, rd, light_distance, |list, _| {
-            for &tri in list.iter().filter(|&&t| t as i32 != last) {
-                tests += 1;
-                if occludes(
-                    &self.triangles[tri as usize],
-                    ro,
-                    rd,
-                    light_distance,
-                    offset,
-                ) {
-                    shadow = true;
-                    break;
-                }
-            }
-            shadow
+    fn occluded(&self, feeler: &Feeler) -> (bool, u64) {
+        let (mut blocked, mut tests) = (false, 0);
+        self.walk(feeler.ro, feeler.rd, feeler.light_distance, |list, _| {
+            let ids = list.iter().map(|&t| t as usize);
+            blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
+            blocked
         });
-        (shadow, tests)
+        (blocked, tests)
     }
 }

@@ -32,16 +32,58 @@ pub trait CpuAccelerator: Send + Sync {
     /// The closest hit of ro + t·rd (t > 0) other than triangle `last`; equal distances go to
     /// the lower triangle id.
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64);
-    /// Whether a triangle other than `last` is hit with `offset` < t < `light_distance` (the
-    /// shadow feeler of Listing 15).
-    fn occluded(
+    /// Whether the shadow feeler is blocked (Listing 15).
+    fn occluded(&self, feeler: &Feeler) -> (bool, u64);
+}
+
+/// A shadow feeler: blocked by a triangle other than `last` hit at `offset` < t <
+/// `light_distance` along ro + t·rd.
+#[derive(Debug, Clone, Copy)]
+pub struct Feeler {
+    pub ro: Vec3,
+    pub rd: Vec3,
+    pub light_distance: f32,
+    pub offset: f32,
+    pub last: i32,
+}
+
+impl Feeler {
+    /// Whether one of the triangles `ids` (in order, `last` skipped) blocks the feeler,
+    /// stopping at the first that does; every test made is added to `tests`.
+    pub fn blocked_among(
         &self,
-        ro: Vec3,
-        rd: Vec3,
-        light_distance: f32,
-        offset: f32,
-        last: i32,
-    ) -> (bool, u64);
+        triangles: &[[Vec3; 3]],
+        ids: impl IntoIterator<Item = usize>,
+        tests: &mut u64,
+    ) -> bool {
+        ids.into_iter().filter(|&i| i as i32 != self.last).any(|i| {
+            *tests += 1;
+            let v = &triangles[i];
+            intersect_triangle(self.ro, self.rd, v[0], v[1], v[2])
+                .is_some_and(|(t, _, _)| t > self.offset && t < self.light_distance)
+        })
+    }
+}
+
+/// The closest hit among the triangles `ids` (`last` skipped) of ro + t·rd, kept in `best`
+/// (equal distances: the lower id, as intersect1's loops); every test made is added to
+/// `tests`.
+pub fn closest_among(
+    best: &mut Option<Hit>,
+    triangles: &[[Vec3; 3]],
+    ids: impl IntoIterator<Item = usize>,
+    (ro, rd, last): (Vec3, Vec3, i32),
+    tests: &mut u64,
+) {
+    for id in ids.into_iter().filter(|&i| i as i32 != last) {
+        *tests += 1;
+        let v = &triangles[id];
+        if let Some((t, u, v)) = intersect_triangle(ro, rd, v[0], v[1], v[2]) {
+            if best.is_none_or(|b| t < b.t || (t == b.t && id < b.id)) {
+                *best = Some(Hit { t, id, u, v });
+            }
+        }
+    }
 }
 
 /// The scene prepared for tracing on the CPU.
@@ -160,8 +202,13 @@ impl Reference {
         if n.dot(rd) <= 0.0 {
             return (true, 0);
         }
-        self.accel
-            .occluded(p, rd, dist, self.shadow_offset, last as i32)
+        self.accel.occluded(&Feeler {
+            ro: p,
+            rd,
+            light_distance: dist,
+            offset: self.shadow_offset,
+            last: last as i32,
+        })
     }
 
     /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.

@@ -8,9 +8,8 @@
 
 use glam::Vec3;
 
-use super::brute_force::{closer_hit, occludes};
 use super::grid::{clip_to_grid, GridMapping, GridSpace};
-use super::{CpuAccelerator, Hit};
+use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 pub struct ThesisGrid {
     triangles: Vec<[Vec3; 3]>,
@@ -76,19 +75,10 @@ impl ThesisGrid {
 
 impl CpuAccelerator for ThesisGrid {
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
-        let mut best: Option<Hit> = None;
-        let mut tests = 0;
+        let (mut best, mut tests): (Option<Hit>, u64) = (None, 0);
         for voxel in self.rayslist(ro, rd, f32::INFINITY) {
-            for &tri in self.lists[voxel].iter().filter(|&&t| t as i32 != last) {
-                tests += 1;
-                closer_hit(
-                    &mut best,
-                    &self.triangles[tri as usize],
-                    tri as usize,
-                    ro,
-                    rd,
-                );
-            }
+            let ids = self.lists[voxel].iter().map(|&t| t as usize);
+            closest_among(&mut best, &self.triangles, ids, (ro, rd, last), &mut tests);
             // Listing 22: a hit in this voxel discards the rest of the list
             if best.is_some() {
                 break;
@@ -97,29 +87,15 @@ impl CpuAccelerator for ThesisGrid {
         (best, tests)
     }
 
-    fn occluded(
-        &self,
-        ro: Vec3,
-        rd: Vec3,
-        light_distance: f32,
-        offset: f32,
-        last: i32,
-    ) -> (bool, u64) {
+    fn occluded(&self, feeler: &Feeler) -> (bool, u64) {
         let mut tests = 0;
-        for voxel in self.rayslist(ro, rd, light_distance) {
-            for &tri in self.lists[voxel].iter().filter(|&&t| t as i32 != last) {
-                tests += 1;
-                if occludes(
-                    &self.triangles[tri as usize],
-                    ro,
-                    rd,
-                    light_distance,
-                    offset,
-                ) {
-                    return (true, tests);
-                }
-            }
-        }
-        (false, tests)
+        let blocked = self
+            .rayslist(feeler.ro, feeler.rd, feeler.light_distance)
+            .into_iter()
+            .any(|voxel| {
+                let ids = self.lists[voxel].iter().map(|&t| t as usize);
+                feeler.blocked_among(&self.triangles, ids, &mut tests)
+            });
+        (blocked, tests)
     }
 }
