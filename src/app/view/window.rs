@@ -4,11 +4,10 @@
 //! and the small raster pass that shows a tracer's output texture: a fragment shader samples
 //! the texture through a 2D sampler and textures a quad that fills the viewport.
 
-use std::ffi::CString;
 use std::num::NonZeroU32;
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Context as _, Result};
+use anyhow::{anyhow, Context as _, Result};
 use glow::HasContext;
 use glutin::config::{ColorBufferType, Config, ConfigTemplateBuilder};
 use glutin::context::{
@@ -23,7 +22,7 @@ use winit::dpi::PhysicalSize;
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
-use gpgpu_rt::gl::context::query_info;
+use gpgpu_rt::gl::context::{load_gl, query_info};
 use gpgpu_rt::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 
 /// A window with a current GL 4.5 core context. Drop GL objects made on `gl` first.
@@ -111,22 +110,13 @@ impl GlWindow {
         if let Err(e) = surface.set_swap_interval(&context, SwapInterval::DontWait) {
             log::info!("cannot turn vsync off: {e}");
         }
-        let load = |name: &str| {
-            let name = CString::new(name).expect("GL symbol names have no NUL");
-            display.get_proc_address(&name)
-        };
-        // SAFETY: the context is current; the loader returns this display's GL entry points.
-        let mut gl = unsafe { Gl::load(load) }?;
-        gl.enable_debug_output_if_requested();
-        let version = gl.version();
-        if (version.major, version.minor) < (4, 5) || version.is_embedded {
-            bail!(
-                "the window's context is OpenGL {}.{}{}, 4.5 core is needed",
-                version.major,
-                version.minor,
-                if version.is_embedded { " ES" } else { "" }
-            );
-        }
+        // SAFETY: the context is current; symbols come from its display.
+        let gl = unsafe {
+            load_gl(
+                |name| display.get_proc_address(name),
+                "the window's context",
+            )
+        }?;
         let info = query_info(&gl, 0, &format!("window ({})", display.version_string()));
         // SAFETY: state changes on the current context: colours reach the window unchanged.
         unsafe {
