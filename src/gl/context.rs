@@ -6,7 +6,7 @@
 //! window surfaces and then finds nothing), and a 4.5 core context is made current without a
 //! surface. All rendering happens in our own textures and framebuffers.
 
-use std::ffi::{c_void, CString};
+use std::ffi::{c_void, CStr, CString};
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context as _, Result};
@@ -117,23 +117,8 @@ impl GlContext {
         let context = context
             .make_current_surfaceless()
             .map_err(|e| anyhow!("cannot make the context current without a surface: {e}"))?;
-        // SAFETY: the context is current on this thread; symbols come from its display.
-        let load = |name: &str| {
-            let name = CString::new(name).expect("GL symbol names have no NUL");
-            display.get_proc_address(&name)
-        };
-        // SAFETY: the context is current; the loader returns this display's GL entry points.
-        let mut gl = unsafe { Gl::load(load) }?;
-        gl.enable_debug_output_if_requested();
-        let version = gl.version();
-        if (version.major, version.minor) < (4, 5) || version.is_embedded {
-            bail!(
-                "the context is OpenGL {}.{}{}, 4.5 core is needed",
-                version.major,
-                version.minor,
-                if version.is_embedded { " ES" } else { "" }
-            );
-        }
+        // SAFETY: the context is current; symbols come from its display.
+        let gl = unsafe { load_gl(|name| display.get_proc_address(name), "the context") }?;
         let info = query_info(&gl, index, device.name().or(device.vendor()).unwrap_or(""));
         Ok(GlContext {
             gl: Arc::new(gl),
@@ -142,6 +127,31 @@ impl GlContext {
             _display: display,
         })
     }
+}
+
+/// Load the GL functions of the current context (debug output as requested) and check that it
+/// is 4.5 core; `what` names the context in the error ("the window's context").
+///
+/// # Safety
+/// A GL context must be current and `get_proc_address` must be its display's.
+pub unsafe fn load_gl(get_proc_address: impl Fn(&CStr) -> *const c_void, what: &str) -> Result<Gl> {
+    let load = |name: &str| {
+        let name = CString::new(name).expect("GL symbol names have no NUL");
+        get_proc_address(&name)
+    };
+    // SAFETY: as this function's contract: the context is current, the symbols its own.
+    let mut gl = unsafe { Gl::load(load) }?;
+    gl.enable_debug_output_if_requested();
+    let version = gl.version();
+    if (version.major, version.minor) < (4, 5) || version.is_embedded {
+        bail!(
+            "{what} is OpenGL {}.{}{}, 4.5 core is needed",
+            version.major,
+            version.minor,
+            if version.is_embedded { " ES" } else { "" }
+        );
+    }
+    Ok(gl)
 }
 
 /// Query the facts of `GlInfo` on a current context (headless or a window's); `device` and

@@ -9,12 +9,22 @@
 //! compile error is shown with file and line while the last good program keeps running.
 //!
 //! In a scene with an `[[area_light]]` the viewer also shows the soft shadows of Klee 2016
-//! ([`SoftShadowRenderer`]: G-buffer from the current camera, shadow pass, quad into its output
+//! (`SoftShadowRenderer`: G-buffer from the current camera, shadow pass, quad into its output
 //! texture, which the same screen-filling quad shows): `--shadows` starts with them, `S`
 //! cycles off (the ray tracer) / exact / linespace / linespace-dda, `L` / shift+`L` change the
 //! light samples (only the shadow kernel is recompiled; the N-tree is built once).
+//!
+//! The parts: `renderer` (the only user of the library's tracer API: the renderers shown,
+//! their frames' statistics), `design` (what is shown, with which options), `keys` (the
+//! key table: dispatch and help), `frames` (what to draw next, `--frames`, FPS), `window`
+//! (the GL window and the screen-filling quad), `orbit` (camera moves), `watch` (the
+//! `--glsl-dir` watcher).
 
+mod design;
+mod frames;
+mod keys;
 pub mod orbit;
+mod renderer;
 pub mod watch;
 pub mod window;
 
@@ -22,66 +32,30 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
-use clap::ValueEnum;
 use glow::HasContext;
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::{Key, ModifiersState, NamedKey};
+use winit::keyboard::ModifiersState;
 use winit::window::WindowId;
 
 use crate::args::SoftShadowArgs;
-use gpgpu_rt::accel::{GridVariant, TracerKind};
-use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::gl::{Gl, GlInfo};
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::softshadow::{scene_light, SoftShadowRenderer};
-use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::scene::ShadowMode;
 use gpgpu_rt::scene::{Camera, Scene};
 
-/// The ray tracer with the accelerator `kind`.
-fn create_tracer(
-    kind: TracerKind,
-    gl: std::sync::Arc<Gl>,
-    info: &GlInfo,
-    scene: &Scene,
-    shaders: &ShaderSource,
-    options: RenderOptions,
-) -> Result<Box<dyn Renderer>> {
-    let options = RenderOptions {
-        tracer: kind,
-        ..options
-    };
-    Ok(Box::new(RayTracer::new(gl, info, scene, shaders, options)?))
-}
-
+use design::Design;
+use frames::{Clock, FrameCount, Picture};
+use renderer::{
+    render_options, soft_shadow_support, GridArgs, RenderOptions, Renderers, ShadowFlags,
+    ShadowMode, Show, Stats, TracerKind,
+};
 use watch::GlslWatcher;
 use window::{
     compile_quad_program, fit_viewport, read_back_buffer, save_png, GlWindow, ScreenQuad, Viewport,
 };
 
-/// The controls, printed by `H` and listed in the README.
-pub const CONTROLS: &str = "\
-mouse: left drag orbit | right/middle drag or shift+left drag pan | wheel zoom
-keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
-       T / shift+T next / previous tracer | V next grid variant
-       G / shift+G grid resolution +4 / -4 | A grid resolution auto
-       ] / [ reflection depth +1 / -1
-       S / shift+S soft shadows next / previous (off, exact, linespace, linespace-dda)
-       L / shift+L light samples +1 / -1 per axis (2x2 ... 10x10; S and L: [[area_light]] scenes)
-       R or F5 reload kernels | P save a screenshot | space pause | H help | Q or Esc quit";
-
 /// How often `--glsl-dir` is polled for changes.
 const WATCH_INTERVAL: Duration = Duration::from_millis(200);
-/// Largest reflection depth the keys go to.
-const MAX_REFL_DEPTH: u32 = 16;
-/// Grid resolution step of the G keys.
-const GRID_STEP: u32 = 4;
-/// Light samples per axis the L keys go between (Klee 2016: 2×2 … 10×10).
-const MIN_LIGHT_SAMPLES: u32 = 2;
-const MAX_LIGHT_SAMPLES: u32 = 10;
 
 /// Options of `gpgpu-rt view`.
 #[derive(clap::Args, Debug, Clone)]
@@ -109,7 +83,7 @@ pub struct ViewArgs {
     /// The grid tracer's options, as for `render` (G / shift+G / A change the resolution, V
     /// the variant).
     #[command(flatten)]
-    pub grid: crate::args::GridArgs,
+    pub grid: GridArgs,
     /// The soft-shadow options, as for `render` (scenes with an `[[area_light]]`; S cycles the
     /// mode, L / shift+L the samples).
     #[command(flatten)]
@@ -160,19 +134,19 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
     if args.soft.shadows.is_some() {
         // the same message as `render --shadows`
-        scene_light(&scene)?;
+        soft_shadow_support(&scene)?;
     }
     let shaders = ShaderSource::from_dir(args.glsl_dir.clone())?;
-    let options = RenderOptions {
-        tracer: args.tracer,
-        width: args.width.unwrap_or(scene.settings.width),
-        height: args.height.unwrap_or(scene.settings.height),
-        refl_depth: args.refl_depth.unwrap_or(scene.settings.refl_depth),
-        tile: args.tile,
-        shadow_flags: args.shadow_flags,
-        aovs: false,
-        grid: args.grid.options(),
-    };
+    let options = render_options(
+        (
+            args.width.unwrap_or(scene.settings.width),
+            args.height.unwrap_or(scene.settings.height),
+        ),
+        args.refl_depth.unwrap_or(scene.settings.refl_depth),
+        args.tile,
+        args.shadow_flags,
+        &args.grid,
+    );
     if options.width == 0 || options.height == 0 {
         bail!(
             "the image size {}x{} must not be zero",
@@ -196,33 +170,24 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
 
 /// What runs while the window is open. Field order is drop order: GL objects before the window.
 struct Running {
-    /// The ray tracer (`App::kind`, `App::options`); `None` until it is first shown, and after
-    /// a change or a reload while the soft shadows are shown (built again when shown).
-    tracer: Option<Box<dyn Renderer>>,
-    /// The soft-shadow renderer, built when first shown and kept while the ray tracer is shown
-    /// (its N-tree is built once).
-    soft: Option<SoftShadowRenderer>,
+    renderers: Renderers,
     quad: ScreenQuad,
     watcher: Option<GlslWatcher>,
     window: GlWindow,
 }
 
 impl Running {
-    /// Render a frame from `camera` with the soft shadows `shadows`, else the ray tracer.
-    fn render(&mut self, shadows: Option<ShadowMode>, camera: &Camera) -> Result<FrameStats> {
-        match (shadows, self.soft.as_mut(), self.tracer.as_mut()) {
-            (Some(_), Some(soft), _) => soft.draw(camera),
-            (None, _, Some(tracer)) => tracer.draw(camera),
-            _ => bail!("no renderer is built"),
+    /// Show `texture` (the last frame, if any) in the window, letterboxed to the `image` size:
+    /// the viewport it fills.
+    fn present(&self, texture: Option<glow::Texture>, image: (u32, u32)) -> Viewport {
+        let size = self.window.size();
+        let viewport = fit_viewport(size, image);
+        if let Some(texture) = texture {
+            // SAFETY: drawing to the window's default framebuffer.
+            unsafe { self.window.gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
+            self.quad.draw(texture, size, viewport);
         }
-    }
-
-    /// The output texture of what is shown (the soft shadows or the ray tracer).
-    fn output_texture(&self, shadows: Option<ShadowMode>) -> Option<glow::Texture> {
-        match shadows {
-            Some(_) => self.soft.as_ref().map(|s| s.output_texture()),
-            None => self.tracer.as_ref().map(|t| t.output_texture()),
-        }
+        viewport
     }
 }
 
@@ -238,58 +203,19 @@ struct App {
     args: ViewArgs,
     scene: Scene,
     shaders: ShaderSource,
-    kind: TracerKind,
-    options: RenderOptions,
-    /// Soft shadows shown (`None`: the ray tracer `kind`).
-    shadows: Option<ShadowMode>,
-    /// Light samples U×V of the soft shadows.
-    samples: (u32, u32),
-    /// Why the scene cannot have soft shadows (no or several area lights); `None`: it can.
-    no_soft: Option<String>,
-    /// The soft-shadow renderer's kernels are older than the sources (a reload while the ray
-    /// tracer was shown): recompiled when it is shown again.
-    soft_stale: bool,
-    /// The grid resolution the grid tracer last reported (for `auto`).
-    grid_in_use: Option<u32>,
+    /// The design shown and its options.
+    design: Design,
     camera: Camera,
     running: Option<Running>,
     result: Result<()>,
     input: Input,
-    /// Render continuously (not paused).
-    continuous: bool,
-    /// Something changed: render the next frame even when paused.
-    dirty: bool,
-    /// The last render failed: do not retry until something changes.
-    render_failed: bool,
-    /// A frame has been rendered into the current tracer's output texture.
-    has_frame: bool,
-    /// Frames rendered (all) and counted toward --frames.
-    frames: u64,
-    counted: u64,
-    /// --wait-reload: frames count only after a successful reload.
-    counting: bool,
-    last_stats: Option<FrameStats>,
+    picture: Picture,
+    frames: FrameCount,
+    clock: Clock,
     /// An error or notice shown in the title until the next success.
     notice: Option<String>,
-    fps_frames: u32,
-    fps_since: Instant,
-    fps: Option<f64>,
-    title_at: Instant,
+    /// Screenshots saved with P.
     screenshots: u32,
-    /// --frames are done: nothing more is drawn while the event loop winds down.
-    finished: bool,
-}
-
-fn kind_name(kind: TracerKind) -> String {
-    kind.to_possible_value()
-        .map(|v| v.get_name().to_string())
-        .unwrap_or_else(|| format!("{kind:?}").to_lowercase())
-}
-
-fn variant_name(v: GridVariant) -> String {
-    v.to_possible_value()
-        .map(|v| v.get_name().to_string())
-        .unwrap_or_else(|| format!("{v:?}").to_lowercase())
 }
 
 /// The first line of an error that names a file and line (the compile log's first error), else
@@ -308,38 +234,35 @@ fn headline(error: &str) -> String {
         .unwrap_or_default()
 }
 
+/// 1234567 -> "1 234 567".
+fn group_digits(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push('\u{202f}');
+        }
+        out.push(c);
+    }
+    out
+}
+
 impl App {
     fn new(args: ViewArgs, scene: Scene, shaders: ShaderSource, options: RenderOptions) -> App {
         App {
-            kind: args.tracer,
-            shadows: args.soft.shadows,
-            samples: args.soft.samples(),
-            no_soft: scene_light(&scene).err().map(|e| format!("{e:#}")),
-            soft_stale: false,
-            grid_in_use: None,
+            design: Design::new(args.tracer, options, args.soft.clone(), &scene),
             camera: scene.camera,
-            counting: !args.wait_reload,
+            frames: FrameCount::new(args.frames, args.screenshot.is_some(), args.wait_reload),
             args,
             scene,
             shaders,
-            options,
             running: None,
             result: Ok(()),
             input: Input::default(),
-            continuous: true,
-            dirty: true,
-            render_failed: false,
-            has_frame: false,
-            frames: 0,
-            counted: 0,
-            last_stats: None,
+            picture: Picture::new(),
+            clock: Clock::new(),
             notice: None,
-            fps_frames: 0,
-            fps_since: Instant::now(),
-            fps: None,
-            title_at: Instant::now(),
             screenshots: 0,
-            finished: false,
         }
     }
 
@@ -360,65 +283,45 @@ impl App {
 
     fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let title = format!("gpgpu-rt view · {}", self.scene_name());
-        let window = GlWindow::new(event_loop, &title, self.options.width, self.options.height)?;
-        let gl = window.gl.clone();
+        let (width, height) = self.design.size();
+        let window = GlWindow::new(event_loop, &title, width, height)?;
         // watch before compiling: an edit made while the first tracer builds is not missed
         let watcher = self
             .shaders
             .dir
             .as_ref()
             .map(|d| GlslWatcher::new(d, WATCH_INTERVAL));
-        let quad = ScreenQuad::new(gl, compile_quad_program(&window.gl, &self.shaders)?)?;
+        let quad = ScreenQuad::new(
+            window.gl.clone(),
+            compile_quad_program(&window.gl, &self.shaders)?,
+        )?;
         let info = window.info.clone();
         self.running = Some(Running {
-            tracer: None,
-            soft: None,
+            renderers: Renderers::new(window.gl.clone(), info.clone()),
             quad,
             watcher,
             window,
         });
-        match self.shadows {
-            Some(mode) => self.show_soft(mode, self.samples)?,
-            None => self.show_tracer(self.kind, self.options.clone(), false)?,
+        match self.design.shadows {
+            Some(mode) => self.show_soft(mode, self.design.samples)?,
+            None => self.show_tracer(self.design.kind, self.design.options.clone(), false)?,
         }
         eprintln!(
-            "{}: {} triangles, {} lights, {} area lights, {}x{}, {} on {} ({}, {})\n{CONTROLS}",
+            "{}: {} triangles, {} lights, {} area lights, {width}x{height}, {} on {} ({}, {})\n{}",
             self.scene.path.display(),
             self.scene.triangle_count(),
             self.scene.lights.len(),
             self.scene.area_lights.len(),
-            self.options.width,
-            self.options.height,
-            self.shown_name(),
+            self.design.name(),
             info.renderer,
             info.version,
             info.egl_device_name,
+            keys::controls(),
         );
         if let Some(w) = self.running.as_ref().and_then(|r| r.watcher.as_ref()) {
             println!("watching {} for kernel changes", w.dir().display());
         }
         Ok(())
-    }
-
-    /// What the window shows: "base tracer", "soft shadows linespace 3x3".
-    fn shown_name(&self) -> String {
-        match self.shadows {
-            Some(mode) => format!(
-                "soft shadows {} {}x{}",
-                mode.name(),
-                self.samples.0,
-                self.samples.1
-            ),
-            None => format!("{} tracer", kind_name(self.kind)),
-        }
-    }
-
-    /// A new renderer or new options: the next frame is rendered, the old statistics go.
-    fn new_picture(&mut self) {
-        self.has_frame = false;
-        self.last_stats = None;
-        self.render_failed = false;
-        self.dirty = true;
     }
 
     /// Show the ray tracer `kind` with `options`; it is built unless `rebuild` is false and one
@@ -430,21 +333,14 @@ impl App {
         rebuild: bool,
     ) -> Result<()> {
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
-        if rebuild || running.tracer.is_none() {
-            let tracer = create_tracer(
-                kind,
-                running.window.gl.clone(),
-                &running.window.info,
-                &self.scene,
-                &self.shaders,
-                options.clone(),
-            )?;
-            running.tracer = Some(tracer);
-        }
-        self.kind = kind;
-        self.options = options;
-        self.shadows = None;
-        self.new_picture();
+        let what = Show::Tracer(kind, &options);
+        running
+            .renderers
+            .show(&self.scene, &self.shaders, what, rebuild)?;
+        self.design.kind = kind;
+        self.design.options = options;
+        self.design.shadows = None;
+        self.picture.reset();
         Ok(())
     }
 
@@ -452,40 +348,17 @@ impl App {
     /// N-tree with it); later only its shadow kernel is recompiled (all its kernels after a
     /// reload). On failure what runs stays.
     fn show_soft(&mut self, mode: ShadowMode, samples: (u32, u32)) -> Result<()> {
-        if let Some(why) = &self.no_soft {
+        if let Some(why) = &self.design.no_soft {
             bail!("{why}");
         }
-        let mut options = self.args.soft.options(
-            mode,
-            self.options.width,
-            self.options.height,
-            self.options.tile,
-        );
-        (options.samples_u, options.samples_v) = samples;
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
-        match running.soft.as_mut() {
-            None => {
-                let soft = SoftShadowRenderer::new(
-                    running.window.gl.clone(),
-                    &running.window.info,
-                    &self.scene,
-                    &self.shaders,
-                    options,
-                )?;
-                running.soft = Some(soft);
-            }
-            Some(s) if self.soft_stale => s.recompile(&self.shaders, mode, samples.0, samples.1)?,
-            Some(s) => {
-                let o = &s.options;
-                if (o.mode, o.samples_u, o.samples_v) != (mode, samples.0, samples.1) {
-                    s.reconfigure(&self.shaders, mode, samples.0, samples.1)?;
-                }
-            }
-        }
-        self.soft_stale = false;
-        self.shadows = Some(mode);
-        self.samples = samples;
-        self.new_picture();
+        let what = self.design.soft_shadows(mode, samples);
+        running
+            .renderers
+            .show(&self.scene, &self.shaders, what, false)?;
+        self.design.shadows = Some(mode);
+        self.design.samples = samples;
+        self.picture.reset();
         Ok(())
     }
 
@@ -501,21 +374,8 @@ impl App {
         } else {
             None
         };
-        let rebuilt = match (self.shadows, running.soft.as_mut()) {
-            (Some(mode), Some(soft)) => {
-                soft.recompile(&self.shaders, mode, self.samples.0, self.samples.1)
-            }
-            _ => create_tracer(
-                self.kind,
-                gl.clone(),
-                &running.window.info,
-                &self.scene,
-                &self.shaders,
-                self.options.clone(),
-            )
-            .map(|t| running.tracer = Some(t)),
-        };
-        if let Err(e) = rebuilt {
+        let shown = self.design.shown();
+        if let Err(e) = running.renderers.reload(&self.scene, &self.shaders, shown) {
             if let Some(p) = program {
                 // SAFETY: deleting the program we just made.
                 unsafe { gl.delete_program(p) };
@@ -525,12 +385,7 @@ impl App {
         if let Some(p) = program {
             running.quad.set_program(p);
         }
-        if self.shadows.is_some() {
-            running.tracer = None;
-        } else {
-            self.soft_stale = running.soft.is_some();
-        }
-        self.new_picture();
+        self.picture.reset();
         Ok(start.elapsed())
     }
 
@@ -540,7 +395,7 @@ impl App {
             Some(files) => (
                 files
                     .iter()
-                    .any(|f| f.to_string_lossy().starts_with("screen_quad")),
+                    .any(|f| f.to_string_lossy().starts_with("common/screen_quad")),
                 files
                     .iter()
                     .map(|f| f.display().to_string())
@@ -553,13 +408,11 @@ impl App {
             Ok(took) => {
                 println!(
                     "reload ok: {what} ({} rebuilt in {:.0} ms)",
-                    self.shown_name(),
+                    self.design.name(),
                     took.as_secs_f64() * 1e3
                 );
                 self.notice = None;
-                if self.args.wait_reload && !self.counting {
-                    self.counting = true;
-                }
+                self.frames.start_counting();
             }
             Err(e) => {
                 let msg = format!("{e:#}");
@@ -567,7 +420,7 @@ impl App {
                 println!("reload failed: {what}: {}", headline(&msg));
                 eprintln!("reload failed: {msg}\nthe last good kernels keep running");
                 self.notice = Some(format!("reload failed: {}", headline(&msg)));
-                self.dirty = true;
+                self.picture.dirty = true;
             }
         }
         self.update_title(true);
@@ -593,11 +446,11 @@ impl App {
     /// for it (it is built with them when S shows it again); else it is rebuilt, and on
     /// failure the running one stays.
     fn change(&mut self, kind: TracerKind, options: RenderOptions, what: String) {
-        if self.shadows.is_some() {
-            self.kind = kind;
-            self.options = options;
+        if self.design.shadows.is_some() {
+            self.design.kind = kind;
+            self.design.options = options;
             if let Some(r) = self.running.as_mut() {
-                r.tracer = None;
+                r.renderers.forget_tracer();
             }
             println!("{what} (for the ray tracer; soft shadows are shown, S switches)");
             self.update_title(true);
@@ -607,61 +460,40 @@ impl App {
         self.report(what, result);
     }
 
+    /// Grid options only matter to tracers that use them; the base tracer keeps running.
+    fn change_grid(&mut self, options: RenderOptions, what: String) {
+        if self.design.kind == TracerKind::Base {
+            self.design.options = options;
+            println!("{what} (used by the grid tracer; the base tracer ignores it)");
+            self.update_title(true);
+        } else {
+            self.change(self.design.kind, options, what);
+        }
+    }
+
+    /// The camera moved (mouse, keys): render from `camera`.
+    fn move_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.picture.moved();
+    }
+
     fn update_title(&mut self, now: bool) {
-        if !now && self.title_at.elapsed() < Duration::from_millis(250) {
+        if !self.clock.title_due(now) {
             return;
         }
-        self.title_at = Instant::now();
         let Some(running) = &self.running else { return };
-        let mut t = format!("gpgpu-rt · {} · ", self.scene_name());
-        match (self.shadows, running.soft.as_ref()) {
-            (Some(mode), Some(soft)) => {
-                t += &format!(
-                    "soft shadows {} {}×{} · N-tree {}/{}",
-                    mode.name(),
-                    self.samples.0,
-                    self.samples.1,
-                    soft.scene.tree.n,
-                    soft.scene.tree.depth
-                );
-            }
-            _ => {
-                t += &kind_name(self.kind);
-                if self.kind != TracerKind::Base {
-                    let g = &self.options.grid;
-                    let res = g
-                        .resolution
-                        .map(|r| r.to_string())
-                        .or_else(|| self.grid_in_use.map(|r| format!("auto={r}")))
-                        .unwrap_or_else(|| "auto".into());
-                    t += &format!(" {} {res}³", variant_name(g.variant));
-                }
-            }
-        }
-        t += &format!(" · {}×{}", self.options.width, self.options.height);
-        if self.shadows.is_none() {
-            t += &format!(" · refl {}", self.options.refl_depth);
-        }
-        if !self.continuous {
+        let mut t = format!(
+            "gpgpu-rt · {} · {}",
+            self.scene_name(),
+            self.design.title(running.renderers.ntree())
+        );
+        if !self.picture.continuous {
             t += " · paused";
-        } else if let Some(fps) = self.fps {
+        } else if let Some(fps) = self.clock.fps() {
             t += &format!(" · {fps:.2} FPS");
         }
-        if let Some(s) = &self.last_stats {
-            let kernels: Vec<String> = s
-                .gpu_ms
-                .iter()
-                .map(|(k, v)| format!("{k} {v:.1}"))
-                .collect();
-            t += &format!(
-                " · GPU {:.1} ms ({}) · {} triangle tests",
-                s.total_gpu_ms(),
-                kernels.join(", "),
-                group_digits(s.total_triangle_tests())
-            );
-            if let Some(n) = s.events.get("linespace_lookups") {
-                t += &format!(" · {} line-space lookups", group_digits(*n));
-            }
+        if let Some(s) = &self.picture.last_stats {
+            t += &s.title();
         }
         if let Some(n) = &self.notice {
             t += &format!(" · ⚠ {n}");
@@ -670,84 +502,18 @@ impl App {
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
-        if self.finished {
+        if self.frames.finished || self.running.is_none() {
             return;
         }
-        let want = (self.continuous || self.dirty) && !self.render_failed;
-        let name = self.shown_name();
-        let Some(running) = self.running.as_mut() else {
-            return;
-        };
-        if want {
-            self.dirty = false;
-            running.window.begin_compute();
-            let rendered = running.render(self.shadows, &self.camera);
-            if let Err(e) = running.window.begin_present() {
+        if self.picture.wanted() {
+            if let Err(e) = self.render_frame() {
                 return self.fail(event_loop, e);
             }
-            match rendered {
-                Ok(frame) => {
-                    self.frames += 1;
-                    self.fps_frames += 1;
-                    self.has_frame = true;
-                    if self.counting {
-                        self.counted += 1;
-                    }
-                    let s = frame;
-                    if self.args.log_frames {
-                        let kernels: Vec<String> = s
-                            .gpu_ms
-                            .iter()
-                            .map(|(k, v)| format!("{k}={v:.3}"))
-                            .collect();
-                        let lookups = s
-                            .events
-                            .get("linespace_lookups")
-                            .map(|n| format!(", line-space lookups {n}"))
-                            .unwrap_or_default();
-                        println!(
-                            "frame {}: {}, wall {:.1} ms, gpu {:.3} ms [{}], triangle tests {}{lookups}",
-                            self.frames,
-                            name,
-                            s.wall_ms,
-                            s.total_gpu_ms(),
-                            kernels.join(" "),
-                            s.total_triangle_tests()
-                        );
-                    }
-                    if self.shadows.is_none() {
-                        if let Some(r) = s.facts.get("grid_resolution").and_then(|r| r.as_u64()) {
-                            self.grid_in_use = Some(r as u32);
-                        }
-                    }
-                    self.last_stats = Some(s);
-                }
-                Err(e) => {
-                    let msg = format!("{e:#}");
-                    if self.args.frames.is_some() || self.args.screenshot.is_some() {
-                        return self.fail(event_loop, anyhow!("rendering a frame failed: {msg}"));
-                    }
-                    eprintln!("rendering a frame failed: {msg}");
-                    self.notice = Some(format!("render failed: {}", headline(&msg)));
-                    self.render_failed = true;
-                }
-            }
         }
-        let size = running.window.size();
-        let viewport = fit_viewport(size, (self.options.width, self.options.height));
-        if let Some(texture) = running
-            .output_texture(self.shadows)
-            .filter(|_| self.has_frame)
-        {
-            // SAFETY: drawing to the window's default framebuffer.
-            unsafe { running.window.gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
-            running.quad.draw(texture, size, viewport);
-        }
-        let target = self.args.frames.unwrap_or(1);
-        let done = (self.args.frames.is_some() || self.args.screenshot.is_some())
-            && self.counted >= target;
-        if done {
-            self.finished = true;
+        let Some(running) = &self.running else { return };
+        let viewport = running.present(self.frame_texture(), self.design.size());
+        if self.frames.done() {
+            self.frames.finished = true;
             if let Some(path) = self.args.screenshot.clone() {
                 if let Err(e) = self.save_screenshot(&path, viewport) {
                     return self.fail(event_loop, e);
@@ -755,30 +521,70 @@ impl App {
             }
             event_loop.exit();
         }
-        let Some(running) = self.running.as_mut() else {
-            return;
-        };
+        let Some(running) = &self.running else { return };
         if let Err(e) = running.window.swap() {
             return self.fail(event_loop, e);
         }
-        let elapsed = self.fps_since.elapsed();
-        if elapsed >= Duration::from_millis(500) {
-            self.fps = Some(self.fps_frames as f64 / elapsed.as_secs_f64());
-            self.fps_frames = 0;
-            self.fps_since = Instant::now();
-        }
+        self.clock.tick();
         self.update_title(false);
+    }
+
+    /// Render a frame into the shown renderer's output texture. A failed frame ends a run that
+    /// counts frames (the error is returned); else it is reported, and no frame is rendered
+    /// until something changes.
+    fn render_frame(&mut self) -> Result<()> {
+        let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
+        self.picture.dirty = false;
+        running.window.begin_compute();
+        let rendered = running
+            .renderers
+            .draw(self.design.shadows.is_some(), &self.camera);
+        running.window.begin_present()?;
+        match rendered {
+            Ok(stats) => self.rendered(stats),
+            Err(e) => {
+                let msg = format!("{e:#}");
+                if self.frames.has_target() {
+                    bail!("rendering a frame failed: {msg}");
+                }
+                eprintln!("rendering a frame failed: {msg}");
+                self.notice = Some(format!("render failed: {}", headline(&msg)));
+                self.picture.render_failed = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// A frame was rendered: count it, log it (--log-frames), keep its statistics.
+    fn rendered(&mut self, stats: Stats) {
+        let n = self.frames.add();
+        self.clock.frame();
+        self.picture.has_frame = true;
+        if self.args.log_frames {
+            println!("frame {n}: {}, {}", self.design.name(), stats.log());
+        }
+        self.design.note(&stats);
+        self.picture.last_stats = Some(stats);
+    }
+
+    /// The output texture of what is shown, once a frame has been rendered into it.
+    fn frame_texture(&self) -> Option<glow::Texture> {
+        let running = self.running.as_ref()?;
+        let soft = self.design.shadows.is_some();
+        running
+            .renderers
+            .output_texture(soft)
+            .filter(|_| self.picture.has_frame)
     }
 
     /// Save the current frame: the window's back buffer when it shows the image at its own
     /// size, else the quad drawn offscreen at the image size.
-    fn save_screenshot(&mut self, path: &Path, viewport: Viewport) -> Result<()> {
+    fn save_screenshot(&self, path: &Path, viewport: Viewport) -> Result<()> {
         let running = self.running.as_ref().ok_or_else(|| anyhow!("no window"))?;
-        let texture = running
-            .output_texture(self.shadows)
-            .filter(|_| self.has_frame)
+        let texture = self
+            .frame_texture()
             .ok_or_else(|| anyhow!("no frame has been rendered yet"))?;
-        let (w, h) = (self.options.width, self.options.height);
+        let (w, h) = self.design.size();
         let (pixels, from) = if (viewport.width, viewport.height) == (w, h) {
             (
                 read_back_buffer(&running.window.gl, viewport),
@@ -797,229 +603,9 @@ impl App {
         println!(
             "screenshot: {} ({w}x{h}, frame {}, {from})",
             path.display(),
-            self.frames
+            self.frames.rendered
         );
         Ok(())
-    }
-
-    fn key(&mut self, event_loop: &ActiveEventLoop, event: KeyEvent) {
-        if event.state != ElementState::Pressed {
-            return;
-        }
-        let shift = self.input.modifiers.shift_key();
-        let cam = self.camera;
-        let moved = |app: &mut App, c: Camera| {
-            app.camera = c;
-            app.dirty = true;
-            app.render_failed = false;
-        };
-        match event.logical_key.as_ref() {
-            Key::Named(NamedKey::Escape) | Key::Character("q") | Key::Character("Q") => {
-                event_loop.exit()
-            }
-            Key::Named(NamedKey::ArrowLeft) if shift => moved(self, orbit::pan(&cam, -0.05, 0.0)),
-            Key::Named(NamedKey::ArrowRight) if shift => moved(self, orbit::pan(&cam, 0.05, 0.0)),
-            Key::Named(NamedKey::ArrowUp) if shift => moved(self, orbit::pan(&cam, 0.0, -0.05)),
-            Key::Named(NamedKey::ArrowDown) if shift => moved(self, orbit::pan(&cam, 0.0, 0.05)),
-            Key::Named(NamedKey::ArrowLeft) => moved(self, orbit::orbit(&cam, -5.0, 0.0)),
-            Key::Named(NamedKey::ArrowRight) => moved(self, orbit::orbit(&cam, 5.0, 0.0)),
-            Key::Named(NamedKey::ArrowUp) => moved(self, orbit::orbit(&cam, 0.0, 5.0)),
-            Key::Named(NamedKey::ArrowDown) => moved(self, orbit::orbit(&cam, 0.0, -5.0)),
-            Key::Character("+") | Key::Character("=") => moved(self, orbit::zoom(&cam, 0.9)),
-            Key::Character("-") | Key::Character("_") => moved(self, orbit::zoom(&cam, 1.0 / 0.9)),
-            Key::Named(NamedKey::Home) | Key::Character("c") | Key::Character("C") => {
-                let c = self.scene.camera;
-                moved(self, c)
-            }
-            Key::Character("t") | Key::Character("T") => {
-                let kinds = TracerKind::value_variants();
-                let i = kinds.iter().position(|k| *k == self.kind).unwrap_or(0);
-                let n = kinds.len();
-                let next = kinds[if shift { (i + n - 1) % n } else { (i + 1) % n }];
-                if self.shadows.is_some() {
-                    // from the soft shadows to the next ray tracer
-                    let rebuild = next != self.kind;
-                    let result = self.show_tracer(next, self.options.clone(), rebuild);
-                    self.report(
-                        format!("tracer {} (soft shadows off)", kind_name(next)),
-                        result,
-                    );
-                } else if n == 1 {
-                    self.notice = Some(format!("{} is the only tracer", kind_name(next)));
-                    self.update_title(true);
-                } else {
-                    self.change(
-                        next,
-                        self.options.clone(),
-                        format!("tracer {}", kind_name(next)),
-                    );
-                }
-            }
-            Key::Character("v") | Key::Character("V") => {
-                let variants = GridVariant::value_variants();
-                let i = variants
-                    .iter()
-                    .position(|v| *v == self.options.grid.variant)
-                    .unwrap_or(0);
-                let mut o = self.options.clone();
-                o.grid.variant = variants[(i + 1) % variants.len()];
-                let what = format!("grid variant {}", variant_name(o.grid.variant));
-                self.change_grid(o, what);
-            }
-            Key::Character("g") | Key::Character("G") => {
-                let current = self
-                    .options
-                    .grid
-                    .resolution
-                    .or(self.grid_in_use)
-                    .unwrap_or(16);
-                let next = if shift {
-                    current.saturating_sub(GRID_STEP).max(1)
-                } else {
-                    current.saturating_add(GRID_STEP)
-                };
-                let mut o = self.options.clone();
-                o.grid.resolution = Some(next);
-                self.change_grid(o, format!("grid resolution {next}³"));
-            }
-            Key::Character("a") | Key::Character("A") => {
-                let mut o = self.options.clone();
-                o.grid.resolution = None;
-                self.change_grid(o, "grid resolution auto".into());
-            }
-            Key::Character("]")
-            | Key::Character("}")
-            | Key::Character("[")
-            | Key::Character("{") => {
-                let up = matches!(
-                    event.logical_key.as_ref(),
-                    Key::Character("]") | Key::Character("}")
-                );
-                let depth = self.options.refl_depth;
-                let next = if up {
-                    (depth + 1).min(MAX_REFL_DEPTH)
-                } else {
-                    depth.saturating_sub(1)
-                };
-                if next != depth {
-                    let mut o = self.options.clone();
-                    o.refl_depth = next;
-                    self.change(self.kind, o, format!("reflection depth {next}"));
-                }
-            }
-            Key::Character("s") | Key::Character("S") => {
-                // off (the ray tracer), exact, linespace, linespace-dda
-                let mut cycle = vec![None];
-                cycle.extend(ShadowMode::value_variants().iter().copied().map(Some));
-                let i = cycle.iter().position(|m| *m == self.shadows).unwrap_or(0);
-                let n = cycle.len();
-                let next = cycle[if shift { (i + n - 1) % n } else { (i + 1) % n }];
-                let (what, result) = match next {
-                    _ if self.no_soft.is_some() => {
-                        ("soft shadows".to_string(), Err(self.no_soft_error()))
-                    }
-                    None => (
-                        format!("soft shadows off: {} tracer", kind_name(self.kind)),
-                        self.show_tracer(self.kind, self.options.clone(), false),
-                    ),
-                    Some(mode) => (
-                        format!(
-                            "soft shadows {} {}x{}",
-                            mode.name(),
-                            self.samples.0,
-                            self.samples.1
-                        ),
-                        self.show_soft(mode, self.samples),
-                    ),
-                };
-                self.report(what, result);
-            }
-            Key::Character("l") | Key::Character("L") => {
-                let step = |n: u32| {
-                    if shift {
-                        if n > MIN_LIGHT_SAMPLES {
-                            n - 1
-                        } else {
-                            n
-                        }
-                    } else {
-                        (n + 1).clamp(MIN_LIGHT_SAMPLES, MAX_LIGHT_SAMPLES)
-                    }
-                };
-                let next = (step(self.samples.0), step(self.samples.1));
-                let what = format!("light samples {}x{}", next.0, next.1);
-                if self.no_soft.is_some() {
-                    let e = self.no_soft_error();
-                    self.report("light samples".into(), Err(e));
-                } else if next == self.samples {
-                    self.notice = Some(format!(
-                        "light samples {}x{}: the keys go from {MIN_LIGHT_SAMPLES}x{MIN_LIGHT_SAMPLES} to \
-                         {MAX_LIGHT_SAMPLES}x{MAX_LIGHT_SAMPLES}",
-                        next.0, next.1
-                    ));
-                    self.update_title(true);
-                } else if let Some(mode) = self.shadows {
-                    let result = self.show_soft(mode, next);
-                    self.report(what, result);
-                } else {
-                    self.samples = next;
-                    println!("{what} (for the soft shadows; S shows them)");
-                    self.notice = None;
-                    self.update_title(true);
-                }
-            }
-            Key::Named(NamedKey::F5) | Key::Character("r") | Key::Character("R") => {
-                self.reload(None)
-            }
-            Key::Character("p") | Key::Character("P") => {
-                self.screenshots += 1;
-                let stem = self
-                    .scene
-                    .path
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().to_string())
-                    .unwrap_or_default();
-                let path = PathBuf::from(format!("gpgpu-rt-{stem}-{:03}.png", self.screenshots));
-                let full = Viewport {
-                    x: 0,
-                    y: 0,
-                    width: 0,
-                    height: 0,
-                };
-                if let Err(e) = self.save_screenshot(&path, full) {
-                    eprintln!("screenshot failed: {e:#}");
-                }
-                self.dirty = true;
-            }
-            Key::Named(NamedKey::Space) => {
-                self.continuous = !self.continuous;
-                self.dirty = true;
-                self.update_title(true);
-            }
-            Key::Named(NamedKey::F1) | Key::Character("h") | Key::Character("H") => {
-                println!("{CONTROLS}")
-            }
-            _ => {}
-        }
-    }
-
-    /// Grid options only matter to tracers that use them; the base tracer keeps running.
-    fn change_grid(&mut self, options: RenderOptions, what: String) {
-        if self.kind == TracerKind::Base {
-            self.options = options;
-            println!("{what} (used by the grid tracer; the base tracer ignores it)");
-            self.update_title(true);
-        } else {
-            self.change(self.kind, options, what);
-        }
-    }
-
-    /// Why S and L do nothing in this scene.
-    fn no_soft_error(&self) -> anyhow::Error {
-        anyhow!(
-            "{} (S and L need a scene with one [[area_light]])",
-            self.no_soft.as_deref().unwrap_or("no area light")
-        )
     }
 
     fn mouse_move(&mut self, x: f64, y: f64) {
@@ -1033,10 +619,8 @@ impl App {
         let h = self
             .running
             .as_ref()
-            .map(|r| {
-                fit_viewport(r.window.size(), (self.options.width, self.options.height)).height
-            })
-            .unwrap_or(self.options.height)
+            .map(|r| fit_viewport(r.window.size(), self.design.size()).height)
+            .unwrap_or(self.design.options.height)
             .max(1) as f32;
         let pan = self.input.panning || (self.input.orbiting && self.input.modifiers.shift_key());
         let cam = if pan {
@@ -1047,23 +631,8 @@ impl App {
         } else {
             return;
         };
-        self.camera = cam;
-        self.dirty = true;
-        self.render_failed = false;
+        self.move_camera(cam);
     }
-}
-
-/// 1234567 -> "1 234 567".
-fn group_digits(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push('\u{202f}');
-        }
-        out.push(c);
-    }
-    out
 }
 
 impl ApplicationHandler for App {
@@ -1115,9 +684,7 @@ impl ApplicationHandler for App {
                     MouseScrollDelta::PixelDelta(p) => (p.y / 40.0) as f32,
                 };
                 if steps != 0.0 {
-                    self.camera = orbit::zoom(&self.camera, 0.9f32.powf(steps));
-                    self.dirty = true;
-                    self.render_failed = false;
+                    self.move_camera(orbit::zoom(&self.camera, 0.9f32.powf(steps)));
                 }
             }
             _ => {}
@@ -1134,7 +701,7 @@ impl ApplicationHandler for App {
             self.reload(Some(files));
         }
         let Some(running) = &self.running else { return };
-        if (self.continuous || self.dirty) && !self.render_failed {
+        if self.picture.wanted() {
             running.window.window.request_redraw();
             event_loop.set_control_flow(ControlFlow::Poll);
         } else if let Some(w) = &running.watcher {

@@ -4,11 +4,10 @@
 //! and the small raster pass that shows a tracer's output texture: a fragment shader samples
 //! the texture through a 2D sampler and textures a quad that fills the viewport.
 
-use std::ffi::CString;
 use std::num::NonZeroU32;
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Context as _, Result};
+use anyhow::{anyhow, Context as _, Result};
 use glow::HasContext;
 use glutin::config::{ColorBufferType, Config, ConfigTemplateBuilder};
 use glutin::context::{
@@ -18,12 +17,12 @@ use glutin::display::GetGlDisplay;
 use glutin::prelude::*;
 use glutin::surface::{Surface, SurfaceAttributesBuilder, SwapInterval, WindowSurface};
 use glutin_winit::{ApiPreference, DisplayBuilder, GlWindow as _};
-use raw_window_handle::HasWindowHandle;
+use raw_window_handle::{HasWindowHandle, RawWindowHandle};
 use winit::dpi::PhysicalSize;
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
-use gpgpu_rt::gl::context::query_info;
+use gpgpu_rt::gl::context::{load_gl, query_info};
 use gpgpu_rt::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 
 /// A window with a current GL 4.5 core context. Drop GL objects made on `gl` first.
@@ -53,6 +52,59 @@ fn config_rank(c: &Config) -> (u32, u8, bool) {
     (deep, c.num_samples(), c.srgb_capable())
 }
 
+/// Open a `width`×`height` window with the best GL config for it (see [`config_rank`]).
+fn open_window(
+    event_loop: &ActiveEventLoop,
+    title: &str,
+    width: u32,
+    height: u32,
+) -> Result<(Window, Config)> {
+    let attributes = Window::default_attributes()
+        .with_title(title)
+        .with_inner_size(PhysicalSize::new(width, height))
+        .with_resizable(true);
+    // EGL first (the same Mesa path as headless rendering, whose GL timer queries time the
+    // compute kernels), GLX where EGL is missing
+    let (window, config) = DisplayBuilder::new()
+        .with_preference(ApiPreference::PreferEgl)
+        .with_window_attributes(Some(attributes))
+        .build(event_loop, ConfigTemplateBuilder::new(), |configs| {
+            configs
+                .min_by_key(config_rank)
+                .expect("glutin offers at least one config")
+        })
+        .map_err(|e| anyhow!("cannot open a window with an OpenGL config: {e}"))?;
+    let window = window.ok_or_else(|| anyhow!("the window system gave no window"))?;
+    Ok((window, config))
+}
+
+/// The window's GL surface (plain, not sRGB); a window of zero size gets the requested size
+/// until the first resize.
+fn window_surface(
+    window: &Window,
+    handle: RawWindowHandle,
+    config: &Config,
+    (width, height): (u32, u32),
+) -> Result<Surface<WindowSurface>> {
+    let size = window.inner_size();
+    let surface_attributes = window
+        .build_surface_attributes(SurfaceAttributesBuilder::new().with_srgb(Some(false)))
+        .or_else(|_| {
+            Ok::<_, anyhow::Error>(SurfaceAttributesBuilder::<WindowSurface>::new().build(
+                handle,
+                NonZeroU32::new(size.width.max(width).max(1)).unwrap(),
+                NonZeroU32::new(size.height.max(height).max(1)).unwrap(),
+            ))
+        })?;
+    // SAFETY: the attributes name this window; the config is the display's.
+    unsafe {
+        config
+            .display()
+            .create_window_surface(config, &surface_attributes)
+    }
+    .map_err(|e| anyhow!("cannot create a GL surface for the window: {e}"))
+}
+
 impl GlWindow {
     /// Open a `width`×`height` window (physical pixels) with a GL 4.5 core context current.
     pub fn new(
@@ -61,22 +113,7 @@ impl GlWindow {
         width: u32,
         height: u32,
     ) -> Result<GlWindow> {
-        let attributes = Window::default_attributes()
-            .with_title(title)
-            .with_inner_size(PhysicalSize::new(width, height))
-            .with_resizable(true);
-        // EGL first (the same Mesa path as headless rendering, whose GL timer queries time the
-        // compute kernels), GLX where EGL is missing
-        let (window, config) = DisplayBuilder::new()
-            .with_preference(ApiPreference::PreferEgl)
-            .with_window_attributes(Some(attributes))
-            .build(event_loop, ConfigTemplateBuilder::new(), |configs| {
-                configs
-                    .min_by_key(config_rank)
-                    .expect("glutin offers at least one config")
-            })
-            .map_err(|e| anyhow!("cannot open a window with an OpenGL config: {e}"))?;
-        let window = window.ok_or_else(|| anyhow!("the window system gave no window"))?;
+        let (window, config) = open_window(event_loop, title, width, height)?;
         let handle = window
             .window_handle()
             .map_err(|e| anyhow!("no native window handle: {e}"))?
@@ -90,20 +127,7 @@ impl GlWindow {
         // SAFETY: the config belongs to this display; the handle is the window's.
         let context = unsafe { display.create_context(&config, &attributes) }
             .map_err(|e| anyhow!("cannot create an OpenGL 4.5 core context for the window: {e}"))?;
-        let size = window.inner_size();
-        let surface_attributes = window
-            .build_surface_attributes(SurfaceAttributesBuilder::new().with_srgb(Some(false)))
-            .or_else(|_| {
-                // a window of zero size: use the requested size until the first resize
-                Ok::<_, anyhow::Error>(SurfaceAttributesBuilder::<WindowSurface>::new().build(
-                    handle,
-                    NonZeroU32::new(size.width.max(width).max(1)).unwrap(),
-                    NonZeroU32::new(size.height.max(height).max(1)).unwrap(),
-                ))
-            })?;
-        // SAFETY: the attributes name this window.
-        let surface = unsafe { display.create_window_surface(&config, &surface_attributes) }
-            .map_err(|e| anyhow!("cannot create a GL surface for the window: {e}"))?;
+        let surface = window_surface(&window, handle, &config, (width, height))?;
         let context = context
             .make_current(&surface)
             .map_err(|e| anyhow!("cannot make the window's GL context current: {e}"))?;
@@ -111,22 +135,13 @@ impl GlWindow {
         if let Err(e) = surface.set_swap_interval(&context, SwapInterval::DontWait) {
             log::info!("cannot turn vsync off: {e}");
         }
-        let load = |name: &str| {
-            let name = CString::new(name).expect("GL symbol names have no NUL");
-            display.get_proc_address(&name)
-        };
-        // SAFETY: the context is current; the loader returns this display's GL entry points.
-        let mut gl = unsafe { Gl::load(load) }?;
-        gl.enable_debug_output_if_requested();
-        let version = gl.version();
-        if (version.major, version.minor) < (4, 5) || version.is_embedded {
-            bail!(
-                "the window's context is OpenGL {}.{}{}, 4.5 core is needed",
-                version.major,
-                version.minor,
-                if version.is_embedded { " ES" } else { "" }
-            );
-        }
+        // SAFETY: the context is current; symbols come from its display.
+        let gl = unsafe {
+            load_gl(
+                |name| display.get_proc_address(name),
+                "the window's context",
+            )
+        }?;
         let info = query_info(&gl, 0, &format!("window ({})", display.version_string()));
         // SAFETY: state changes on the current context: colours reach the window unchanged.
         unsafe {
@@ -182,14 +197,17 @@ impl GlWindow {
     }
 }
 
-/// The screen-filling quad's program (`glsl/screen_quad.vert` + `.frag`), from `source` when it
+/// The screen-filling quad's program (`glsl/common/screen_quad.vert` + `.frag`), from `source` when it
 /// has them, else from the copies built into the binary (a `--glsl-dir` made before the viewer
 /// existed lacks them).
 pub fn compile_quad_program(gl: &Gl, source: &ShaderSource) -> Result<glow::Program> {
     let has_own = source
         .dir
         .as_ref()
-        .map(|d| d.join("screen_quad.vert").is_file() && d.join("screen_quad.frag").is_file())
+        .map(|d| {
+            d.join("common/screen_quad.vert").is_file()
+                && d.join("common/screen_quad.frag").is_file()
+        })
         .unwrap_or(true);
     let embedded = ShaderSource::default();
     let source = if has_own { source } else { &embedded };
@@ -197,8 +215,8 @@ pub fn compile_quad_program(gl: &Gl, source: &ShaderSource) -> Result<glow::Prog
         gl,
         source,
         &[
-            (glow::VERTEX_SHADER, "screen_quad.vert"),
-            (glow::FRAGMENT_SHADER, "screen_quad.frag"),
+            (glow::VERTEX_SHADER, "common/screen_quad.vert"),
+            (glow::FRAGMENT_SHADER, "common/screen_quad.frag"),
         ],
         &Defines::new(),
     )

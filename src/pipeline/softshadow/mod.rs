@@ -236,19 +236,14 @@ impl SoftShadowRenderer {
         Ok(())
     }
 
-    /// Recompile every kernel (G-buffer, shadow pass, quad) from `shaders` with a mode and a
-    /// number of samples: the viewer's live reload. The N-tree and the line spaces stay; on
+    /// Recompile every kernel (G-buffer, shadow pass, quad) from `shaders`, with the current
+    /// mode and samples: the viewer's live reload. The N-tree and the line spaces stay; on
     /// failure the old programs stay too.
-    pub fn recompile(
-        &mut self,
-        shaders: &ShaderSource,
-        mode: ShadowMode,
-        su: u32,
-        sv: u32,
-    ) -> Result<()> {
+    pub fn recompile(&mut self, shaders: &ShaderSource) -> Result<()> {
         let raster = gbuffer::raster_kernel(&self.gl, shaders)?;
         let quad = present::quad_kernel(&self.gl, shaders)?;
-        self.reconfigure(shaders, mode, su, sv)?;
+        let o = &self.options;
+        self.reconfigure(shaders, o.mode, o.samples_u, o.samples_v)?;
         self.gbuffer.set_kernel(raster);
         self.present.set_kernel(quad);
         Ok(())
