@@ -385,7 +385,7 @@ fn kernel_edit_reloads_live() {
     lines.expect("frame ");
 
     save(&shading, &magenta);
-    lines.expect("reload ok: shading.comp");
+    lines.expect("reload ok: mueller2015/shading.comp");
     let shot_line = lines.expect("screenshot: ");
     assert!(shot_line.contains("window framebuffer"), "{shot_line}");
     let status = child.wait(deadline);
@@ -450,7 +450,7 @@ fn soft_shadow_kernel_edit_reloads_live() {
     lines.expect("watching ");
     lines.expect("frame 1: soft shadows linespace 2x2");
     save(&quad, &magenta);
-    let ok = lines.expect("reload ok: linespace_quad.frag");
+    let ok = lines.expect("reload ok: klee2016/linespace_quad.frag");
     assert!(ok.contains("soft shadows linespace 2x2"), "{ok}");
     lines.expect("screenshot: ");
     let status = child.wait(deadline);
