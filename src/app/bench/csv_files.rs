@@ -21,9 +21,9 @@ pub fn names(protocol: &str) -> Vec<PathBuf> {
 
 /// Write both CSVs of `protocol` into `out`.
 pub fn write(out: &Path, protocol: &str, outcomes: &[Outcome], rotate: Rotation) -> Result<()> {
-    let [frames, summary] = [0, 1].map(|i| out.join(&names(protocol)[i]));
-    write_frames_csv(&frames, protocol, outcomes, rotate)?;
-    write_summary_csv(&summary, protocol, outcomes, rotate)
+    let files = names(protocol);
+    write_frames_csv(&out.join(&files[0]), protocol, outcomes, rotate)?;
+    write_summary_csv(&out.join(&files[1]), protocol, outcomes, rotate)
 }
 
 /// Write `rows` under `header` to `path`.
