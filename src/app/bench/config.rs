@@ -169,4 +169,26 @@ mod tests {
         assert_eq!(full[1], 1.0);
         assert_eq!(full[359], 359.0);
     }
+
+    #[test]
+    fn grid_variants_keep_their_command_line_names() {
+        use clap::ValueEnum;
+        let names: Vec<String> = GridVariant::value_variants()
+            .iter()
+            .filter_map(|v| Some(v.to_possible_value()?.get_name().to_string()))
+            .collect();
+        assert_eq!(names, ["thesis", "exact"]);
+        assert_eq!(
+            GridVariant::from_str("exact", false),
+            Ok(GridVariant::Exact)
+        );
+        let spec = TracerSpec::Grid {
+            variant: GridVariant::Thesis,
+            resolution: 24,
+        };
+        assert_eq!(
+            (spec.label(), spec.slug()),
+            ("grid thesis 24³".into(), "grid-thesis-24".into())
+        );
+    }
 }
