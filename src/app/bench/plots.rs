@@ -2,7 +2,7 @@
 //! and written with `image`. Text is drawn with a bundled DejaVu Sans through `ab_glyph`, so no
 //! system fonts are needed.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 use anyhow::{anyhow, Context as _, Result};
@@ -74,6 +74,77 @@ pub struct Chart {
     pub x_range: Option<(f64, f64)>,
     /// A logarithmic y axis (for series that differ by orders of magnitude).
     pub log_y: bool,
+}
+
+impl Chart {
+    /// A panel with linear axes fitted to the data.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: &str,
+        y_label: &str,
+        series: Vec<Series>,
+    ) -> Chart {
+        Chart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series,
+            ..Chart::default()
+        }
+    }
+
+    /// The same panel with a logarithmic y axis.
+    pub fn log_y(self) -> Chart {
+        Chart {
+            log_y: true,
+            ..self
+        }
+    }
+
+    /// The same panel with the x axis from `lo` to `hi`.
+    pub fn x_range(self, lo: f64, hi: f64) -> Chart {
+        Chart {
+            x_range: Some((lo, hi)),
+            ..self
+        }
+    }
+}
+
+/// A PNG of one or more panels side by side, and its caption in the report.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    /// The file name, relative to the output folder.
+    pub file: PathBuf,
+    pub caption: String,
+    /// Width and height of each panel in pixels.
+    pub panel: (u32, u32),
+    pub charts: Vec<Chart>,
+}
+
+impl Figure {
+    pub fn new(file: &str, caption: &str, panel: (u32, u32), charts: Vec<Chart>) -> Figure {
+        Figure {
+            file: file.into(),
+            caption: caption.into(),
+            panel,
+            charts,
+        }
+    }
+
+    /// Draw the figure into the output folder `out`.
+    pub fn save(&self, out: &Path) -> Result<()> {
+        save(
+            &out.join(&self.file),
+            self.panel.0,
+            self.panel.1,
+            &self.charts,
+        )
+    }
+
+    /// The markdown that shows it: `![caption](file)`.
+    pub fn markdown(&self) -> String {
+        format!("![{}]({})\n", self.caption, self.file.display())
+    }
 }
 
 const PALETTE: [RGBColor; 8] = [
@@ -202,44 +273,7 @@ where
         .draw()
         .map_err(|e| err(&e))?;
     for s in &chart.series {
-        let col = color(s.color);
-        let legend_style = col.stroke_width(2);
-        match s.style {
-            Style::Line | Style::LinePoints => {
-                c.draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    col.stroke_width(2),
-                ))
-                .map_err(|e| err(&e))?
-                .label(&s.name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], legend_style));
-                if s.style == Style::LinePoints {
-                    c.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                        .map_err(|e| err(&e))?;
-                }
-            }
-            Style::Dashed => {
-                c.draw_series(DashedLineSeries::new(
-                    s.points.iter().copied(),
-                    8,
-                    5,
-                    col.stroke_width(2),
-                ))
-                .map_err(|e| err(&e))?
-                .label(&s.name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], legend_style));
-            }
-            Style::Crosses => {
-                c.draw_series(
-                    s.points
-                        .iter()
-                        .map(|&p| Cross::new(p, 7, col.stroke_width(3))),
-                )
-                .map_err(|e| err(&e))?
-                .label(&s.name)
-                .legend(move |(x, y)| Cross::new((x + 9, y), 5, col.stroke_width(2)));
-            }
-        }
+        draw_series::<Y>(&mut c, s).map_err(|e| err(&e))?;
     }
     if chart.series.iter().any(|s| !s.name.is_empty()) {
         let corner = legend_corner::<Y>(&c, chart);
@@ -250,6 +284,49 @@ where
             .position(corner)
             .draw()
             .map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// A chart's plotting context with an f64 x axis and the y axis `Y`.
+type Context<'a, 'b, Y> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<RangedCoordf64, <Y as AsRangedCoord>::CoordDescType>,
+>;
+
+/// Draw one series in its style, with its legend entry.
+fn draw_series<Y>(
+    c: &mut Context<'_, '_, Y>,
+    s: &Series,
+) -> Result<(), DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>>
+where
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: Ranged<ValueType = f64>,
+{
+    let col = color(s.color);
+    let line = col.stroke_width(2);
+    let points = s.points.iter().copied();
+    let legend_line = move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], line);
+    match s.style {
+        Style::Line | Style::LinePoints => {
+            c.draw_series(LineSeries::new(points, line))?
+                .label(&s.name)
+                .legend(legend_line);
+            if s.style == Style::LinePoints {
+                c.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, col.filled())))?;
+            }
+        }
+        Style::Dashed => {
+            c.draw_series(DashedLineSeries::new(points, 8, 5, line))?
+                .label(&s.name)
+                .legend(legend_line);
+        }
+        Style::Crosses => {
+            c.draw_series(points.map(|p| Cross::new(p, 7, col.stroke_width(3))))?
+                .label(&s.name)
+                .legend(move |(x, y)| Cross::new((x + 9, y), 5, line));
+        }
     }
     Ok(())
 }

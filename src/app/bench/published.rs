@@ -2,6 +2,8 @@
 //! belongs to. Only numbers the text states are here: Figures 19–22 are plots whose values the
 //! text does not give, so for them only the stated setup and the qualitative findings are kept.
 
+use super::format::table;
+
 /// The thesis' test system (ch. 5, first paragraph), and its parts.
 pub const GPU: &str = "NVIDIA GeForce GTX 780 (2304 shader units, 3 GB)";
 pub const CPU: &str = "Intel Core i7-4770, 3.4 GHz";
@@ -18,12 +20,33 @@ pub const MEASURES: &str = "frames per second (FPS) and ray–triangle intersect
 pub struct Published {
     /// Where: "Fig. 23", "ch. 5.1", ...
     pub figure: &'static str,
-    /// What the number is (the source's words), for a reader of this table.
-    #[allow(dead_code)]
+    /// What the number is (the source's words), for a reader of the report's tables.
     pub what: &'static str,
-    pub value: f64,
     /// The number as printed, German separators translated ("1 137 720 816" → "1,137,720,816").
     pub printed: &'static str,
+}
+
+impl Published {
+    const fn new(figure: &'static str, what: &'static str, printed: &'static str) -> Published {
+        Published {
+            figure,
+            what,
+            printed,
+        }
+    }
+
+    /// The number.
+    pub fn value(&self) -> f64 {
+        let digits = self.printed.replace(',', "");
+        digits
+            .parse()
+            .unwrap_or_else(|_| panic!("published number {:?}", self.printed))
+    }
+
+    /// "0.8804 (Fig. 23)".
+    pub fn cited(&self) -> String {
+        format!("{} ({})", self.printed, self.figure)
+    }
 }
 
 /// ch. 5.1: the three teapot scenes (a floor is included in each count).
@@ -58,68 +81,66 @@ pub const SEC52_FINDINGS: [&str; 3] = [
      and limit it.",
 ];
 
+/// The thesis' findings about `figures` (given as plots only) beside ours, as a table.
+pub fn beside_findings(figures: &str, rows: Vec<(&str, String)>) -> String {
+    let rows: Vec<Vec<String>> = rows
+        .into_iter()
+        .map(|(finding, ours)| vec![finding.to_string(), ours])
+        .collect();
+    format!(
+        "\nThe thesis gives {figures} as plots only; its text states these findings, set here beside \
+         ours:\n\n{}",
+        table(&["Müller 2015", "ours"], &rows)
+    )
+}
+
 /// ch. 5.3: the bunny, one light, no reflections.
 pub const BUNNY_TRIANGLES: u64 = 69451;
-pub const BUNNY_BASE_FPS: Published = Published {
-    figure: "Fig. 23",
-    what: "bunny, base tracer, mean FPS",
-    value: 0.8804,
-    printed: "0.8804",
-};
 pub const BUNNY_GRID_RESOLUTION: u32 = 24;
-pub const BUNNY_GRID_FPS: Published = Published {
-    figure: "Fig. 23",
-    what: "bunny, grid 24³, mean FPS",
-    value: 4.8339,
-    printed: "4.8339",
-};
+pub const BUNNY_BASE_FPS: Published =
+    Published::new("Fig. 23", "bunny, base tracer, mean FPS", "0.8804");
+pub const BUNNY_GRID_FPS: Published =
+    Published::new("Fig. 23", "bunny, grid 24³, mean FPS", "4.8339");
 /// The speed-up as the text states it ("Beschleunigung um den Faktor 5.5").
-pub const BUNNY_SPEEDUP_STATED: Published = Published {
-    figure: "ch. 5.3",
-    what: "bunny, speed-up grid 24³ over base",
-    value: 5.5,
-    printed: "5.5",
-};
-pub const BUNNY_BASE_TESTS: Published = Published {
-    figure: "Fig. 24",
-    what: "bunny, base tracer, mean triangle tests per frame",
-    value: 1_137_720_816.0,
-    printed: "1,137,720,816",
-};
-pub const BUNNY_GRID_TESTS: Published = Published {
-    figure: "Fig. 24",
-    what: "bunny, grid 24³, mean triangle tests per frame",
-    value: 287_728_727.1,
-    printed: "287,728,727.1",
-};
+pub const BUNNY_SPEEDUP_STATED: Published =
+    Published::new("ch. 5.3", "bunny, speed-up grid 24³ over base", "5.5");
+pub const BUNNY_BASE_TESTS: Published = Published::new(
+    "Fig. 24",
+    "bunny, base tracer, mean triangle tests per frame",
+    "1,137,720,816",
+);
+pub const BUNNY_GRID_TESTS: Published = Published::new(
+    "Fig. 24",
+    "bunny, grid 24³, mean triangle tests per frame",
+    "287,728,727.1",
+);
 
 /// ch. 5.3: the dragon, in a scene with one light and a reflective floor.
 pub const DRAGON_TRIANGLES: u64 = 204088;
 pub const DRAGON_GRID_RESOLUTION: u32 = 28;
-pub const DRAGON_GRID_FPS: Published = Published {
-    figure: "ch. 5.3",
-    what: "dragon (204088 triangles), grid 28³, mean FPS",
-    value: 1.396,
-    printed: "1.396",
-};
+pub const DRAGON_GRID_FPS: Published = Published::new(
+    "ch. 5.3",
+    "dragon (204088 triangles), grid 28³, mean FPS",
+    "1.396",
+);
 pub const DRAGON_BASE: &str =
     "the base tracer could not render it: the operating system's driver watchdog \
                                ended the long dispatches (\"time out\")";
 /// The published speed-up computed from the two FPS values (4.8339 / 0.8804 = 5.49).
 pub fn bunny_speedup() -> f64 {
-    BUNNY_GRID_FPS.value / BUNNY_BASE_FPS.value
+    BUNNY_GRID_FPS.value() / BUNNY_BASE_FPS.value()
 }
 
 /// The published test reduction (1,137,720,816 / 287,728,727.1 = 3.95; "only a quarter").
 pub fn bunny_test_reduction() -> f64 {
-    BUNNY_BASE_TESTS.value / BUNNY_GRID_TESTS.value
+    BUNNY_BASE_TESTS.value() / BUNNY_GRID_TESTS.value()
 }
 
 /// The published base count divided by the bunny's triangles: the number of rays that would
 /// have tested every triangle, had the count been a full 64-bit count (16381.6, just below
 /// 128² = 16384, though shadow feelers add tests too).
 pub fn bunny_base_tests_per_triangle() -> f64 {
-    BUNNY_BASE_TESTS.value / BUNNY_TRIANGLES as f64
+    BUNNY_BASE_TESTS.value() / BUNNY_TRIANGLES as f64
 }
 
 #[cfg(test)]
@@ -133,6 +154,8 @@ mod tests {
         // "nur ein Viertel der Tests"
         assert!((bunny_test_reduction() - 4.0).abs() < 0.1);
         assert!((bunny_base_tests_per_triangle() - 16381.6).abs() < 0.1);
+        assert_eq!(BUNNY_GRID_TESTS.value(), 287_728_727.1);
+        assert_eq!(DRAGON_GRID_FPS.value(), 1.396);
         assert_eq!(
             TEAPOT_TRIANGLES.iter().map(|t| t.1).sum::<u64>(),
             14592 + 27392 + 46592

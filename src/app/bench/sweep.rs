@@ -1,38 +1,42 @@
 //! What the grid-resolution protocols (ch. 5.2, 5.3) share: configurations over resolutions
 //! and variants, the table per resolution, and the curves per variant.
 
-use super::plots::{Series, Style};
-use super::report::{self, int, mmm, num, ratio};
-use super::runner::{variant_name, Config, Outcome, Sizing, TracerSpec};
-use gpgpu_rt::accel::GridVariant;
+use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use super::format::{int, ratio, table};
+use super::outcome::{Outcome, MEASURED_COLUMNS};
+use super::plots::{Chart, Series, Style};
 
 /// Grid configurations for every variant × resolution of `scene`.
 pub fn grid_configs(
     scene: &str,
     refl_depth: u32,
     s: Sizing,
-    angles: &[f64],
     variants: &[GridVariant],
     resolutions: &[u32],
 ) -> Vec<Config> {
     let mut v = Vec::new();
     for &variant in variants {
         for &resolution in resolutions {
-            v.push(Config {
-                scene: scene.into(),
-                tracer: TracerSpec::Grid {
-                    variant,
-                    resolution,
-                },
-                refl_depth,
-                width: s.width,
-                height: s.height,
-                angles: angles.to_vec(),
-                warmup: s.warmup,
-            });
+            let tracer = TracerSpec::Grid {
+                variant,
+                resolution,
+            };
+            v.push(Config::new(scene, tracer, refl_depth, s));
         }
     }
     v
+}
+
+/// "4³, 8³, 12³".
+pub fn resolutions_text(resolutions: &[u32]) -> String {
+    let r: Vec<String> = resolutions.iter().map(|r| format!("{r}³")).collect();
+    r.join(", ")
+}
+
+/// "thesis, exact".
+pub fn variants_text(variants: &[GridVariant]) -> String {
+    let v: Vec<&str> = variants.iter().map(|v| variant_name(*v)).collect();
+    v.join(", ")
 }
 
 /// The speed-up of `o` over `base`: ratio of the FPS over the whole runs (frames / total time,
@@ -65,94 +69,76 @@ pub fn base_outcome<'a>(outcomes: &'a [Outcome], scene: &str) -> Option<&'a Outc
 
 /// A markdown table with a row per grid configuration (and the base tracer first, if given).
 pub fn resolution_table(grid: &[&Outcome], base: Option<&Outcome>) -> String {
+    let failed_or = |o: &Outcome, events: String| match o.error {
+        Some(_) => "failed".to_string(),
+        None => events,
+    };
     let mut rows = Vec::new();
     if let Some(b) = base {
-        rows.push(vec![
-            "base".into(),
-            "–".into(),
-            mmm(b.fps(), num),
-            b.mean_fps().map(num).unwrap_or("–".into()),
-            mmm(b.gpu_ms(), num),
-            mmm(b.tests(), int),
-            b.tests().map(|t| int(t.mean)).unwrap_or("–".into()),
-            "–".into(),
-            "×1".into(),
-            "×1".into(),
-            "–".into(),
-            if b.error.is_some() {
-                "failed".into()
-            } else {
-                "–".into()
-            },
-        ]);
+        let mut row = vec!["base".into(), "–".into()];
+        row.extend(b.measured_cells());
+        row.extend(["–", "×1", "×1", "–"].map(String::from));
+        row.push(failed_or(b, "–".into()));
+        rows.push(row);
     }
     for o in grid {
-        let TracerSpec::Grid {
-            variant,
-            resolution,
-        } = o.config.tracer
-        else {
+        let Some((variant, resolution)) = o.config.tracer.grid() else {
             continue;
         };
-        rows.push(vec![
+        let mut row = vec![
             format!("grid {}", variant_name(variant)),
             format!("{resolution}³"),
-            mmm(o.fps(), num),
-            o.mean_fps().map(num).unwrap_or("–".into()),
-            mmm(o.gpu_ms(), num),
-            mmm(o.tests(), int),
-            o.tests().map(|t| int(t.mean)).unwrap_or("–".into()),
+        ];
+        row.extend(o.measured_cells());
+        row.extend([
             o.voxels().map(|v| int(v.median)).unwrap_or("–".into()),
             ratio(speedup(o, base)),
             ratio(test_reduction(o, base)),
-            report::fact(o, "grid_bytes")
+            o.fact("grid_bytes")
                 .map(|b| format!("{:.1}", b / (1024.0 * 1024.0)))
                 .unwrap_or("–".into()),
-            if o.error.is_some() {
-                "failed".into()
-            } else {
-                report::event_summary(o)
-            },
+            failed_or(o, o.event_summary()),
         ]);
+        rows.push(row);
     }
-    report::table(
-        &[
-            "tracer",
-            "grid",
-            "FPS",
-            "FPS (run)",
-            "GPU ms",
-            "triangle tests per frame",
-            "mean tests",
-            "voxels visited",
-            "speed-up",
-            "test reduction",
-            "grid MiB",
-            "events",
-        ],
-        &rows,
-    )
+    let mut header = vec!["tracer", "grid"];
+    header.extend(MEASURED_COLUMNS);
+    header.extend([
+        "voxels visited",
+        "speed-up",
+        "test reduction",
+        "grid MiB",
+        "events",
+    ]);
+    table(&header, &rows)
+}
+
+/// Both grid variants, in the order of the tables and the colours of the curves.
+pub const VARIANTS: [GridVariant; 2] = [GridVariant::Thesis, GridVariant::Exact];
+
+/// (resolution, f(outcome)) of `variant` over the successful configurations.
+pub fn variant_points(
+    grid: &[&Outcome],
+    variant: GridVariant,
+    f: impl Fn(&Outcome) -> Option<f64>,
+) -> Vec<(u32, f64)> {
+    grid.iter()
+        .filter(|o| o.ok() && o.config.tracer.variant() == Some(variant))
+        .filter_map(|o| Some((o.config.tracer.resolution()?, f(o)?)))
+        .collect()
 }
 
 /// One curve per variant: (resolution, f(outcome)) over the successful configurations.
 pub fn variant_curves(grid: &[&Outcome], f: impl Fn(&Outcome) -> Option<f64>) -> Vec<Series> {
     let mut out = Vec::new();
-    for (i, variant) in [GridVariant::Thesis, GridVariant::Exact]
-        .into_iter()
-        .enumerate()
-    {
-        let pts: Vec<(f64, f64)> = grid
-            .iter()
-            .filter(|o| o.ok() && o.config.tracer.variant() == Some(variant))
-            .filter_map(|o| Some((o.config.tracer.resolution()? as f64, f(o)?)))
+    for (i, variant) in VARIANTS.into_iter().enumerate() {
+        let pts: Vec<(f64, f64)> = variant_points(grid, variant, &f)
+            .into_iter()
+            .map(|(r, y)| (r as f64, y))
             .collect();
         if !pts.is_empty() {
-            out.push(Series::new(
-                format!("grid, {} variant", variant_name(variant)),
-                pts,
-                Style::LinePoints,
-                i,
-            ));
+            let name = format!("grid, {} variant", variant_name(variant));
+            out.push(Series::new(name, pts, Style::LinePoints, i));
         }
     }
     out
@@ -168,18 +154,26 @@ pub fn reference_line(name: &str, y: f64, curves: &[Series], color: usize) -> Op
         .then(|| Series::new(name, vec![(lo, y), (hi, y)], Style::Dashed, color))
 }
 
+/// `curves` and, where the base tracer was measured (`base_y`), its value as a dashed line.
+pub fn with_base_line(curves: Vec<Series>, base_y: Option<f64>) -> Vec<Series> {
+    let line = base_y.and_then(|y| reference_line("base tracer", y, &curves, 2));
+    curves.into_iter().chain(line).collect()
+}
+
+/// A panel over the grid resolution with a logarithmic y axis.
+pub fn resolution_chart(title: impl Into<String>, y_label: &str, series: Vec<Series>) -> Chart {
+    Chart::new(title, "grid resolution N (N³ voxels)", y_label, series).log_y()
+}
+
 /// The resolution with the highest FPS (run) per variant: "thesis 16³, exact 20³".
 pub fn best_resolutions(grid: &[&Outcome]) -> Vec<(GridVariant, u32, f64)> {
-    let mut out = Vec::new();
-    for variant in [GridVariant::Thesis, GridVariant::Exact] {
-        let best = grid
-            .iter()
-            .filter(|o| o.ok() && o.config.tracer.variant() == Some(variant))
-            .filter_map(|o| Some((o.config.tracer.resolution()?, o.mean_fps()?)))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((r, fps)) = best {
-            out.push((variant, r, fps));
-        }
-    }
-    out
+    let best = |v| {
+        variant_points(grid, v, |o| o.mean_fps())
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    };
+    VARIANTS
+        .into_iter()
+        .filter_map(|v| best(v).map(|(r, fps)| (v, r, fps)))
+        .collect()
 }

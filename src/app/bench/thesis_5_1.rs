@@ -3,233 +3,176 @@
 //! reflection depth 1, the scene rotated through 360° with one frame per degree; FPS (Fig. 19)
 //! and triangle tests (Fig. 20) per frame.
 
-use std::fmt::Write as _;
-use std::path::PathBuf;
-
 use anyhow::Result;
 
-use super::plots::{self, Chart, Series, Style};
+use super::config::{Config, Sizing, TracerSpec};
+use super::format::{int, percent, ratio, table};
+use super::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
+use super::plots::{self, Chart, Figure, Series, Style};
+use super::protocol::{Protocol, Section};
 use super::published::{self, TEAPOT_TRIANGLES};
-use super::report::{self, int, mmm, num, table, Section};
-use super::runner::{rotation_angles, Bench, Config, Sizing, TracerSpec};
-use super::{Protocol, FULL_SIZE, QUICK_SIZE};
+use super::runner::Bench;
 
-pub struct Thesis51;
+pub const PROTOCOL: Protocol = Protocol {
+    name: "thesis-5.1",
+    title: "influence of the number of triangles, base tracer (Müller 2015, ch. 5.1, Fig. 19, 20)",
+    run,
+};
 
 /// Quick: 8 angles (every 45°), 1 warm-up frame. Full: 360 angles (every degree), 5 warm-up.
-pub const QUICK: Sizing = Sizing {
-    width: QUICK_SIZE.0,
-    height: QUICK_SIZE.1,
-    angles: 8,
-    warmup: 1,
-};
-pub const FULL: Sizing = Sizing {
-    width: FULL_SIZE.0,
-    height: FULL_SIZE.1,
-    angles: 360,
-    warmup: 5,
-};
+pub const QUICK: Sizing = Sizing::quick(8, 1);
+pub const FULL: Sizing = Sizing::full(360, 5);
 
-impl Protocol for Thesis51 {
-    fn name(&self) -> &'static str {
-        "thesis-5.1"
-    }
+fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
+    // configure: the base tracer on the three teapot scenes, reflection depth 1
+    let s = bench.sizing(QUICK, FULL);
+    let configs: Vec<Config> = TEAPOT_TRIANGLES
+        .iter()
+        .map(|(name, _)| Config::new(&format!("{name}.toml"), TracerSpec::Base, 1, s))
+        .collect();
+    // measure
+    let outcomes = bench.measure(p.name, &configs)?;
+    // report
+    let markdown = setup_text(s) + &results_table(&outcomes) + &findings(&outcomes);
+    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures(s, &outcomes))
+}
 
-    fn title(&self) -> &'static str {
-        "influence of the number of triangles, base tracer (Müller 2015, ch. 5.1, Fig. 19, 20)"
-    }
+/// Fig. 19 and 20: one curve per scene over the rotation.
+fn figures(s: Sizing, outcomes: &[Outcome]) -> Vec<Figure> {
+    let size = s.size();
+    let style = if s.angles > 60 {
+        Style::Line
+    } else {
+        Style::LinePoints
+    };
+    let figure = |file, caption, title: String, y_label, f: fn(&FrameRecord) -> f64| {
+        let curves = outcomes.iter().enumerate().map(|(i, o)| {
+            let name = format!(
+                "{} ({} triangles)",
+                o.config.scene_name(),
+                int(o.triangles as f64)
+            );
+            let points = o.frames.iter().map(|fr| (fr.angle, f(fr))).collect();
+            Series::new(name, points, style, i)
+        });
+        let chart = Chart::new(
+            title,
+            "rotation of the scene (degrees)",
+            y_label,
+            curves.collect(),
+        );
+        Figure::new(file, caption, (900, 480), vec![chart.x_range(0.0, 360.0)])
+    };
+    vec![
+        figure(
+            "fig19_fps.png",
+            "Fig. 19 (ours)",
+            format!("Fig. 19 (ours): FPS of the base tracer over the rotation, {size}"),
+            "FPS",
+            FrameRecord::fps,
+        ),
+        figure(
+            "fig20_tests.png",
+            "Fig. 20 (ours)",
+            format!("Fig. 20 (ours): triangle tests per frame, base tracer, {size}"),
+            "triangle tests per frame",
+            |f| f.tests() as f64,
+        ),
+    ]
+}
 
-    fn run(&self, bench: &mut Bench) -> Result<Section> {
-        let s = bench.sizing(QUICK, FULL);
-        let angles = rotation_angles(s.angles);
-        let configs: Vec<Config> = TEAPOT_TRIANGLES
-            .iter()
-            .map(|(name, _)| Config {
-                scene: format!("{name}.toml"),
-                tracer: TracerSpec::Base,
-                refl_depth: 1,
-                width: s.width,
-                height: s.height,
-                angles: angles.clone(),
-                warmup: s.warmup,
-            })
-            .collect();
-        let outcomes = bench.measure(self.name(), &configs)?;
+fn setup_text(s: Sizing) -> String {
+    let angles = if s.angles == 360 {
+        "one per degree, as the thesis".to_string()
+    } else {
+        format!("every {}°", plots::si(360.0 / s.angles as f64))
+    };
+    format!(
+        "Setup (thesis): {}. Ours: `scenes/teapot1.toml`, `teapot3.toml`, `teapot6.toml`, reflection depth \
+         1, one light, {} pixels, {} angles ({angles}), {} warm-up frame(s) per scene.\n\n",
+        published::SEC51_SETUP,
+        s.size(),
+        s.angles,
+        s.warmup
+    )
+}
 
-        // Fig. 19 and 20: one curve per scene over the rotation
-        let style = if s.angles > 60 {
-            Style::Line
-        } else {
-            Style::LinePoints
-        };
-        let curve = |f: &dyn Fn(&super::runner::FrameRecord) -> f64| -> Vec<Series> {
-            outcomes
+/// A row per scene: triangles (ours and the thesis'), FPS, tests, and the FPS's spread.
+fn results_table(outcomes: &[Outcome]) -> String {
+    let rows: Vec<Vec<String>> = outcomes
+        .iter()
+        .map(|o| {
+            let scene = o.config.scene_name();
+            let thesis = TEAPOT_TRIANGLES
                 .iter()
-                .enumerate()
-                .map(|(i, o)| {
-                    Series::new(
-                        format!(
-                            "{} ({} triangles)",
-                            o.config.scene_name(),
-                            int(o.triangles as f64)
-                        ),
-                        o.frames.iter().map(|fr| (fr.angle, f(fr))).collect(),
-                        style,
-                        i,
-                    )
-                })
-                .collect()
-        };
-        let size = format!("{}×{}", s.width, s.height);
-        let fig19 = PathBuf::from("fig19_fps.png");
-        plots::save(
-            &bench.out.join(&fig19),
-            900,
-            480,
-            &[Chart {
-                title: format!("Fig. 19 (ours): FPS of the base tracer over the rotation, {size}"),
-                x_label: "rotation of the scene (degrees)".into(),
-                y_label: "FPS".into(),
-                series: curve(&|f| f.fps()),
-                x_range: Some((0.0, 360.0)),
-                log_y: false,
-            }],
-        )?;
-        let fig20 = PathBuf::from("fig20_tests.png");
-        plots::save(
-            &bench.out.join(&fig20),
-            900,
-            480,
-            &[Chart {
-                title: format!("Fig. 20 (ours): triangle tests per frame, base tracer, {size}"),
-                x_label: "rotation of the scene (degrees)".into(),
-                y_label: "triangle tests per frame".into(),
-                series: curve(&|f| f.tests() as f64),
-                x_range: Some((0.0, 360.0)),
-                log_y: false,
-            }],
-        )?;
+                .find(|t| t.0 == scene)
+                .map_or(0, |t| t.1);
+            let mut row = vec![
+                scene.to_string(),
+                format!("{} / {}", int(o.triangles as f64), int(thesis as f64)),
+            ];
+            row.extend(o.measured_cells());
+            row.push(o.fps().map_or("–".into(), |f| percent(f.spread())));
+            row
+        })
+        .collect();
+    let mut header = vec!["scene", "triangles (ours / thesis)"];
+    header.extend(MEASURED_COLUMNS);
+    header.push("FPS spread (max−min)/median");
+    table(&header, &rows)
+}
 
-        // the report section
-        let mut md = String::new();
-        let _ = writeln!(
-            md,
-            "Setup (thesis): {}. Ours: `scenes/teapot1.toml`, `teapot3.toml`, `teapot6.toml`, reflection depth \
-             1, one light, {size} pixels, {} angles ({}), {} warm-up frame(s) per scene.\n",
-            published::SEC51_SETUP,
-            s.angles,
-            if s.angles == 360 {
-                "one per degree, as the thesis".to_string()
-            } else {
-                format!("every {}°", super::plots::si(360.0 / s.angles as f64))
-            },
-            s.warmup
-        );
-        let rows: Vec<Vec<String>> = outcomes
-            .iter()
-            .map(|o| {
-                let published = TEAPOT_TRIANGLES
-                    .iter()
-                    .find(|t| t.0 == o.config.scene_name())
-                    .map(|t| t.1)
-                    .unwrap_or(0);
-                vec![
-                    o.config.scene_name().to_string(),
-                    format!("{} / {}", int(o.triangles as f64), int(published as f64)),
-                    mmm(o.fps(), num),
-                    o.mean_fps().map(num).unwrap_or("–".into()),
-                    mmm(o.gpu_ms(), num),
-                    mmm(o.tests(), int),
-                    o.tests().map(|t| int(t.mean)).unwrap_or("–".into()),
-                    o.fps()
-                        .map(|f| format!("{:.0} %", 100.0 * f.spread()))
-                        .unwrap_or("–".into()),
-                ]
-            })
-            .collect();
-        md.push_str(&table(
-            &[
-                "scene",
-                "triangles (ours / thesis)",
-                "FPS",
-                "FPS (run)",
-                "GPU ms",
-                "triangle tests per frame",
-                "mean tests",
-                "FPS spread (max−min)/median",
-            ],
-            &rows,
-        ));
+/// "teapot1 <f(teapot1)>, teapot3 ..." over the scenes `f` has a value for.
+fn per_scene(ok: &[&Outcome], f: impl Fn(&Outcome) -> Option<String>) -> String {
+    let parts: Vec<String> = ok
+        .iter()
+        .filter_map(|o| Some(format!("{} {}", o.config.scene_name(), f(o)?)))
+        .collect();
+    parts.join(", ")
+}
 
-        let _ = writeln!(
-            md,
-            "\nThe thesis gives Fig. 19 and 20 as plots only; its text states these findings, set here beside ours:\n"
-        );
-        let mut cmp = Vec::new();
-        let ok: Vec<_> = outcomes.iter().filter(|o| o.ok()).collect();
-        if let (Some(first), Some(last)) = (ok.first(), ok.last()) {
-            if first.config.scene != last.config.scene {
-                if let (Some(f1), Some(f6)) = (first.fps(), last.fps()) {
-                    cmp.push(vec![
-                        published::SEC51_FINDINGS[0].to_string(),
-                        format!(
-                            "FPS {} / {} = {} (median), triangles {} / {} = {}; FPS × triangles: {}",
-                            first.config.scene_name(),
-                            last.config.scene_name(),
-                            report::ratio(Some(f1.median / f6.median)),
-                            last.config.scene_name(),
-                            first.config.scene_name(),
-                            report::ratio(Some(last.triangles as f64 / first.triangles as f64)),
-                            ok.iter()
-                                .filter_map(|o| o.fps().map(|f| format!("{} {}", o.config.scene_name(), int(f.median * o.triangles as f64))))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    ]);
-                }
-            }
-        }
-        cmp.push(vec![
-            published::SEC51_FINDINGS[1].to_string(),
-            format!(
-                "FPS spread (max−min)/median: {}",
-                ok.iter()
-                    .filter_map(|o| o.fps().map(|f| format!(
-                        "{} {:.0} %",
-                        o.config.scene_name(),
-                        100.0 * f.spread()
-                    )))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        ]);
-        cmp.push(vec![
-            published::SEC51_FINDINGS[2].to_string(),
-            format!(
-                "tests spread (max−min)/median: {}; tests per frame / triangles (rays that tested every \
-                 triangle): {}",
-                ok.iter()
-                    .filter_map(|o| o.tests().map(|t| format!("{} {:.0} %", o.config.scene_name(), 100.0 * t.spread())))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                ok.iter()
-                    .filter_map(|o| o.tests().map(|t| format!("{} {}", o.config.scene_name(), int(t.median / o.triangles as f64))))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        ]);
-        cmp.push(vec![
-            published::SEC51_FINDINGS[3].to_string(),
-            "see the curves of Fig. 20 (ours); with reflection depth 1 a ray reflects once"
-                .to_string(),
-        ]);
-        md.push_str(&table(&["Müller 2015", "ours"], &cmp));
-        md.push('\n');
-        Ok(Section::of_sweep(
-            self,
-            md,
-            &outcomes,
-            vec![(fig19, "Fig. 19 (ours)"), (fig20, "Fig. 20 (ours)")],
-        ))
+/// The thesis' findings (its text; Fig. 19 and 20 are plots) beside ours.
+fn findings(outcomes: &[Outcome]) -> String {
+    let ok: Vec<&Outcome> = outcomes.iter().filter(|o| o.ok()).collect();
+    let [proportional, fluctuates, test_phases, reflections] = published::SEC51_FINDINGS;
+    let mut rows = Vec::new();
+    if let Some(ours) = inverse_proportion(&ok) {
+        rows.push((proportional, ours));
     }
+    let fps_spread = per_scene(&ok, |o| Some(percent(o.fps()?.spread())));
+    rows.push((
+        fluctuates,
+        format!("FPS spread (max−min)/median: {fps_spread}"),
+    ));
+    let tests_spread = per_scene(&ok, |o| Some(percent(o.tests()?.spread())));
+    let per_triangle = per_scene(&ok, |o| Some(int(o.tests()?.median / o.triangles as f64)));
+    rows.push((
+        test_phases,
+        format!(
+            "tests spread (max−min)/median: {tests_spread}; tests per frame / triangles (rays that tested \
+             every triangle): {per_triangle}"
+        ),
+    ));
+    rows.push((
+        reflections,
+        "see the curves of Fig. 20 (ours); with reflection depth 1 a ray reflects once".to_string(),
+    ));
+    published::beside_findings("Fig. 19 and 20", rows)
+}
+
+/// FPS of the first scene over the last beside their triangles' ratio, and FPS × triangles per
+/// scene (constant if FPS is inversely proportional to the triangles).
+fn inverse_proportion(ok: &[&Outcome]) -> Option<String> {
+    let (first, last) = (ok.first()?, ok.last()?);
+    if first.config.scene == last.config.scene {
+        return None;
+    }
+    let (f1, f6) = (first.fps()?, last.fps()?);
+    let (n1, n6) = (first.config.scene_name(), last.config.scene_name());
+    Some(format!(
+        "FPS {n1} / {n6} = {} (median), triangles {n6} / {n1} = {}; FPS × triangles: {}",
+        ratio(Some(f1.median / f6.median)),
+        ratio(Some(last.triangles as f64 / first.triangles as f64)),
+        per_scene(ok, |o| Some(int(o.fps()?.median * o.triangles as f64)))
+    ))
 }

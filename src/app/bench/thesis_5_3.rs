@@ -4,394 +4,426 @@
 //! tracer timed out on it). Published: bunny 0.8804 FPS base vs 4.8339 FPS with the grid at
 //! 24³, 1,137,720,816 vs 287,728,727.1 tests per frame; dragon (204088 triangles) 1.396 FPS.
 
-use std::fmt::Write as _;
-use std::path::PathBuf;
-
 use anyhow::Result;
 
-use super::plots::{self, Chart, Series, Style, BLACK_INDEX};
+use super::args::Scale;
+use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use super::format::{int, num, ratio, table};
+use super::outcome::Outcome;
+use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
+use super::protocol::{Protocol, Section};
 use super::published::{self as p, Published};
-use super::report::{self, int, num, ratio, Section};
-use super::runner::{rotation_angles, variant_name, Bench, Config, Sizing, TracerSpec};
-use super::sweep;
-use super::{Protocol, Scale, FULL_SIZE, QUICK_SIZE};
-use gpgpu_rt::accel::GridVariant;
+use super::runner::Bench;
+use super::sweep::{self, resolution_chart};
 
-pub struct Thesis53;
+pub const PROTOCOL: Protocol = Protocol {
+    name: "thesis-5.3",
+    title: "base tracer vs uniform grid: bunny and dragon (Müller 2015, ch. 5.3, Fig. 23, 24)",
+    run,
+};
 
 pub const BUNNY: &str = "bunny.toml";
 pub const DRAGON: &str = "dragon.toml";
 /// Quick: 4 angles, 1 warm-up frame. Full: 36 angles (every 10°), 3 warm-up frames.
-pub const QUICK: Sizing = Sizing {
-    width: QUICK_SIZE.0,
-    height: QUICK_SIZE.1,
-    angles: 4,
-    warmup: 1,
-};
-pub const FULL: Sizing = Sizing {
-    width: FULL_SIZE.0,
-    height: FULL_SIZE.1,
-    angles: 36,
-    warmup: 3,
-};
+pub const QUICK: Sizing = Sizing::quick(4, 1);
+pub const FULL: Sizing = Sizing::full(36, 3);
 pub const QUICK_RESOLUTIONS: &[u32] = &[8, 16, 24, 32];
 pub const FULL_RESOLUTIONS: &[u32] = &[8, 12, 16, 20, 24, 28, 32, 40];
 
-impl Protocol for Thesis53 {
-    fn name(&self) -> &'static str {
-        "thesis-5.3"
-    }
+/// What a run of the protocol measures.
+struct Plan {
+    sizing: Sizing,
+    resolutions: Vec<u32>,
+    variants: Vec<GridVariant>,
+    /// The base tracer renders the dragon too (at full scale only: it needs a GPU).
+    dragon_base: bool,
+}
 
-    fn title(&self) -> &'static str {
-        "base tracer vs uniform grid: bunny and dragon (Müller 2015, ch. 5.3, Fig. 23, 24)"
-    }
+fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
+    let plan = Plan {
+        sizing: bench.sizing(QUICK, FULL),
+        resolutions: bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS),
+        variants: bench.variants(),
+        dragon_base: bench.scale() == Scale::Full,
+    };
+    let outcomes = bench.measure(p.name, &plan.configs())?;
+    let results = Results::of(&outcomes, dragon_mesh_triangles(bench));
+    let markdown =
+        setup_text(&plan, &results) + &comparison(&results, &plan.variants) + &tables(&results);
+    let figures = figures(plan.sizing, &results);
+    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
+}
 
-    fn run(&self, bench: &mut Bench) -> Result<Section> {
-        let s = bench.sizing(QUICK, FULL);
-        let angles = rotation_angles(s.angles);
-        let resolutions = bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS);
-        let variants = bench.variants();
-        let full = bench.scale() == Scale::Full;
-        let base = |scene: &str, refl_depth: u32| Config {
-            scene: scene.into(),
-            tracer: TracerSpec::Base,
-            refl_depth,
-            width: s.width,
-            height: s.height,
-            angles: angles.clone(),
-            warmup: s.warmup,
-        };
-        // the bunny: no reflections (REFL_DEPTH 0), base and grid
-        let mut configs = vec![base(BUNNY, 0)];
+impl Plan {
+    /// The bunny without reflections (REFL_DEPTH 0), base and grid; the dragon with the grid
+    /// at 28³ (the thesis' scene had a reflective floor, so REFL_DEPTH 1), and at full scale
+    /// with the base tracer (202520 triangles per ray).
+    fn configs(&self) -> Vec<Config> {
+        let (s, variants) = (self.sizing, &self.variants);
+        let mut configs = vec![Config::new(BUNNY, TracerSpec::Base, 0, s)];
         configs.extend(sweep::grid_configs(
             BUNNY,
             0,
             s,
-            &angles,
-            &variants,
-            &resolutions,
+            variants,
+            &self.resolutions,
         ));
-        // the dragon: grid 28³; the thesis' scene had a reflective floor, so REFL_DEPTH 1. The
-        // base tracer only at full scale (it needs a GPU: 202520 triangles per ray).
-        configs.extend(sweep::grid_configs(
-            DRAGON,
-            1,
-            s,
-            &angles,
-            &variants,
-            &[p::DRAGON_GRID_RESOLUTION],
-        ));
-        if full {
-            configs.push(base(DRAGON, 1));
+        let dragon_res = [p::DRAGON_GRID_RESOLUTION];
+        configs.extend(sweep::grid_configs(DRAGON, 1, s, variants, &dragon_res));
+        if self.dragon_base {
+            configs.push(Config::new(DRAGON, TracerSpec::Base, 1, s));
         }
-        let outcomes = bench.measure(self.name(), &configs)?;
+        configs
+    }
+}
 
-        let bunny_base = sweep::base_outcome(&outcomes, BUNNY);
-        let bunny_grid = sweep::grid_outcomes(&outcomes, BUNNY);
-        let dragon_base = sweep::base_outcome(&outcomes, DRAGON);
-        let dragon_grid = sweep::grid_outcomes(&outcomes, DRAGON);
-        let size = format!("{}×{}", s.width, s.height);
+/// The dragon mesh alone: the scene's largest object (the rest is the floor); 0 if unknown.
+fn dragon_mesh_triangles(bench: &mut Bench) -> usize {
+    let scene = bench.scene(DRAGON);
+    let meshes = scene.map(|s| s.objects.iter().map(|o| o.mesh.triangle_count()).max());
+    meshes.ok().flatten().unwrap_or(0)
+}
 
-        // Fig. 23: FPS by resolution with the base tracer as a line; speed-up with the thesis' point
-        let fps = sweep::variant_curves(&bunny_grid, |o| o.mean_fps());
-        let mut fps_series = fps.clone();
-        fps_series.extend(
-            bunny_base
-                .and_then(|b| b.mean_fps())
-                .and_then(|y| sweep::reference_line("base tracer", y, &fps, 2)),
-        );
-        let mut speedup = sweep::variant_curves(&bunny_grid, |o| sweep::speedup(o, bunny_base));
-        speedup.push(Series::new(
-            "Müller 2015, 24³",
-            vec![(p::BUNNY_GRID_RESOLUTION as f64, p::bunny_speedup())],
-            Style::Crosses,
-            BLACK_INDEX,
-        ));
-        let fig23 = PathBuf::from("fig23_bunny_fps.png");
-        plots::save(
-            &bench.out.join(&fig23),
-            640,
-            460,
-            &[
-                Chart {
-                    title: format!("Fig. 23 (ours): bunny, FPS, {size}"),
-                    x_label: "grid resolution N (N³ voxels)".into(),
-                    y_label: "FPS (frames / total time)".into(),
-                    series: fps_series,
-                    x_range: None,
-                    log_y: true,
-                },
-                Chart {
-                    title: "speed-up of the grid over the base tracer".into(),
-                    x_label: "grid resolution N (N³ voxels)".into(),
-                    y_label: "FPS grid / FPS base".into(),
-                    series: speedup,
-                    x_range: None,
-                    log_y: true,
-                },
-            ],
-        )?;
-        // Fig. 24: tests by resolution; test reduction with the thesis' point
-        let tests = sweep::variant_curves(&bunny_grid, |o| o.tests().map(|t| t.mean));
-        let mut test_series = tests.clone();
-        test_series.extend(
-            bunny_base
-                .and_then(|b| b.tests())
-                .and_then(|t| sweep::reference_line("base tracer", t.mean, &tests, 2)),
-        );
-        let mut reduction =
-            sweep::variant_curves(&bunny_grid, |o| sweep::test_reduction(o, bunny_base));
-        reduction.push(Series::new(
-            "Müller 2015, 24³",
-            vec![(p::BUNNY_GRID_RESOLUTION as f64, p::bunny_test_reduction())],
-            Style::Crosses,
-            BLACK_INDEX,
-        ));
-        let fig24 = PathBuf::from("fig24_bunny_tests.png");
-        plots::save(
-            &bench.out.join(&fig24),
-            640,
-            460,
-            &[
-                Chart {
-                    title: format!("Fig. 24 (ours): bunny, mean triangle tests per frame, {size}"),
-                    x_label: "grid resolution N (N³ voxels)".into(),
-                    y_label: "mean triangle tests per frame".into(),
-                    series: test_series,
-                    x_range: None,
-                    log_y: true,
-                },
-                Chart {
-                    title: "test reduction: base / grid".into(),
-                    x_label: "grid resolution N (N³ voxels)".into(),
-                    y_label: "tests base / tests grid".into(),
-                    series: reduction,
-                    x_range: None,
-                    log_y: true,
-                },
-            ],
-        )?;
+/// The outcomes the report reads, by scene and tracer.
+struct Results<'a> {
+    bunny_base: Option<&'a Outcome>,
+    bunny_grid: Vec<&'a Outcome>,
+    dragon_base: Option<&'a Outcome>,
+    dragon_grid: Vec<&'a Outcome>,
+    /// Triangles of the bunny's and the dragon's scenes, and of the dragon mesh alone.
+    bunny_triangles: usize,
+    dragon_triangles: usize,
+    dragon_mesh: usize,
+}
 
-        // the report section
-        let mut md = String::new();
-        let bunny_tris = outcomes
-            .iter()
-            .find(|o| o.config.scene == BUNNY)
-            .map(|o| o.triangles)
-            .unwrap_or(0);
-        let dragon_tris = outcomes
-            .iter()
-            .find(|o| o.config.scene == DRAGON)
-            .map(|o| o.triangles)
-            .unwrap_or(0);
-        // the dragon mesh alone: the scene's largest object (the rest is the floor)
-        let dragon_mesh = bench
-            .scene(DRAGON)
-            .map(|s| {
-                s.objects
-                    .iter()
-                    .map(|o| o.mesh.triangle_count())
-                    .max()
-                    .unwrap_or(0)
-            })
-            .unwrap_or(0);
-        let _ = writeln!(
-            md,
-            "Setup (thesis): the bunny ({} triangles), one light, no reflections; the dragon ({}) in a scene with \
-             one light and a reflective floor. Ours: `scenes/{BUNNY}` ({} triangles, REFL_DEPTH 0) and \
-             `scenes/{DRAGON}` ({} triangles: Stanford's `dragon_vrip_res2` decimation of {} triangles, the closest \
-             available to the thesis' mesh, {} triangles {}, and a reflective floor; REFL_DEPTH 1), {size} \
-             pixels, {} angles of the rotation, {} warm-up frame(s), grid resolutions {} for the bunny and 28³ \
-             for the dragon, variants {}.{}\n",
-            int(p::BUNNY_TRIANGLES as f64),
-            int(p::DRAGON_TRIANGLES as f64),
-            int(bunny_tris as f64),
-            int(dragon_tris as f64),
-            int(dragon_mesh as f64),
-            int((p::DRAGON_TRIANGLES as f64 - dragon_mesh as f64).abs()),
-            if dragon_mesh as u64 <= p::DRAGON_TRIANGLES { "fewer" } else { "more" },
-            s.angles,
-            s.warmup,
-            resolutions.iter().map(|r| format!("{r}³")).collect::<Vec<_>>().join(", "),
-            variants.iter().map(|v| variant_name(*v)).collect::<Vec<_>>().join(", "),
-            if full {
-                " The base tracer also renders the dragon here (the thesis' timed out)."
-            } else {
-                " The base tracer does not render the dragon at quick scale (a brute-force dragon frame takes \
-                 seconds on llvmpipe); `--scale full` adds it."
-            }
-        );
-
-        // published vs ours
-        let grid24 = |v: GridVariant| {
-            bunny_grid.iter().copied().find(|o| {
-                o.ok()
-                    && o.config.tracer
-                        == TracerSpec::Grid {
-                            variant: v,
-                            resolution: p::BUNNY_GRID_RESOLUTION,
-                        }
-            })
+impl<'a> Results<'a> {
+    fn of(outcomes: &'a [Outcome], dragon_mesh: usize) -> Results<'a> {
+        let triangles = |scene: &str| {
+            let o = outcomes.iter().find(|o| o.config.scene == scene);
+            o.map_or(0, |o| o.triangles)
         };
-        let dragon28 = |v: GridVariant| {
-            dragon_grid.iter().copied().find(|o| {
-                o.ok()
-                    && o.config.tracer
-                        == TracerSpec::Grid {
-                            variant: v,
-                            resolution: p::DRAGON_GRID_RESOLUTION,
-                        }
-            })
+        Results {
+            bunny_base: sweep::base_outcome(outcomes, BUNNY),
+            bunny_grid: sweep::grid_outcomes(outcomes, BUNNY),
+            dragon_base: sweep::base_outcome(outcomes, DRAGON),
+            dragon_grid: sweep::grid_outcomes(outcomes, DRAGON),
+            bunny_triangles: triangles(BUNNY),
+            dragon_triangles: triangles(DRAGON),
+            dragon_mesh,
+        }
+    }
+
+    /// The bunny's base tracer, if it was measured without error.
+    fn bunny_base_ok(&self) -> Option<&'a Outcome> {
+        self.bunny_base.filter(|b| b.ok())
+    }
+
+    /// The successful grid configuration of `variant` at `resolution` among `grid`.
+    fn grid_at(grid: &[&'a Outcome], variant: GridVariant, resolution: u32) -> Option<&'a Outcome> {
+        let spec = TracerSpec::Grid {
+            variant,
+            resolution,
         };
-        let cols: Vec<GridVariant> = variants.clone();
-        let mut header = vec!["quantity".to_string(), "Müller 2015 (GTX 780)".to_string()];
-        header.extend(
-            cols.iter()
-                .map(|v| format!("ours, {} variant", variant_name(*v))),
-        );
-        let mut rows: Vec<Vec<String>> = Vec::new();
-        let mut row =
-            |what: String, published: String, ours: &dyn Fn(GridVariant) -> Option<String>| {
-                let mut r = vec![what, published];
-                r.extend(
-                    cols.iter()
-                        .map(|v| ours(*v).unwrap_or_else(|| "not measured".into())),
-                );
-                rows.push(r);
-            };
-        let pubv = |x: &Published| format!("{} ({})", x.printed, x.figure);
-        row(
-            "bunny, base tracer, FPS (run)".into(),
-            pubv(&p::BUNNY_BASE_FPS),
-            &|_| {
-                bunny_base
-                    .filter(|b| b.ok())
-                    .and_then(|b| b.mean_fps())
-                    .map(num)
-            },
-        );
-        row(
-            "bunny, grid 24³, FPS (run)".into(),
-            pubv(&p::BUNNY_GRID_FPS),
-            &|v| grid24(v)?.mean_fps().map(num),
-        );
-        row(
-            "**bunny, speed-up grid 24³ / base**".into(),
+        grid.iter()
+            .copied()
+            .find(|o| o.ok() && o.config.tracer == spec)
+    }
+
+    /// The bunny with the grid at 24³ (the thesis' published resolution).
+    fn grid24(&self, v: GridVariant) -> Option<&'a Outcome> {
+        Self::grid_at(&self.bunny_grid, v, p::BUNNY_GRID_RESOLUTION)
+    }
+
+    /// The dragon with the grid at 28³.
+    fn dragon28(&self, v: GridVariant) -> Option<&'a Outcome> {
+        Self::grid_at(&self.dragon_grid, v, p::DRAGON_GRID_RESOLUTION)
+    }
+
+    /// "202,520 (1,568 fewer; 210,712 with the floor)".
+    fn dragon_mesh_text(&self) -> Option<String> {
+        let (difference, side) = self.dragon_difference();
+        (self.dragon_mesh > 0).then(|| {
             format!(
-                "**{}** (4.8339 / 0.8804; stated: ×{})",
-                ratio(Some(p::bunny_speedup())),
+                "{} ({difference} {side}; {} with the floor)",
+                int(self.dragon_mesh as f64),
+                int(self.dragon_triangles as f64)
+            )
+        })
+    }
+
+    /// How many triangles our dragon mesh has fewer or more than the thesis': ("1,568", "fewer").
+    fn dragon_difference(&self) -> (String, &'static str) {
+        let d = self.dragon_mesh as f64 - p::DRAGON_TRIANGLES as f64;
+        (int(d.abs()), if d <= 0.0 { "fewer" } else { "more" })
+    }
+
+    /// The dragon with the base tracer: FPS and tests, why not, or not run.
+    fn dragon_base_text(&self) -> Option<String> {
+        match self.dragon_base {
+            None => Some("not run at this scale".into()),
+            Some(b) if b.ok() => {
+                let tests = b.tests().map(|t| t.mean).unwrap_or(0.0);
+                Some(format!(
+                    "{} FPS, {} mean tests",
+                    num(b.mean_fps()?),
+                    int(tests)
+                ))
+            }
+            Some(b) => Some(format!("failed: {}", b.error.as_deref().unwrap_or(""))),
+        }
+    }
+}
+
+fn setup_text(plan: &Plan, r: &Results) -> String {
+    let s = plan.sizing;
+    let dragon_base = if plan.dragon_base {
+        " The base tracer also renders the dragon here (the thesis' timed out)."
+    } else {
+        " The base tracer does not render the dragon at quick scale (a brute-force dragon frame takes \
+         seconds on llvmpipe); `--scale full` adds it."
+    };
+    let (difference, side) = r.dragon_difference();
+    format!(
+        "Setup (thesis): the bunny ({} triangles), one light, no reflections; the dragon ({}) in a scene with \
+         one light and a reflective floor. Ours: `scenes/{BUNNY}` ({} triangles, REFL_DEPTH 0) and \
+         `scenes/{DRAGON}` ({} triangles: Stanford's `dragon_vrip_res2` decimation of {} triangles, the closest \
+         available to the thesis' mesh, {difference} triangles {side}, and a reflective floor; REFL_DEPTH 1), {} \
+         pixels, {} angles of the rotation, {} warm-up frame(s), grid resolutions {} for the bunny and 28³ \
+         for the dragon, variants {}.{dragon_base}\n\n",
+        int(p::BUNNY_TRIANGLES as f64),
+        int(p::DRAGON_TRIANGLES as f64),
+        int(r.bunny_triangles as f64),
+        int(r.dragon_triangles as f64),
+        int(r.dragon_mesh as f64),
+        s.size(),
+        s.angles,
+        s.warmup,
+        sweep::resolutions_text(&plan.resolutions),
+        sweep::variants_text(&plan.variants),
+    )
+}
+
+/// Our value in a row of the comparison, per grid variant: a cell as it is, or a
+/// hardware-independent ratio (shown in bold).
+enum Ours {
+    Cell(fn(&Results, GridVariant) -> Option<String>),
+    Ratio(fn(&Results, GridVariant) -> Option<f64>),
+}
+
+/// "**×5.49**".
+fn bold_ratio(x: f64) -> String {
+    format!("**{}**", ratio(Some(x)))
+}
+
+/// A row of the comparison: the quantity, the published value, ours per variant.
+struct Row {
+    quantity: String,
+    published: String,
+    ours: Ours,
+}
+
+impl Row {
+    /// A published number: the quantity in the thesis' words, the number with its figure.
+    fn published(n: &Published, ours: fn(&Results, GridVariant) -> Option<String>) -> Row {
+        Row::new(n.what, n.cited(), ours)
+    }
+
+    fn new(
+        quantity: &str,
+        published: String,
+        ours: fn(&Results, GridVariant) -> Option<String>,
+    ) -> Row {
+        Row {
+            quantity: quantity.into(),
+            published,
+            ours: Ours::Cell(ours),
+        }
+    }
+
+    /// A hardware-independent ratio, in bold: the published ratio with a note, and ours.
+    fn ratio(
+        quantity: &str,
+        published: f64,
+        note: &str,
+        ours: fn(&Results, GridVariant) -> Option<f64>,
+    ) -> Row {
+        Row {
+            quantity: format!("**{quantity}**"),
+            published: format!("{} {note}", bold_ratio(published)),
+            ours: Ours::Ratio(ours),
+        }
+    }
+
+    /// Our cell for `variant`; `None` where it was not measured.
+    fn ours(&self, r: &Results, variant: GridVariant) -> Option<String> {
+        match self.ours {
+            Ours::Cell(f) => f(r, variant),
+            Ours::Ratio(f) => f(r, variant).map(bold_ratio),
+        }
+    }
+}
+
+/// "287,728,727": the mean triangle tests per frame.
+fn mean_tests(o: &Outcome) -> Option<String> {
+    o.tests().map(|t| int(t.mean))
+}
+
+/// The published numbers, row by row, with ours beside them.
+fn comparison_rows() -> Vec<Row> {
+    vec![
+        Row::published(&p::BUNNY_BASE_FPS, |r, _| {
+            r.bunny_base_ok()?.mean_fps().map(num)
+        }),
+        Row::published(&p::BUNNY_GRID_FPS, |r, v| r.grid24(v)?.mean_fps().map(num)),
+        Row::ratio(
+            p::BUNNY_SPEEDUP_STATED.what,
+            p::bunny_speedup(),
+            &format!(
+                "(4.8339 / 0.8804; stated: ×{})",
                 p::BUNNY_SPEEDUP_STATED.printed
             ),
-            &|v| {
-                Some(format!(
-                    "**{}**",
-                    ratio(sweep::speedup(grid24(v)?, bunny_base)?.into())
-                ))
-            },
-        );
-        row(
-            "bunny, base tracer, mean tests per frame".into(),
-            pubv(&p::BUNNY_BASE_TESTS),
-            &|_| {
-                bunny_base
-                    .filter(|b| b.ok())
-                    .and_then(|b| b.tests())
-                    .map(|t| int(t.mean))
-            },
-        );
-        row(
-            "bunny, grid 24³, mean tests per frame".into(),
-            pubv(&p::BUNNY_GRID_TESTS),
-            &|v| grid24(v)?.tests().map(|t| int(t.mean)),
-        );
-        row(
-            "**bunny, test reduction base / grid 24³**".into(),
-            format!(
-                "**{}** (\"only a quarter\")",
-                ratio(Some(p::bunny_test_reduction()))
-            ),
-            &|v| {
-                Some(format!(
-                    "**{}**",
-                    ratio(sweep::test_reduction(grid24(v)?, bunny_base)?.into())
-                ))
-            },
-        );
-        row(
-            "dragon mesh, triangles".into(),
+            |r, v| sweep::speedup(r.grid24(v)?, r.bunny_base),
+        ),
+        Row::published(&p::BUNNY_BASE_TESTS, |r, _| mean_tests(r.bunny_base_ok()?)),
+        Row::published(&p::BUNNY_GRID_TESTS, |r, v| mean_tests(r.grid24(v)?)),
+        Row::ratio(
+            "bunny, test reduction base / grid 24³",
+            p::bunny_test_reduction(),
+            "(\"only a quarter\")",
+            |r, v| sweep::test_reduction(r.grid24(v)?, r.bunny_base),
+        ),
+        Row::new(
+            "dragon mesh, triangles",
             format!("{} (ch. 5.3)", int(p::DRAGON_TRIANGLES as f64)),
-            &|_| {
-                (dragon_mesh > 0).then(|| {
-                    let d = dragon_mesh as f64 - p::DRAGON_TRIANGLES as f64;
-                    let side = if d < 0.0 { "fewer" } else { "more" };
-                    format!(
-                        "{} ({} {side}; {} with the floor)",
-                        int(dragon_mesh as f64),
-                        int(d.abs()),
-                        int(dragon_tris as f64)
-                    )
-                })
-            },
-        );
-        row(
-            "dragon, grid 28³, FPS (run)".into(),
-            pubv(&p::DRAGON_GRID_FPS),
-            &|v| dragon28(v)?.mean_fps().map(num),
-        );
-        row(
-            "**dragon grid 28³ FPS / bunny grid 24³ FPS**".into(),
-            format!(
-                "**{}** (1.396 / 4.8339)",
-                ratio(Some(p::DRAGON_GRID_FPS.value / p::BUNNY_GRID_FPS.value))
-            ),
-            &|v| {
-                Some(format!(
-                    "**{}**",
-                    ratio(Some(dragon28(v)?.mean_fps()? / grid24(v)?.mean_fps()?))
-                ))
-            },
-        );
-        row(
-            "dragon, grid 28³, mean tests per frame".into(),
+            |r, _| r.dragon_mesh_text(),
+        ),
+        Row::published(&p::DRAGON_GRID_FPS, |r, v| {
+            r.dragon28(v)?.mean_fps().map(num)
+        }),
+        Row::ratio(
+            "dragon grid 28³ FPS / bunny grid 24³ FPS",
+            p::DRAGON_GRID_FPS.value() / p::BUNNY_GRID_FPS.value(),
+            "(1.396 / 4.8339)",
+            |r, v| Some(r.dragon28(v)?.mean_fps()? / r.grid24(v)?.mean_fps()?),
+        ),
+        Row::new(
+            "dragon, grid 28³, mean tests per frame",
             "not given".into(),
-            &|v| dragon28(v)?.tests().map(|t| int(t.mean)),
-        );
-        row(
-            "dragon, base tracer".into(),
+            |r, v| mean_tests(r.dragon28(v)?),
+        ),
+        Row::new(
+            "dragon, base tracer",
             format!("no frame: {}", p::DRAGON_BASE),
-            &|_| match dragon_base {
-                None => Some("not run at this scale".into()),
-                Some(b) if b.ok() => b.mean_fps().map(|f| {
-                    format!(
-                        "{} FPS, {} mean tests",
-                        num(f),
-                        int(b.tests().map(|t| t.mean).unwrap_or(0.0))
-                    )
-                }),
-                Some(b) => Some(format!("failed: {}", b.error.as_deref().unwrap_or(""))),
-            },
-        );
-        let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
-        md.push_str(&report::table(&header_refs, &rows));
-        let _ = writeln!(
-            md,
-            "\nBold rows are the hardware-independent comparisons. FPS (run) = frames / total wall time; the \
-             speed-up is its ratio, the test reduction the ratio of mean tests per frame. Fig. 23 and 24 show \
-             further resolutions as plots only; the text gives the 24³ values above. The thesis variant is the \
-             faithful design (triangles registered along their edges into fixed-size voxel lists, per-ray voxel \
-             lists): its counts are the ones to set beside the published ones. The exact variant is our corrected \
-             design (triangle/box overlap, compact lists, 3D-DDA) and tests far fewer triangles.\n"
-        );
-        let _ = writeln!(md, "### Bunny, every configuration\n");
-        md.push_str(&sweep::resolution_table(&bunny_grid, bunny_base));
-        let _ = writeln!(md, "\n### Dragon\n");
-        md.push_str(&sweep::resolution_table(&dragon_grid, dragon_base));
-        md.push('\n');
-        Ok(Section::of_sweep(
-            self,
-            md,
-            &outcomes,
-            vec![(fig23, "Fig. 23 (ours)"), (fig24, "Fig. 24 (ours)")],
-        ))
-    }
+            |r, _| r.dragon_base_text(),
+        ),
+    ]
+}
+
+/// The table of published numbers and ours per variant, and what to compare.
+fn comparison(r: &Results, variants: &[GridVariant]) -> String {
+    let mut header = vec!["quantity".to_string(), "Müller 2015 (GTX 780)".to_string()];
+    header.extend(
+        variants
+            .iter()
+            .map(|v| format!("ours, {} variant", variant_name(*v))),
+    );
+    let rows: Vec<Vec<String>> = comparison_rows()
+        .into_iter()
+        .map(|row| {
+            let mut cells = vec![row.quantity.clone(), row.published.clone()];
+            let ours = variants.iter().map(|v| row.ours(r, *v));
+            cells.extend(ours.map(|c| c.unwrap_or_else(|| "not measured".into())));
+            cells
+        })
+        .collect();
+    let header: Vec<&str> = header.iter().map(String::as_str).collect();
+    table(&header, &rows)
+        + "\nBold rows are the hardware-independent comparisons. Our mean FPS is FPS (run) = frames / total \
+           wall time; the speed-up is its ratio, the test reduction the ratio of mean tests per frame. Fig. 23 \
+           and 24 show further resolutions as plots only; the text gives the 24³ values above. The thesis \
+           variant is the faithful design (triangles registered along their edges into fixed-size voxel lists, \
+           per-ray voxel lists): its counts are the ones to set beside the published ones. The exact variant is \
+           our corrected design (triangle/box overlap, compact lists, 3D-DDA) and tests far fewer triangles.\n\n"
+}
+
+/// Every configuration of the bunny and of the dragon.
+fn tables(r: &Results) -> String {
+    format!(
+        "### Bunny, every configuration\n\n{}\n### Dragon\n\n{}",
+        sweep::resolution_table(&r.bunny_grid, r.bunny_base),
+        sweep::resolution_table(&r.dragon_grid, r.dragon_base)
+    )
+}
+
+/// Fig. 23 and 24: a measure of the grid by resolution beside the base tracer's, and its ratio
+/// to the base tracer with the thesis' value at 24³.
+fn figures(s: Sizing, r: &Results) -> Vec<Figure> {
+    let size = s.size();
+    let fig23 = vec![
+        measure_chart(
+            r,
+            format!("Fig. 23 (ours): bunny, FPS, {size}"),
+            "FPS (frames / total time)",
+            Outcome::mean_fps,
+        ),
+        ratio_chart(
+            r,
+            "speed-up of the grid over the base tracer",
+            "FPS grid / FPS base",
+            sweep::speedup,
+            p::bunny_speedup(),
+        ),
+    ];
+    let tests = |o: &Outcome| Some(o.tests()?.mean);
+    let fig24 = vec![
+        measure_chart(
+            r,
+            format!("Fig. 24 (ours): bunny, mean triangle tests per frame, {size}"),
+            "mean triangle tests per frame",
+            tests,
+        ),
+        ratio_chart(
+            r,
+            "test reduction: base / grid",
+            "tests base / tests grid",
+            sweep::test_reduction,
+            p::bunny_test_reduction(),
+        ),
+    ];
+    vec![
+        Figure::new("fig23_bunny_fps.png", "Fig. 23 (ours)", (640, 460), fig23),
+        Figure::new("fig24_bunny_tests.png", "Fig. 24 (ours)", (640, 460), fig24),
+    ]
+}
+
+/// `f` of the bunny's grid by resolution, with the base tracer's as a dashed line.
+fn measure_chart(
+    r: &Results,
+    title: String,
+    y_label: &str,
+    f: fn(&Outcome) -> Option<f64>,
+) -> Chart {
+    let curves = sweep::variant_curves(&r.bunny_grid, f);
+    let base = r.bunny_base.and_then(f);
+    resolution_chart(title, y_label, sweep::with_base_line(curves, base))
+}
+
+/// `ratio` of the bunny's grid to its base tracer by resolution, with the thesis' `published`
+/// value at 24³.
+fn ratio_chart(
+    r: &Results,
+    title: &str,
+    y_label: &str,
+    ratio: fn(&Outcome, Option<&Outcome>) -> Option<f64>,
+    published: f64,
+) -> Chart {
+    let mut series = sweep::variant_curves(&r.bunny_grid, |o| ratio(o, r.bunny_base));
+    let at_24 = vec![(p::BUNNY_GRID_RESOLUTION as f64, published)];
+    series.push(Series::new(
+        "Müller 2015, 24³",
+        at_24,
+        Style::Crosses,
+        BLACK_INDEX,
+    ));
+    resolution_chart(title, y_label, series)
 }

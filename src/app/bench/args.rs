@@ -1,0 +1,148 @@
+//! `gpgpu-rt bench`'s command line: the protocols to run, the scale, and the overrides of the
+//! protocols' sizes and of the tracers' options.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+
+use super::config::GridVariant;
+
+/// The protocols `gpgpu-rt bench` knows: the command line's values (`super::protocol_of` says
+/// which protocol each one runs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
+pub enum ProtocolId {
+    /// Müller 2015, ch. 5.1: the base tracer on 1, 3 and 6 teapots over a 360° rotation (Fig. 19, 20).
+    #[value(name = "thesis-5.1")]
+    Thesis51,
+    /// Müller 2015, ch. 5.2: the grid tracer on six teapots at resolutions 4³…40³ (Fig. 21, 22).
+    #[value(name = "thesis-5.2")]
+    Thesis52,
+    /// Müller 2015, ch. 5.3: bunny, base vs grid; dragon with the grid (Fig. 23, 24).
+    #[value(name = "thesis-5.3")]
+    Thesis53,
+    /// Klee 2016, Table 1: primary rays, GPU rasterisation vs CPU ray casting (bunny, dragon).
+    #[value(name = "klee-table1")]
+    KleeTable1,
+    /// Klee 2016, Table 2: triangle tests vs line-space lookups on the CPU (bunny, 4 rays).
+    #[value(name = "klee-table2")]
+    KleeTable2,
+    /// Klee 2016, Table 3: coherent grid traversal vs 3D-DDA on the CPU (4/9/16/100 rays).
+    #[value(name = "klee-table3")]
+    KleeTable3,
+    /// Klee 2016, Fig. 12: 2×2 … 10×10 shadow rays, CPU vs GPU (bunny).
+    #[value(name = "klee-fig12")]
+    KleeFig12,
+    /// Klee 2016, Fig. 13: bunny vs dragon on the GPU, 2×2 … 10×10 shadow rays.
+    #[value(name = "klee-fig13")]
+    KleeFig13,
+}
+
+/// `--scale`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Scale {
+    /// Few angles and a small image: minutes on Mesa llvmpipe.
+    Quick,
+    /// The published protocol (one frame per degree, larger images): for a GPU.
+    Full,
+}
+
+/// `--rotate`: how "the scene rotated through 360°" is done.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Rotation {
+    /// Turn every object about the vertical axis through the scene's centre (model matrices);
+    /// camera and light stay.
+    Objects,
+    /// Orbit the camera about that axis instead; the light stays fixed to the objects.
+    Camera,
+}
+
+/// `gpgpu-rt bench`'s command line.
+#[derive(clap::Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// Protocols to run, one or more.
+    #[arg(required = true, value_enum, value_name = "PROTOCOL")]
+    pub protocols: Vec<ProtocolId>,
+    /// `quick`: few angles, a small image (minutes on Mesa); `full`: the thesis' protocol.
+    #[arg(long, value_enum, default_value = "quick")]
+    pub scale: Scale,
+    /// Output folder for the CSVs, plots and report.md (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "bench-results")]
+    pub out: PathBuf,
+    /// Image width (default: 64 quick, 512 full; the thesis does not state its size).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height (default: 64 quick, 512 full).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Number of rotation angles, evenly spaced over 360° (default: the protocol's for the scale).
+    #[arg(long, value_name = "N")]
+    pub angles: Option<u32>,
+    /// Warm-up frames per configuration, not counted (default: the protocol's for the scale).
+    #[arg(long, value_name = "N")]
+    pub warmup: Option<u32>,
+    /// Grid resolutions N (N³ voxels), comma-separated (default: the protocol's for the scale).
+    #[arg(long, value_delimiter = ',', value_name = "N,N,...")]
+    pub grid_res: Option<Vec<u32>>,
+    /// Grid variants to measure, comma-separated (default: both).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
+    pub variants: Option<Vec<GridVariant>>,
+    /// Thesis grid variant: triangle ids per voxel list (default: the tracer's, Listing 17: 512).
+    #[arg(long, value_name = "L")]
+    pub voxel_array_length: Option<u32>,
+    /// Thesis grid variant: voxel ids per ray list (default: the tracer's, 3·N as Listing 17).
+    #[arg(long, value_name = "R")]
+    pub ray_array_length: Option<u32>,
+    /// How the scene turns: its objects (default) or the camera around them.
+    #[arg(long, value_enum, default_value = "objects")]
+    pub rotate: Rotation,
+    /// Split dispatches into tiles of at most N×N pixels (multiple of 8; 0: one dispatch per
+    /// kernel as the thesis).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub tile: u32,
+    /// Folder with the scene files (default: ./scenes, else the source tree's).
+    #[arg(long, value_name = "DIR")]
+    pub scenes: Option<PathBuf>,
+    /// EGL device index (default: the first that gives an OpenGL 4.5 core context).
+    #[arg(long)]
+    pub device: Option<usize>,
+    /// Load the GLSL kernels from this directory instead of the copies built into the binary.
+    #[arg(long, value_name = "DIR")]
+    pub glsl_dir: Option<PathBuf>,
+    /// No progress bar (it shows only on a terminal anyway).
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+impl BenchArgs {
+    /// Refuse values no protocol can use, naming the option.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("--width", self.width),
+            ("--height", self.height),
+            ("--voxel-array-length", self.voxel_array_length),
+            ("--ray-array-length", self.ray_array_length),
+        ] {
+            if v == Some(0) {
+                bail!("{name} must be at least 1");
+            }
+        }
+        if self.angles == Some(0) {
+            bail!("--angles must be at least 1");
+        }
+        if let Some(r) = &self.grid_res {
+            if r.is_empty() || r.contains(&0) {
+                bail!("--grid-res needs resolutions of at least 1, e.g. --grid-res 8,16,24");
+            }
+        }
+        if self.variants.as_ref().is_some_and(|v| v.is_empty()) {
+            bail!("--variants needs at least one of thesis, exact");
+        }
+        if !self.tile.is_multiple_of(8) {
+            bail!(
+                "--tile {} must be a multiple of 8 (the kernels' work group size)",
+                self.tile
+            );
+        }
+        Ok(())
+    }
+}

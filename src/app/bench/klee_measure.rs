@@ -1,0 +1,228 @@
+//! What the Klee 2016 protocols share: a scene with its soft-shadow renderer, the shadow pass
+//! timed on the GPU and the same shadows (or the primary rays) timed on the CPU, the CSV of
+//! the measurements, and the section's opening paragraph.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Result;
+use glam::Vec3;
+
+use super::adapter::{ShadowFrame, SoftShadows};
+use super::config::Sizing;
+use super::csv_files::write_rows;
+use super::plots::Figure;
+use super::protocol::{Protocol, Section};
+use super::runner::Bench;
+use gpgpu_rt::reference::linespace::ShadowCounts;
+use gpgpu_rt::scene::{Scene, ShadowMode};
+
+/// Mean/min/max seconds of a measurement and its counts (per frame).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Meas {
+    pub mean_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    pub frames: u32,
+    pub triangle_tests: u64,
+    pub linespace_lookups: u64,
+}
+
+fn meas(times: &[f64], tests: u64, lookups: u64) -> Meas {
+    let n = times.len().max(1) as f64;
+    Meas {
+        mean_s: times.iter().sum::<f64>() / n,
+        min_s: times.iter().copied().fold(f64::INFINITY, f64::min),
+        max_s: times.iter().copied().fold(0.0, f64::max),
+        frames: times.len() as u32,
+        triangle_tests: tests,
+        linespace_lookups: lookups,
+    }
+}
+
+/// The shadow pass on the GPU: its time per frame, the G-buffer pass's, and the last frame.
+pub struct GpuRun {
+    pub shadow: Meas,
+    pub gbuffer: Meas,
+    pub last: ShadowFrame,
+}
+
+/// A scene with its soft-shadow renderer (the N-tree built once).
+pub struct Setup {
+    pub scene: Scene,
+    shadows: SoftShadows,
+    sizing: Sizing,
+}
+
+impl Setup {
+    pub fn new(bench: &mut Bench, scene: &str, s: Sizing) -> Result<Setup> {
+        let scene = bench.scene(scene)?.clone();
+        let shadows = SoftShadows::new(&bench.gpu, &scene, s, bench.args.tile)?;
+        Ok(Setup {
+            scene,
+            shadows,
+            sizing: s,
+        })
+    }
+
+    /// GPU: the shadow kernel's time per frame (and the G-buffer pass's), after warm-up.
+    pub fn gpu(&mut self, bench: &Bench, mode: ShadowMode, su: u32, sv: u32) -> Result<GpuRun> {
+        self.shadows.configure(&bench.gpu, mode, su, sv)?;
+        for _ in 0..self.sizing.warmup {
+            self.shadows.render(&self.scene.camera)?;
+        }
+        let (mut shadow, mut gbuf) = (Vec::new(), Vec::new());
+        let mut last = None;
+        for _ in 0..self.sizing.angles.max(1) {
+            let f = self.shadows.render(&self.scene.camera)?;
+            let gpu_s = |kernel: &dyn Fn(&str) -> bool| {
+                let ms = f.stats.gpu_ms.iter().filter(|(k, _)| kernel(k));
+                ms.map(|(_, v)| v).sum::<f64>() / 1e3
+            };
+            shadow.push(gpu_s(&|k| k.starts_with("shadow")));
+            gbuf.push(gpu_s(&|k| k == "gbuffer"));
+            last = Some(f);
+        }
+        let last = last.expect("one frame");
+        let tests = last.stats.triangle_tests.values().sum();
+        let lookups = last.stats.events.get("linespace_lookups").copied();
+        Ok(GpuRun {
+            shadow: meas(&shadow, tests, lookups.unwrap_or(0)),
+            gbuffer: meas(&gbuf, 0, 0),
+            last,
+        })
+    }
+
+    /// Frames timed on the CPU: 3 where the GPU has more than 2, else 1.
+    fn cpu_frames(&self) -> u32 {
+        if self.sizing.angles > 2 {
+            3
+        } else {
+            1
+        }
+    }
+
+    /// CPU: the shadow values of every pixel of `f`'s G-buffer, one thread.
+    pub fn cpu(&self, f: &ShadowFrame, mode: ShadowMode, su: u32, sv: u32) -> Meas {
+        let mut cpu = self.shadows.cpu();
+        cpu.samples_u = su;
+        cpu.samples_v = sv;
+        let mut times = Vec::new();
+        let mut counts = Default::default();
+        for _ in 0..self.cpu_frames() {
+            counts = ShadowCounts::default();
+            let t = Instant::now();
+            for (p, n) in f.gbuffer_position.iter().zip(&f.gbuffer_normal) {
+                if p[3] > 0.0 {
+                    let (_, c) = cpu.shadow(
+                        mode,
+                        Vec3::new(p[0], p[1], p[2]),
+                        Vec3::new(n[0], n[1], n[2]).normalize(),
+                    );
+                    counts += c;
+                }
+            }
+            times.push(t.elapsed().as_secs_f64());
+        }
+        meas(&times, counts.triangle_tests, counts.linespace_lookups)
+    }
+
+    /// CPU: the primary rays ray cast through the N-tree, one thread.
+    pub fn cpu_primary(&self) -> Meas {
+        let cpu = self.shadows.cpu();
+        let (w, h) = (self.sizing.width, self.sizing.height);
+        let rays = self.scene.camera.rays(w, h);
+        let mut times = Vec::new();
+        let mut counts = ShadowCounts::default();
+        for _ in 0..self.cpu_frames() {
+            counts = Default::default();
+            let t = Instant::now();
+            for y in 0..h {
+                for x in 0..w {
+                    let (o, d) = rays.primary_ray(x, y);
+                    std::hint::black_box(cpu.closest_hit(o, d, &mut counts));
+                }
+            }
+            times.push(t.elapsed().as_secs_f64());
+        }
+        meas(&times, counts.triangle_tests, 0)
+    }
+}
+
+/// One CSV row.
+pub struct Row {
+    pub scene: String,
+    pub variant: String,
+    pub device: String,
+    pub rays: u32,
+    pub m: Meas,
+}
+
+impl Row {
+    pub fn new(scene: &str, variant: &str, device: &str, rays: u32, m: Meas) -> Row {
+        Row {
+            scene: scene.into(),
+            variant: variant.into(),
+            device: device.into(),
+            rays,
+            m,
+        }
+    }
+}
+
+/// `<out>/<name>.csv`: one line per row; its path relative to the output folder.
+fn write_csv(bench: &Bench, name: &str, rows: &[Row], s: Sizing) -> Result<PathBuf> {
+    let rel = PathBuf::from(format!("{name}.csv"));
+    let header = [
+        "scene",
+        "variant",
+        "device",
+        "width",
+        "height",
+        "rays",
+        "frames",
+        "mean_s",
+        "min_s",
+        "max_s",
+        "fps",
+        "triangle_tests",
+        "linespace_lookups",
+    ];
+    let lines: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let mut line = vec![r.scene.clone(), r.variant.clone(), r.device.clone()];
+            line.extend([s.width, s.height, r.rays, r.m.frames].map(|v| v.to_string()));
+            line.extend([r.m.mean_s, r.m.min_s, r.m.max_s].map(|v| format!("{v:.6}")));
+            line.push(format!("{:.4}", 1.0 / r.m.mean_s));
+            line.extend([r.m.triangle_tests, r.m.linespace_lookups].map(|v| v.to_string()));
+            line
+        })
+        .collect();
+    let header: Vec<String> = header.map(String::from).to_vec();
+    write_rows(&bench.out.join(&rel), &header, &lines)?;
+    Ok(rel)
+}
+
+/// The section of a Klee protocol: the common opening paragraph, `markdown`, the `figures`,
+/// and the CSV of `rows`.
+pub fn section(
+    p: &Protocol,
+    bench: &Bench,
+    s: Sizing,
+    markdown: &str,
+    rows: &[Row],
+    figures: &[Figure],
+) -> Result<Section> {
+    let csv = write_csv(bench, p.name, rows, s)?;
+    let opening = format!(
+        "{} pixels, N-tree N = 10, depth 3, mean over {} frames (after {} warm-up); GPU: {}; CPU: one \
+         thread of this machine. Published: NVIDIA GTX 760 / Xeon E3-1230 v3, 512×512. Compare ratios, \
+         not seconds.\n\n",
+        s.size(),
+        s.angles,
+        s.warmup,
+        bench.machine.gl_renderer
+    );
+    Section::new(p, opening + markdown, vec![csv]).with_figures(&bench.out, figures)
+}

@@ -1,0 +1,102 @@
+//! A benchmark protocol, and the section of `report.md` it returns.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use super::csv_files;
+use super::outcome::Outcome;
+use super::plots::Figure;
+use super::runner::Bench;
+
+/// A benchmark protocol: what it measures, and how.
+pub struct Protocol {
+    /// The command-line name, e.g. `thesis-5.3`; also the CSV file names.
+    pub name: &'static str,
+    /// The section title in `report.md`.
+    pub title: &'static str,
+    /// Configure, measure (CSVs and plots into `bench.out`) and report: the section.
+    pub run: fn(&Protocol, &mut Bench) -> Result<Section>,
+}
+
+/// A protocol's part of the report.
+#[derive(Debug, Clone, Default)]
+pub struct Section {
+    pub protocol: String,
+    pub title: String,
+    pub markdown: String,
+    /// Configurations that failed (their errors are in the markdown).
+    pub failures: usize,
+    /// Files written, relative to the output folder.
+    pub files: Vec<PathBuf>,
+}
+
+impl Section {
+    /// The section of `p`: `markdown` and the `files` (relative to the output folder) it wrote.
+    pub fn new(p: &Protocol, markdown: String, files: Vec<PathBuf>) -> Section {
+        Section {
+            protocol: p.name.into(),
+            title: p.title.into(),
+            markdown,
+            failures: 0,
+            files,
+        }
+    }
+
+    /// The section of a protocol that failed as a whole.
+    pub fn failed(p: &Protocol, e: &anyhow::Error) -> Section {
+        Section {
+            failures: 1,
+            ..Section::new(p, format!("**The protocol failed:** `{e:#}`\n"), vec![])
+        }
+    }
+
+    /// The section of a protocol that measured `outcomes` (see [`Bench::measure`]): the
+    /// `markdown`, the `figures` drawn into `out`, and the failed configurations; its files are
+    /// the two CSVs, the figures and each configuration's first frame.
+    pub fn of_sweep(
+        p: &Protocol,
+        out: &Path,
+        markdown: String,
+        outcomes: &[Outcome],
+        figures: &[Figure],
+    ) -> Result<Section> {
+        let mut s =
+            Section::new(p, markdown, csv_files::names(p.name)).with_figures(out, figures)?;
+        s.markdown.push_str(&failures(outcomes));
+        s.files
+            .extend(outcomes.iter().filter_map(|o| o.image.clone()));
+        s.failures = outcomes.iter().filter(|o| o.error.is_some()).count();
+        Ok(s)
+    }
+
+    /// Draw `figures` into `out`, show each after the markdown, and list it as a file.
+    pub fn with_figures(mut self, out: &Path, figures: &[Figure]) -> Result<Section> {
+        for f in figures {
+            f.save(out)?;
+            self.markdown.push('\n');
+            self.markdown.push_str(&f.markdown());
+            self.files.push(f.file.clone());
+        }
+        Ok(self)
+    }
+}
+
+/// The configurations that failed, as a list (empty string when none did).
+fn failures(outcomes: &[Outcome]) -> String {
+    let mut s = String::new();
+    for o in outcomes.iter().filter(|o| o.error.is_some()) {
+        let _ = writeln!(
+            s,
+            "- **{} failed** after {} measured frames: `{}`",
+            o.config.label(),
+            o.frames.len(),
+            o.error.as_deref().unwrap_or("")
+        );
+    }
+    if !s.is_empty() {
+        s.insert_str(0, "\nFailed configurations:\n\n");
+    }
+    s
+}
