@@ -17,7 +17,7 @@ pub const ENTRY: Entry = Entry {
     grid_variant: None,
     label: "base",
     gpu: BruteForce::create,
-    cpu: |scene, _, _| -> Result<Box<dyn CpuAccelerator>> {
+    cpu: |scene, _| -> Result<Box<dyn CpuAccelerator>> {
         Ok(Box::new(reference::brute_force::BruteForce::new(
             scene.world_triangles(),
         )))

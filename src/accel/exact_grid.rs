@@ -28,7 +28,7 @@ pub const ENTRY: Entry = Entry {
     grid_variant: Some(GridVariant::Exact),
     label: "grid-exact",
     gpu: ExactGrid::create,
-    cpu: |scene, options, _| -> Result<Box<dyn CpuAccelerator>> {
+    cpu: |scene, options| -> Result<Box<dyn CpuAccelerator>> {
         let n = resolution(scene, options, MAX_RESOLUTION)?;
         Ok(Box::new(reference::exact_grid::ExactGrid::new(
             scene.world_triangles(),

@@ -142,6 +142,11 @@ pub fn auto_resolution(triangles: usize) -> u32 {
     ((triangles as f64 / 5.0).cbrt().round() as u32).clamp(4, 64)
 }
 
+/// Makes the GPU side of an accelerator.
+pub type MakeGpu = fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>;
+/// Makes the CPU twin of an accelerator.
+pub type MakeCpu = fn(&Scene, &GridOptions) -> Result<Box<dyn CpuAccelerator>>;
+
 /// One accelerator: how the command line names it, and how its GPU side and CPU twin are made.
 pub struct Entry {
     /// The `--tracer` value.
@@ -150,9 +155,9 @@ pub struct Entry {
     pub grid_variant: Option<GridVariant>,
     /// A name for reports: "base", "grid-thesis", "grid-exact".
     pub label: &'static str,
-    pub gpu: fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>,
+    pub gpu: MakeGpu,
     /// The CPU twin over the scene as loaded.
-    pub cpu: fn(&Scene, &GridOptions, (u32, u32)) -> Result<Box<dyn CpuAccelerator>>,
+    pub cpu: MakeCpu,
 }
 
 /// Every accelerator of the four-kernel pipeline.

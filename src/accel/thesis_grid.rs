@@ -33,7 +33,7 @@ pub const ENTRY: Entry = Entry {
     grid_variant: Some(GridVariant::Thesis),
     label: "grid-thesis",
     gpu: ThesisGrid::create,
-    cpu: |scene, options, _| -> Result<Box<dyn CpuAccelerator>> {
+    cpu: |scene, options| -> Result<Box<dyn CpuAccelerator>> {
         let n = resolution(scene, options, MAX_RESOLUTION)?;
         Ok(Box::new(reference::thesis_grid::ThesisGrid::new(
             scene.world_triangles(),
