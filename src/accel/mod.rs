@@ -147,6 +147,9 @@ pub fn auto_resolution(triangles: usize) -> u32 {
     ((triangles as f64 / 5.0).cbrt().round() as u32).clamp(4, 64)
 }
 
+/// How an [`Entry`] makes its CPU twin: from the scene as loaded, the options and the image size.
+pub type CpuTwinFn = fn(&Scene, &GridOptions, (u32, u32)) -> Result<Box<dyn CpuAccelerator>>;
+
 /// One accelerator: how the command line names it, and how its GPU side and CPU twin are made.
 pub struct Entry {
     /// The `--tracer` value.
@@ -157,7 +160,7 @@ pub struct Entry {
     pub label: &'static str,
     pub gpu: fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>,
     /// The CPU twin over the scene as loaded.
-    pub cpu: fn(&Scene, &GridOptions, (u32, u32)) -> Result<Box<dyn CpuAccelerator>>,
+    pub cpu: CpuTwinFn,
 }
 
 /// Every accelerator of the four-kernel pipeline.
