@@ -282,33 +282,7 @@ fn exact_grid_gives_the_base_tracers_image() {
             },
         );
         let grid = t.render(&scene.camera).unwrap();
-        let (a, b) = (base.aovs.unwrap(), grid.aovs.unwrap());
-        let differ = a
-            .triangle_id
-            .iter()
-            .zip(&b.triangle_id)
-            .filter(|(x, y)| x != y)
-            .count();
-        assert_eq!(
-            differ, 0,
-            "{name}: {differ} triangle ids differ from the base tracer"
-        );
-        assert_eq!(a.hit_t, b.hit_t, "{name}");
-        let colour_diff = base
-            .color
-            .iter()
-            .zip(&grid.color)
-            .map(|(x, y)| {
-                (x[0] - y[0])
-                    .abs()
-                    .max((x[1] - y[1]).abs())
-                    .max((x[2] - y[2]).abs())
-            })
-            .fold(0.0f32, f32::max);
-        assert!(
-            colour_diff < 1e-4,
-            "{name}: colours differ by {colour_diff}"
-        );
+        assert_same_image(&base, &grid, name);
         // far fewer tests
         let (tb, tg) = (
             base.stats.total_triangle_tests(),

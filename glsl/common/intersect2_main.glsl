@@ -56,7 +56,9 @@ void main()
     countAdd(0, tests);
     countAdd(1, truncated);
     countAdd(2, voxelsVisited);
+    countAdd(3, nodesVisited);
     countersEnd(0, COUNTER_INTERSECT2);
     countersEnd(1, COUNTER_TRUNCATED_RAYS);
     countersEnd(2, COUNTER_VOXELS_VISITED);
+    countersEnd(3, COUNTER_NODES_VISITED);
 }

@@ -6,6 +6,7 @@
 //! | `base` | [`brute_force::BruteForce`] | `glsl/brute_force/` | `reference::brute_force` |
 //! | `grid --grid-variant thesis` | [`thesis_grid::ThesisGrid`] | `glsl/thesis_grid/` | `reference::thesis_grid` |
 //! | `grid --grid-variant exact` | [`exact_grid::ExactGrid`] | `glsl/exact_grid/` | `reference::exact_grid` |
+//! | `bvh` | [`bvh::Bvh`] | `glsl/bvh/` | `reference::bvh` |
 //!
 //! An accelerator answers the pipeline's two questions — the closest hit of every ray
 //! (intersect1) and whether a shadow feeler is blocked (intersect2) — and may rebuild itself
@@ -15,6 +16,7 @@
 //! every accelerator once.
 
 pub mod brute_force;
+pub mod bvh;
 pub mod exact_grid;
 pub mod grid_frame;
 pub mod thesis_grid;
@@ -97,6 +99,9 @@ pub enum TracerKind {
     Base,
     /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
     Grid,
+    /// A BVH built on the CPU with the SAH, rebuilt when an object moved (ours, after Wagner
+    /// 2018 ch. 3.2, 4.2); the grid options are ignored.
+    Bvh,
 }
 
 /// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2).
@@ -153,7 +158,7 @@ pub struct Entry {
     pub tracer: TracerKind,
     /// The `--grid-variant` it answers to (`None`: any; the option is then ignored).
     pub grid_variant: Option<GridVariant>,
-    /// A name for reports: "base", "grid-thesis", "grid-exact".
+    /// A name for reports: "base", "grid-thesis", "grid-exact", "bvh".
     pub label: &'static str,
     pub gpu: MakeGpu,
     /// The CPU twin over the scene as loaded.
@@ -161,7 +166,12 @@ pub struct Entry {
 }
 
 /// Every accelerator of the four-kernel pipeline.
-pub const REGISTRY: &[Entry] = &[brute_force::ENTRY, thesis_grid::ENTRY, exact_grid::ENTRY];
+pub const REGISTRY: &[Entry] = &[
+    brute_force::ENTRY,
+    thesis_grid::ENTRY,
+    exact_grid::ENTRY,
+    bvh::ENTRY,
+];
 
 /// The accelerator `--tracer tracer` with `options` selects.
 pub fn entry(tracer: TracerKind, options: &GridOptions) -> Result<&'static Entry> {

@@ -251,6 +251,7 @@ impl RenderArgs {
         match self.tracer {
             TracerKind::Base => "base",
             TracerKind::Grid => "grid",
+            TracerKind::Bvh => "bvh",
         }
     }
 }

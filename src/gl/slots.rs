@@ -45,6 +45,9 @@ slot_table! {
         BLOCK_SUMS = 13,
         GRID_TOTAL = 14,
         VOXEL_TRIS = 15,
+        // the BVH (glsl/bvh/): its nodes and the triangle ids of its leaves
+        BVH_NODES = 10,
+        BVH_TRIS = 11,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,

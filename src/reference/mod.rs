@@ -4,6 +4,7 @@
 //! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
 
 pub mod brute_force;
+pub mod bvh;
 pub mod exact_grid;
 pub mod grid;
 pub mod linespace;

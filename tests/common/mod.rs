@@ -147,3 +147,35 @@ pub fn copy_dir(from: &Path, to: &Path) {
         }
     }
 }
+
+/// `other` shows the base tracer's image: the same first triangle ids and hit distances in every
+/// pixel, colours within 1e-4.
+pub fn assert_same_image(base: &Frame, other: &Frame, what: &str) {
+    let (a, b) = (base.aovs.as_ref().unwrap(), other.aovs.as_ref().unwrap());
+    let differ = a
+        .triangle_id
+        .iter()
+        .zip(&b.triangle_id)
+        .filter(|(x, y)| x != y)
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{what}: {differ} triangle ids differ from the base tracer"
+    );
+    assert_eq!(a.hit_t, b.hit_t, "{what}");
+    let colour_diff = base
+        .color
+        .iter()
+        .zip(&other.color)
+        .map(|(x, y)| {
+            (x[0] - y[0])
+                .abs()
+                .max((x[1] - y[1]).abs())
+                .max((x[2] - y[2]).abs())
+        })
+        .fold(0.0f32, f32::max);
+    assert!(
+        colour_diff < 1e-4,
+        "{what}: colours differ by {colour_diff}"
+    );
+}

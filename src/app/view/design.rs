@@ -108,10 +108,10 @@ impl Design {
         t
     }
 
-    /// "base", "grid exact 16³", "grid thesis auto=12³".
+    /// "base", "bvh", "grid exact 16³", "grid thesis auto=12³".
     fn tracer_title(&self) -> String {
         let mut t = value_name(self.kind);
-        if self.kind != TracerKind::Base {
+        if self.kind == TracerKind::Grid {
             let g = &self.options.grid;
             let res = g
                 .resolution

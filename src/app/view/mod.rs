@@ -462,9 +462,9 @@ impl App {
 
     /// Grid options only matter to tracers that use them; the base tracer keeps running.
     fn change_grid(&mut self, options: RenderOptions, what: String) {
-        if self.design.kind == TracerKind::Base {
+        if self.design.kind != TracerKind::Grid {
             self.design.options = options;
-            println!("{what} (used by the grid tracer; the base tracer ignores it)");
+            println!("{what} (used by the grid tracer; this tracer ignores it)");
             self.update_title(true);
         } else {
             self.change(self.design.kind, options, what);

@@ -71,6 +71,7 @@ pub const COUNTERS: &[&str] = &[
     "voxels_visited",
     "dropped_triangle_refs",
     "ray_list_overflows",
+    "nodes_visited",
 ];
 
 /// The counters that count ray–triangle tests (the rest count events).
@@ -297,6 +298,7 @@ impl Renderer for RayTracer {
         match self.options.tracer {
             TracerKind::Base => "base",
             TracerKind::Grid => "grid",
+            TracerKind::Bvh => "bvh",
         }
     }
 

@@ -1,0 +1,44 @@
+// intersect1 kernel of the BVH — ours, after Wagner 2018 ch. 3.2 (SAH BVH, eq. 4.1) and 4.2
+// (traversal, Möller–Trumbore Listing 4.2 = Müller's Algorithm 1): the closest hit of each ray
+// by an ordered traversal of the CPU-built BVH (bvh/traverse.glsl). Deviations: see there;
+// equal distances go to the lower triangle id, as in the base tracer's loop, so the image
+// equals the base tracer's. Listings 13, 14 of Müller 2015: common/intersect1_main.glsl.
+#include "../common/intersect_head.glsl"
+#include "traverse.glsl"
+
+// the ray and its closest hit so far, for leafHit
+vec3 rayO = vec3(0.0), rayD = vec3(0.0);
+int rayLast = -1;
+float bestT = 0.0;
+int bestID = -1;
+float bestU = 0.0, bestV = 0.0;
+
+bool leafHit(uint first, uint count, inout float limit)
+{
+    for (uint k = first; k < first + count; k++) {
+        int tri = bvhTris[k];
+        if (tri == rayLast) continue;
+        float t, u, v;
+        tests++;
+        if (intersectTriangle(rayO, rayD, vertex[3 * tri].xyz, vertex[3 * tri + 1].xyz,
+                              vertex[3 * tri + 2].xyz, t, u, v)
+            && (t < bestT || (t == bestT && tri < bestID))) {
+            bestT = t;
+            bestID = tri;
+            bestU = u; bestV = v;
+        }
+    }
+    limit = bestT;
+    return false;
+}
+
+void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
+                inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
+{
+    rayO = ro; rayD = rd; rayLast = lastTriID;
+    bestT = t_min; bestID = triID; bestU = hit_u; bestV = hit_v;
+    traverse(ro, rd, bestT);
+    t_min = bestT; triID = bestID; hit_u = bestU; hit_v = bestV;
+}
+
+#include "../common/intersect1_main.glsl"

@@ -1,0 +1,35 @@
+// intersect2 kernel of the BVH — ours, after Wagner 2018 ch. 4.2 (hard shadows: a shadow ray
+// towards the one light through the same BVH): the shadow feeler walks the BVH
+// (bvh/traverse.glsl, nodes beyond the light pruned) and tests the triangles of each leaf
+// until the first occluder (any hit). Deviations: see traverse.glsl; any number of lights.
+// Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
+#include "../common/intersect_head.glsl"
+#include "traverse.glsl"
+
+// the feeler, for leafHit
+vec3 rayO = vec3(0.0), rayD = vec3(0.0);
+int rayLast = -1;
+float rayLight = 0.0;
+
+bool leafHit(uint first, uint count, inout float limit)
+{
+    for (uint k = first; k < first + count; k++) {
+        int tri = bvhTris[k];
+        if (tri == rayLast) continue;
+        float t, u, v;
+        tests++;
+        if (intersectTriangle(rayO, rayD, vertex[3 * tri].xyz, vertex[3 * tri + 1].xyz,
+                              vertex[3 * tri + 2].xyz, t, u, v)
+            && t > SHADOW_OFFSET && t < rayLight)
+            return true;
+    }
+    return false;
+}
+
+bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
+{
+    rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
+    return traverse(ro, rd, lightDistance);
+}
+
+#include "../common/intersect2_main.glsl"

@@ -1,0 +1,192 @@
+//! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
+//! (`reference::bvh`, binned SAH, rayon) and uploaded into two storage buffers (nodes, triangle
+//! ids), traversed in the intersection kernels with an ordered stack (`glsl/bvh/`). Objects
+//! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
+//! matrix changed since the last build, and not otherwise. Its image equals the base
+//! tracer's. CPU twin: `reference::bvh::Bvh`.
+
+use std::any::Any;
+use std::sync::Arc;
+
+use anyhow::Result;
+use glam::{Mat4, Vec3};
+use serde_json::json;
+
+use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
+use crate::frame::FrameStats;
+use crate::gl::resources::Ssbo;
+use crate::gl::slots::ssbo;
+use crate::gl::{Gl, Kernel};
+use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
+use crate::reference::CpuAccelerator;
+use crate::scene::Scene;
+
+pub const ENTRY: Entry = Entry {
+    tracer: TracerKind::Bvh,
+    grid_variant: None,
+    label: "bvh",
+    gpu: Bvh::create,
+    cpu: |scene, _| -> Result<Box<dyn CpuAccelerator>> {
+        Ok(Box::new(CpuBvh::new(scene.world_triangles())))
+    },
+};
+
+/// The uploaded hierarchy.
+struct Buffers {
+    nodes: Ssbo,
+    tris: Ssbo,
+}
+
+impl Buffers {
+    fn bind(&self, gl: &Gl) {
+        self.nodes.bind(gl, ssbo::BVH_NODES);
+        self.tris.bind(gl, ssbo::BVH_TRIS);
+    }
+
+    fn delete(&self, gl: &Gl) {
+        self.nodes.delete(gl);
+        self.tris.delete(gl);
+    }
+}
+
+pub struct Bvh {
+    gl: Arc<Gl>,
+    intersect1: Kernel,
+    intersect2: Kernel,
+    /// object-space vertex positions of every object (triangle soup, scene order)
+    objects: Vec<Vec<Vec3>>,
+    /// the model matrices of the last build (`None`: not built yet)
+    built_for: Option<Vec<Mat4>>,
+    buffers: Option<Buffers>,
+    max_ssbo: i64,
+    stats: BvhStats,
+    /// builds so far (the first and one per frame in which something moved)
+    builds: u64,
+    /// whether the last frame rebuilt
+    rebuilt: bool,
+}
+
+impl Bvh {
+    fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        Ok(Box::new(Bvh {
+            gl: b.gl.clone(),
+            intersect1: b.kernel("bvh/intersect1.comp", &[], "intersect1")?,
+            intersect2: b.kernel("bvh/intersect2.comp", &[], "intersect2")?,
+            objects: scene
+                .objects
+                .iter()
+                .map(|o| o.mesh.positions.clone())
+                .collect(),
+            built_for: None,
+            buffers: None,
+            max_ssbo: b.info.max_ssbo_block_size,
+            stats: BvhStats::default(),
+            builds: 0,
+            rebuilt: false,
+        }))
+    }
+
+    /// The world triangles under `models`, as `Scene::world_triangles` computes them.
+    fn world_triangles(&self, models: &[Mat4]) -> Vec<[Vec3; 3]> {
+        let mut out = Vec::new();
+        for (positions, m) in self.objects.iter().zip(models) {
+            for t in positions.chunks_exact(3) {
+                out.push([0, 1, 2].map(|k| m.transform_point3(t[k])));
+            }
+        }
+        out
+    }
+
+    /// Build on the CPU and upload.
+    fn rebuild(&mut self, models: &[Mat4]) -> Result<()> {
+        let start = std::time::Instant::now();
+        let bvh = CpuBvh::new(self.world_triangles(models));
+        let gl = &self.gl;
+        let nodes = Ssbo::new(
+            gl,
+            "bvhNodes",
+            std::mem::size_of_val(&bvh.nodes[..]),
+            Some(bytemuck::cast_slice(&bvh.nodes)),
+            self.max_ssbo,
+        )?;
+        let tris = Ssbo::new(
+            gl,
+            "bvhTris",
+            4 * bvh.tris.len(),
+            Some(bytemuck::cast_slice(&bvh.tris)),
+            self.max_ssbo,
+        );
+        let tris = tris.inspect_err(|_| nodes.delete(gl))?;
+        if let Some(old) = self.buffers.replace(Buffers { nodes, tris }) {
+            old.delete(gl);
+        }
+        self.stats = bvh.stats;
+        // the build time includes the world transform and the upload
+        self.stats.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.built_for = Some(models.to_vec());
+        self.builds += 1;
+        Ok(())
+    }
+
+    /// The facts of the last build.
+    pub fn build_stats(&self) -> BvhStats {
+        self.stats
+    }
+
+    /// The number of builds so far.
+    pub fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    fn bind(&self, gl: &Gl) {
+        if let Some(b) = &self.buffers {
+            b.bind(gl);
+        }
+    }
+}
+
+impl Accelerator for Bvh {
+    fn build(&mut self, f: &mut FrameContext) -> Result<()> {
+        self.rebuilt = self.built_for.as_deref() != Some(f.models);
+        if self.rebuilt {
+            self.rebuild(f.models)?;
+        }
+        Ok(())
+    }
+
+    fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
+        self.bind(f.gl);
+        self.intersect1.use_program();
+        &self.intersect1
+    }
+
+    fn any_hit(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+        self.bind(f.gl);
+        self.intersect2.use_program();
+        &self.intersect2
+    }
+
+    fn stats(&self, stats: &mut FrameStats) {
+        let s = &self.stats;
+        let f = &mut stats.facts;
+        f.insert("bvh_build_ms".into(), json!(s.build_ms));
+        f.insert("bvh_rebuilt".into(), json!(self.rebuilt));
+        f.insert("bvh_nodes".into(), json!(s.nodes));
+        f.insert("bvh_leaves".into(), json!(s.leaves));
+        f.insert("bvh_depth".into(), json!(s.depth));
+        f.insert("bvh_bytes".into(), json!(s.bytes));
+        f.insert("bvh_sah_cost".into(), json!(s.sah_cost));
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+impl Drop for Bvh {
+    fn drop(&mut self) {
+        if let Some(b) = &self.buffers {
+            b.delete(&self.gl);
+        }
+    }
+}

@@ -1,0 +1,617 @@
+//! The SAH bounding volume hierarchy — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
+//! top-down, each node split where the simplified SAH of eq. 4.1 (half surface area times
+//! triangle count, summed over both children) is lowest, a leaf when it holds at most
+//! [`LEAF_SIZE`] triangles or no split beats the node's own SAH (Listings 4.3, 4.4). Where
+//! Wagner tries split distances one after another, we evaluate [`BINS`] bins per axis (binned
+//! SAH, Wald 2007, his [13]) and build the two children in parallel (rayon) above
+//! [`PARALLEL_BUILD`] triangles.
+//!
+//! Layout for upload ([`Node`], 32 bytes): bounds min/max and either the index of the left
+//! child (the right child follows it) or, in a leaf, the first entry of its triangles in
+//! [`Bvh::tris`] (triangle ids, reordered per leaf). Wagner stored the tree in three textures
+//! (Fig. 4.3); we use one storage buffer of nodes and one of triangle ids.
+//!
+//! This module is also the CPU twin of `accel::bvh` (`glsl/bvh/`): [`Bvh::traverse`] walks the
+//! nodes in exactly the kernels' order — an explicit stack of [`STACK_SIZE`] entries, the
+//! nearer child first (the left on equal entry distances), nodes beyond the current limit
+//! pruned — and counts triangle tests as they do.
+
+use std::ops::ControlFlow;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::{closest_among, CpuAccelerator, Feeler, Hit};
+
+/// Bins per axis of the binned SAH.
+pub const BINS: usize = 16;
+/// Wagner's leaf size: a node of at most this many triangles is a leaf.
+pub const LEAF_SIZE: usize = 4;
+/// A node of more triangles is split even when the SAH says a split does not pay.
+pub const MAX_LEAF: usize = 16;
+/// Below this depth the SAH chooses the split; deeper, the triangles are halved (by centroid
+/// order on the widest axis), which bounds the depth by this plus log2(triangles).
+pub const SAH_DEPTH: u32 = 40;
+/// The traversal stack of the kernels (`glsl/bvh/traverse.glsl`); a deeper tree could overflow it.
+pub const STACK_SIZE: usize = 64;
+/// Subtrees of more triangles build their two children in parallel.
+pub const PARALLEL_BUILD: usize = 4096;
+
+/// One node as uploaded (std430 `struct BvhNode { vec3 lo; int first; vec3 hi; int count; }`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct Node {
+    pub lo: [f32; 3],
+    /// Inner node: the left child (the right is `first + 1`); leaf: the first of its
+    /// triangles in [`Bvh::tris`].
+    pub first: u32,
+    pub hi: [f32; 3],
+    /// 0: inner node; else the number of triangles of the leaf.
+    pub count: u32,
+}
+
+impl Node {
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb {
+        lo: Vec3::splat(f32::INFINITY),
+        hi: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn grow(&mut self, o: &Aabb) {
+        self.lo = self.lo.min(o.lo);
+        self.hi = self.hi.max(o.hi);
+    }
+
+    fn grow_point(&mut self, p: Vec3) {
+        self.lo = self.lo.min(p);
+        self.hi = self.hi.max(p);
+    }
+
+    /// Half the surface area (eq. 4.1 without the triangle count); 0 for an empty box.
+    pub fn half_area(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    pub fn contains(&self, o: &Aabb) -> bool {
+        self.lo.cmple(o.lo).all() && o.hi.cmple(self.hi).all()
+    }
+}
+
+/// The facts of a build, for the statistics.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BvhStats {
+    pub nodes: usize,
+    pub leaves: usize,
+    /// The deepest leaf (root: 0).
+    pub depth: u32,
+    /// SAH cost relative to the root: Σ inner A(n)/A(root) + Σ leaves A(l)/A(root)·N(l)
+    /// (A: surface area; one unit per node traversal and per triangle test).
+    pub sah_cost: f64,
+    /// Bytes of the nodes and triangle ids as uploaded.
+    pub bytes: usize,
+    pub build_ms: f64,
+}
+
+/// The hierarchy over a list of triangles, and the CPU twin of its kernels.
+pub struct Bvh {
+    triangles: Vec<[Vec3; 3]>,
+    pub nodes: Vec<Node>,
+    /// Triangle ids in leaf order.
+    pub tris: Vec<u32>,
+    pub stats: BvhStats,
+}
+
+/// What the build knows of each triangle: its bounds and its centroid.
+struct Prims {
+    bounds: Vec<Aabb>,
+    centroids: Vec<Vec3>,
+}
+
+/// A subtree before it is laid out.
+enum Tree {
+    Leaf {
+        bounds: Aabb,
+        start: usize,
+        count: usize,
+    },
+    Inner {
+        bounds: Aabb,
+        children: Box<[Tree; 2]>,
+    },
+}
+
+impl Tree {
+    fn bounds(&self) -> &Aabb {
+        match self {
+            Tree::Leaf { bounds, .. } | Tree::Inner { bounds, .. } => bounds,
+        }
+    }
+}
+
+impl Bvh {
+    /// Build the hierarchy over `triangles` (triangle id = index).
+    pub fn new(triangles: Vec<[Vec3; 3]>) -> Bvh {
+        let start = std::time::Instant::now();
+        let prims = Prims::of(&triangles);
+        let mut ids: Vec<u32> = (0..triangles.len() as u32).collect();
+        let tree = build(&prims, &mut ids, 0, 0);
+        let mut nodes = vec![Node::zeroed()];
+        layout(&tree, 0, &mut nodes);
+        let mut stats = BvhStats {
+            nodes: nodes.len(),
+            leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
+            bytes: nodes.len() * std::mem::size_of::<Node>() + 4 * ids.len(),
+            ..BvhStats::default()
+        };
+        measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
+        stats.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        Bvh {
+            triangles,
+            nodes,
+            tris: ids,
+            stats,
+        }
+    }
+
+    /// The triangles it was built over.
+    pub fn triangles(&self) -> &[[Vec3; 3]] {
+        &self.triangles
+    }
+
+    /// Walk the nodes along ro + t·rd for 0 ≤ t ≤ `limit`, as `glsl/bvh/traverse.glsl`: every
+    /// leaf reached goes to `leaf` (its triangle ids), which returns the new limit or breaks the
+    /// walk. Returns the number of nodes visited.
+    pub fn traverse(
+        &self,
+        ro: Vec3,
+        rd: Vec3,
+        mut limit: f32,
+        mut leaf: impl FnMut(&[u32]) -> ControlFlow<(), f32>,
+    ) -> u64 {
+        let inv = safe_inverse(rd);
+        if self.enter(0, ro, inv, limit).is_none() {
+            return 0;
+        }
+        let mut stack: Vec<(usize, f32)> = Vec::with_capacity(STACK_SIZE);
+        let (mut node, mut visited) = (0usize, 0u64);
+        loop {
+            visited += 1;
+            let n = &self.nodes[node];
+            let next = if n.is_leaf() {
+                let ids = &self.tris[n.first as usize..(n.first + n.count) as usize];
+                match leaf(ids) {
+                    ControlFlow::Break(()) => return visited,
+                    ControlFlow::Continue(l) => limit = l,
+                }
+                None
+            } else {
+                let (l, r) = (n.first as usize, n.first as usize + 1);
+                match (self.enter(l, ro, inv, limit), self.enter(r, ro, inv, limit)) {
+                    (Some(tl), Some(tr)) => {
+                        let (near, far) = if tr < tl { (r, (l, tl)) } else { (l, (r, tr)) };
+                        // a full stack drops the far child (the kernels count a truncated ray)
+                        if stack.len() < STACK_SIZE {
+                            stack.push(far);
+                        }
+                        Some(near)
+                    }
+                    (Some(_), None) => Some(l),
+                    (None, Some(_)) => Some(r),
+                    (None, None) => None,
+                }
+            };
+            // nothing to descend into: the nearest node on the stack still within reach
+            let next = next.or_else(|| {
+                while let Some((n, t)) = stack.pop() {
+                    if t <= limit {
+                        return Some(n);
+                    }
+                }
+                None
+            });
+            match next {
+                Some(n) => node = n,
+                None => return visited,
+            }
+        }
+    }
+
+    /// The entry distance of the ray into node `n`'s box if it enters it at t ≤ `limit`
+    /// (the slab test of Wagner 2018, Listing 4.5, as `boxEntry` in the kernels).
+    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
+        let node = &self.nodes[n];
+        let t0 = (Vec3::from(node.lo) - ro) * inv;
+        let t1 = (Vec3::from(node.hi) - ro) * inv;
+        let near = t0.x.min(t1.x).max(t0.y.min(t1.y));
+        let near = near.max(t0.z.min(t1.z).max(0.0));
+        let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z));
+        (near <= far && near <= limit).then_some(near)
+    }
+}
+
+/// 1/rd with zero (and tiny) components replaced by 1e-20, so the slab test never computes
+/// 0·∞ (the kernels do the same).
+fn safe_inverse(rd: Vec3) -> Vec3 {
+    let s = |d: f32| if d.abs() < 1e-20 { 1e-20 } else { d };
+    Vec3::new(1.0 / s(rd.x), 1.0 / s(rd.y), 1.0 / s(rd.z))
+}
+
+impl Prims {
+    /// Bounds and centroids of every triangle; the bounds are widened by a small margin
+    /// relative to the scene so that rounding in the slab test (and ulp differences of the
+    /// GPU's transformed vertices) never loses a triangle that touches its box.
+    fn of(triangles: &[[Vec3; 3]]) -> Prims {
+        let mut scene = Aabb::EMPTY;
+        for t in triangles {
+            t.iter().for_each(|&p| scene.grow_point(p));
+        }
+        let extent = (scene.hi - scene.lo)
+            .max_element()
+            .max(scene.hi.abs().max_element());
+        let pad = Vec3::splat(1e-5 * extent.max(1e-20));
+        let bounds = triangles
+            .iter()
+            .map(|t| {
+                let mut b = Aabb::EMPTY;
+                t.iter().for_each(|&p| b.grow_point(p));
+                Aabb {
+                    lo: b.lo - pad,
+                    hi: b.hi + pad,
+                }
+            })
+            .collect::<Vec<_>>();
+        let centroids = bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect();
+        Prims { bounds, centroids }
+    }
+
+    fn bounds_of(&self, ids: &[u32]) -> (Aabb, Aabb) {
+        let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
+        for &i in ids {
+            b.grow(&self.bounds[i as usize]);
+            c.grow_point(self.centroids[i as usize]);
+        }
+        (b, c)
+    }
+}
+
+/// A split: the axis and the number of bins left of the plane.
+struct Split {
+    axis: usize,
+    bins_left: usize,
+    cost: f32,
+}
+
+/// The bin of centroid coordinate `c` on an axis from `lo` with `scale` = BINS / extent.
+fn bin(c: f32, lo: f32, scale: f32) -> usize {
+    (((c - lo) * scale) as usize).min(BINS - 1)
+}
+
+/// The cheapest binned split of `ids` by eq. 4.1 (Σ children half area · count), if any
+/// separates them.
+fn best_split(prims: &Prims, ids: &[u32], centroids: &Aabb) -> Option<Split> {
+    let mut best: Option<Split> = None;
+    for axis in 0..3 {
+        let (lo, extent) = (centroids.lo[axis], centroids.hi[axis] - centroids.lo[axis]);
+        if extent <= 0.0 || !extent.is_finite() {
+            continue;
+        }
+        let scale = BINS as f32 / extent;
+        let mut bins = [(Aabb::EMPTY, 0usize); BINS];
+        for &i in ids {
+            let b = &mut bins[bin(prims.centroids[i as usize][axis], lo, scale)];
+            b.0.grow(&prims.bounds[i as usize]);
+            b.1 += 1;
+        }
+        // right-to-left sweep: the cost of every right side
+        let mut right = [0.0f32; BINS];
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for k in (1..BINS).rev() {
+            acc.grow(&bins[k].0);
+            n += bins[k].1;
+            right[k] = acc.half_area() * n as f32;
+        }
+        let (mut acc, mut n) = (Aabb::EMPTY, 0);
+        for k in 1..BINS {
+            acc.grow(&bins[k - 1].0);
+            n += bins[k - 1].1;
+            if n == 0 || n == ids.len() {
+                continue;
+            }
+            let cost = acc.half_area() * n as f32 + right[k];
+            if best.as_ref().is_none_or(|b| cost < b.cost) {
+                best = Some(Split {
+                    axis,
+                    bins_left: k,
+                    cost,
+                });
+            }
+        }
+    }
+    best
+}
+
+/// Reorder `ids` so that those for which `left` holds come first; returns their number.
+fn partition(ids: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+    let (mut i, mut j) = (0, ids.len());
+    while i < j {
+        if left(ids[i]) {
+            i += 1;
+        } else {
+            j -= 1;
+            ids.swap(i, j);
+        }
+    }
+    i
+}
+
+/// Build the subtree over `ids`, which start at `offset` in the full id list.
+fn build(prims: &Prims, ids: &mut [u32], offset: usize, depth: u32) -> Tree {
+    let (bounds, centroids) = prims.bounds_of(ids);
+    let leaf = Tree::Leaf {
+        bounds,
+        start: offset,
+        count: ids.len(),
+    };
+    if ids.len() <= LEAF_SIZE {
+        return leaf;
+    }
+    let split = (depth < SAH_DEPTH)
+        .then(|| best_split(prims, ids, &centroids))
+        .flatten();
+    let mid = match split {
+        // Listing 4.4: split only where it pays (unless the node is too large for a leaf)
+        Some(s) if s.cost < bounds.half_area() * ids.len() as f32 || ids.len() > MAX_LEAF => {
+            let (lo, extent) = (
+                centroids.lo[s.axis],
+                centroids.hi[s.axis] - centroids.lo[s.axis],
+            );
+            let scale = BINS as f32 / extent;
+            partition(ids, |i| {
+                bin(prims.centroids[i as usize][s.axis], lo, scale) < s.bins_left
+            })
+        }
+        Some(_) => return leaf,
+        None if ids.len() <= MAX_LEAF && depth < SAH_DEPTH => return leaf,
+        // no binned split separates them (or too deep): halve in centroid order
+        None => median(prims, ids, &centroids),
+    };
+    let (left, right) = ids.split_at_mut(mid);
+    let (l, r) = if left.len() + right.len() > PARALLEL_BUILD {
+        rayon::join(
+            || build(prims, left, offset, depth + 1),
+            || build(prims, right, offset + mid, depth + 1),
+        )
+    } else {
+        (
+            build(prims, left, offset, depth + 1),
+            build(prims, right, offset + mid, depth + 1),
+        )
+    };
+    Tree::Inner {
+        bounds,
+        children: Box::new([l, r]),
+    }
+}
+
+/// Sort `ids` by centroid on the widest centroid axis (then by id) and return the middle.
+fn median(prims: &Prims, ids: &mut [u32], centroids: &Aabb) -> usize {
+    let d = centroids.hi - centroids.lo;
+    let axis = if d.x >= d.y && d.x >= d.z {
+        0
+    } else if d.y >= d.z {
+        1
+    } else {
+        2
+    };
+    ids.sort_unstable_by(|&a, &b| {
+        let (ca, cb) = (
+            prims.centroids[a as usize][axis],
+            prims.centroids[b as usize][axis],
+        );
+        ca.total_cmp(&cb).then(a.cmp(&b))
+    });
+    ids.len() / 2
+}
+
+/// Write `tree` into `nodes[index]`, its children into two adjacent new nodes.
+fn layout(tree: &Tree, index: usize, nodes: &mut Vec<Node>) {
+    let b = tree.bounds();
+    let (lo, hi) = (b.lo.to_array(), b.hi.to_array());
+    match tree {
+        Tree::Leaf { start, count, .. } => {
+            nodes[index] = Node {
+                lo,
+                first: *start as u32,
+                hi,
+                count: *count as u32,
+            };
+        }
+        Tree::Inner { children, .. } => {
+            let first = nodes.len();
+            nodes.extend([Node::zeroed(); 2]);
+            nodes[index] = Node {
+                lo,
+                first: first as u32,
+                hi,
+                count: 0,
+            };
+            layout(&children[0], first, nodes);
+            layout(&children[1], first + 1, nodes);
+        }
+    }
+}
+
+/// Add the SAH cost and the depth of `tree` to `stats`.
+fn measure(tree: &Tree, depth: u32, root_area: f64, stats: &mut BvhStats) {
+    let rel = if root_area > 0.0 {
+        tree.bounds().half_area() as f64 / root_area
+    } else {
+        1.0
+    };
+    match tree {
+        Tree::Leaf { count, .. } => {
+            stats.sah_cost += rel * *count as f64;
+            stats.depth = stats.depth.max(depth);
+        }
+        Tree::Inner { children, .. } => {
+            stats.sah_cost += rel;
+            for c in children.iter() {
+                measure(c, depth + 1, root_area, stats);
+            }
+        }
+    }
+}
+
+impl CpuAccelerator for Bvh {
+    fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
+        let (mut best, mut tests): (Option<Hit>, u64) = (None, 0);
+        self.traverse(ro, rd, f32::INFINITY, |ids| {
+            let ids = ids.iter().map(|&i| i as usize);
+            closest_among(&mut best, &self.triangles, ids, (ro, rd, last), &mut tests);
+            ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))
+        });
+        (best, tests)
+    }
+
+    fn occluded(&self, feeler: &Feeler) -> (bool, u64) {
+        let (mut blocked, mut tests) = (false, 0);
+        self.traverse(feeler.ro, feeler.rd, feeler.light_distance, |ids| {
+            let ids = ids.iter().map(|&i| i as usize);
+            blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
+            if blocked {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(feeler.light_distance)
+            }
+        });
+        (blocked, tests)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic triangle soup: a jittered grid of triangles, a few duplicates
+    /// (equal centroids) and a long sliver.
+    fn soup() -> Vec<[Vec3; 3]> {
+        let mut out = Vec::new();
+        let mut s = 12345u32;
+        let mut rnd = || {
+            s = s.wrapping_mul(1664525).wrapping_add(1013904223);
+            (s >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for _ in 0..3000 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 10.0;
+            let e = 0.3;
+            out.push([
+                c,
+                c + Vec3::new(rnd() * e, rnd() * e, 0.0),
+                c + Vec3::new(0.0, rnd() * e, rnd() * e),
+            ]);
+        }
+        let dup = out[7];
+        out.extend(std::iter::repeat_n(dup, 40));
+        out.push([
+            Vec3::ZERO,
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::new(10.0, 0.01, 0.0),
+        ]);
+        out
+    }
+
+    #[test]
+    fn every_triangle_in_exactly_one_leaf_and_bounds_nest() {
+        let tris = soup();
+        let bvh = Bvh::new(tris.clone());
+        let mut seen = vec![0u32; tris.len()];
+        for n in &bvh.nodes {
+            let nb = Aabb {
+                lo: Vec3::from(n.lo),
+                hi: Vec3::from(n.hi),
+            };
+            if n.is_leaf() {
+                assert!(n.count as usize <= MAX_LEAF);
+                for &t in &bvh.tris[n.first as usize..(n.first + n.count) as usize] {
+                    seen[t as usize] += 1;
+                    for p in tris[t as usize] {
+                        assert!(nb.contains(&Aabb { lo: p, hi: p }), "triangle {t} outside");
+                    }
+                }
+            } else {
+                for c in [n.first, n.first + 1] {
+                    let c = &bvh.nodes[c as usize];
+                    let cb = Aabb {
+                        lo: Vec3::from(c.lo),
+                        hi: Vec3::from(c.hi),
+                    };
+                    assert!(nb.contains(&cb), "child outside its parent");
+                }
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1), "every triangle exactly once");
+        // every node but the root is some inner node's child, exactly once
+        let mut parents = vec![0u32; bvh.nodes.len()];
+        for n in bvh.nodes.iter().filter(|n| !n.is_leaf()) {
+            parents[n.first as usize] += 1;
+            parents[n.first as usize + 1] += 1;
+        }
+        assert_eq!(parents[0], 0);
+        assert!(parents[1..].iter().all(|&p| p == 1));
+        let s = bvh.stats;
+        assert_eq!(s.nodes, 2 * s.leaves - 1);
+        assert!(s.depth < STACK_SIZE as u32, "depth {}", s.depth);
+        // far better than one leaf of everything
+        assert!(
+            s.sah_cost > 1.0 && s.sah_cost < tris.len() as f64 / 20.0,
+            "{s:?}"
+        );
+    }
+
+    #[test]
+    fn traversal_finds_the_brute_force_hits() {
+        let tris = soup();
+        let bvh = Bvh::new(tris.clone());
+        let brute = super::super::brute_force::BruteForce::new(tris);
+        let ro = Vec3::new(-2.0, 5.0, 5.0);
+        let (mut hits, mut fewer) = (0, 0);
+        for k in 0..400 {
+            let a = k as f32 * 0.013;
+            let rd = Vec3::new(1.0, (a * 3.1).sin() * 0.5, (a * 1.7).cos() * 0.5).normalize();
+            let (b, bt) = bvh.closest_hit(ro, rd, -1);
+            let (f, ft) = brute.closest_hit(ro, rd, -1);
+            assert_eq!(b.map(|h| (h.id, h.t)), f.map(|h| (h.id, h.t)), "ray {k}");
+            hits += b.is_some() as u32;
+            fewer += (bt < ft / 10) as u32;
+            let feeler = Feeler {
+                ro,
+                rd,
+                light_distance: 6.0,
+                offset: 0.0,
+                last: -1,
+            };
+            assert_eq!(
+                bvh.occluded(&feeler).0,
+                brute.occluded(&feeler).0,
+                "feeler {k}"
+            );
+        }
+        assert!(
+            hits > 50 && fewer == 400,
+            "{hits} hits, {fewer} with few tests"
+        );
+    }
+}
