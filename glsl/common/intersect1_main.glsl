@@ -85,15 +85,5 @@ void trace(ivec2 storePos)
 
 void main()
 {
-    countersBegin();
-    ivec2 storePos = pixelPosition();
-    if (insideImage(storePos)) trace(storePos);
-    countAdd(0, tests);
-    countAdd(1, truncated);
-    countAdd(2, voxelsVisited);
-    countAdd(3, nodesVisited);
-    countersEnd(0, COUNTER_INTERSECT1);
-    countersEnd(1, COUNTER_TRUNCATED_RAYS);
-    countersEnd(2, COUNTER_VOXELS_VISITED);
-    countersEnd(3, COUNTER_NODES_VISITED);
+    traceAndCount(COUNTER_INTERSECT1);
 }

@@ -14,3 +14,23 @@ uint tests = 0u;         // ray–triangle tests of this invocation
 uint truncated = 0u;     // 1 if a loop of this invocation ended early (see loopLimit)
 uint voxelsVisited = 0u; // voxels whose triangle lists this invocation walked
 uint nodesVisited = 0u;  // BVH nodes this invocation visited
+
+// The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl.
+void trace(ivec2 storePos);
+
+// main() of every intersection kernel: trace this invocation's pixel, then add its work counts
+// to the 64-bit counters — its triangle tests to `testsSlot` (COUNTER_INTERSECT1 or 2).
+void traceAndCount(int testsSlot)
+{
+    countersBegin();
+    ivec2 storePos = pixelPosition();
+    if (insideImage(storePos)) trace(storePos);
+    countAdd(0, tests);
+    countAdd(1, truncated);
+    countAdd(2, voxelsVisited);
+    countAdd(3, nodesVisited);
+    countersEnd(0, testsSlot);
+    countersEnd(1, COUNTER_TRUNCATED_RAYS);
+    countersEnd(2, COUNTER_VOXELS_VISITED);
+    countersEnd(3, COUNTER_NODES_VISITED);
+}
