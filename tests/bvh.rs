@@ -10,22 +10,9 @@ use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::Bvh;
 use gpgpu_rt::accel::TracerKind;
-use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::scene::Scene;
 use serde_json::json;
-
-fn tracer(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> RayTracer {
-    RayTracer::new(
-        ctx.gl.clone(),
-        &ctx.info,
-        scene,
-        &ShaderSource::default(),
-        opts,
-    )
-    .expect("tracer")
-}
 
 fn bvh_options(w: u32, h: u32, refl: u32) -> RenderOptions {
     RenderOptions {
@@ -67,8 +54,8 @@ fn bvh_gives_the_base_tracers_image() {
 fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
     let ctx = context();
     let mut scene = load("teapot1.toml");
-    let mut bvh = tracer(&ctx, &scene, bvh_options(40, 40, 1));
-    let mut base = tracer(&ctx, &scene, options(40, 40, 1));
+    let mut bvh = ray_tracer(&ctx, &scene, bvh_options(40, 40, 1));
+    let mut base = ray_tracer(&ctx, &scene, options(40, 40, 1));
     let first = bvh.render(&scene.camera).unwrap();
     assert_eq!(first.stats.facts["bvh_rebuilt"], json!(true));
     let still = bvh.render(&scene.camera).unwrap();

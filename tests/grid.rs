@@ -193,17 +193,6 @@ fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
     }
 }
 
-fn grid_tracer(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, opts: RenderOptions) -> RayTracer {
-    RayTracer::new(
-        ctx.gl.clone(),
-        &ctx.info,
-        scene,
-        &ShaderSource::default(),
-        opts,
-    )
-    .expect("grid tracer")
-}
-
 /// The grid's voxel lists of the last frame and its scene-to-grid mapping (centre, scale).
 fn read_lists(t: &RayTracer) -> (Vec<Vec<i32>>, Vec3, f32) {
     let a = t.accelerator().as_any();
@@ -220,7 +209,7 @@ fn read_lists(t: &RayTracer) -> (Vec<Vec<i32>>, Vec3, f32) {
 
 /// The GPU's voxel lists equal the CPU reference's, as sets per voxel.
 fn check_lists(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, variant: GridVariant, n: u32) {
-    let mut t = grid_tracer(ctx, scene, grid_options(16, 16, variant, n));
+    let mut t = ray_tracer(ctx, scene, grid_options(16, 16, variant, n));
     t.render(&scene.camera).unwrap();
     let (lists, center, scale) = read_lists(&t);
     let g = GridSpace { n };
@@ -273,7 +262,7 @@ fn exact_grid_gives_the_base_tracers_image() {
     ] {
         let scene = load(name);
         let base = render_gpu(&ctx, &scene, options(48, 40, refl));
-        let mut t = grid_tracer(
+        let mut t = ray_tracer(
             &ctx,
             &scene,
             RenderOptions {
@@ -325,7 +314,7 @@ fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
             .filter(|&&i| i >= 0)
             .count()
     };
-    let mut thesis = grid_tracer(
+    let mut thesis = ray_tracer(
         &ctx,
         &scene,
         RenderOptions {
@@ -333,7 +322,7 @@ fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
             ..grid_options(48, 48, GridVariant::Thesis, 16)
         },
     );
-    let mut exact = grid_tracer(
+    let mut exact = ray_tracer(
         &ctx,
         &scene,
         RenderOptions {
@@ -374,7 +363,7 @@ fn thesis_grid_counts_what_its_fixed_lists_drop() {
         },
         ..options(24, 24, 0)
     };
-    let mut t = grid_tracer(&ctx, &scene, opts);
+    let mut t = ray_tracer(&ctx, &scene, opts);
     let f = t.render(&scene.camera).unwrap();
     let dropped = f.stats.events["dropped_triangle_refs"];
     let overflows = f.stats.events["ray_list_overflows"];
@@ -391,7 +380,7 @@ fn moving_object_is_rebuilt_every_frame() {
     let ctx = context();
     let mut scene = load("teapot1.toml");
     let opts = grid_options(40, 40, GridVariant::Exact, 16);
-    let mut grid = grid_tracer(&ctx, &scene, opts.clone());
+    let mut grid = ray_tracer(&ctx, &scene, opts.clone());
     let mut base = RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,

@@ -39,16 +39,22 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
     }
 }
 
-pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
-    let mut t = RayTracer::new(
+/// The ray tracer with the accelerator `opts.tracer` for `scene`, kernels built in.
+pub fn ray_tracer(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> RayTracer {
+    RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
         scene,
         &ShaderSource::default(),
         opts,
     )
-    .expect("tracer");
-    t.render(&scene.camera).expect("frame")
+    .expect("tracer")
+}
+
+pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
+    ray_tracer(ctx, scene, opts)
+        .render(&scene.camera)
+        .expect("frame")
 }
 
 pub fn render_cpu(scene: &Scene, opts: &RenderOptions) -> ReferenceFrame {
