@@ -52,6 +52,8 @@ fn render_writes_png_aovs_and_stats() {
     let o = run(&[
         "render",
         &scene("cow.toml"),
+        "--tracer",
+        "base",
         "-o",
         png.to_str().unwrap(),
         "--width",

@@ -31,7 +31,10 @@ pub struct RenderArgs {
     /// Image height (default: the scene's render.height).
     #[arg(long)]
     height: Option<u32>,
-    #[arg(long, value_enum, default_value = "base")]
+    /// The accelerator of Müller 2015's four-kernel pipeline: `bvh` (ours: an SAH BVH, the
+    /// fastest), `base` (the thesis' base tracer, every ray against every triangle) or `grid`
+    /// (the thesis' uniform grid, see --grid-variant).
+    #[arg(long, value_enum, default_value = "bvh")]
     tracer: TracerKind,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
     #[arg(long)]

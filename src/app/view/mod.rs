@@ -69,7 +69,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// The tracer to start with (T switches).
-    #[arg(long, value_enum, default_value = "base")]
+    #[arg(long, value_enum, default_value = "bvh")]
     pub tracer: TracerKind,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
     #[arg(long)]
