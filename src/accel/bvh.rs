@@ -19,7 +19,7 @@ use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
 use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
 use crate::reference::CpuAccelerator;
-use crate::scene::Scene;
+use crate::scene::{transform_triangles, Scene};
 
 pub const ENTRY: Entry = Entry {
     tracer: TracerKind::Bvh,
@@ -86,21 +86,15 @@ impl Bvh {
         }))
     }
 
-    /// The world triangles under `models`, as `Scene::world_triangles` computes them.
-    fn world_triangles(&self, models: &[Mat4]) -> Vec<[Vec3; 3]> {
-        let mut out = Vec::new();
-        for (positions, m) in self.objects.iter().zip(models) {
-            for t in positions.chunks_exact(3) {
-                out.push([0, 1, 2].map(|k| m.transform_point3(t[k])));
-            }
-        }
-        out
-    }
-
     /// Build on the CPU and upload.
     fn rebuild(&mut self, models: &[Mat4]) -> Result<()> {
         let start = std::time::Instant::now();
-        let bvh = CpuBvh::new(self.world_triangles(models));
+        let bvh = CpuBvh::new(transform_triangles(
+            self.objects
+                .iter()
+                .map(Vec::as_slice)
+                .zip(models.iter().copied()),
+        ));
         let gl = &self.gl;
         let nodes = Ssbo::new(
             gl,

@@ -104,6 +104,17 @@ pub enum TracerKind {
     Bvh,
 }
 
+impl TracerKind {
+    /// The `--tracer` value.
+    pub fn name(self) -> &'static str {
+        match self {
+            TracerKind::Base => "base",
+            TracerKind::Grid => "grid",
+            TracerKind::Bvh => "bvh",
+        }
+    }
+}
+
 /// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
 #[serde(rename_all = "lowercase")]

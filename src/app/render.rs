@@ -230,7 +230,7 @@ fn summary(
         None => format!(
             "{} lights, {} tracer",
             scene.lights.len(),
-            args.tracer_name()
+            args.tracer.name()
         ),
     };
     let mut line = format!(
@@ -247,16 +247,6 @@ fn summary(
         line += &format!(", {n} line-space lookups");
     }
     line + &format!(" -> {}", args.output.display())
-}
-
-impl RenderArgs {
-    fn tracer_name(&self) -> &'static str {
-        match self.tracer {
-            TracerKind::Base => "base",
-            TracerKind::Grid => "grid",
-            TracerKind::Bvh => "bvh",
-        }
-    }
 }
 
 /// `render`: load, check the options, render `--frames` frames, write the last.

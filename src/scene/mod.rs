@@ -192,13 +192,11 @@ impl Scene {
     /// World-space triangles in triangle-id order, transformed exactly as the transform pass
     /// does (f32 model matrix times (p, 1)).
     pub fn world_triangles(&self) -> Vec<[Vec3; 3]> {
-        let mut out = Vec::with_capacity(self.triangle_count());
-        for o in &self.objects {
-            for t in o.mesh.positions.chunks_exact(3) {
-                out.push([0, 1, 2].map(|k| o.model.transform_point3(t[k])));
-            }
-        }
-        out
+        transform_triangles(
+            self.objects
+                .iter()
+                .map(|o| (o.mesh.positions.as_slice(), o.model)),
+        )
     }
 
     /// World-space per-vertex data (positions, normals, colours, texture coordinates) and
@@ -731,6 +729,20 @@ fn default_specular() -> f32 {
 }
 fn default_shininess() -> f32 {
     32.0
+}
+
+/// The triangles of objects given as (object-space positions, 3 per triangle; model matrix),
+/// in world space, in object order: the scene's triangle ids.
+pub fn transform_triangles<'a>(
+    objects: impl IntoIterator<Item = (&'a [Vec3], Mat4)>,
+) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for (positions, m) in objects {
+        for t in positions.chunks_exact(3) {
+            out.push([0, 1, 2].map(|k| m.transform_point3(t[k])));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

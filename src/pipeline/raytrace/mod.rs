@@ -295,11 +295,7 @@ impl RayTracer {
 
 impl Renderer for RayTracer {
     fn name(&self) -> &'static str {
-        match self.options.tracer {
-            TracerKind::Base => "base",
-            TracerKind::Grid => "grid",
-            TracerKind::Bvh => "bvh",
-        }
+        self.options.tracer.name()
     }
 
     fn size(&self) -> (u32, u32) {
@@ -376,7 +372,7 @@ impl Renderer for RayTracer {
         *self
             .models
             .get_mut(object)
-            .ok_or_else(|| anyhow!("object {object} of {n}"))? = model;
+            .ok_or_else(|| anyhow!("no object {object}: the scene has {n} objects"))? = model;
         Ok(())
     }
 

@@ -48,12 +48,8 @@ pub fn rgba32f_texture(gl: &Gl, w: u32, h: u32) -> Result<glow::Texture> {
 /// (attribute locations 0, 1, 2 of gbuffer.vert).
 fn upload_vertices(gl: &Gl, scene: &Scene) -> Result<(glow::VertexArray, Vec<glow::Buffer>)> {
     let attrs = scene.world_attributes();
-    let pos: Vec<[f32; 3]> = scene
-        .world_triangles()
-        .iter()
-        .flatten()
-        .map(|v| v.to_array())
-        .collect();
+    // the world positions in triangle-id order, as `Scene::world_triangles`
+    let pos: Vec<[f32; 3]> = attrs.positions.iter().map(|v| v.to_array()).collect();
     let nor: Vec<[f32; 3]> = attrs.normals.iter().map(|v| v.to_array()).collect();
     let col: Vec<[f32; 3]> = attrs.colors.iter().map(|v| v.to_array()).collect();
     // SAFETY: GL object creation and uploads on a current context; slices match sizes.

@@ -120,6 +120,8 @@ pub struct SoftShadowRenderer {
     shadow: ShadowPass,
     present: Present,
     timers: GpuTimers,
+    /// The image and the tiles of the shadow pass's dispatches.
+    pixels: PixelGrid,
     /// Dispatches the shadow rays of a pixel are split into (1: the whole packet at once).
     /// Doubled when a frame hits llvmpipe's loop limit, kept for the next frames, back to 1
     /// when the mode or the samples change.
@@ -187,7 +189,7 @@ impl SoftShadowRenderer {
         if options.width == 0 || options.height == 0 {
             bail!("width and height must be positive");
         }
-        PixelGrid::new(options.width, options.height, options.tile)?;
+        let pixels = PixelGrid::new(options.width, options.height, options.tile)?;
         let packed = pack(&gl, info, &tree)?;
         let samples = (options.samples_u, options.samples_v);
         let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples)?;
@@ -213,6 +215,7 @@ impl SoftShadowRenderer {
             },
             options,
             timers: GpuTimers::default(),
+            pixels,
             ray_batches: 1,
             last: None,
             gl,
@@ -295,7 +298,7 @@ impl SoftShadowRenderer {
         self.gbuffer
             .draw(&mut self.timers, &vp, eye, self.scene.background);
         crate::gl::check_error(&self.gl, "the G-buffer pass")?;
-        let pixels = PixelGrid::new(w, h, self.options.tile)?;
+        let pixels = self.pixels;
         let batches = (self.rays(), self.ray_batches);
         let counts = self.shadow.run(
             &mut self.timers,
