@@ -13,16 +13,15 @@ float bestT = 0.0;
 int bestID = -1;
 float bestU = 0.0, bestV = 0.0;
 
-bool leafHit(uint first, uint count, inout float limit)
+bool leafHit(int first, int count, inout float limit)
 {
-    for (uint k = first; k < first + count; k++) {
-        int tri = bvhTris[k];
-        if (tri == rayLast) continue;
+    for (int k = first; k < first + count; k++) {
+        int tri;
         float t, u, v;
+        bool hit = intersectLeafTriangle(rayO, rayD, k, tri, t, u, v);
+        if (tri == rayLast) continue;
         tests++;
-        if (intersectTriangle(rayO, rayD, vertex[3 * tri].xyz, vertex[3 * tri + 1].xyz,
-                              vertex[3 * tri + 2].xyz, t, u, v)
-            && (t < bestT || (t == bestT && tri < bestID))) {
+        if (hit && (t < bestT || (t == bestT && tri < bestID))) {
             bestT = t;
             bestID = tri;
             bestU = u; bestV = v;

@@ -11,17 +11,15 @@ vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float rayLight = 0.0;
 
-bool leafHit(uint first, uint count, inout float limit)
+bool leafHit(int first, int count, inout float limit)
 {
-    for (uint k = first; k < first + count; k++) {
-        int tri = bvhTris[k];
-        if (tri == rayLast) continue;
+    for (int k = first; k < first + count; k++) {
+        int tri;
         float t, u, v;
+        bool hit = intersectLeafTriangle(rayO, rayD, k, tri, t, u, v);
+        if (tri == rayLast) continue;
         tests++;
-        if (intersectTriangle(rayO, rayD, vertex[3 * tri].xyz, vertex[3 * tri + 1].xyz,
-                              vertex[3 * tri + 2].xyz, t, u, v)
-            && t > SHADOW_OFFSET && t < rayLight)
-            return true;
+        if (hit && t > SHADOW_OFFSET && t < rayLight) return true;
     }
     return false;
 }

@@ -2,85 +2,91 @@
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
 // the CPU, ch. 3.2). CPU twin: src/reference/bvh.rs (Bvh::traverse), same order and counts.
 //
-// Nodes (32 bytes, std430): bounds lo/hi; an inner node (count 0) names its left child in
-// `first`, the right child is first + 1; a leaf names its first triangle id in bvhTris and
-// holds `count` of them. Wagner kept the tree in three textures (Fig. 4.3): here it is one
-// storage buffer of nodes and one of triangle ids.
+// The hierarchy in texture buffers, as Wagner's three textures of Fig. 4.3 (his node bounds,
+// node integers and per-leaf triangle ids), plus the miss links:
+//   bvhNodes  two RGBA32F texels per node: (lo, first) and (hi, meta), the integers as bits;
+//             an inner node's left child is `first`, its right child first + 1, its meta
+//             −1 − the split axis; a leaf's triangles are leaf slots first .. first + meta − 1
+//   bvhLinks  R32I, 8 per node: where a ray of each octant goes on when it misses the node or
+//             is done with it (−1: the walk is over)
+//   bvhLeafTriangles  three RGBA32F texels per leaf slot: (v0, triangle id), edge1, edge2
 //
-// Order: of two children hit, the nearer (smaller entry distance; the left on a tie) is
-// visited first, the other pushed with its entry distance; a node is skipped when its entry
-// lies beyond the current limit (the closest hit so far, or the light). Deviations from
-// Wagner: an ordered traversal with pruning (his visits children in fixed order), a bounded
-// stack of BVH_STACK entries (a push onto a full stack drops the node and counts the ray as
-// truncated; the builder keeps the depth below it) and a loop bounded by 2·nodes + 2
-// iterations (each node is visited at most once), so no input can exceed llvmpipe's loop limit
-// (see loopLimit in common/intersect.glsl).
+// Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
+// and from a stack walk): stackless. Every inner node whose box the ray enters (at some
+// 0 <= t <= limit) is followed by its near child — the left one, on the low side of the split
+// plane, unless the ray points down the split axis — and every box missed, or beyond the
+// limit, and every leaf done is followed by its miss link: a depth-first walk, near side first,
+// pruned by the closest hit so far (or the light). On llvmpipe a per-invocation stack array
+// costs several times more than these texel fetches (docs/results/bvh_steps.md). Each node is
+// visited at most once, so the loop is bounded by the node count; a walk cut short (llvmpipe's
+// loop limit, see loopLimit in common/intersect.glsl) counts the ray as truncated.
 //
 // The including kernel defines leafHit (declared below), which tests a leaf's triangles, may
 // lower the limit, and returns true to end the walk.
 
-struct BvhNode { vec3 lo; int first; vec3 hi; int count; };
-layout(std430, binding = SSBO_BVH_NODES) readonly buffer BvhNodeBuffer { BvhNode bvhNodes[]; };
-layout(std430, binding = SSBO_BVH_TRIS) readonly buffer BvhTriBuffer { int bvhTris[]; };
+layout(binding = SAMPLER_BVH_NODES) uniform samplerBuffer bvhNodes;
+layout(binding = SAMPLER_BVH_LINKS) uniform isamplerBuffer bvhLinks;
+layout(binding = SAMPLER_BVH_LEAF_TRIANGLES) uniform samplerBuffer bvhLeafTriangles;
 
-#define BVH_STACK 64
-
-bool leafHit(uint first, uint count, inout float limit);
+bool leafHit(int first, int count, inout float limit);
 
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 
-// Listing 4.5: does the ray enter node n's box at some 0 <= t <= limit? tNear: the entry.
-bool boxEntry(int n, vec3 ro, vec3 inv, float limit, out float tNear)
+// Listing 4.5: does the ray enter the box [lo, hi] at some 0 <= t <= limit?
+bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float limit)
 {
-    vec3 t0 = (bvhNodes[n].lo - ro) * inv;
-    vec3 t1 = (bvhNodes[n].hi - ro) * inv;
-    tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    vec3 t0 = (lo - ro) * inv;
+    vec3 t1 = (hi - ro) * inv;
+    float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
     float tFar = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
     return tNear <= tFar && tNear <= limit;
+}
+
+// Algorithm 1 of Müller 2015 (common/intersect.glsl) with the edges read from the leaf
+// triangle: the same operations on the same values as intersectTriangle(v0, v1, v2), whose
+// first two lines form edge1 = v1 − v0 and edge2 = v2 − v0.
+bool intersectLeafTriangle(vec3 r0, vec3 rd, int slot, out int id, out float t, out float u,
+                           out float v)
+{
+    vec4 v0id = texelFetch(bvhLeafTriangles, 3 * slot);
+    vec3 edge1 = texelFetch(bvhLeafTriangles, 3 * slot + 1).xyz;
+    vec3 edge2 = texelFetch(bvhLeafTriangles, 3 * slot + 2).xyz;
+    id = floatBitsToInt(v0id.w);
+    vec3 pvec = cross(rd, edge2);
+    float det = dot(edge1, pvec);
+    float invDet = 1.0 / det;
+    vec3 tvec = r0 - v0id.xyz;
+    u = invDet * dot(tvec, pvec);
+    vec3 qvec = cross(tvec, edge1);
+    v = invDet * dot(rd, qvec);
+    t = invDet * dot(edge2, qvec);
+    return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
 }
 
 // true if leafHit ended the walk
 bool traverse(vec3 ro, vec3 rd, float limit)
 {
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
-    float tNear;
-    if (!boxEntry(0, ro, inv, limit, tNear)) return false;
-    int stackNode[BVH_STACK];
-    float stackT[BVH_STACK];
-    int sp = 0;
+    int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
     int node = 0;
-    int bound = 2 * bvhNodes.length() + 2;
+    int bound = textureSize(bvhNodes) / 2 + 1;
     for (int guard = 0; guard < bound; guard++) {
+        if (node < 0) return false;
         nodesVisited++;
-        int first = bvhNodes[node].first, count = bvhNodes[node].count;
-        bool descend = false;
-        if (count > 0) {
-            if (leafHit(uint(first), uint(count), limit)) return true;
-        } else {
-            float tl, tr;
-            bool hl = boxEntry(first, ro, inv, limit, tl);
-            bool hr = boxEntry(first + 1, ro, inv, limit, tr);
-            if (hl && hr) {
-                int near = first, far = first + 1;
-                float tFar = tr;
-                if (tr < tl) { near = first + 1; far = first; tFar = tl; }
-                if (sp < BVH_STACK) { stackNode[sp] = far; stackT[sp] = tFar; sp++; }
-                else truncated = 1u;
-                node = near;
-                descend = true;
-            } else if (hl || hr) {
-                node = hl ? first : first + 1;
-                descend = true;
+        vec4 loFirst = texelFetch(bvhNodes, 2 * node);
+        vec4 hiMeta = texelFetch(bvhNodes, 2 * node + 1);
+        int first = floatBitsToInt(loFirst.w), meta = floatBitsToInt(hiMeta.w);
+        if (boxEntered(loFirst.xyz, hiMeta.xyz, ro, inv, limit)) {
+            if (meta < 0) {
+                // inner node: the near child next
+                node = first + (inv[-1 - meta] < 0.0 ? 1 : 0);
+                continue;
             }
+            if (leafHit(first, meta, limit)) return true;
         }
-        // nothing to descend into: the nearest node on the stack still within reach
-        while (!descend && sp > 0) {
-            sp--;
-            if (stackT[sp] <= limit) { node = stackNode[sp]; descend = true; }
-        }
-        if (!descend) return false;
+        node = texelFetch(bvhLinks, 8 * node + octant).x;
     }
-    truncated = 1u;
+    if (node >= 0) truncated = 1u;
     return false;
 }

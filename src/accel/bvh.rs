@@ -1,6 +1,7 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
-//! (`reference::bvh`, binned SAH, rayon) and uploaded into two storage buffers (nodes, triangle
-//! ids), traversed in the intersection kernels with an ordered stack (`glsl/bvh/`). Objects
+//! (`reference::bvh`, binned SAH, rayon) and uploaded into three texture buffers (nodes, miss
+//! links, leaf triangles), traversed in the intersection kernels without a stack, near child
+//! first (`glsl/bvh/`). Objects
 //! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
 //! matrix changed since the last build, and not otherwise. Its image equals the base
 //! tracer's. CPU twin: `reference::bvh::Bvh`.
@@ -14,8 +15,8 @@ use serde_json::json;
 
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
 use crate::frame::FrameStats;
-use crate::gl::resources::Ssbo;
-use crate::gl::slots::ssbo;
+use crate::gl::resources::TexBuffer;
+use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
 use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
 use crate::reference::CpuAccelerator;
@@ -31,21 +32,58 @@ pub const ENTRY: Entry = Entry {
     },
 };
 
-/// The uploaded hierarchy.
-struct Buffers {
-    nodes: Ssbo,
-    tris: Ssbo,
-}
+/// The uploaded hierarchy: nodes, miss links, leaf triangles (`glsl/bvh/traverse.glsl`).
+struct Buffers([TexBuffer; 3]);
+
+/// The sampler slot of each of [`Buffers`].
+const SLOTS: [u32; 3] = [
+    sampler::BVH_NODES,
+    sampler::BVH_LINKS,
+    sampler::BVH_LEAF_TRIANGLES,
+];
 
 impl Buffers {
+    fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<Buffers> {
+        let leaf_triangles = bvh.leaf_triangles();
+        let parts: [(&str, u32, usize, &[u8]); 3] = [
+            (
+                "bvhNodes",
+                glow::RGBA32F,
+                16,
+                bytemuck::cast_slice(&bvh.nodes),
+            ),
+            ("bvhLinks", glow::R32I, 4, bytemuck::cast_slice(&bvh.links)),
+            (
+                "bvhLeafTriangles",
+                glow::RGBA32F,
+                16,
+                bytemuck::cast_slice(&leaf_triangles),
+            ),
+        ];
+        let mut done: Vec<TexBuffer> = Vec::with_capacity(3);
+        for (name, format, texel, data) in parts {
+            match TexBuffer::new(gl, name, format, texel, data) {
+                Ok(b) => done.push(b),
+                Err(e) => {
+                    done.iter().for_each(|b| b.delete(gl));
+                    return Err(e);
+                }
+            }
+        }
+        let Ok(all) = <[TexBuffer; 3]>::try_from(done) else {
+            unreachable!("three buffers uploaded")
+        };
+        Ok(Buffers(all))
+    }
+
     fn bind(&self, gl: &Gl) {
-        self.nodes.bind(gl, ssbo::BVH_NODES);
-        self.tris.bind(gl, ssbo::BVH_TRIS);
+        for (b, slot) in self.0.iter().zip(SLOTS) {
+            b.bind(gl, slot);
+        }
     }
 
     fn delete(&self, gl: &Gl) {
-        self.nodes.delete(gl);
-        self.tris.delete(gl);
+        self.0.iter().for_each(|b| b.delete(gl));
     }
 }
 
@@ -58,7 +96,6 @@ pub struct Bvh {
     /// the model matrices of the last build (`None`: not built yet)
     built_for: Option<Vec<Mat4>>,
     buffers: Option<Buffers>,
-    max_ssbo: i64,
     stats: BvhStats,
     /// builds so far (the first and one per frame in which something moved)
     builds: u64,
@@ -79,7 +116,6 @@ impl Bvh {
                 .collect(),
             built_for: None,
             buffers: None,
-            max_ssbo: b.info.max_ssbo_block_size,
             stats: BvhStats::default(),
             builds: 0,
             rebuilt: false,
@@ -95,24 +131,9 @@ impl Bvh {
                 .map(Vec::as_slice)
                 .zip(models.iter().copied()),
         ));
-        let gl = &self.gl;
-        let nodes = Ssbo::new(
-            gl,
-            "bvhNodes",
-            std::mem::size_of_val(&bvh.nodes[..]),
-            Some(bytemuck::cast_slice(&bvh.nodes)),
-            self.max_ssbo,
-        )?;
-        let tris = Ssbo::new(
-            gl,
-            "bvhTris",
-            4 * bvh.tris.len(),
-            Some(bytemuck::cast_slice(&bvh.tris)),
-            self.max_ssbo,
-        );
-        let tris = tris.inspect_err(|_| nodes.delete(gl))?;
-        if let Some(old) = self.buffers.replace(Buffers { nodes, tris }) {
-            old.delete(gl);
+        let buffers = Buffers::upload(&self.gl, &bvh)?;
+        if let Some(old) = self.buffers.replace(buffers) {
+            old.delete(&self.gl);
         }
         self.stats = bvh.stats;
         // the build time includes the world transform and the upload

@@ -95,6 +95,62 @@ impl Ssbo {
     }
 }
 
+/// A buffer read through a texture-buffer sampler (`samplerBuffer`, `texelFetch`): for data
+/// every invocation reads at its own index, where llvmpipe fetches texels for 8 lanes at once
+/// but loads storage buffers lane by lane.
+pub struct TexBuffer {
+    pub buffer: glow::Buffer,
+    pub texture: glow::Texture,
+}
+
+impl TexBuffer {
+    /// Upload `data` as texels of `format` (`texel_bytes` each), after checking the texel
+    /// count against `GL_MAX_TEXTURE_BUFFER_SIZE`.
+    pub fn new(gl: &Gl, name: &str, format: u32, texel_bytes: usize, data: &[u8]) -> Result<Self> {
+        let texels = data.len().div_ceil(texel_bytes).max(1);
+        // SAFETY: a limit query on a current context.
+        let max = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) }.max(0) as usize;
+        if texels > max {
+            bail!(
+                "texture buffer `{name}` needs {texels} texels, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max} \
+                 of this GL implementation; use a smaller scene"
+            );
+        }
+        let mut bytes = data.to_vec();
+        bytes.resize(texels * texel_bytes, 0);
+        // SAFETY: buffer and texture creation on a current context.
+        unsafe {
+            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
+            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
+            gl.buffer_storage(glow::TEXTURE_BUFFER, bytes.len() as i32, Some(&bytes), 0);
+            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
+            gl.tex_buffer(format, buffer);
+            gl.bind_texture(glow::TEXTURE_BUFFER, None);
+            Ok(TexBuffer { buffer, texture })
+        }
+    }
+
+    /// Bind to texture unit `unit` (a `SAMPLER_...` slot).
+    pub fn bind(&self, gl: &Gl, unit: u32) {
+        // SAFETY: binding an existing texture.
+        unsafe {
+            gl.active_texture(glow::TEXTURE0 + unit);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture));
+            gl.active_texture(glow::TEXTURE0);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own objects.
+        unsafe {
+            gl.delete_texture(self.texture);
+            gl.delete_buffer(self.buffer);
+        }
+    }
+}
+
 /// A 2D texture used as an image (RGBA32F or RGBA32UI).
 pub struct Image2d {
     pub texture: glow::Texture,

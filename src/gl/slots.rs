@@ -45,9 +45,6 @@ slot_table! {
         BLOCK_SUMS = 13,
         GRID_TOTAL = 14,
         VOXEL_TRIS = 15,
-        // the BVH (glsl/bvh/): its nodes and the triangle ids of its leaves
-        BVH_NODES = 10,
-        BVH_TRIS = 11,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,
@@ -81,6 +78,10 @@ slot_table! {
         TEXTURES = 0,
         /// Klee 2016's node pool (a texture buffer)
         NODE_POOL = 1,
+        /// the BVH's texture buffers (glsl/bvh/traverse.glsl): nodes, miss links, leaf triangles
+        BVH_NODES = 1,
+        BVH_LINKS = 2,
+        BVH_LEAF_TRIANGLES = 3,
         /// the texture a screen-filling quad shows
         QUAD_COLOR = 0,
     }
