@@ -32,6 +32,8 @@ use glam::Vec3;
 
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
+mod build;
+
 /// Bins per axis of the binned SAH.
 pub const BINS: usize = 16;
 /// Wagner's leaf size: a node of at most this many triangles is a leaf.
@@ -97,7 +99,7 @@ impl Aabb {
         self.hi = self.hi.max(o.hi);
     }
 
-    fn grow_point(&mut self, p: Vec3) {
+    pub(super) fn grow_point(&mut self, p: Vec3) {
         self.lo = self.lo.min(p);
         self.hi = self.hi.max(p);
     }
@@ -153,43 +155,13 @@ pub struct LeafTriangle {
     pub pad2: u32,
 }
 
-/// What the build knows of each triangle: its bounds and its centroid.
-struct Prims {
-    bounds: Vec<Aabb>,
-    centroids: Vec<Vec3>,
-}
-
-/// A subtree before it is laid out.
-enum Tree {
-    Leaf {
-        bounds: Aabb,
-        start: usize,
-        count: usize,
-    },
-    Inner {
-        bounds: Aabb,
-        axis: usize,
-        children: Box<[Tree; 2]>,
-    },
-}
-
-impl Tree {
-    fn bounds(&self) -> &Aabb {
-        match self {
-            Tree::Leaf { bounds, .. } | Tree::Inner { bounds, .. } => bounds,
-        }
-    }
-}
-
 impl Bvh {
     /// Build the hierarchy over `triangles` (triangle id = index).
     pub fn new(triangles: Vec<[Vec3; 3]>) -> Bvh {
         let start = std::time::Instant::now();
-        let prims = Prims::of(&triangles);
-        let mut ids: Vec<u32> = (0..triangles.len() as u32).collect();
-        let tree = build(&prims, &mut ids, 0, 0);
+        let (tree, ids) = build::build(&triangles);
         let mut nodes = vec![Node::zeroed()];
-        layout(&tree, 0, &mut nodes);
+        build::layout(&tree, 0, &mut nodes);
         let links = miss_links(&nodes);
         let mut stats = BvhStats {
             nodes: nodes.len(),
@@ -199,7 +171,7 @@ impl Bvh {
                 + ids.len() * (4 + std::mem::size_of::<LeafTriangle>()),
             ..BvhStats::default()
         };
-        measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
+        build::measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
         stats.build_ms = start.elapsed().as_secs_f64() * 1e3;
         Bvh {
             triangles,
@@ -292,213 +264,6 @@ fn safe_inverse(rd: Vec3) -> Vec3 {
     Vec3::new(1.0 / s(rd.x), 1.0 / s(rd.y), 1.0 / s(rd.z))
 }
 
-impl Prims {
-    /// Bounds and centroids of every triangle; the bounds are widened by a small margin
-    /// relative to the scene so that rounding in the slab test (and ulp differences of the
-    /// GPU's transformed vertices) never loses a triangle that touches its box.
-    fn of(triangles: &[[Vec3; 3]]) -> Prims {
-        let mut scene = Aabb::EMPTY;
-        for t in triangles {
-            t.iter().for_each(|&p| scene.grow_point(p));
-        }
-        let extent = (scene.hi - scene.lo)
-            .max_element()
-            .max(scene.hi.abs().max_element());
-        let pad = Vec3::splat(1e-5 * extent.max(1e-20));
-        let bounds = triangles
-            .iter()
-            .map(|t| {
-                let mut b = Aabb::EMPTY;
-                t.iter().for_each(|&p| b.grow_point(p));
-                Aabb {
-                    lo: b.lo - pad,
-                    hi: b.hi + pad,
-                }
-            })
-            .collect::<Vec<_>>();
-        let centroids = bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect();
-        Prims { bounds, centroids }
-    }
-
-    fn bounds_of(&self, ids: &[u32]) -> (Aabb, Aabb) {
-        let (mut b, mut c) = (Aabb::EMPTY, Aabb::EMPTY);
-        for &i in ids {
-            b.grow(&self.bounds[i as usize]);
-            c.grow_point(self.centroids[i as usize]);
-        }
-        (b, c)
-    }
-}
-
-/// A split: the axis and the number of bins left of the plane.
-struct Split {
-    axis: usize,
-    bins_left: usize,
-    cost: f32,
-}
-
-/// The bin of centroid coordinate `c` on an axis from `lo` with `scale` = BINS / extent.
-fn bin(c: f32, lo: f32, scale: f32) -> usize {
-    (((c - lo) * scale) as usize).min(BINS - 1)
-}
-
-/// The cheapest binned split of `ids` by eq. 4.1 (Σ children half area · count), if any
-/// separates them.
-fn best_split(prims: &Prims, ids: &[u32], centroids: &Aabb) -> Option<Split> {
-    let mut best: Option<Split> = None;
-    for axis in 0..3 {
-        let (lo, extent) = (centroids.lo[axis], centroids.hi[axis] - centroids.lo[axis]);
-        if extent <= 0.0 || !extent.is_finite() {
-            continue;
-        }
-        let scale = BINS as f32 / extent;
-        let mut bins = [(Aabb::EMPTY, 0usize); BINS];
-        for &i in ids {
-            let b = &mut bins[bin(prims.centroids[i as usize][axis], lo, scale)];
-            b.0.grow(&prims.bounds[i as usize]);
-            b.1 += 1;
-        }
-        // right-to-left sweep: the cost of every right side
-        let mut right = [0.0f32; BINS];
-        let (mut acc, mut n) = (Aabb::EMPTY, 0);
-        for k in (1..BINS).rev() {
-            acc.grow(&bins[k].0);
-            n += bins[k].1;
-            right[k] = acc.half_area() * n as f32;
-        }
-        let (mut acc, mut n) = (Aabb::EMPTY, 0);
-        for k in 1..BINS {
-            acc.grow(&bins[k - 1].0);
-            n += bins[k - 1].1;
-            if n == 0 || n == ids.len() {
-                continue;
-            }
-            let cost = acc.half_area() * n as f32 + right[k];
-            if best.as_ref().is_none_or(|b| cost < b.cost) {
-                best = Some(Split {
-                    axis,
-                    bins_left: k,
-                    cost,
-                });
-            }
-        }
-    }
-    best
-}
-
-/// Reorder `ids` so that those for which `left` holds come first; returns their number.
-fn partition(ids: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
-    let (mut i, mut j) = (0, ids.len());
-    while i < j {
-        if left(ids[i]) {
-            i += 1;
-        } else {
-            j -= 1;
-            ids.swap(i, j);
-        }
-    }
-    i
-}
-
-/// Build the subtree over `ids`, which start at `offset` in the full id list.
-fn build(prims: &Prims, ids: &mut [u32], offset: usize, depth: u32) -> Tree {
-    let (bounds, centroids) = prims.bounds_of(ids);
-    let leaf = Tree::Leaf {
-        bounds,
-        start: offset,
-        count: ids.len(),
-    };
-    if ids.len() <= LEAF_SIZE {
-        return leaf;
-    }
-    let split = (depth < SAH_DEPTH)
-        .then(|| best_split(prims, ids, &centroids))
-        .flatten();
-    let (mid, axis) = match split {
-        // Listing 4.4: split only where it pays (unless the node is too large for a leaf)
-        Some(s) if s.cost < bounds.half_area() * ids.len() as f32 || ids.len() > MAX_LEAF => {
-            let (lo, extent) = (
-                centroids.lo[s.axis],
-                centroids.hi[s.axis] - centroids.lo[s.axis],
-            );
-            let scale = BINS as f32 / extent;
-            let mid = partition(ids, |i| {
-                bin(prims.centroids[i as usize][s.axis], lo, scale) < s.bins_left
-            });
-            (mid, s.axis)
-        }
-        Some(_) => return leaf,
-        None if ids.len() <= MAX_LEAF && depth < SAH_DEPTH => return leaf,
-        // no binned split separates them (or too deep): halve in centroid order
-        None => median(prims, ids, &centroids),
-    };
-    let (left, right) = ids.split_at_mut(mid);
-    let (l, r) = if left.len() + right.len() > PARALLEL_BUILD {
-        rayon::join(
-            || build(prims, left, offset, depth + 1),
-            || build(prims, right, offset + mid, depth + 1),
-        )
-    } else {
-        (
-            build(prims, left, offset, depth + 1),
-            build(prims, right, offset + mid, depth + 1),
-        )
-    };
-    Tree::Inner {
-        bounds,
-        axis,
-        children: Box::new([l, r]),
-    }
-}
-
-/// Sort `ids` by centroid on the widest centroid axis (then by id); the middle and the axis.
-fn median(prims: &Prims, ids: &mut [u32], centroids: &Aabb) -> (usize, usize) {
-    let d = centroids.hi - centroids.lo;
-    let axis = if d.x >= d.y && d.x >= d.z {
-        0
-    } else if d.y >= d.z {
-        1
-    } else {
-        2
-    };
-    ids.sort_unstable_by(|&a, &b| {
-        let (ca, cb) = (
-            prims.centroids[a as usize][axis],
-            prims.centroids[b as usize][axis],
-        );
-        ca.total_cmp(&cb).then(a.cmp(&b))
-    });
-    (ids.len() / 2, axis)
-}
-
-/// Write `tree` into `nodes[index]`, its children into two adjacent new nodes.
-fn layout(tree: &Tree, index: usize, nodes: &mut Vec<Node>) {
-    let b = tree.bounds();
-    let (lo, hi) = (b.lo.to_array(), b.hi.to_array());
-    match tree {
-        Tree::Leaf { start, count, .. } => {
-            nodes[index] = Node {
-                lo,
-                first: *start as u32,
-                hi,
-                meta: *count as i32,
-            };
-        }
-        Tree::Inner { children, axis, .. } => {
-            let first = nodes.len();
-            nodes.extend([Node::zeroed(); 2]);
-            nodes[index] = Node {
-                lo,
-                first: first as u32,
-                hi,
-                meta: -1 - *axis as i32,
-            };
-            layout(&children[0], first, nodes);
-            layout(&children[1], first + 1, nodes);
-        }
-    }
-}
-
 /// The miss links of every node for every octant: the depth-first order of that octant (the
 /// near child of every split first) continues after a node's subtree at its miss link.
 fn miss_links(nodes: &[Node]) -> Vec<i32> {
@@ -520,27 +285,6 @@ fn miss_links(nodes: &[Node]) -> Vec<i32> {
         }
     }
     links
-}
-
-/// Add the SAH cost and the depth of `tree` to `stats`.
-fn measure(tree: &Tree, depth: u32, root_area: f64, stats: &mut BvhStats) {
-    let rel = if root_area > 0.0 {
-        tree.bounds().half_area() as f64 / root_area
-    } else {
-        1.0
-    };
-    match tree {
-        Tree::Leaf { count, .. } => {
-            stats.sah_cost += rel * *count as f64;
-            stats.depth = stats.depth.max(depth);
-        }
-        Tree::Inner { children, .. } => {
-            stats.sah_cost += rel;
-            for c in children.iter() {
-                measure(c, depth + 1, root_area, stats);
-            }
-        }
-    }
 }
 
 impl CpuAccelerator for Bvh {
