@@ -278,7 +278,7 @@ def report(results, a, command, load):
     lines += ["", "## Details", "",
               "| scene | Embree upload ms (embreex copy) | cores Embree got: build, "
               f"{th}-thread rays (CPU / wall time) | Embree best Mrays/s ({th} threads) | ties "
-              "| other disagreements (on a shared edge) | max t difference, same id |",
+              "| other disagreements (on a shared edge) | max relative t difference, same id |",
               "|---|---:|---:|---:|---:|---:|---:|"]
     for r in results:
         m = r["primary"]
