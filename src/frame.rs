@@ -42,8 +42,9 @@ pub struct Aovs {
     pub hit_t: Vec<f32>,
     pub triangle_id: Vec<i32>,
     pub normal: Vec<[f32; 3]>,
-    /// Soft shadows (Klee 2016): the fraction of unblocked shadow rays per pixel (1 where no
-    /// geometry was hit); `shadow.npy`.
+    /// The fraction of unblocked shadow rays per pixel (1 where no geometry was hit);
+    /// `shadow.npy`. Soft shadows (Klee 2016): of the light samples; the ray tracer: of the
+    /// point lights' feelers from the first hit (a light behind the surface counts as blocked).
     pub shadow: Option<Vec<f32>>,
 }
 

@@ -37,8 +37,8 @@ pub fn write_npy<T: npyz::AutoSerialize + Copy>(
 }
 
 /// The AOVs of the GUIDE: ray_origin, ray_direction (f32 `[H,W,3]`), hit_t (f32 `[H,W]`, +inf on
-/// a miss), triangle_id (i32 `[H,W]`, -1 on a miss), normal (f32 `[H,W,3]`), and with soft
-/// shadows shadow (f32 `[H,W]`, the fraction of unblocked shadow rays); row 0 = top.
+/// a miss), triangle_id (i32 `[H,W]`, -1 on a miss), normal (f32 `[H,W,3]`), and shadow (f32
+/// `[H,W]`, the fraction of unblocked shadow rays) where the renderer has it; row 0 = top.
 pub fn write_aovs(dir: &Path, width: u32, height: u32, aovs: &Aovs) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (h, w) = (height as u64, width as u64);

@@ -161,6 +161,9 @@ fn info_json_reports_gl_and_scene_counts() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["triangles"], 27392, "thesis ch. 5.1: 8192 + 3 × 6400");
     assert_eq!(v["lights"], 1);
+    // where the shadow feelers go (tools/embree_peer.py casts them with Embree)
+    assert_eq!(v["light_positions"], serde_json::json!([[3.0, 5.0, 3.0]]));
+    assert_eq!(v["shadow_offset"].as_f64(), Some(0.02f32 as f64));
     assert!(v["version"].as_str().unwrap().starts_with("4."), "{v}");
     assert!(!v["renderer"].as_str().unwrap().is_empty());
     let o = run(&["info", &scene("teapot6.toml"), "--json"]);

@@ -43,7 +43,8 @@ enum Command {
     /// Replicate a published evaluation (thesis-5.x: Müller 2015, ch. 5; klee-*: Klee 2016,
     /// ch. 5): CSVs, plots and report.md with our numbers beside the published ones.
     Bench(bench::BenchArgs),
-    /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts.
+    /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts
+    /// (with its point lights' positions and shadow offset).
     Info {
         scene: Option<PathBuf>,
         /// Print JSON.
@@ -92,6 +93,10 @@ fn info(scene: Option<PathBuf>, json: bool, gpu: args::GpuArgs) -> Result<()> {
         doc["scene"] = json!(s.path);
         doc["triangles"] = json!(s.triangle_count());
         doc["lights"] = json!(s.lights.len());
+        // where the shadow feelers of intersect2 go, and where they start (tools/embree_peer.py)
+        let positions: Vec<[f32; 3]> = s.lights.iter().map(|l| l.position.to_array()).collect();
+        doc["light_positions"] = json!(positions);
+        doc["shadow_offset"] = json!(s.settings.shadow_offset);
         doc["area_lights"] = json!(s.area_lights.len());
         doc["objects"] = json!(s.objects.len());
         doc["materials"] = json!(s.materials.len());

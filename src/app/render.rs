@@ -46,7 +46,7 @@ pub struct RenderArgs {
     /// so that no dispatch runs long enough for a driver watchdog.
     #[arg(long, default_value_t = 256, value_name = "N")]
     tile: u32,
-    /// Write NumPy AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal) here.
+    /// Write NumPy AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal, shadow) here.
     #[arg(long, value_name = "DIR")]
     aov_dir: Option<PathBuf>,
     /// Write the statistics of the frame as JSON.

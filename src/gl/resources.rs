@@ -237,6 +237,26 @@ impl Image2d {
         read_texture_rgba32f(gl, self.texture, self.width, self.height)
     }
 
+    /// Read back RGBA32UI texels, row 0 = the bottom row (GL order).
+    pub fn read_u32(&self, gl: &Gl) -> Vec<[u32; 4]> {
+        let mut data = vec![[0u32; 4]; (self.width * self.height) as usize];
+        // SAFETY: the slice holds w·h RGBA uints.
+        unsafe {
+            gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT);
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            gl.get_tex_image(
+                glow::TEXTURE_2D,
+                0,
+                glow::RGBA_INTEGER,
+                glow::UNSIGNED_INT,
+                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
+            );
+            gl.bind_texture(glow::TEXTURE_2D, None);
+        }
+        data
+    }
+
     pub fn delete(&self, gl: &Gl) {
         // SAFETY: deleting our own texture.
         unsafe { gl.delete_texture(self.texture) };

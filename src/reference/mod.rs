@@ -222,6 +222,7 @@ impl Reference {
             hit_t: f32::INFINITY,
             triangle_id: -1,
             normal: Vec3::ZERO,
+            lit: 1.0,
             ..Default::default()
         };
         let a = &self.attributes;
@@ -266,17 +267,22 @@ impl Reference {
                     // shadow feelers and shading at p
                     let view = (camera_pos - p).normalize();
                     let mut temp = self.ambient * color;
+                    let mut unblocked = 0;
                     for &(lp, lc) in &self.lights {
                         let (shadow, tests) = self.shadowed(p, n, id, lp);
                         out.tests2 += tests;
                         if shadow {
                             continue;
                         }
+                        unblocked += 1;
                         let l = (lp - p).normalize();
                         let diffuse = n.dot(l).max(0.0);
                         let r = reflect(-l, n);
                         let specular = mat.y * r.dot(view).max(0.0).powf(mat.z);
                         temp += lc * (diffuse * color + Vec3::splat(specular));
+                    }
+                    if pass == 0 && !self.lights.is_empty() {
+                        out.lit = unblocked as f32 / self.lights.len() as f32;
                     }
                     ro = p;
                     last = id as i32;
@@ -320,7 +326,10 @@ impl Reference {
             width,
             height,
             color: Vec::with_capacity(pixels.len()),
-            aovs: Aovs::default(),
+            aovs: Aovs {
+                shadow: Some(Vec::with_capacity(pixels.len())),
+                ..Default::default()
+            },
             intersect1_tests: 0,
             intersect2_tests: 0,
         };
@@ -331,6 +340,7 @@ impl Reference {
             frame.aovs.hit_t.push(p.hit_t);
             frame.aovs.triangle_id.push(p.triangle_id);
             frame.aovs.normal.push(p.normal.to_array());
+            frame.aovs.shadow.as_mut().unwrap().push(p.lit);
             frame.intersect1_tests += p.tests1;
             frame.intersect2_tests += p.tests2;
         }
@@ -344,6 +354,8 @@ struct PixelResult {
     hit_t: f32,
     triangle_id: i32,
     normal: Vec3,
+    /// the share of the lights whose feeler of the first hit is unblocked (the shadow AOV)
+    lit: f32,
     tests1: u64,
     tests2: u64,
 }

@@ -1,6 +1,6 @@
 //! The ray-state textures of Müller 2015 ch. 3.1.2, bound to the image units of
 //! `glsl/common/images.glsl` ([`crate::gl::slots::image`]) and cleared every frame — and the
-//! copies of the primary rays and normals kept for the AOVs.
+//! copies of the primary rays, normals and shadow flags kept for the AOVs.
 
 use anyhow::Result;
 
@@ -25,10 +25,7 @@ pub struct RayImages {
 impl RayImages {
     pub fn new(gl: &Gl, w: u32, h: u32, flags: ShadowFlags) -> Result<RayImages> {
         let f = glow::RGBA32F;
-        let shadow = match flags {
-            ShadowFlags::Rgba => glow::RGBA32F,
-            ShadowFlags::Bits => glow::RGBA32UI,
-        };
+        let shadow = flags.format();
         Ok(RayImages {
             ray_origin: Image2d::new(gl, w, h, f)?,
             ray_dir: Image2d::new(gl, w, h, f)?,
@@ -71,20 +68,27 @@ impl RayImages {
     }
 }
 
-/// The primary rays and the first hits' normals, copied on the GPU while a frame runs (the
-/// ray-state textures are overwritten by the reflection passes), read back on demand.
+/// The primary rays, and the first hits' normals and shadow flags, copied on the GPU while a
+/// frame runs (the ray-state textures are overwritten by the reflection passes), read back on
+/// demand.
 pub struct AovImages {
     ray_origin: Image2d,
     ray_dir: Image2d,
     normal: Image2d,
+    shadow: Image2d,
+    flags: ShadowFlags,
+    lights: usize,
 }
 
 impl AovImages {
-    pub fn new(gl: &Gl, w: u32, h: u32) -> Result<AovImages> {
+    pub fn new(gl: &Gl, w: u32, h: u32, flags: ShadowFlags, lights: usize) -> Result<AovImages> {
         Ok(AovImages {
             ray_origin: Image2d::new(gl, w, h, glow::RGBA32F)?,
             ray_dir: Image2d::new(gl, w, h, glow::RGBA32F)?,
             normal: Image2d::new(gl, w, h, glow::RGBA32F)?,
+            shadow: Image2d::new(gl, w, h, flags.format())?,
+            flags,
+            lights,
         })
     }
 
@@ -94,9 +98,41 @@ impl AovImages {
         self.ray_dir.copy_from(gl, &images.ray_dir);
     }
 
-    /// After the first pass: keep the normals of the first hits.
-    pub fn keep_normals(&self, gl: &Gl, images: &RayImages) {
+    /// After the first pass: keep the normals and the shadow flags of the first hits.
+    pub fn keep_first_hits(&self, gl: &Gl, images: &RayImages) {
         self.normal.copy_from(gl, &images.normal);
+        self.shadow.copy_from(gl, &images.shadow);
+    }
+
+    /// Per pixel, the share of the point lights whose shadow feeler of the first pass was not
+    /// blocked (a light behind the surface counts as blocked, as Listing 15 treats it); 1 where
+    /// the primary ray missed (no feelers) or the scene has no lights. GL row order.
+    fn lit_share(&self, gl: &Gl) -> Vec<f32> {
+        let n = self.lights;
+        let blocked: Vec<usize> = match self.flags {
+            ShadowFlags::Bits => self
+                .shadow
+                .read_u32(gl)
+                .iter()
+                .map(|f| f.iter().map(|w| w.count_ones() as usize).sum())
+                .collect(),
+            ShadowFlags::Rgba => self
+                .shadow
+                .read_f32(gl)
+                .iter()
+                .map(|f| f[..n.min(4)].iter().filter(|&&c| c > 0.5).count())
+                .collect(),
+        };
+        blocked
+            .iter()
+            .map(|&b| {
+                if n == 0 {
+                    1.0
+                } else {
+                    (n - b) as f32 / n as f32
+                }
+            })
+            .collect()
     }
 
     /// The AOVs of the last frame, row 0 = the top image row.
@@ -109,12 +145,12 @@ impl AovImages {
             hit_t: hit.iter().map(|v| v[0]).collect(),
             triangle_id: hit.iter().map(|v| v[1].to_bits() as i32).collect(),
             normal: flip_xyz(&self.normal.read_f32(gl), w, h),
-            shadow: None,
+            shadow: Some(flip_rows(&self.lit_share(gl), w, h)),
         }
     }
 
     pub fn delete(&self, gl: &Gl) {
-        for img in [&self.ray_origin, &self.ray_dir, &self.normal] {
+        for img in [&self.ray_origin, &self.ray_dir, &self.normal, &self.shadow] {
             img.delete(gl);
         }
     }

@@ -43,6 +43,14 @@ impl ShadowFlags {
             ShadowFlags::Bits => 128,
         }
     }
+
+    /// The texture format of the flags.
+    pub fn format(self) -> u32 {
+        match self {
+            ShadowFlags::Rgba => glow::RGBA32F,
+            ShadowFlags::Bits => glow::RGBA32UI,
+        }
+    }
 }
 
 /// Options of one render.
@@ -191,7 +199,7 @@ impl RayTracer {
             images: RayImages::new(&gl, w, h, options.shadow_flags)?,
             aov_images: options
                 .aovs
-                .then(|| AovImages::new(&gl, w, h))
+                .then(|| AovImages::new(&gl, w, h, options.shadow_flags, scene.lights.len()))
                 .transpose()?,
             scene: gpu_scene,
             kernels,
@@ -327,7 +335,7 @@ impl Renderer for RayTracer {
         for pass in 0..=self.options.refl_depth {
             self.pass(&cam, pass);
             if let (0, Some(a)) = (pass, &self.aov_images) {
-                a.keep_normals(&gl, &self.images);
+                a.keep_first_hits(&gl, &self.images);
             }
         }
         let mut stats = self.frame_stats();

@@ -1,0 +1,154 @@
+//! The ray tracer's AOVs hold what tools outside read from them (`tools/embree_peer.py` casts
+//! the same rays with Intel Embree): `ray_origin`/`ray_direction` are the camera's primary rays
+//! of Listing 11 for every pixel in image row order (row 0 = top), `o + hit_t·d` lies on the
+//! triangle `triangle_id` of the scene's triangle list (the order of `export-triangles`), and
+//! `shadow` is the share of the point lights whose first-hit feeler is unblocked, as the CPU
+//! twin computes it. Reflection passes run after the first, so the AOVs must come from it.
+
+mod common;
+
+use common::*;
+use glam::{DVec3, Vec3};
+use gpgpu_rt::accel::{self, GridOptions, TracerKind};
+use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
+use gpgpu_rt::reference::Reference;
+use gpgpu_rt::scene::Light;
+
+fn bvh_options(w: u32, h: u32) -> RenderOptions {
+    RenderOptions {
+        tracer: TracerKind::Bvh,
+        ..options(w, h, 1)
+    }
+}
+
+/// Barycentric (u, v) of the projection of `p` onto the triangle's plane, and the distance of
+/// `p` from that plane, in f64.
+fn on_triangle(p: Vec3, tri: &[Vec3; 3]) -> (f64, f64, f64) {
+    let [a, b, c] = tri.map(|v| v.as_dvec3());
+    let (e1, e2, ep) = (b - a, c - a, p.as_dvec3() - a);
+    let n = e1.cross(e2);
+    let dist = n.dot(ep).abs() / n.length();
+    // ep = u·e1 + v·e2 in the plane: Cramer's rule on the normal equations
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1p, d2p) = (e1.dot(ep), e2.dot(ep));
+    let den = d11 * d22 - d12 * d12;
+    let u = (d22 * d1p - d12 * d2p) / den;
+    let v = (d11 * d2p - d12 * d1p) / den;
+    (u, v, dist)
+}
+
+#[test]
+fn ray_aovs_hold_the_primary_rays_and_hits_lie_on_their_triangles() {
+    let ctx = context();
+    let scene = load("teapot1.toml");
+    // not square, so that swapped width and height or a wrong row order show
+    let (w, h) = (64u32, 40u32);
+    let f = render_gpu(&ctx, &scene, bvh_options(w, h));
+    let a = f.aovs.as_ref().expect("AOVs");
+    let n = (w * h) as usize;
+    assert_eq!(
+        (a.ray_origin.len(), a.ray_direction.len(), a.hit_t.len()),
+        (n, n, n)
+    );
+    let cam = scene.camera.rays(w, h);
+    let c = &scene.camera;
+    let forward = (DVec3::from(c.look_at.map(f64::from)) - DVec3::from(c.position.map(f64::from)))
+        .normalize();
+    let tris = scene.world_triangles();
+    let mut hits = 0;
+    for row in 0..h {
+        for x in 0..w {
+            let i = (row * w + x) as usize;
+            let (o, d) = (Vec3::from(a.ray_origin[i]), Vec3::from(a.ray_direction[i]));
+            // the camera model of Listing 11 on the CPU: GL row h-1-row is image row `row`
+            let (eo, ed) = cam.primary_ray(x, h - 1 - row);
+            assert!(
+                (o - eo).length() < 1e-5,
+                "pixel ({x}, {row}): origin {o} != {eo}"
+            );
+            assert!(
+                (d - ed).length() < 1e-5,
+                "pixel ({x}, {row}): direction {d} != {ed}"
+            );
+            assert!((d.length() - 1.0).abs() < 1e-5, "unit direction: {d}");
+            // the origin lies on the image plane, on the line from the camera along d
+            let from_cam = (o - cam.cam_position).as_dvec3();
+            assert!((from_cam.dot(forward) - c.near as f64).abs() < 1e-5);
+            assert!(from_cam.normalize().cross(d.as_dvec3()).length() < 1e-5);
+
+            let (id, t) = (a.triangle_id[i], a.hit_t[i]);
+            if id < 0 {
+                assert_eq!(id, -1);
+                assert!(t.is_infinite() && t > 0.0, "miss: hit_t = +inf, not {t}");
+                continue;
+            }
+            hits += 1;
+            let (u, v, dist) = on_triangle(o + t * d, &tris[id as usize]);
+            assert!(
+                dist < 1e-5,
+                "pixel ({x}, {row}): o + t·d is {dist} off triangle {id}'s plane"
+            );
+            let inside = u.min(v).min(1.0 - u - v);
+            assert!(
+                inside > -1e-3,
+                "pixel ({x}, {row}): o + t·d lies outside triangle {id} (u {u}, v {v})"
+            );
+        }
+    }
+    assert!(
+        hits > n / 2,
+        "{hits} of {n} pixels hit the floor or the teapot"
+    );
+}
+
+#[test]
+fn shadow_aov_is_the_share_of_unblocked_lights() {
+    let ctx = context();
+    let mut scene = load("teapot1.toml");
+    // the scene's light throws the teapot's shadow on the floor; the second one is below the
+    // floor (light behind the surface: blocked without a test), the third one low at the side
+    scene.lights.push(Light {
+        position: Vec3::new(0.0, -2.0, 0.0),
+        color: Vec3::splat(0.3),
+    });
+    scene.lights.push(Light {
+        position: Vec3::new(-3.0, 1.0, -1.0),
+        color: Vec3::splat(0.3),
+    });
+    let (w, h) = (48, 40);
+    let twin = (accel::entry(TracerKind::Bvh, &GridOptions::default())
+        .unwrap()
+        .cpu)(&scene, &GridOptions::default())
+    .expect("CPU twin");
+    let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
+    let want = cpu
+        .aovs
+        .shadow
+        .as_ref()
+        .expect("the reference's shadow shares");
+    for flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
+        let opts = RenderOptions {
+            shadow_flags: flags,
+            ..bvh_options(w, h)
+        };
+        let f = render_gpu(&ctx, &scene, opts);
+        let a = f.aovs.as_ref().unwrap();
+        let got = a.shadow.as_ref().expect("the ray tracer's shadow AOV");
+        let differ = (0..got.len()).filter(|&i| got[i] != want[i]).count();
+        assert_eq!(
+            differ, 0,
+            "{flags:?}: {differ} pixels' shadow shares differ"
+        );
+        for (i, &s) in got.iter().enumerate() {
+            if a.triangle_id[i] < 0 {
+                assert_eq!(s, 1.0, "{flags:?}: a miss has no feelers");
+            }
+        }
+        // the shares vary: the floor in the open is lit by 2 of the 3 lights, in the teapot's
+        // shadow by 1, and parts of the teapot by none
+        for share in [0.0, 1.0 / 3.0, 2.0 / 3.0] {
+            let k = got.iter().filter(|&&s| (s - share).abs() < 1e-6).count();
+            assert!(k > 0, "{flags:?}: no pixel is lit by a share of {share}");
+        }
+    }
+}
