@@ -77,7 +77,7 @@ impl Design {
         (self.options.width, self.options.height)
     }
 
-    /// What the window shows: "base tracer", "soft shadows linespace 3x3".
+    /// What the window shows: "base tracer", "bvh wagner tracer", "soft shadows linespace 3x3".
     pub fn name(&self) -> String {
         match self.shadows {
             Some(mode) => format!(
@@ -86,6 +86,9 @@ impl Design {
                 self.samples.0,
                 self.samples.1
             ),
+            None if self.kind == TracerKind::Bvh => {
+                format!("bvh {} tracer", value_name(self.options.bvh_variant))
+            }
             None => format!("{} tracer", value_name(self.kind)),
         }
     }
