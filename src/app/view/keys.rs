@@ -355,7 +355,7 @@ mod tests {
     const CONTROLS: &str = "\
 mouse: left drag orbit | right/middle drag or shift+left drag pan | wheel zoom
 keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
-       T / shift+T next / previous tracer | V next grid variant
+       T / shift+T next / previous tracer | V next grid variant | B next BVH variant (sah, wagner)
        G / shift+G grid resolution +4 / -4 | A grid resolution auto
        ] / [ reflection depth +1 / -1
        S / shift+S soft shadows next / previous (off, exact, linespace, linespace-dda)
@@ -395,6 +395,8 @@ keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
             ("C or Home", &[Named(Home), Ch("c"), Ch("C")]),
             ("T / shift+T", &[Ch("t"), Ch("T")]),
             ("V", &[Ch("v"), Ch("V")]),
+            // added with the BVH variants
+            ("B", &[Ch("b"), Ch("B")]),
             ("G / shift+G", &[Ch("g"), Ch("G")]),
             ("A", &[Ch("a"), Ch("A")]),
             ("] / [", &[Ch("]"), Ch("}"), Ch("["), Ch("{")]),
