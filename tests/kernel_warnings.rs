@@ -12,6 +12,7 @@ use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, ShaderSource};
 use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::ShadowMode;
 
@@ -42,6 +43,17 @@ fn every_kernel_compiles_without_warnings() {
             t.render(&scene.camera).expect("frame");
         }
     }
+
+    // Wagner 2018's kernel
+    let opts = WagnerOptions {
+        width: 8,
+        height: 8,
+        tile: 0,
+        aovs: true,
+    };
+    let mut r = WagnerRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
+        .expect("Wagner 2018's renderer");
+    r.render(&scene.camera).expect("frame");
 
     // the soft shadows: G-buffer, the three shadow modes, the quad
     let area = common::load("bunny_area.toml");

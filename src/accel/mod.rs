@@ -128,6 +128,30 @@ pub enum GridVariant {
     Exact,
 }
 
+/// The two BVH designs of `--tracer bvh` (`--bvh-variant`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum BvhVariant {
+    /// Ours: a binned-SAH BVH, an accelerator of Müller 2015's four-kernel pipeline
+    /// ([`bvh::Bvh`]).
+    #[default]
+    Sah,
+    /// Wagner 2018, faithful: Listings 4.3/4.4 with eq. 4.1, three textures (Fig. 4.3), one
+    /// kernel per pixel with Lambert shading and a hard shadow — its own pipeline
+    /// (`pipeline::wagner2018`).
+    Wagner,
+}
+
+impl BvhVariant {
+    /// The `--bvh-variant` value.
+    pub fn name(self) -> &'static str {
+        match self {
+            BvhVariant::Sah => "sah",
+            BvhVariant::Wagner => "wagner",
+        }
+    }
+}
+
 /// Options of the accelerators (today: the grids').
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GridOptions {

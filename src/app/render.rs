@@ -9,13 +9,13 @@ use clap::ArgMatches;
 use serde_json::json;
 
 use crate::args::{GpuArgs, GridArgs, SoftShadowArgs};
-use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::accel::{BvhVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output;
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::SoftShadowRenderer;
-use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::scene::{Scene, ShadowMode};
 
 #[derive(clap::Args)]
@@ -36,6 +36,11 @@ pub struct RenderArgs {
     /// (the thesis' uniform grid, see --grid-variant).
     #[arg(long, value_enum, default_value = "bvh")]
     tracer: TracerKind,
+    /// With --tracer bvh: `sah` (ours, in the four-kernel pipeline) or `wagner` (Wagner 2018
+    /// faithful: his BVH build, three textures, one kernel per pixel, one light, Lambert, hard
+    /// shadows, no reflection).
+    #[arg(long, value_enum, default_value = "sah")]
+    bvh_variant: BvhVariant,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
     #[arg(long)]
     refl_depth: Option<u32>,
@@ -92,6 +97,7 @@ fn refuse_other_pipeline(
     if let Some(mode) = args.soft.shadows {
         let ray_tracer_only = given(&[
             "tracer",
+            "bvh_variant",
             "refl_depth",
             "shadow_flags",
             "grid",
@@ -114,6 +120,7 @@ fn refuse_other_pipeline(
             );
         }
     } else {
+        refuse_for_bvh_variant(args, &given)?;
         let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
         if !soft_only.is_empty() {
             bail!(
@@ -127,8 +134,32 @@ fn refuse_other_pipeline(
     Ok(())
 }
 
+/// `--bvh-variant` only with `--tracer bvh`; Wagner 2018's kernel has no reflection passes and
+/// no shadow-flag texture, so their options are refused with it.
+fn refuse_for_bvh_variant(args: &RenderArgs, given: &dyn Fn(&[&str]) -> Vec<String>) -> Result<()> {
+    if args.tracer != TracerKind::Bvh && !given(&["bvh_variant"]).is_empty() {
+        bail!(
+            "--bvh-variant applies to --tracer bvh only (this render uses --tracer {})",
+            args.tracer.name()
+        );
+    }
+    if args.tracer == TracerKind::Bvh && args.bvh_variant == BvhVariant::Wagner {
+        let not_wagner = given(&["refl_depth", "shadow_flags"]);
+        if !not_wagner.is_empty() {
+            let (does, an_option) = verb(&not_wagner);
+            bail!(
+                "{} {does} not apply: {an_option} of Müller 2015's pipeline, and --bvh-variant wagner \
+                 renders with Wagner 2018's kernel (one light, hard shadows, no reflection)",
+                not_wagner.join(", ")
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The renderer the options choose: Klee 2016's soft shadows with `--shadows` (or the scene's
-/// render.shadows), else Müller 2015's ray tracer with the `--tracer` accelerator.
+/// render.shadows), else the point-light ray tracer: Müller 2015's with the `--tracer` accelerator, or
+/// Wagner 2018's with `--tracer bvh --bvh-variant wagner`.
 fn make_renderer(
     ctx: &GlContext,
     scene: &Scene,
@@ -151,14 +182,9 @@ fn make_renderer(
         shadow_flags: args.shadow_flags,
         aovs: args.aov_dir.is_some(),
         grid: args.grid.options(),
+        bvh_variant: args.bvh_variant,
     };
-    Ok(Box::new(RayTracer::new(
-        ctx.gl.clone(),
-        &ctx.info,
-        scene,
-        shaders,
-        options,
-    )?))
+    pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, shaders, options)
 }
 
 /// The statistics document of a frame (the keys of `render --stats`).
@@ -226,6 +252,9 @@ fn summary(
         Some(mode) => {
             let (u, v) = args.soft.samples();
             format!("soft shadows `{}` with {u}x{v} samples", mode.name())
+        }
+        None if args.tracer == TracerKind::Bvh && args.bvh_variant == BvhVariant::Wagner => {
+            "1 light, Wagner 2018's bvh tracer".to_string()
         }
         None => format!(
             "{} lights, {} tracer",

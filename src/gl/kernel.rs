@@ -150,14 +150,18 @@ impl Kernel {
     /// Dispatch this kernel (in use) over the image in tiles of `grid`, each dispatch timed,
     /// the tile's origin in the uniform `tileOffset`, followed by a barrier.
     pub fn dispatch_pixels(&self, timers: &mut GpuTimers, grid: PixelGrid) {
+        self.dispatch_pixel_groups(timers, grid, PIXEL_GROUP);
+    }
+
+    /// [`Kernel::dispatch_pixels`] for a kernel of `group`×`group` work groups (Wagner 2018's
+    /// 16×16); the tiles should be multiples of `group`.
+    pub fn dispatch_pixel_groups(&self, timers: &mut GpuTimers, grid: PixelGrid, group: u32) {
         let gl = &self.gl;
         for (tx, ty, tw, th) in grid.tiles() {
             self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
             timers.time(gl, self.timer, || {
                 // SAFETY: dispatch of the program in use.
-                unsafe {
-                    gl.dispatch_compute(tw.div_ceil(PIXEL_GROUP), th.div_ceil(PIXEL_GROUP), 1)
-                }
+                unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
             });
         }
         barrier(gl);

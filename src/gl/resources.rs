@@ -263,6 +263,73 @@ impl Image2d {
     }
 }
 
+/// A buffer texture (`GL_TEXTURE_BUFFER`): texels in a buffer, read by kernels with
+/// `texelFetch` through a `samplerBuffer` (Wagner 2018 keeps its BVH in such textures, Fig. 4.3).
+pub struct TextureBuffer {
+    pub buffer: glow::Buffer,
+    pub texture: glow::Texture,
+    /// Texels and bytes of the data.
+    pub texels: usize,
+    pub bytes: usize,
+}
+
+impl TextureBuffer {
+    /// Upload `data` as texels of `format` (`texel_bytes` each), after checking the count
+    /// against `GL_MAX_TEXTURE_BUFFER_SIZE`; `name` is for the message.
+    pub fn new(
+        gl: &Gl,
+        name: &str,
+        format: u32,
+        texel_bytes: usize,
+        data: &[u8],
+    ) -> Result<TextureBuffer> {
+        let texels = data.len() / texel_bytes;
+        // SAFETY: a limit query on a current context.
+        let max = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
+        if texels as i64 > max || data.len() > i32::MAX as usize {
+            bail!(
+                "texture `{name}` needs {texels} texels, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max} \
+                 of this GL implementation; use a smaller scene"
+            );
+        }
+        // SAFETY: buffer and texture creation on a current context.
+        unsafe {
+            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
+            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
+            gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, data, glow::STATIC_DRAW);
+            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
+            gl.tex_buffer(format, buffer);
+            gl.bind_texture(glow::TEXTURE_BUFFER, None);
+            Ok(TextureBuffer {
+                buffer,
+                texture,
+                texels,
+                bytes: data.len(),
+            })
+        }
+    }
+
+    /// Bind to texture unit `unit` (a `samplerBuffer` with `layout(binding = unit)`).
+    pub fn bind(&self, gl: &Gl, unit: u32) {
+        // SAFETY: binding our own texture to a texture unit.
+        unsafe {
+            gl.active_texture(glow::TEXTURE0 + unit);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture));
+            gl.active_texture(glow::TEXTURE0);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own texture and buffer.
+        unsafe {
+            gl.delete_texture(self.texture);
+            gl.delete_buffer(self.buffer);
+        }
+    }
+}
+
 /// Read back a w×h RGBA32F 2D texture (written by image stores or by rendering into it),
 /// row 0 = the bottom row (GL order).
 pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {

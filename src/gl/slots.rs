@@ -68,6 +68,13 @@ slot_table! {
         GBUFFER_DIFFUSE = 2,
         SHADOW_VALUE = 3,
         LINESPACE = 4,
+        // Wagner 2018's kernel (glsl/wagner2018/raytrace.comp): the image it renders (ch. 4.3's
+        // surface), and ours for the AOVs: the first hit (t, triangle id, u, v), the primary
+        // ray's direction, the normal at the hit (w: 1 lit, 0 in shadow)
+        WAGNER_OUTPUT = 0,
+        WAGNER_HIT = 1,
+        WAGNER_RAY = 2,
+        WAGNER_NORMAL = 3,
     }
 }
 
@@ -84,6 +91,16 @@ slot_table! {
         BVH_LEAF_TRIANGLES = 3,
         /// the texture a screen-filling quad shows
         QUAD_COLOR = 0,
+        /// Wagner 2018's BVH in three textures (Fig. 4.3, texture buffers): the boxes (centre,
+        /// half extent), the node integers (leaf flag, children / triangle range), the
+        /// triangle ids grouped per leaf
+        WAGNER_BVH_BOUNDS = 1,
+        WAGNER_BVH_NODES = 2,
+        WAGNER_BVH_TRIANGLES = 3,
+        /// ... and its triangles: world-space vertices, normals, colours (3 texels each)
+        WAGNER_VERTICES = 4,
+        WAGNER_NORMALS = 5,
+        WAGNER_COLORS = 6,
     }
 }
 

@@ -5,15 +5,21 @@
 //! |---|---|---|---|---|
 //! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`raytrace`] | `glsl/mueller2015/` | every one of [`crate::accel::REGISTRY`] |
 //! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`softshadow`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
+//! | one kernel per pixel (primary ray, BVH walk, Lambert, hard shadow) | Wagner 2018 | [`wagner2018`] | `glsl/wagner2018/` | its BVH in three textures (`--tracer bvh --bvh-variant wagner`) |
 
 pub mod raytrace;
 pub mod softshadow;
+pub mod wagner2018;
+
+use std::sync::Arc;
 
 use anyhow::Result;
 use glam::Mat4;
 
+use crate::accel::{BvhVariant, TracerKind};
 use crate::frame::{Frame, FrameStats};
-use crate::scene::Camera;
+use crate::gl::{Gl, GlInfo, ShaderSource};
+use crate::scene::{Camera, Scene};
 
 /// A pipeline with its scene on the GPU, ready to render frames.
 pub trait Renderer {
@@ -42,4 +48,23 @@ pub trait Renderer {
         self.draw(camera)?;
         self.read_back()
     }
+}
+
+/// The point-light ray tracer `options` choose: Müller 2015's four-kernel pipeline with the
+/// `--tracer` accelerator, or, for `--tracer bvh --bvh-variant wagner`, Wagner 2018's
+/// one-kernel pipeline (which takes only the size, the tiles and the AOVs of `options`).
+pub fn ray_tracer(
+    gl: Arc<Gl>,
+    info: &GlInfo,
+    scene: &Scene,
+    shaders: &ShaderSource,
+    options: raytrace::RenderOptions,
+) -> Result<Box<dyn Renderer>> {
+    if options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner {
+        let o = wagner2018::WagnerOptions::of(&options);
+        let r = wagner2018::WagnerRenderer::new(gl, info, scene, shaders, o)?;
+        return Ok(Box::new(r));
+    }
+    let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;
+    Ok(Box::new(r))
 }

@@ -10,6 +10,8 @@ pub mod grid;
 pub mod linespace;
 pub mod ntree;
 pub mod thesis_grid;
+pub mod wagner2018;
+pub mod wagner_bvh;
 
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;

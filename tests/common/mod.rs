@@ -36,6 +36,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         shadow_flags: ShadowFlags::Bits,
         aovs: true,
         grid: Default::default(),
+        bvh_variant: Default::default(),
     }
 }
 

@@ -13,11 +13,11 @@ use glam::Mat4;
 
 use super::args::BenchArgs;
 use super::config::{Config, Sizing};
-use gpgpu_rt::accel::{GridOptions, TracerKind};
+use gpgpu_rt::accel::{BvhVariant, GridOptions, TracerKind};
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
-use gpgpu_rt::pipeline::raytrace::{self, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::reference::linespace::LinespaceShadows;
 use gpgpu_rt::scene::{Camera, Scene, ShadowMode};
 
@@ -85,10 +85,11 @@ impl RayTracer {
             shadow_flags: ShadowFlags::Rgba,
             aovs: false,
             grid,
+            bvh_variant: BvhVariant::default(),
         };
         let (gl, info) = (gpu.ctx.gl.clone(), &gpu.ctx.info);
-        let tracer = raytrace::RayTracer::new(gl, info, scene, &gpu.shaders, options)?;
-        Ok(RayTracer(Box::new(tracer)))
+        let tracer = pipeline::ray_tracer(gl, info, scene, &gpu.shaders, options)?;
+        Ok(RayTracer(tracer))
     }
 
     /// Place object `object` (index in the scene's objects) for the next frames.

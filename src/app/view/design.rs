@@ -4,7 +4,9 @@ use std::fmt::Debug;
 
 use clap::ValueEnum;
 
-use super::renderer::{soft_shadow_support, RenderOptions, ShadowMode, Show, Stats, TracerKind};
+use super::renderer::{
+    soft_shadow_support, BvhVariant, RenderOptions, ShadowMode, Show, Stats, TracerKind,
+};
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::scene::Scene;
 
@@ -75,7 +77,7 @@ impl Design {
         (self.options.width, self.options.height)
     }
 
-    /// What the window shows: "base tracer", "soft shadows linespace 3x3".
+    /// What the window shows: "base tracer", "bvh wagner tracer", "soft shadows linespace 3x3".
     pub fn name(&self) -> String {
         match self.shadows {
             Some(mode) => format!(
@@ -84,6 +86,9 @@ impl Design {
                 self.samples.0,
                 self.samples.1
             ),
+            None if self.kind == TracerKind::Bvh => {
+                format!("bvh {} tracer", value_name(self.options.bvh_variant))
+            }
             None => format!("{} tracer", value_name(self.kind)),
         }
     }
@@ -102,15 +107,23 @@ impl Design {
             _ => self.tracer_title(),
         };
         t += &format!(" · {}×{}", self.options.width, self.options.height);
-        if self.shadows.is_none() {
+        if self.shadows.is_none() && !self.wagner() {
             t += &format!(" · refl {}", self.options.refl_depth);
         }
         t
     }
 
-    /// "base", "bvh", "grid exact 16³", "grid thesis auto=12³".
+    /// Wagner 2018's pipeline (`--tracer bvh --bvh-variant wagner`): no reflection.
+    fn wagner(&self) -> bool {
+        self.kind == TracerKind::Bvh && self.options.bvh_variant == BvhVariant::Wagner
+    }
+
+    /// "base", "bvh sah", "bvh wagner", "grid exact 16³", "grid thesis auto=12³".
     fn tracer_title(&self) -> String {
         let mut t = value_name(self.kind);
+        if self.kind == TracerKind::Bvh {
+            t += &format!(" {}", value_name(self.options.bvh_variant));
+        }
         if self.kind == TracerKind::Grid {
             let g = &self.options.grid;
             let res = g

@@ -8,7 +8,7 @@ use winit::keyboard::Key::{self, Character as Ch, Named};
 use winit::keyboard::NamedKey;
 
 use super::design::value_name;
-use super::renderer::{GridVariant, ShadowMode, TracerKind};
+use super::renderer::{BvhVariant, GridVariant, ShadowMode, TracerKind};
 use super::window::Viewport;
 use super::{orbit, App};
 
@@ -67,6 +67,7 @@ static KEYS: &[&[Binding]] = &[
     &[
         bind("T / shift+T", &[Ch("t")], "next / previous tracer", next_tracer),
         bind("V", &[Ch("v")], "next grid variant", next_variant),
+        bind("B", &[Ch("b")], "next BVH variant (sah, wagner)", next_bvh_variant),
     ],
     &[
         bind("G / shift+G", &[Ch("g")], "grid resolution +4 / -4", grid_step),
@@ -197,6 +198,13 @@ fn next_variant(app: &mut App, _: &Press) {
     o.grid.variant = step(GridVariant::value_variants(), &o.grid.variant, false);
     let what = format!("grid variant {}", value_name(o.grid.variant));
     app.change_grid(o, what);
+}
+
+fn next_bvh_variant(app: &mut App, _: &Press) {
+    let mut o = app.design.options.clone();
+    o.bvh_variant = step(BvhVariant::value_variants(), &o.bvh_variant, false);
+    let what = format!("BVH variant {}", value_name(o.bvh_variant));
+    app.change_for(TracerKind::Bvh, o, what);
 }
 
 fn grid_step(app: &mut App, press: &Press) {
@@ -347,7 +355,7 @@ mod tests {
     const CONTROLS: &str = "\
 mouse: left drag orbit | right/middle drag or shift+left drag pan | wheel zoom
 keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
-       T / shift+T next / previous tracer | V next grid variant
+       T / shift+T next / previous tracer | V next grid variant | B next BVH variant (sah, wagner)
        G / shift+G grid resolution +4 / -4 | A grid resolution auto
        ] / [ reflection depth +1 / -1
        S / shift+S soft shadows next / previous (off, exact, linespace, linespace-dda)
@@ -387,6 +395,8 @@ keys:  arrows orbit (shift: pan) | + - zoom | C or Home reset camera
             ("C or Home", &[Named(Home), Ch("c"), Ch("C")]),
             ("T / shift+T", &[Ch("t"), Ch("T")]),
             ("V", &[Ch("v"), Ch("V")]),
+            // added with the BVH variants
+            ("B", &[Ch("b"), Ch("B")]),
             ("G / shift+G", &[Ch("g"), Ch("G")]),
             ("A", &[Ch("a"), Ch("A")]),
             ("] / [", &[Ch("]"), Ch("}"), Ch("["), Ch("{")]),

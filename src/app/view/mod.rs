@@ -46,8 +46,8 @@ use gpgpu_rt::scene::{Camera, Scene};
 use design::Design;
 use frames::{Clock, FrameCount, Picture};
 use renderer::{
-    render_options, soft_shadow_support, GridArgs, RenderOptions, Renderers, ShadowFlags,
-    ShadowMode, Show, Stats, TracerKind,
+    render_options, soft_shadow_support, BvhVariant, GridArgs, RenderOptions, Renderers,
+    ShadowFlags, ShadowMode, Show, Stats, TracerKind,
 };
 use watch::GlslWatcher;
 use window::{
@@ -71,6 +71,10 @@ pub struct ViewArgs {
     /// The tracer to start with (T switches).
     #[arg(long, value_enum, default_value = "bvh")]
     pub tracer: TracerKind,
+    /// With --tracer bvh: `sah` (ours) or `wagner` (Wagner 2018's own one-kernel pipeline; B
+    /// switches).
+    #[arg(long, value_enum, default_value = "sah")]
+    pub bvh_variant: BvhVariant,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
     #[arg(long)]
     pub refl_depth: Option<u32>,
@@ -146,6 +150,7 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
         args.tile,
         args.shadow_flags,
         &args.grid,
+        args.bvh_variant,
     );
     if options.width == 0 || options.height == 0 {
         bail!(
@@ -462,9 +467,15 @@ impl App {
 
     /// Grid options only matter to tracers that use them; the base tracer keeps running.
     fn change_grid(&mut self, options: RenderOptions, what: String) {
-        if self.design.kind != TracerKind::Grid {
+        self.change_for(TracerKind::Grid, options, what);
+    }
+
+    /// Options only `used_by` uses: another tracer keeps running, the options are kept.
+    fn change_for(&mut self, used_by: TracerKind, options: RenderOptions, what: String) {
+        if self.design.kind != used_by {
             self.design.options = options;
-            println!("{what} (used by the grid tracer; this tracer ignores it)");
+            let name = design::value_name(used_by);
+            println!("{what} (used by the {name} tracer; this tracer ignores it)");
             self.update_title(true);
         } else {
             self.change(self.design.kind, options, what);

@@ -13,13 +13,12 @@ use super::group_digits;
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::{Gl, GlInfo, ShaderSource};
-use gpgpu_rt::pipeline::raytrace::RayTracer;
 use gpgpu_rt::pipeline::softshadow::{scene_light, SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::scene::{Camera, Scene};
 
 pub use crate::args::GridArgs;
-pub use gpgpu_rt::accel::{GridVariant, TracerKind};
+pub use gpgpu_rt::accel::{BvhVariant, GridVariant, TracerKind};
 pub use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 pub use gpgpu_rt::scene::ShadowMode;
 
@@ -30,6 +29,7 @@ pub fn render_options(
     tile: u32,
     shadow_flags: ShadowFlags,
     grid: &GridArgs,
+    bvh_variant: BvhVariant,
 ) -> RenderOptions {
     RenderOptions {
         // set to the kind shown when the tracer is made
@@ -41,6 +41,7 @@ pub fn render_options(
         shadow_flags,
         aovs: false,
         grid: grid.options(),
+        bvh_variant,
     }
 }
 
@@ -131,8 +132,7 @@ impl Renderers {
             tracer: kind,
             ..options.clone()
         };
-        let t = RayTracer::new(self.gl.clone(), &self.info, scene, shaders, options)?;
-        Ok(Box::new(t))
+        pipeline::ray_tracer(self.gl.clone(), &self.info, scene, shaders, options)
     }
 
     fn show_soft(

@@ -18,7 +18,9 @@ use serde_json::json;
 use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
 use super::Renderer;
-use crate::accel::{self, Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
+use crate::accel::{
+    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, TracerKind,
+};
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
@@ -69,6 +71,9 @@ pub struct RenderOptions {
     pub aovs: bool,
     /// Grid options (ignored by the other accelerators).
     pub grid: GridOptions,
+    /// `--bvh-variant` of `--tracer bvh`: `sah` is this pipeline's accelerator, `wagner` is
+    /// Wagner 2018's own pipeline ([`super::wagner2018`]; [`super::ray_tracer`] picks).
+    pub bvh_variant: BvhVariant,
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -137,6 +142,12 @@ pub struct RayTracer {
 
 /// Refuse options the pipeline cannot honour, before anything is allocated.
 fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Result<PixelGrid> {
+    if options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner {
+        bail!(
+            "--bvh-variant wagner is Wagner 2018's own pipeline, not an accelerator of this one \
+             (make it with pipeline::ray_tracer)"
+        );
+    }
     if scene.lights.len() > options.shadow_flags.max_lights() {
         bail!(
             "{}: {} lights, but --shadow-flags {} holds at most {} (use --shadow-flags bits)",
@@ -393,6 +404,7 @@ impl Renderer for RayTracer {
             ("tile", json!(o.tile)),
         ]
         .into_iter()
+        .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(o.bvh_variant))))
         .map(|(k, v)| (k.to_string(), v))
         .collect()
     }

@@ -1,0 +1,174 @@
+//! The GPU side of Wagner 2018's pipeline: the BVH in the three textures of Fig. 4.3 and the
+//! triangles in three more (texture buffers, bound to the samplers of [`crate::gl::slots`]),
+//! the images the kernel writes, and its uniforms.
+
+use anyhow::Result;
+use glam::Vec3;
+
+use crate::gl::resources::{Image2d, TextureBuffer};
+use crate::gl::slots::{image, sampler};
+use crate::gl::{Gl, Kernel};
+use crate::reference::wagner2018::{Lighting, WagnerCamera};
+use crate::reference::wagner_bvh::WagnerBvh;
+
+/// RGBA32F texels of `v` (w = 0): CUDA's float4 textures held float3 too (Wagner 2018, ch. 6).
+fn float4(v: &[Vec3]) -> Vec<[f32; 4]> {
+    v.iter().map(|p| p.extend(0.0).to_array()).collect()
+}
+
+/// The six texture buffers: the BVH (Fig. 4.3) and the triangles.
+pub struct SceneTextures {
+    /// bounds, node integers, triangle ids; vertices, normals, colours
+    textures: Vec<(TextureBuffer, u32)>,
+}
+
+/// One texture's data: name (for messages), texel format and size, bytes, sampler unit.
+struct TextureData {
+    name: &'static str,
+    format: u32,
+    texel_bytes: usize,
+    bytes: Vec<u8>,
+    unit: u32,
+}
+
+/// The texels of the six textures.
+fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TextureData; 6] {
+    let vertices: Vec<Vec3> = bvh.triangles.iter().flatten().copied().collect();
+    let tri_ids: Vec<i32> = bvh.tri_ids.iter().map(|&i| i as i32).collect();
+    let data = |name, format, texel_bytes, bytes: &[u8], unit| TextureData {
+        name,
+        format,
+        texel_bytes,
+        bytes: bytes.to_vec(),
+        unit,
+    };
+    let float4 = |name, v: &[Vec3], unit| {
+        let texels = float4(v);
+        data(name, glow::RGBA32F, 16, bytemuck::cast_slice(&texels), unit)
+    };
+    [
+        data(
+            "bvhBounds",
+            glow::RGBA32F,
+            16,
+            bytemuck::cast_slice(&bvh.bounds_texels()),
+            sampler::WAGNER_BVH_BOUNDS,
+        ),
+        data(
+            "bvhNodes",
+            glow::RGBA32I,
+            16,
+            bytemuck::cast_slice(&bvh.node_texels()),
+            sampler::WAGNER_BVH_NODES,
+        ),
+        data(
+            "bvhTriangles",
+            glow::R32I,
+            4,
+            bytemuck::cast_slice(&tri_ids),
+            sampler::WAGNER_BVH_TRIANGLES,
+        ),
+        float4("triVertices", &vertices, sampler::WAGNER_VERTICES),
+        float4("triNormals", normals, sampler::WAGNER_NORMALS),
+        float4("triColors", colors, sampler::WAGNER_COLORS),
+    ]
+}
+
+impl SceneTextures {
+    /// Upload `bvh` and the triangles' per-vertex `normals` and `colors` (3 per triangle).
+    pub fn upload(
+        gl: &Gl,
+        bvh: &WagnerBvh,
+        normals: &[Vec3],
+        colors: &[Vec3],
+    ) -> Result<SceneTextures> {
+        let mut made: Vec<(TextureBuffer, u32)> = Vec::with_capacity(6);
+        for d in texture_data(bvh, normals, colors) {
+            match TextureBuffer::new(gl, d.name, d.format, d.texel_bytes, &d.bytes) {
+                Ok(t) => made.push((t, d.unit)),
+                Err(e) => {
+                    made.iter().for_each(|(t, _)| t.delete(gl));
+                    return Err(e);
+                }
+            }
+        }
+        Ok(SceneTextures { textures: made })
+    }
+
+    /// Bytes of the three BVH textures and of the three triangle textures.
+    pub fn bytes(&self) -> (usize, usize) {
+        let sum = |ts: &[(TextureBuffer, u32)]| ts.iter().map(|(t, _)| t.bytes).sum();
+        (sum(&self.textures[..3]), sum(&self.textures[3..]))
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        for (t, unit) in &self.textures {
+            t.bind(gl, *unit);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        for (t, _) in &self.textures {
+            t.delete(gl);
+        }
+    }
+}
+
+/// The images the kernel writes (RGBA32F, GL row order).
+pub struct Images {
+    /// ch. 4.3: the rendered image (rgb, 1)
+    pub output: Image2d,
+    /// (t, triangle id as bits, u, v) of the first hit
+    pub hit: Image2d,
+    /// the primary ray's direction (AOVs only)
+    pub ray: Image2d,
+    /// the normal at the first hit, w: 1 lit, 0 in shadow (AOVs only)
+    pub normal: Image2d,
+}
+
+impl Images {
+    pub fn new(gl: &Gl, w: u32, h: u32) -> Result<Images> {
+        let f = glow::RGBA32F;
+        Ok(Images {
+            output: Image2d::new(gl, w, h, f)?,
+            hit: Image2d::new(gl, w, h, f)?,
+            ray: Image2d::new(gl, w, h, f)?,
+            normal: Image2d::new(gl, w, h, f)?,
+        })
+    }
+
+    fn all(&self) -> [(&Image2d, u32); 4] {
+        [
+            (&self.output, image::WAGNER_OUTPUT),
+            (&self.hit, image::WAGNER_HIT),
+            (&self.ray, image::WAGNER_RAY),
+            (&self.normal, image::WAGNER_NORMAL),
+        ]
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        self.all()
+            .iter()
+            .for_each(|(i, unit)| i.bind_image(gl, *unit));
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        self.all().iter().for_each(|(i, _)| i.delete(gl));
+    }
+}
+
+/// The kernel's uniforms for a frame: Listing 4.1's camera, the light, the image.
+pub fn set_uniforms(k: &Kernel, cam: &WagnerCamera, l: &Lighting, size: (u32, u32), aovs: bool) {
+    k.set_vec3("camera.position", cam.position.to_array());
+    k.set_vec3("camera.direction", cam.direction.to_array());
+    k.set_vec3("camera.xDirection", cam.x_direction.to_array());
+    k.set_vec3("camera.yDirection", cam.y_direction.to_array());
+    k.set_f32("camera.xScale", cam.x_scale);
+    k.set_f32("camera.yScale", cam.y_scale);
+    k.set_ivec2("imageSize2", [size.0 as i32, size.1 as i32]);
+    k.set_vec3("lightPosition", l.light_position.to_array());
+    k.set_vec3("lightColor", l.light_color.to_array());
+    k.set_vec3("ambientColor", l.ambient.to_array());
+    k.set_vec3("backgroundColor", l.background.to_array());
+    k.set_i32("storeAovs", aovs as i32);
+}
