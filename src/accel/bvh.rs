@@ -15,7 +15,7 @@ use serde_json::json;
 
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
 use crate::frame::FrameStats;
-use crate::gl::resources::TexBuffer;
+use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
 use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
@@ -32,59 +32,42 @@ pub const ENTRY: Entry = Entry {
     },
 };
 
-/// The uploaded hierarchy: nodes, miss links, leaf triangles (`glsl/bvh/traverse.glsl`).
-struct Buffers([TexBuffer; 3]);
-
-/// The sampler slot of each of [`Buffers`].
-const SLOTS: [u32; 3] = [
-    sampler::BVH_NODES,
-    sampler::BVH_LINKS,
-    sampler::BVH_LEAF_TRIANGLES,
-];
-
-impl Buffers {
-    fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<Buffers> {
-        let leaf_triangles = bvh.leaf_triangles();
-        let parts: [(&str, u32, usize, &[u8]); 3] = [
-            (
+/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes, miss links, leaf triangles.
+fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
+    let leaf_triangles = bvh.leaf_triangles();
+    let data = |name, format, texel_bytes, bytes: &[u8], unit| TexelData {
+        name,
+        format,
+        texel_bytes,
+        bytes: bytes.to_vec().into(),
+        unit,
+    };
+    TextureBuffers::upload(
+        gl,
+        [
+            data(
                 "bvhNodes",
                 glow::RGBA32F,
                 16,
                 bytemuck::cast_slice(&bvh.nodes),
+                sampler::BVH_NODES,
             ),
-            ("bvhLinks", glow::R32I, 4, bytemuck::cast_slice(&bvh.links)),
-            (
+            data(
+                "bvhLinks",
+                glow::R32I,
+                4,
+                bytemuck::cast_slice(&bvh.links),
+                sampler::BVH_LINKS,
+            ),
+            data(
                 "bvhLeafTriangles",
                 glow::RGBA32F,
                 16,
                 bytemuck::cast_slice(&leaf_triangles),
+                sampler::BVH_LEAF_TRIANGLES,
             ),
-        ];
-        let mut done: Vec<TexBuffer> = Vec::with_capacity(3);
-        for (name, format, texel, data) in parts {
-            match TexBuffer::new(gl, name, format, texel, data) {
-                Ok(b) => done.push(b),
-                Err(e) => {
-                    done.iter().for_each(|b| b.delete(gl));
-                    return Err(e);
-                }
-            }
-        }
-        let Ok(all) = <[TexBuffer; 3]>::try_from(done) else {
-            unreachable!("three buffers uploaded")
-        };
-        Ok(Buffers(all))
-    }
-
-    fn bind(&self, gl: &Gl) {
-        for (b, slot) in self.0.iter().zip(SLOTS) {
-            b.bind(gl, slot);
-        }
-    }
-
-    fn delete(&self, gl: &Gl) {
-        self.0.iter().for_each(|b| b.delete(gl));
-    }
+        ],
+    )
 }
 
 pub struct Bvh {
@@ -95,7 +78,7 @@ pub struct Bvh {
     objects: Vec<Vec<Vec3>>,
     /// the model matrices of the last build (`None`: not built yet)
     built_for: Option<Vec<Mat4>>,
-    buffers: Option<Buffers>,
+    buffers: Option<TextureBuffers>,
     stats: BvhStats,
     /// builds so far (the first and one per frame in which something moved)
     builds: u64,
@@ -131,7 +114,7 @@ impl Bvh {
                 .map(Vec::as_slice)
                 .zip(models.iter().copied()),
         ));
-        let buffers = Buffers::upload(&self.gl, &bvh)?;
+        let buffers = upload(&self.gl, &bvh)?;
         if let Some(old) = self.buffers.replace(buffers) {
             old.delete(&self.gl);
         }

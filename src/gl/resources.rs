@@ -95,62 +95,6 @@ impl Ssbo {
     }
 }
 
-/// A buffer read through a texture-buffer sampler (`samplerBuffer`, `texelFetch`): for data
-/// every invocation reads at its own index, where llvmpipe fetches texels for 8 lanes at once
-/// but loads storage buffers lane by lane.
-pub struct TexBuffer {
-    pub buffer: glow::Buffer,
-    pub texture: glow::Texture,
-}
-
-impl TexBuffer {
-    /// Upload `data` as texels of `format` (`texel_bytes` each), after checking the texel
-    /// count against `GL_MAX_TEXTURE_BUFFER_SIZE`.
-    pub fn new(gl: &Gl, name: &str, format: u32, texel_bytes: usize, data: &[u8]) -> Result<Self> {
-        let texels = data.len().div_ceil(texel_bytes).max(1);
-        // SAFETY: a limit query on a current context.
-        let max = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) }.max(0) as usize;
-        if texels > max {
-            bail!(
-                "texture buffer `{name}` needs {texels} texels, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max} \
-                 of this GL implementation; use a smaller scene"
-            );
-        }
-        let mut bytes = data.to_vec();
-        bytes.resize(texels * texel_bytes, 0);
-        // SAFETY: buffer and texture creation on a current context.
-        unsafe {
-            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
-            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
-            gl.buffer_storage(glow::TEXTURE_BUFFER, bytes.len() as i32, Some(&bytes), 0);
-            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
-            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
-            gl.tex_buffer(format, buffer);
-            gl.bind_texture(glow::TEXTURE_BUFFER, None);
-            Ok(TexBuffer { buffer, texture })
-        }
-    }
-
-    /// Bind to texture unit `unit` (a `SAMPLER_...` slot).
-    pub fn bind(&self, gl: &Gl, unit: u32) {
-        // SAFETY: binding an existing texture.
-        unsafe {
-            gl.active_texture(glow::TEXTURE0 + unit);
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture));
-            gl.active_texture(glow::TEXTURE0);
-        }
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own objects.
-        unsafe {
-            gl.delete_texture(self.texture);
-            gl.delete_buffer(self.buffer);
-        }
-    }
-}
-
 /// A 2D texture used as an image (RGBA32F or RGBA32UI).
 pub struct Image2d {
     pub texture: glow::Texture,
@@ -265,6 +209,8 @@ impl Image2d {
 
 /// A buffer texture (`GL_TEXTURE_BUFFER`): texels in a buffer, read by kernels with
 /// `texelFetch` through a `samplerBuffer` (Wagner 2018 keeps its BVH in such textures, Fig. 4.3).
+/// For data every invocation reads at its own index: llvmpipe fetches texels for its 8 lanes
+/// at once, where it loads storage buffers lane by lane.
 pub struct TextureBuffer {
     pub buffer: glow::Buffer,
     pub texture: glow::Texture,
@@ -283,10 +229,13 @@ impl TextureBuffer {
         texel_bytes: usize,
         data: &[u8],
     ) -> Result<TextureBuffer> {
-        let texels = data.len() / texel_bytes;
+        // at least one texel: an empty list still makes a valid texture
+        let texels = data.len().div_ceil(texel_bytes).max(1);
+        let mut padded = data.to_vec();
+        padded.resize(texels * texel_bytes, 0);
         // SAFETY: a limit query on a current context.
         let max = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
-        if texels as i64 > max || data.len() > i32::MAX as usize {
+        if texels as i64 > max || padded.len() > i32::MAX as usize {
             bail!(
                 "texture `{name}` needs {texels} texels, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max} \
                  of this GL implementation; use a smaller scene"
@@ -296,7 +245,7 @@ impl TextureBuffer {
         unsafe {
             let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
             gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
-            gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, data, glow::STATIC_DRAW);
+            gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, &padded, glow::STATIC_DRAW);
             gl.bind_buffer(glow::TEXTURE_BUFFER, None);
             let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
@@ -327,6 +276,54 @@ impl TextureBuffer {
             gl.delete_texture(self.texture);
             gl.delete_buffer(self.buffer);
         }
+    }
+}
+
+/// One texture buffer's data: its name (for messages), texel format and size, bytes, and the
+/// sampler slot it binds to.
+pub struct TexelData<'a> {
+    pub name: &'static str,
+    pub format: u32,
+    pub texel_bytes: usize,
+    pub bytes: std::borrow::Cow<'a, [u8]>,
+    pub unit: u32,
+}
+
+/// Texture buffers uploaded and bound together (a design's data structure).
+pub struct TextureBuffers(Vec<(TextureBuffer, u32)>);
+
+impl TextureBuffers {
+    /// Upload every one; on an error the ones made so far are deleted.
+    pub fn upload<'a>(
+        gl: &Gl,
+        data: impl IntoIterator<Item = TexelData<'a>>,
+    ) -> Result<TextureBuffers> {
+        let mut made = TextureBuffers(Vec::new());
+        for d in data {
+            match TextureBuffer::new(gl, d.name, d.format, d.texel_bytes, &d.bytes) {
+                Ok(t) => made.0.push((t, d.unit)),
+                Err(e) => {
+                    made.delete(gl);
+                    return Err(e);
+                }
+            }
+        }
+        Ok(made)
+    }
+
+    /// Bytes of the buffers in `range` (in upload order).
+    pub fn bytes(&self, range: std::ops::Range<usize>) -> usize {
+        self.0[range].iter().map(|(t, _)| t.bytes).sum()
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        for (t, unit) in &self.0 {
+            t.bind(gl, *unit);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        self.0.iter().for_each(|(t, _)| t.delete(gl));
     }
 }
 

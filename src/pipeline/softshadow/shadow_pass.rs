@@ -12,7 +12,7 @@ use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
 use super::SoftShadowOptions;
-use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::resources::{GpuTimers, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::reference::ntree::{NTree, PackedLinespaces};
@@ -87,31 +87,14 @@ pub struct ShadowPass {
     pub kernel: Kernel,
     /// r: shadow value, g: lit rays (summed over batches)
     pub shadow_texture: glow::Texture,
-    node_buffer: glow::Buffer,
-    node_texture: glow::Texture,
+    /// the node pool (Fig. 8–9), RG32UI texels
+    node_pool: TextureBuffer,
     linespace_texture: glow::Texture,
     /// triVertex, leafTriangles, counters
     buffers: [Ssbo; 3],
     min_bound: Vec3,
     inv_node_size: f32,
     texture_layout: [u32; 3],
-}
-
-/// The node pool as a texture buffer of RG32UI texels (Fig. 8–9).
-fn node_pool(gl: &Gl, tree: &NTree) -> Result<(glow::Buffer, glow::Texture)> {
-    // SAFETY: buffer and texture creation on a current context.
-    unsafe {
-        let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
-        gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
-        let data = bytemuck::cast_slice(&tree.nodes);
-        gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, data, glow::STATIC_DRAW);
-        gl.bind_buffer(glow::TEXTURE_BUFFER, None);
-        let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
-        gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
-        gl.tex_buffer(glow::RG32UI, buffer);
-        gl.bind_texture(glow::TEXTURE_BUFFER, None);
-        Ok((buffer, texture))
-    }
 }
 
 /// The line spaces as a 3D R32UI texture laid out as Listing 3.
@@ -171,13 +154,13 @@ impl ShadowPass {
             )?,
             Ssbo::new(gl, "counters", 8 * COUNTERS.len(), None, max)?,
         ];
-        let (node_buffer, node_texture) = node_pool(gl, tree)?;
+        let pool = bytemuck::cast_slice(&tree.nodes);
+        let node_pool = TextureBuffer::new(gl, "nodePool", glow::RG32UI, 8, pool)?;
         let pass = ShadowPass {
             gl: gl.clone(),
             kernel,
             shadow_texture: rgba32f_texture(gl, options.width, options.height)?,
-            node_buffer,
-            node_texture,
+            node_pool,
             linespace_texture: linespace_texture(gl, packed)?,
             buffers,
             min_bound: tree.min_bound,
@@ -210,9 +193,7 @@ impl ShadowPass {
         let (rw, ro, f) = (glow::READ_WRITE, glow::READ_ONLY, glow::RGBA32F);
         // SAFETY: binding our textures to their units.
         unsafe {
-            gl.active_texture(glow::TEXTURE0 + sampler::NODE_POOL);
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.node_texture));
-            gl.active_texture(glow::TEXTURE0);
+            self.node_pool.bind(gl, sampler::NODE_POOL);
             let img = |unit, t, access, format| {
                 gl.bind_image_texture(unit, Some(t), 0, false, 0, access, format)
             };
@@ -285,10 +266,9 @@ impl Drop for ShadowPass {
         // SAFETY: deleting our own objects.
         unsafe {
             gl.delete_texture(self.shadow_texture);
-            gl.delete_texture(self.node_texture);
             gl.delete_texture(self.linespace_texture);
-            gl.delete_buffer(self.node_buffer);
         }
+        self.node_pool.delete(gl);
         for b in &self.buffers {
             b.delete(gl);
         }

@@ -5,7 +5,7 @@
 use anyhow::Result;
 use glam::Vec3;
 
-use crate::gl::resources::{Image2d, TextureBuffer};
+use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
 use crate::gl::slots::{image, sampler};
 use crate::gl::{Gl, Kernel};
 use crate::reference::wagner2018::{Lighting, WagnerCamera};
@@ -19,27 +19,18 @@ fn float4(v: &[Vec3]) -> Vec<[f32; 4]> {
 /// The six texture buffers: the BVH (Fig. 4.3) and the triangles.
 pub struct SceneTextures {
     /// bounds, node integers, triangle ids; vertices, normals, colours
-    textures: Vec<(TextureBuffer, u32)>,
-}
-
-/// One texture's data: name (for messages), texel format and size, bytes, sampler unit.
-struct TextureData {
-    name: &'static str,
-    format: u32,
-    texel_bytes: usize,
-    bytes: Vec<u8>,
-    unit: u32,
+    textures: TextureBuffers,
 }
 
 /// The texels of the six textures.
-fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TextureData; 6] {
+fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TexelData<'static>; 6] {
     let vertices: Vec<Vec3> = bvh.triangles.iter().flatten().copied().collect();
     let tri_ids: Vec<i32> = bvh.tri_ids.iter().map(|&i| i as i32).collect();
-    let data = |name, format, texel_bytes, bytes: &[u8], unit| TextureData {
+    let data = |name, format, texel_bytes, bytes: &[u8], unit| TexelData {
         name,
         format,
         texel_bytes,
-        bytes: bytes.to_vec(),
+        bytes: bytes.to_vec().into(),
         unit,
     };
     let float4 = |name, v: &[Vec3], unit| {
@@ -82,35 +73,22 @@ impl SceneTextures {
         normals: &[Vec3],
         colors: &[Vec3],
     ) -> Result<SceneTextures> {
-        let mut made: Vec<(TextureBuffer, u32)> = Vec::with_capacity(6);
-        for d in texture_data(bvh, normals, colors) {
-            match TextureBuffer::new(gl, d.name, d.format, d.texel_bytes, &d.bytes) {
-                Ok(t) => made.push((t, d.unit)),
-                Err(e) => {
-                    made.iter().for_each(|(t, _)| t.delete(gl));
-                    return Err(e);
-                }
-            }
-        }
-        Ok(SceneTextures { textures: made })
+        Ok(SceneTextures {
+            textures: TextureBuffers::upload(gl, texture_data(bvh, normals, colors))?,
+        })
     }
 
     /// Bytes of the three BVH textures and of the three triangle textures.
     pub fn bytes(&self) -> (usize, usize) {
-        let sum = |ts: &[(TextureBuffer, u32)]| ts.iter().map(|(t, _)| t.bytes).sum();
-        (sum(&self.textures[..3]), sum(&self.textures[3..]))
+        (self.textures.bytes(0..3), self.textures.bytes(3..6))
     }
 
     pub fn bind(&self, gl: &Gl) {
-        for (t, unit) in &self.textures {
-            t.bind(gl, *unit);
-        }
+        self.textures.bind(gl);
     }
 
     pub fn delete(&self, gl: &Gl) {
-        for (t, _) in &self.textures {
-            t.delete(gl);
-        }
+        self.textures.delete(gl);
     }
 }
 
