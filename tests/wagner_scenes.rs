@@ -310,6 +310,14 @@ fn bad_procedural_parameters_are_refused_with_file_key_and_limit() {
         "type = \"floor\"\nradius = 3.0\n",
         &["radius", "\"sphere\""],
     );
+    // an unknown key names its own line
+    let e = Scene::load(&scene_file(d, "type = \"sphere\"\nfoo = 3\n"))
+        .expect_err("foo")
+        .to_string();
+    assert!(
+        e.contains("s.toml:10") && e.contains("unknown field `foo`"),
+        "{e}"
+    );
     // an override no object takes
     let e = Scene::load_with(&scene_path("sphere.toml"), &Overrides { level: Some(2) })
         .expect_err("the sphere has no square")

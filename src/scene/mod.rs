@@ -191,7 +191,7 @@ impl Overrides {
             return Ok(());
         };
         let squares = objects.iter_mut().filter(|d| d.kind.get_ref() == "square");
-        if squares.map(|d| d.level = Some(level)).count() == 0 {
+        if squares.map(|d| d.shape.level = Some(level)).count() == 0 {
             return Err(SceneError::at(
                 path,
                 None,
@@ -332,6 +332,9 @@ impl Scene {
         let dir = path.parent().unwrap_or(Path::new("."));
         for (k, def) in file.object.into_iter().enumerate() {
             let type_line = def.kind.span().start;
+            if let Some(key) = def.unknown.keys().next() {
+                return Err(src.unknown_object_key(type_line, key));
+            }
             let object = scene.build_object(dir, k, def).map_err(|e| match e {
                 // errors about the object itself point at its `type` line
                 ObjectError::Here(m) => src.error_at(type_line, m),
@@ -498,31 +501,33 @@ impl ObjectDef {
     fn teapot_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
         let path = self.model_path(dir, "models/teapot.bpt")?;
         // 32 patches in Newell's teapot (a .bpt with more patches gives more)
-        let n = procedural_size("tessellation", self.tessellation, 10, 1, |n| 32 * 2 * n * n)?;
+        let n = procedural_size("tessellation", self.shape.tessellation, 10, 1, |n| {
+            32 * 2 * n * n
+        })?;
         let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
         Ok(mesh)
     }
 
     fn floor_mesh(&self) -> Result<Mesh, ObjectError> {
-        let quads = procedural_size("quads", self.quads, 64, 1, |q| 2 * q * q)?;
-        let checker = match (self.checker, self.color) {
+        let quads = procedural_size("quads", self.shape.quads, 64, 1, |q| 2 * q * q)?;
+        let checker = match (self.shape.checker, self.color) {
             (Some([a, b]), _) => [Vec3::from(a), Vec3::from(b)],
             (None, Some(c)) => [Vec3::from(c); 2],
             (None, None) => [Vec3::splat(0.75), Vec3::splat(0.35)],
         };
-        Ok(mesh::floor(self.size.unwrap_or(4.0), quads, checker))
+        Ok(mesh::floor(self.shape.size.unwrap_or(4.0), quads, checker))
     }
 
     /// Wagner 2018's sphere (Fig. 5.2): 16 stacks × 24 slices = 720 triangles by default, blue.
     fn sphere_mesh(&self) -> Result<Mesh, ObjectError> {
-        let stacks = procedural_size("stacks", self.stacks, 16, 2, |_| 0)?;
-        let slices = procedural_size("slices", self.slices, 24, 3, |_| 0)?;
+        let stacks = procedural_size("stacks", self.shape.stacks, 16, 2, |_| 0)?;
+        let slices = procedural_size("slices", self.shape.slices, 24, 3, |_| 0)?;
         at_most_triangles(
             &format!("stacks = {stacks} with slices = {slices}"),
             shapes::sphere_triangles(stacks as u64, slices as u64),
         )?;
-        let radius = self.radius.unwrap_or(1.0);
+        let radius = self.shape.radius.unwrap_or(1.0);
         if !(radius.is_finite() && radius > 0.0) {
             return Err(ObjectError::Here(format!(
                 "radius = {radius} must be finite and positive"
@@ -534,8 +539,8 @@ impl ObjectDef {
 
     /// Wagner 2018's square (ch. 5.1, Table A.1): 2·4^level triangles, level 1 (8) by default.
     fn square_mesh(&self) -> Result<Mesh, ObjectError> {
-        let level = procedural_size("level", self.level, 1, 1, shapes::square_triangles)?;
-        let size = self.size.unwrap_or(1.0);
+        let level = procedural_size("level", self.shape.level, 1, 1, shapes::square_triangles)?;
+        let size = self.shape.size.unwrap_or(1.0);
         Ok(shapes::square(size, level, self.color_or(Vec3::splat(0.8))))
     }
 
@@ -546,14 +551,18 @@ impl ObjectDef {
             return Ok(()); // the unknown type is the error, reported when the mesh is built
         }
         let given: [(&str, bool, &[&str]); 8] = [
-            ("size", self.size.is_some(), &["floor", "square"]),
-            ("quads", self.quads.is_some(), &["floor"]),
-            ("checker", self.checker.is_some(), &["floor"]),
-            ("tessellation", self.tessellation.is_some(), &["teapot"]),
-            ("radius", self.radius.is_some(), &["sphere"]),
-            ("stacks", self.stacks.is_some(), &["sphere"]),
-            ("slices", self.slices.is_some(), &["sphere"]),
-            ("level", self.level.is_some(), &["square"]),
+            ("size", self.shape.size.is_some(), &["floor", "square"]),
+            ("quads", self.shape.quads.is_some(), &["floor"]),
+            ("checker", self.shape.checker.is_some(), &["floor"]),
+            (
+                "tessellation",
+                self.shape.tessellation.is_some(),
+                &["teapot"],
+            ),
+            ("radius", self.shape.radius.is_some(), &["sphere"]),
+            ("stacks", self.shape.stacks.is_some(), &["sphere"]),
+            ("slices", self.shape.slices.is_some(), &["sphere"]),
+            ("level", self.shape.level.is_some(), &["square"]),
         ];
         match given
             .iter()
@@ -578,7 +587,7 @@ impl ObjectDef {
             && finite(&self.rotate)
             && self.scale.vector().is_finite()
             && self.fit.is_none_or(|f| f.is_finite() && f > 0.0)
-            && self.size.is_none_or(|s| s.is_finite() && s > 0.0))
+            && self.shape.size.is_none_or(|s| s.is_finite() && s > 0.0))
         {
             return Err(ObjectError::Here(
                 "translate, rotate and scale must be finite, fit and size finite and positive"
@@ -586,7 +595,7 @@ impl ObjectDef {
             ));
         }
         if !(finite(&self.color.unwrap_or_default())
-            && finite(self.checker.unwrap_or_default().as_flattened())
+            && finite(self.shape.checker.unwrap_or_default().as_flattened())
             && finite(&[self.specular, self.shininess]))
         {
             return Err(ObjectError::Here(
@@ -612,6 +621,30 @@ impl ObjectDef {
         Ok(model)
     }
 }
+
+/// The keys of an `[[object]]`.
+const OBJECT_KEYS: &[&str] = &[
+    "type",
+    "name",
+    "path",
+    "translate",
+    "rotate",
+    "scale",
+    "fit",
+    "color",
+    "texture",
+    "reflection",
+    "specular",
+    "shininess",
+    "checker",
+    "size",
+    "quads",
+    "tessellation",
+    "radius",
+    "stacks",
+    "slices",
+    "level",
+];
 
 /// The object types of a scene file.
 const OBJECT_TYPES: &[&str] = &["obj", "ply", "teapot", "floor", "sphere", "square"];
@@ -694,6 +727,33 @@ impl SceneText<'_> {
     /// An error at the line of byte `byte`.
     fn error_at(&self, byte: usize, message: String) -> SceneError {
         SceneError::at(self.path, Some(line_of(self.text, byte)), message)
+    }
+
+    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
+    /// naming the key's line (found in the text of that object's table).
+    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
+        let start = self.text[..type_at].rfind("[[object]]").unwrap_or(0);
+        let (mut at, mut offset) = (type_at, start);
+        for line in self.text[start..].split_inclusive('\n') {
+            let t = line.trim_start();
+            if offset > start && t.starts_with('[') {
+                break; // the next table
+            }
+            if let Some((name, _)) = t.split_once('=') {
+                if name.trim().trim_matches('"') == key {
+                    at = offset;
+                    break;
+                }
+            }
+            offset += line.len();
+        }
+        self.error_at(
+            at,
+            format!(
+                "unknown field `{key}` of an [[object]], expected one of {}",
+                quoted(OBJECT_KEYS)
+            ),
+        )
     }
 
     /// `item` through `convert`; its error names the line where the item starts.
@@ -806,8 +866,9 @@ impl Scale {
     }
 }
 
+/// An `[[object]]`. Its keys are checked by hand (`unknown`): serde's `deny_unknown_fields`
+/// does not combine with `flatten`.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct ObjectDef {
     #[serde(rename = "type")]
     kind: Spanned<String>,
@@ -823,7 +884,6 @@ struct ObjectDef {
     /// Centre the model (bottom at y = 0) and scale its largest extent to this size first.
     fit: Option<f32>,
     color: Option<[f32; 3]>,
-    checker: Option<[[f32; 3]; 2]>,
     texture: Option<Spanned<String>>,
     #[serde(default)]
     reflection: f32,
@@ -831,6 +891,20 @@ struct ObjectDef {
     specular: f32,
     #[serde(default = "default_shininess")]
     shininess: f32,
+    /// The keys of the procedural types.
+    #[serde(flatten)]
+    shape: ShapeKeys,
+    /// Every other key: an error.
+    #[serde(flatten)]
+    unknown: std::collections::BTreeMap<String, toml::Value>,
+}
+
+/// The keys of the procedural object types, each taken by some of them only
+/// ([`ObjectDef::check_type_keys`]).
+#[derive(Deserialize, Default)]
+struct ShapeKeys {
+    /// floor: two colours of the checkerboard.
+    checker: Option<[[f32; 3]; 2]>,
     /// floor: side length (4); square: side length (1).
     size: Option<f32>,
     /// floor: quads per side (64).
