@@ -8,11 +8,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use glam::Mat4;
 
 use super::args::BenchArgs;
-use super::config::{Config, Sizing};
+use super::config::{BvhVariant, Config, Sizing, TracerSpec};
 use gpgpu_rt::accel::{GridOptions, TracerKind};
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::raytrace::{self, RenderOptions, ShadowFlags};
@@ -51,30 +51,48 @@ pub fn grid_list_defaults() -> (u32, Option<u32>) {
     (d.voxel_array_length, d.ray_array_length)
 }
 
+/// The BVH variants this build measures (`bench wagner-a1`, `wagner-a2`, unless
+/// `--bvh-variants` says otherwise). **Where Wagner's faithful megakernel is wired in:** once
+/// `--bvh-variant wagner` exists in the library, add `BvhVariant::Wagner` here and make its arm
+/// in [`RayTracer::new`] build that renderer; nothing else in the bench changes.
+pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah];
+
 /// The tracer kind and grid options of configuration `c`, with the command line's list
-/// lengths. The grid tracer is looked up by its `--tracer` name, so a build without it fails
-/// here with a message, not at compile time.
+/// lengths.
 fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)> {
     let Some((variant, resolution)) = c.tracer.grid() else {
-        return Ok((TracerKind::Base, GridOptions::default()));
+        let kind = match c.tracer {
+            TracerSpec::Bvh { .. } => TracerKind::Bvh,
+            _ => TracerKind::Base,
+        };
+        return Ok((kind, GridOptions::default()));
     };
     let d = GridOptions::default();
     let grid = GridOptions {
         variant,
         resolution: Some(resolution),
-        voxel_array_length: args.voxel_array_length.unwrap_or(d.voxel_array_length),
-        ray_array_length: args.ray_array_length.or(d.ray_array_length),
+        voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
+        ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
     };
     Ok((TracerKind::Grid, grid))
 }
 
-/// A ray tracer made for one scene (Müller 2015's pipeline with the base tracer or the grid).
+/// A ray tracer made for one scene (Müller 2015's pipeline with the base tracer, the grid or
+/// the SAH BVH).
 pub struct RayTracer(Box<dyn Renderer>);
 
 impl RayTracer {
     /// The tracer of configuration `c` (with the command line's `--tile` and list lengths):
     /// compile the kernels and upload `scene`.
     pub fn new(gpu: &Gpu, scene: &Scene, c: &Config, args: &BenchArgs) -> Result<RayTracer> {
+        match c.tracer.bvh_variant() {
+            None | Some(BvhVariant::Sah) => {}
+            // the one arm to change when Wagner's megakernel lands (see BVH_VARIANTS)
+            Some(BvhVariant::Wagner) => bail!(
+                "the bvh variant \"wagner\" (Wagner 2018's megakernel) is not in this build yet; \
+                 measure --bvh-variants sah"
+            ),
+        }
         let (kind, grid) = tracer_kind(c, args)?;
         let options = RenderOptions {
             tracer: kind,
