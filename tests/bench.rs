@@ -339,6 +339,7 @@ fn bad_bench_options_fail_with_a_message() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
+    let out = dir.path().join("out");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![], "PROTOCOL"),
         (vec!["thesis-9"], "thesis-5.1"),
@@ -360,7 +361,14 @@ fn bad_bench_options_fail_with_a_message() {
         // until Wagner's megakernel is wired into the bench (adapter::BVH_VARIANTS): a clear
         // failure of each configuration, not a silent substitute
         (
-            vec!["wagner-a2", "--bvh-variants", "wagner", "--quiet"],
+            vec![
+                "wagner-a2",
+                "--bvh-variants",
+                "wagner",
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+            ],
             "not in this build yet",
         ),
         (
