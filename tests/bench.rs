@@ -74,9 +74,17 @@ fn check_summary_against_frames(
     summary: &[HashMap<String, String>],
 ) {
     let key = |r: &HashMap<String, String>| {
-        ["scene", "tracer", "variant", "grid_resolution"]
-            .map(|k| r[k].clone())
-            .join("/")
+        [
+            "scene",
+            "level",
+            "tracer",
+            "variant",
+            "grid_resolution",
+            "width",
+            "height",
+        ]
+        .map(|k| r[k].clone())
+        .join("/")
     };
     for s in summary.iter().filter(|s| s["error"].is_empty()) {
         let mine: Vec<_> = frames.iter().filter(|r| key(r) == key(s)).collect();
@@ -344,6 +352,11 @@ fn bad_bench_options_fail_with_a_message() {
         (vec!["thesis-5.2", "--grid-res", "8,0"], "--grid-res"),
         (vec!["thesis-5.2", "--grid-res", "8,x"], "invalid value"),
         (vec!["thesis-5.1", "--tile", "12"], "multiple of 8"),
+        (vec!["wagner-a1", "--levels", "0"], "--levels"),
+        (vec!["wagner-a1", "--levels", "13"], "1 to 12"),
+        (vec!["wagner-a1", "--sizes", "640"], "not an image size"),
+        (vec!["wagner-a1", "--sizes", "0x480"], "not an image size"),
+        (vec!["wagner-a1", "--bvh-variants", "kd"], "sah"),
         (
             vec!["thesis-5.1", "--scenes", "/nonexistent-scenes"],
             "not a folder",
@@ -383,4 +396,192 @@ fn missing_scene_fails_the_protocol_and_is_reported() {
         report.contains("The protocol failed") && report.contains("teapot1.toml"),
         "{report}"
     );
+}
+
+/// A CSV's rows whose `col` is `value`.
+fn rows_with<'a>(
+    rows: &'a [HashMap<String, String>],
+    col: &str,
+    value: &str,
+) -> Vec<&'a HashMap<String, String>> {
+    rows.iter().filter(|r| r[col] == value).collect()
+}
+
+/// The ratio CSV of a Wagner protocol agrees with its summary: the same FPS (run) per
+/// configuration, and the ratio column is that FPS over the reference configuration's, which
+/// `reference` picks among the rows.
+fn check_ratios(
+    ratios: &[HashMap<String, String>],
+    summary: &[HashMap<String, String>],
+    reference: impl Fn(&HashMap<String, String>, &HashMap<String, String>) -> bool,
+) {
+    let at = |r: &HashMap<String, String>| {
+        ["scene", "variant", "level", "width", "height"].map(|k| r[k].clone())
+    };
+    for r in ratios {
+        let s: Vec<_> = summary.iter().filter(|s| at(s) == at(r)).collect();
+        assert_eq!(s.len(), 1, "{:?}", at(r));
+        let fps = f(r, "fps_run");
+        assert!(
+            (fps - f(s[0], "fps_run")).abs() <= 1e-4 * fps,
+            "{:?}: fps_run",
+            at(r)
+        );
+        let refs: Vec<_> = ratios.iter().filter(|q| reference(r, q)).collect();
+        assert_eq!(refs.len(), 1, "{:?}: one reference", at(r));
+        let want = fps / f(refs[0], "fps_run");
+        let got = f(r, "fps_ratio");
+        assert!(
+            (got - want).abs() <= 1e-5 * want,
+            "{:?}: ratio {got} vs {want}",
+            at(r)
+        );
+        // the published ratio is the published FPS over the published reference's
+        if let (Ok(p), Ok(p_ref)) = (
+            r["published_fps"].parse::<f64>(),
+            refs[0]["published_fps"].parse::<f64>(),
+        ) {
+            let pr = f(r, "published_ratio");
+            assert!(
+                (pr - p / p_ref).abs() < 1e-5,
+                "{:?}: published ratio",
+                at(r)
+            );
+        }
+    }
+}
+
+/// The published FPS of the ratio row at `scene`, `level`, `width`×`height` ("" if none).
+fn published(
+    ratios: &[HashMap<String, String>],
+    scene: &str,
+    level: &str,
+    w: u32,
+    h: u32,
+) -> String {
+    let row = ratios.iter().find(|r| {
+        r["scene"] == scene
+            && r["level"] == level
+            && u(r, "width") == w as u64
+            && u(r, "height") == h as u64
+    });
+    row.unwrap_or_else(|| panic!("no row {scene} {level} {w}x{h}"))["published_fps"].clone()
+}
+
+#[test]
+fn wagner_a1_and_a2_tiny_rows_published_values_and_ratios() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bw");
+    // 64×48 and the reference 320×240 (always measured); levels 1 (always) and 2
+    let o = bench(&[
+        "wagner-a1",
+        "wagner-a2",
+        "--sizes",
+        "64x48",
+        "--levels",
+        "2",
+        "--angles",
+        "1",
+        "--warmup",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // Table A.1: the square at levels 1 and 2 × two sizes × both BVH variants, nothing moving
+    let frames = read_csv(&out.join("wagner-a1.csv"));
+    assert_eq!(frames.len(), 2 * 2 * 2, "{frames:?}");
+    assert_eq!(rows_with(&frames, "variant", "wagner").len(), 2 * 2);
+    for r in &frames {
+        assert_eq!(
+            (r["scene"].as_str(), r["tracer"].as_str()),
+            ("square", "bvh")
+        );
+        assert!(["sah", "wagner"].contains(&r["variant"].as_str()), "{r:?}");
+        let level = u(r, "level") as u32;
+        assert_eq!(u(r, "triangles"), 8 * 4u64.pow(level - 1));
+        assert_eq!((u(r, "refl_depth"), u(r, "lights")), (0, 1));
+        assert_eq!(r["angle_deg"], "0");
+        assert_eq!(
+            r["fact_bvh_rebuilt"], "false",
+            "camera and objects fixed: no rebuild"
+        );
+        assert!(f(r, "fact_bvh_build_ms") > 0.0 && u(r, "fact_bvh_nodes") >= 1);
+    }
+    let summary = read_csv(&out.join("wagner-a1_summary.csv"));
+    check_summary_against_frames(&frames, &summary);
+    let ratios = read_csv(&out.join("wagner-a1_ratios.csv"));
+    assert_eq!(ratios.len(), 8);
+    check_ratios(&ratios, &summary, |r, q| {
+        q["level"] == "1"
+            && q["variant"] == r["variant"]
+            && (&q["width"], &q["height"]) == (&r["width"], &r["height"])
+    });
+    // typed in from Table A.1: 8 and 32 triangles at 320×240; 64×48 is not in the table
+    assert_eq!(published(&ratios, "square", "1", 320, 240), "162.990000");
+    assert_eq!(published(&ratios, "square", "2", 320, 240), "113.790000");
+    assert_eq!(published(&ratios, "square", "2", 64, 48), "");
+
+    // Table A.2: sphere and cow × two sizes, and the dragon's build
+    let frames = read_csv(&out.join("wagner-a2.csv"));
+    let triangles: HashMap<&str, u64> = [("sphere", 720), ("cow", 5804), ("dragon", 210712)].into();
+    for r in &frames {
+        assert_eq!(u(r, "triangles"), triangles[r["scene"].as_str()]);
+        assert_eq!(r["fact_bvh_rebuilt"], "false");
+    }
+    assert_eq!(rows_with(&frames, "scene", "sphere").len(), 2 * 2);
+    assert_eq!(rows_with(&frames, "scene", "cow").len(), 2 * 2);
+    let dragon = rows_with(&frames, "scene", "dragon");
+    assert_eq!(
+        dragon.len(),
+        1,
+        "the faithful build of the dragon at full scale only"
+    );
+    assert!(f(dragon[0], "fact_bvh_build_ms") > 0.0);
+    let summary = read_csv(&out.join("wagner-a2_summary.csv"));
+    check_summary_against_frames(&frames, &summary);
+    let ratios = read_csv(&out.join("wagner-a2_ratios.csv"));
+    assert_eq!(ratios.len(), 8, "sphere and cow; the dragon has no ratio");
+    check_ratios(&ratios, &summary, |r, q| {
+        q["scene"] == r["scene"]
+            && q["variant"] == r["variant"]
+            && (u(q, "width"), u(q, "height")) == (320, 240)
+    });
+    assert_eq!(published(&ratios, "sphere", "", 320, 240), "20.120000");
+    assert_eq!(published(&ratios, "cow", "", 320, 240), "11.910000");
+    assert_eq!(published(&ratios, "cow", "", 64, 48), "");
+
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for needle in [
+        "Wagner 2018",
+        "GTX 1060",
+        "Table A.1",
+        "Fig. 5.1",
+        "162.99 (×1.00)",
+        "45.07 (×0.28)",
+        "9.41 (×1.00)",
+        "Fig. 5.4",
+        "20.12 (×1.00)",
+        "1.33 (×0.11)",
+        "18 (3) / 12 (3)",
+        "five minutes",
+        "210,712",
+        "kernel per pixel",
+    ] {
+        assert!(report.contains(needle), "report.md lacks {needle:?}");
+    }
+    check_report_links(&out, &report);
+    for png in ["fig5_1_triangles_fps.png", "fig5_4_resolution_fps.png"] {
+        assert!(out.join(png).is_file(), "{png}");
+    }
+    // frames that differ only in size get the size in their names
+    for variant in ["sah", "wagner"] {
+        let png = format!("frames/wagner-a2/sphere_bvh-{variant}_64x48.png");
+        assert!(out.join(&png).is_file(), "{png}");
+    }
+    assert!(out
+        .join("frames/wagner-a1/square-level-2_bvh-sah_320x240.png")
+        .is_file());
 }

@@ -129,7 +129,9 @@ pub enum GridVariant {
 }
 
 /// The two BVH designs of `--tracer bvh` (`--bvh-variant`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, clap::ValueEnum, Serialize, Default,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum BvhVariant {
     /// Ours: a binned-SAH BVH, an accelerator of Müller 2015's four-kernel pipeline

@@ -29,7 +29,14 @@ impl Mesh {
         self.positions.len() / 3
     }
 
-    fn push_triangle(&mut self, p: [Vec3; 3], n: [Vec3; 3], c: [Vec3; 3], t: [Vec2; 3], m: u32) {
+    pub(super) fn push_triangle(
+        &mut self,
+        p: [Vec3; 3],
+        n: [Vec3; 3],
+        c: [Vec3; 3],
+        t: [Vec2; 3],
+        m: u32,
+    ) {
         self.positions.extend_from_slice(&p);
         self.normals.extend_from_slice(&n);
         self.colors.extend_from_slice(&c);

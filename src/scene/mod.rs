@@ -1,10 +1,11 @@
 //! Scenes: a TOML scene file with a camera, background and ambient colour, point lights and
-//! objects (OBJ files, or the procedural `teapot` and `floor`), each with a transform and a
-//! material. See `scenes/*.toml` and the README for the format.
+//! objects (OBJ and PLY files, or the procedural `teapot`, `floor`, `sphere` and `square`), each
+//! with a transform and a material. See `scenes/*.toml` and the README for the format.
 
 pub mod camera;
 pub mod mesh;
 pub mod shadows;
+pub mod shapes;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -174,11 +175,43 @@ pub struct Scene {
     pub textures: Vec<(PathBuf, image::RgbaImage)>,
 }
 
+/// Procedural sizes set from outside the scene file: each replaces its key in every object of
+/// the type that takes it (`bench wagner-a1` renders one `square.toml` at every subdivision
+/// level this way). An override that no object of the scene takes is an error.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub struct Overrides {
+    /// `level` of every object of type `square`.
+    pub level: Option<u32>,
+}
+
+impl Overrides {
+    /// Put the overrides into the objects' definitions (before they are built and checked).
+    fn apply(&self, path: &Path, objects: &mut [ObjectDef]) -> Result<(), SceneError> {
+        let Some(level) = self.level else {
+            return Ok(());
+        };
+        let squares = objects.iter_mut().filter(|d| d.kind.get_ref() == "square");
+        if squares.map(|d| d.shape.level = Some(level)).count() == 0 {
+            return Err(SceneError::at(
+                path,
+                None,
+                format!("level = {level} was set for the scene's squares, but it has no [[object]] of type \"square\""),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Scene {
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with(path, &Overrides::default())
+    }
+
+    /// Load a scene file with some of its procedural sizes replaced by `overrides`.
+    pub fn load_with(path: &Path, overrides: &Overrides) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
-        Self::parse(path, &text)
+        Self::parse(path, &text, overrides)
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -261,9 +294,10 @@ impl Scene {
         )
     }
 
-    fn parse(path: &Path, text: &str) -> Result<Scene, SceneError> {
+    fn parse(path: &Path, text: &str, overrides: &Overrides) -> Result<Scene, SceneError> {
         let src = SceneText { path, text };
-        let file = src.deserialize()?;
+        let mut file = src.deserialize()?;
+        overrides.apply(path, &mut file.object)?;
         let camera = src.check(file.camera, |c| c.validate().map(|()| c))?;
         let (settings, render_line) = match file.render {
             Some(r) => (*r.get_ref(), Some(line_of(text, r.span().start))),
@@ -298,6 +332,9 @@ impl Scene {
         let dir = path.parent().unwrap_or(Path::new("."));
         for (k, def) in file.object.into_iter().enumerate() {
             let type_line = def.kind.span().start;
+            if let Some(key) = def.unknown.keys().next() {
+                return Err(src.unknown_object_key(type_line, key));
+            }
             let object = scene.build_object(dir, k, def).map_err(|e| match e {
                 // errors about the object itself point at its `type` line
                 ObjectError::Here(m) => src.error_at(type_line, m),
@@ -334,6 +371,7 @@ impl Scene {
         def: ObjectDef,
     ) -> Result<Object, ObjectError> {
         let base = def.base_material()?;
+        def.check_type_keys()?;
         let texture = match &def.texture {
             Some(t) => Some(self.load_texture(&dir.join(t.get_ref()))?),
             None => None,
@@ -365,9 +403,12 @@ impl Scene {
             "ply" => def.ply_mesh(dir)?,
             "teapot" => def.teapot_mesh(dir)?,
             "floor" => def.floor_mesh()?,
+            "sphere" => def.sphere_mesh()?,
+            "square" => def.square_mesh()?,
             other => {
                 return Err(ObjectError::Here(format!(
-                    "unknown object type \"{other}\" (expected \"obj\", \"ply\", \"teapot\" or \"floor\")"
+                    "unknown object type \"{other}\" (expected one of {})",
+                    quoted(OBJECT_TYPES)
                 )))
             }
         };
@@ -460,20 +501,79 @@ impl ObjectDef {
     fn teapot_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
         let path = self.model_path(dir, "models/teapot.bpt")?;
         // 32 patches in Newell's teapot (a .bpt with more patches gives more)
-        let n = procedural_size("tessellation", self.tessellation, 10, |n| 32 * 2 * n * n)?;
+        let n = procedural_size("tessellation", self.shape.tessellation, 10, 1, |n| {
+            32 * 2 * n * n
+        })?;
         let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
         Ok(mesh)
     }
 
     fn floor_mesh(&self) -> Result<Mesh, ObjectError> {
-        let quads = procedural_size("quads", self.quads, 64, |q| 2 * q * q)?;
-        let checker = match (self.checker, self.color) {
+        let quads = procedural_size("quads", self.shape.quads, 64, 1, |q| 2 * q * q)?;
+        let checker = match (self.shape.checker, self.color) {
             (Some([a, b]), _) => [Vec3::from(a), Vec3::from(b)],
             (None, Some(c)) => [Vec3::from(c); 2],
             (None, None) => [Vec3::splat(0.75), Vec3::splat(0.35)],
         };
-        Ok(mesh::floor(self.size.unwrap_or(4.0), quads, checker))
+        Ok(mesh::floor(self.shape.size.unwrap_or(4.0), quads, checker))
+    }
+
+    /// Wagner 2018's sphere (Fig. 5.2): 16 stacks × 24 slices = 720 triangles by default, blue.
+    fn sphere_mesh(&self) -> Result<Mesh, ObjectError> {
+        let stacks = procedural_size("stacks", self.shape.stacks, 16, 2, |_| 0)?;
+        let slices = procedural_size("slices", self.shape.slices, 24, 3, |_| 0)?;
+        at_most_triangles(
+            &format!("stacks = {stacks} with slices = {slices}"),
+            shapes::sphere_triangles(stacks as u64, slices as u64),
+        )?;
+        let radius = self.shape.radius.unwrap_or(1.0);
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(ObjectError::Here(format!(
+                "radius = {radius} must be finite and positive"
+            )));
+        }
+        let blue = Vec3::new(0.15, 0.3, 0.9);
+        Ok(shapes::sphere(radius, stacks, slices, self.color_or(blue)))
+    }
+
+    /// Wagner 2018's square (ch. 5.1, Table A.1): 2·4^level triangles, level 1 (8) by default.
+    fn square_mesh(&self) -> Result<Mesh, ObjectError> {
+        let level = procedural_size("level", self.shape.level, 1, 1, shapes::square_triangles)?;
+        let size = self.shape.size.unwrap_or(1.0);
+        Ok(shapes::square(size, level, self.color_or(Vec3::splat(0.8))))
+    }
+
+    /// Keys that only some object types take are refused on the others, rather than ignored.
+    fn check_type_keys(&self) -> Result<(), ObjectError> {
+        let kind = self.kind.get_ref().as_str();
+        if !OBJECT_TYPES.contains(&kind) {
+            return Ok(()); // the unknown type is the error, reported when the mesh is built
+        }
+        let given: [(&str, bool, &[&str]); 8] = [
+            ("size", self.shape.size.is_some(), &["floor", "square"]),
+            ("quads", self.shape.quads.is_some(), &["floor"]),
+            ("checker", self.shape.checker.is_some(), &["floor"]),
+            (
+                "tessellation",
+                self.shape.tessellation.is_some(),
+                &["teapot"],
+            ),
+            ("radius", self.shape.radius.is_some(), &["sphere"]),
+            ("stacks", self.shape.stacks.is_some(), &["sphere"]),
+            ("slices", self.shape.slices.is_some(), &["sphere"]),
+            ("level", self.shape.level.is_some(), &["square"]),
+        ];
+        match given
+            .iter()
+            .find(|(_, set, types)| *set && !types.contains(&kind))
+        {
+            Some((key, _, types)) => Err(ObjectError::Here(format!(
+                "{key} applies to objects of type {}, not \"{kind}\"",
+                quoted(types)
+            ))),
+            None => Ok(()),
+        }
     }
 
     fn color_or(&self, default: Vec3) -> Vec3 {
@@ -487,7 +587,7 @@ impl ObjectDef {
             && finite(&self.rotate)
             && self.scale.vector().is_finite()
             && self.fit.is_none_or(|f| f.is_finite() && f > 0.0)
-            && self.size.is_none_or(|s| s.is_finite() && s > 0.0))
+            && self.shape.size.is_none_or(|s| s.is_finite() && s > 0.0))
         {
             return Err(ObjectError::Here(
                 "translate, rotate and scale must be finite, fit and size finite and positive"
@@ -495,7 +595,7 @@ impl ObjectDef {
             ));
         }
         if !(finite(&self.color.unwrap_or_default())
-            && finite(self.checker.unwrap_or_default().as_flattened())
+            && finite(self.shape.checker.unwrap_or_default().as_flattened())
             && finite(&[self.specular, self.shininess]))
         {
             return Err(ObjectError::Here(
@@ -522,31 +622,79 @@ impl ObjectDef {
     }
 }
 
-/// The most triangles a procedural object (`teapot`, `floor`) may have: far beyond what the GL
-/// buffers of any device hold (those limits are checked when the scene is uploaded), but it
-/// keeps a mistyped `quads` or `tessellation` from exhausting the memory first.
+/// The keys of an `[[object]]`.
+const OBJECT_KEYS: &[&str] = &[
+    "type",
+    "name",
+    "path",
+    "translate",
+    "rotate",
+    "scale",
+    "fit",
+    "color",
+    "texture",
+    "reflection",
+    "specular",
+    "shininess",
+    "checker",
+    "size",
+    "quads",
+    "tessellation",
+    "radius",
+    "stacks",
+    "slices",
+    "level",
+];
+
+/// The object types of a scene file.
+const OBJECT_TYPES: &[&str] = &["obj", "ply", "teapot", "floor", "sphere", "square"];
+
+/// "\"a\", \"b\" or \"c\"".
+fn quoted(names: &[&str]) -> String {
+    let q: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+    match q.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => q.join(""),
+    }
+}
+
+/// The most triangles a procedural object (`teapot`, `floor`, `sphere`, `square`) may have:
+/// far beyond what the GL buffers of any device hold (those limits are checked when the scene
+/// is uploaded), but it keeps a mistyped `quads`, `tessellation`, `stacks` or `level` from
+/// exhausting the memory first (a square's `level` may be at most 12).
 pub const MAX_PROCEDURAL_TRIANGLES: u64 = 1 << 26;
 
-/// The size `key` of a procedural object (`default` when not given): positive, and giving at
-/// most [`MAX_PROCEDURAL_TRIANGLES`] by `triangles`.
+/// The size `key` of a procedural object (`default` when not given): at least `min`, and
+/// giving at most [`MAX_PROCEDURAL_TRIANGLES`] by `triangles`.
 fn procedural_size(
     key: &str,
     value: Option<u32>,
     default: u32,
-    triangles: fn(u64) -> u64,
+    min: u32,
+    triangles: impl Fn(u64) -> u64,
 ) -> Result<u32, ObjectError> {
     let value = value.unwrap_or(default);
-    if value == 0 {
-        return Err(ObjectError::Here(format!("{key} must be positive")));
+    if value < min {
+        let what = if min == 1 {
+            "must be positive".to_string()
+        } else {
+            format!("must be at least {min}")
+        };
+        return Err(ObjectError::Here(format!("{key} = {value} {what}")));
     }
-    let triangles = triangles(value as u64);
+    at_most_triangles(&format!("{key} = {value}"), triangles(value as u64))?;
+    Ok(value)
+}
+
+/// `triangles`, which the sizes `sizes` give, must be at most [`MAX_PROCEDURAL_TRIANGLES`].
+fn at_most_triangles(sizes: &str, triangles: u64) -> Result<(), ObjectError> {
     if triangles > MAX_PROCEDURAL_TRIANGLES {
         return Err(ObjectError::Here(format!(
-            "{key} = {value} gives {triangles} triangles; a procedural object may have at most \
+            "{sizes} gives {triangles} triangles; a procedural object may have at most \
              {MAX_PROCEDURAL_TRIANGLES}"
         )));
     }
-    Ok(value)
+    Ok(())
 }
 
 /// World-space vertex attributes of the whole scene: one triangle soup whose
@@ -579,6 +727,33 @@ impl SceneText<'_> {
     /// An error at the line of byte `byte`.
     fn error_at(&self, byte: usize, message: String) -> SceneError {
         SceneError::at(self.path, Some(line_of(self.text, byte)), message)
+    }
+
+    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
+    /// naming the key's line (found in the text of that object's table).
+    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
+        let start = self.text[..type_at].rfind("[[object]]").unwrap_or(0);
+        let (mut at, mut offset) = (type_at, start);
+        for line in self.text[start..].split_inclusive('\n') {
+            let t = line.trim_start();
+            if offset > start && t.starts_with('[') {
+                break; // the next table
+            }
+            if let Some((name, _)) = t.split_once('=') {
+                if name.trim().trim_matches('"') == key {
+                    at = offset;
+                    break;
+                }
+            }
+            offset += line.len();
+        }
+        self.error_at(
+            at,
+            format!(
+                "unknown field `{key}` of an [[object]], expected one of {}",
+                quoted(OBJECT_KEYS)
+            ),
+        )
     }
 
     /// `item` through `convert`; its error names the line where the item starts.
@@ -691,8 +866,9 @@ impl Scale {
     }
 }
 
+/// An `[[object]]`. Its keys are checked by hand (`unknown`): serde's `deny_unknown_fields`
+/// does not combine with `flatten`.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct ObjectDef {
     #[serde(rename = "type")]
     kind: Spanned<String>,
@@ -708,7 +884,6 @@ struct ObjectDef {
     /// Centre the model (bottom at y = 0) and scale its largest extent to this size first.
     fit: Option<f32>,
     color: Option<[f32; 3]>,
-    checker: Option<[[f32; 3]; 2]>,
     texture: Option<Spanned<String>>,
     #[serde(default)]
     reflection: f32,
@@ -716,9 +891,32 @@ struct ObjectDef {
     specular: f32,
     #[serde(default = "default_shininess")]
     shininess: f32,
+    /// The keys of the procedural types.
+    #[serde(flatten)]
+    shape: ShapeKeys,
+    /// Every other key: an error.
+    #[serde(flatten)]
+    unknown: std::collections::BTreeMap<String, toml::Value>,
+}
+
+/// The keys of the procedural object types, each taken by some of them only
+/// ([`ObjectDef::check_type_keys`]).
+#[derive(Deserialize, Default)]
+struct ShapeKeys {
+    /// floor: two colours of the checkerboard.
+    checker: Option<[[f32; 3]; 2]>,
+    /// floor: side length (4); square: side length (1).
     size: Option<f32>,
+    /// floor: quads per side (64).
     quads: Option<u32>,
+    /// teapot: quads per patch side (10).
     tessellation: Option<u32>,
+    /// sphere: radius (1), rings of latitude pole to pole (16), meridians (24).
+    radius: Option<f32>,
+    stacks: Option<u32>,
+    slices: Option<u32>,
+    /// square: subdivision level (1: 2×2 quads, 8 triangles; each level ×4).
+    level: Option<u32>,
 }
 
 fn unit_scale() -> Scale {
@@ -751,12 +949,13 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let text = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[object]]\ntype = \"sphere\"\n";
-        let e = Scene::parse(Path::new("x.toml"), text).unwrap_err();
+        let text =
+            "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[object]]\ntype = \"cube\"\n";
+        let e = Scene::parse(Path::new("x.toml"), text, &Overrides::default()).unwrap_err();
         assert_eq!(e.line, Some(6), "{e}");
         assert!(e.to_string().contains("unknown object type"), "{e}");
         let text = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfov = 3\n";
-        let e = Scene::parse(Path::new("x.toml"), text).unwrap_err();
+        let e = Scene::parse(Path::new("x.toml"), text, &Overrides::default()).unwrap_err();
         assert_eq!(e.line, Some(4), "{e}");
     }
 }

@@ -12,8 +12,8 @@ use anyhow::{Context as _, Result};
 use glam::Mat4;
 
 use super::args::BenchArgs;
-use super::config::{Config, Sizing};
-use gpgpu_rt::accel::{BvhVariant, GridOptions, TracerKind};
+use super::config::{BvhVariant, Config, Sizing, TracerSpec};
+use gpgpu_rt::accel::{GridOptions, TracerKind};
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
@@ -51,24 +51,32 @@ pub fn grid_list_defaults() -> (u32, Option<u32>) {
     (d.voxel_array_length, d.ray_array_length)
 }
 
+/// The BVH variants the Wagner protocols measure (`bench wagner-a1`, `wagner-a2`, unless
+/// `--bvh-variants` says otherwise): ours in Müller's pipeline and Wagner's megakernel.
+pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
+
 /// The tracer kind and grid options of configuration `c`, with the command line's list
-/// lengths. The grid tracer is looked up by its `--tracer` name, so a build without it fails
-/// here with a message, not at compile time.
+/// lengths.
 fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)> {
     let Some((variant, resolution)) = c.tracer.grid() else {
-        return Ok((TracerKind::Base, GridOptions::default()));
+        let kind = match c.tracer {
+            TracerSpec::Bvh { .. } => TracerKind::Bvh,
+            _ => TracerKind::Base,
+        };
+        return Ok((kind, GridOptions::default()));
     };
     let d = GridOptions::default();
     let grid = GridOptions {
         variant,
         resolution: Some(resolution),
-        voxel_array_length: args.voxel_array_length.unwrap_or(d.voxel_array_length),
-        ray_array_length: args.ray_array_length.or(d.ray_array_length),
+        voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
+        ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
     };
     Ok((TracerKind::Grid, grid))
 }
 
-/// A ray tracer made for one scene (Müller 2015's pipeline with the base tracer or the grid).
+/// A ray tracer made for one scene (Müller 2015's pipeline with the base tracer, the grid or
+/// the SAH BVH).
 pub struct RayTracer(Box<dyn Renderer>);
 
 impl RayTracer {
@@ -85,7 +93,7 @@ impl RayTracer {
             shadow_flags: ShadowFlags::Rgba,
             aovs: false,
             grid,
-            bvh_variant: BvhVariant::default(),
+            bvh_variant: c.tracer.bvh_variant().unwrap_or_default(),
         };
         let (gl, info) = (gpu.ctx.gl.clone(), &gpu.ctx.info);
         let tracer = pipeline::ray_tracer(gl, info, scene, &gpu.shaders, options)?;

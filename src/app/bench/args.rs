@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use super::config::GridVariant;
+use super::config::{BvhVariant, GridVariant};
 
 /// The protocols `gpgpu-rt bench` knows: the command line's values (`super::protocol_of` says
 /// which protocol each one runs).
@@ -35,6 +35,12 @@ pub enum ProtocolId {
     /// Klee 2016, Fig. 13: bunny vs dragon on the GPU, 2×2 … 10×10 shadow rays.
     #[value(name = "klee-fig13")]
     KleeFig13,
+    /// Wagner 2018, Table A.1 / Fig. 5.1: the square of 8 … 32768 triangles × 5 resolutions.
+    #[value(name = "wagner-a1")]
+    WagnerA1,
+    /// Wagner 2018, Table A.2 / Table 5.1 / Fig. 5.4: sphere and cow × 5 resolutions.
+    #[value(name = "wagner-a2")]
+    WagnerA2,
 }
 
 /// `--scale`.
@@ -80,18 +86,10 @@ pub struct BenchArgs {
     /// Warm-up frames per configuration, not counted (default: the protocol's for the scale).
     #[arg(long, value_name = "N")]
     pub warmup: Option<u32>,
-    /// Grid resolutions N (N³ voxels), comma-separated (default: the protocol's for the scale).
-    #[arg(long, value_delimiter = ',', value_name = "N,N,...")]
-    pub grid_res: Option<Vec<u32>>,
-    /// Grid variants to measure, comma-separated (default: both).
-    #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
-    pub variants: Option<Vec<GridVariant>>,
-    /// Thesis grid variant: triangle ids per voxel list (default: the tracer's, Listing 17: 512).
-    #[arg(long, value_name = "L")]
-    pub voxel_array_length: Option<u32>,
-    /// Thesis grid variant: voxel ids per ray list (default: the tracer's, 3·N as Listing 17).
-    #[arg(long, value_name = "R")]
-    pub ray_array_length: Option<u32>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    #[command(flatten)]
+    pub wagner: WagnerArgs,
     /// How the scene turns: its objects (default) or the camera around them.
     #[arg(long, value_enum, default_value = "objects")]
     pub rotate: Rotation,
@@ -113,14 +111,61 @@ pub struct BenchArgs {
     pub quiet: bool,
 }
 
+/// The options of the grid protocols (Müller 2015, ch. 5.2, 5.3).
+#[derive(clap::Args, Debug, Clone)]
+pub struct GridArgs {
+    /// Grid resolutions N (N³ voxels), comma-separated (default: the protocol's for the scale).
+    #[arg(long, value_delimiter = ',', value_name = "N,N,...")]
+    pub grid_res: Option<Vec<u32>>,
+    /// Grid variants to measure, comma-separated (default: both).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
+    pub variants: Option<Vec<GridVariant>>,
+    /// Thesis grid variant: triangle ids per voxel list (default: the tracer's, Listing 17: 512).
+    #[arg(long, value_name = "L")]
+    pub voxel_array_length: Option<u32>,
+    /// Thesis grid variant: voxel ids per ray list (default: the tracer's, 3·N as Listing 17).
+    #[arg(long, value_name = "R")]
+    pub ray_array_length: Option<u32>,
+}
+
+/// The options of the Wagner 2018 protocols.
+#[derive(clap::Args, Debug, Clone)]
+pub struct WagnerArgs {
+    /// Image sizes of the Wagner 2018 protocols, comma-separated, e.g. 320x240,640x480
+    /// (default: the protocol's for the scale; 320x240 is always measured, the reference).
+    #[arg(long, value_delimiter = ',', value_name = "WxH,...", value_parser = parse_size)]
+    pub sizes: Option<Vec<(u32, u32)>>,
+    /// Subdivision levels of the square for wagner-a1, comma-separated: level L has 2·4^L
+    /// triangles (default: the protocol's for the scale; level 1 is always measured).
+    #[arg(long, value_delimiter = ',', value_name = "L,...")]
+    pub levels: Option<Vec<u32>>,
+    /// BVH variants of the Wagner 2018 protocols, comma-separated (default: those this build
+    /// has, `sah`).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
+    pub bvh_variants: Option<Vec<BvhVariant>>,
+}
+
+/// The finest square `--levels` takes: 2·4^12 = 33,554,432 triangles, within the scene
+/// loader's limit for a procedural object.
+pub const MAX_LEVEL: u32 = 12;
+
+/// "640x480" → (640, 480).
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let parsed = s.split_once(['x', 'X', '×']).and_then(|(w, h)| {
+        let (w, h) = (w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?);
+        (w > 0 && h > 0).then_some((w, h))
+    });
+    parsed.ok_or_else(|| format!("{s:?} is not an image size WxH with W, H ≥ 1, e.g. 640x480"))
+}
+
 impl BenchArgs {
     /// Refuse values no protocol can use, naming the option.
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("--width", self.width),
             ("--height", self.height),
-            ("--voxel-array-length", self.voxel_array_length),
-            ("--ray-array-length", self.ray_array_length),
+            ("--voxel-array-length", self.grid.voxel_array_length),
+            ("--ray-array-length", self.grid.ray_array_length),
         ] {
             if v == Some(0) {
                 bail!("{name} must be at least 1");
@@ -129,13 +174,29 @@ impl BenchArgs {
         if self.angles == Some(0) {
             bail!("--angles must be at least 1");
         }
-        if let Some(r) = &self.grid_res {
+        if let Some(r) = &self.grid.grid_res {
             if r.is_empty() || r.contains(&0) {
                 bail!("--grid-res needs resolutions of at least 1, e.g. --grid-res 8,16,24");
             }
         }
-        if self.variants.as_ref().is_some_and(|v| v.is_empty()) {
+        if self.grid.variants.as_ref().is_some_and(|v| v.is_empty()) {
             bail!("--variants needs at least one of thesis, exact");
+        }
+        if self
+            .wagner
+            .bvh_variants
+            .as_ref()
+            .is_some_and(|v| v.is_empty())
+        {
+            bail!("--bvh-variants needs at least one of sah, wagner");
+        }
+        if let Some(l) = &self.wagner.levels {
+            if l.is_empty() || l.iter().any(|l| !(1..=MAX_LEVEL).contains(l)) {
+                bail!(
+                    "--levels takes subdivision levels 1 to {MAX_LEVEL} of the square (2·4^L triangles), \
+                     e.g. --levels 1,3,5"
+                );
+            }
         }
         if !self.tile.is_multiple_of(8) {
             bail!(

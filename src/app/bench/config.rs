@@ -1,6 +1,8 @@
 //! What a protocol configures: the sizes at each scale, and the configurations it measures
 //! (scene, tracer, image size, reflection depth, rotation angles, warm-up frames).
 
+pub use gpgpu_rt::scene::Overrides;
+
 /// Default image size at `--scale quick`: small enough for Mesa llvmpipe.
 pub const QUICK_SIZE: (u32, u32) = (64, 64);
 /// Default image size at `--scale full`. The thesis does not state its image size.
@@ -44,6 +46,10 @@ impl Sizing {
 /// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2); `--variants`.
 pub use gpgpu_rt::accel::GridVariant;
 
+/// The two BVH designs after Wagner 2018 (`--bvh-variants`): which of them this build
+/// measures is [`super::adapter::BVH_VARIANTS`].
+pub use gpgpu_rt::accel::BvhVariant;
+
 /// Which tracer a configuration measures.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TracerSpec {
@@ -54,6 +60,8 @@ pub enum TracerSpec {
         variant: GridVariant,
         resolution: u32,
     },
+    /// A BVH tracer (`--tracer bvh`) of one variant.
+    Bvh { variant: BvhVariant },
 }
 
 impl TracerSpec {
@@ -61,37 +69,55 @@ impl TracerSpec {
         match self {
             TracerSpec::Base => "base",
             TracerSpec::Grid { .. } => "grid",
+            TracerSpec::Bvh { .. } => "bvh",
         }
     }
-    /// The grid's variant and resolution; `None` for the base tracer.
+    /// The grid's variant and resolution; `None` for the other tracers.
     pub fn grid(&self) -> Option<(GridVariant, u32)> {
         match *self {
-            TracerSpec::Base => None,
             TracerSpec::Grid {
                 variant,
                 resolution,
             } => Some((variant, resolution)),
+            _ => None,
         }
     }
+    /// The grid's variant; `None` for the other tracers.
     pub fn variant(&self) -> Option<GridVariant> {
         self.grid().map(|g| g.0)
     }
     pub fn resolution(&self) -> Option<u32> {
         self.grid().map(|g| g.1)
     }
-    /// "base", "grid thesis 24³".
-    pub fn label(&self) -> String {
-        match self.grid() {
-            None => "base".into(),
-            Some((v, r)) => format!("grid {} {r}³", variant_name(v)),
+    /// The BVH's variant; `None` for the other tracers.
+    pub fn bvh_variant(&self) -> Option<BvhVariant> {
+        match *self {
+            TracerSpec::Bvh { variant } => Some(variant),
+            _ => None,
         }
     }
-    /// A file-name friendly form: "base", "grid-thesis-24".
-    pub fn slug(&self) -> String {
-        match self.grid() {
-            None => "base".into(),
-            Some((v, r)) => format!("grid-{}-{r}", variant_name(v)),
+    /// The variant's name, of the grid or the BVH: "thesis", "sah"; `None` for the base tracer.
+    pub fn variant_label(&self) -> Option<&'static str> {
+        match *self {
+            TracerSpec::Base => None,
+            TracerSpec::Grid { variant, .. } => Some(variant_name(variant)),
+            TracerSpec::Bvh { variant } => Some(variant.name()),
         }
+    }
+    /// "base", "grid thesis 24³", "bvh sah".
+    pub fn label(&self) -> String {
+        match *self {
+            TracerSpec::Base => "base".into(),
+            TracerSpec::Grid {
+                variant,
+                resolution,
+            } => format!("grid {} {resolution}³", variant_name(variant)),
+            TracerSpec::Bvh { variant } => format!("bvh {}", variant.name()),
+        }
+    }
+    /// A file-name friendly form: "base", "grid-thesis-24", "bvh-sah".
+    pub fn slug(&self) -> String {
+        self.label().replace('³', "").replace(' ', "-")
     }
 }
 
@@ -107,6 +133,8 @@ pub fn variant_name(v: GridVariant) -> &'static str {
 pub struct Config {
     /// File name in the scenes folder, e.g. `bunny.toml`.
     pub scene: String,
+    /// Procedural sizes that replace the scene file's (the square's `level`).
+    pub overrides: Overrides,
     pub tracer: TracerSpec,
     /// REFL_DEPTH: reflection passes after the primary pass.
     pub refl_depth: u32,
@@ -123,6 +151,7 @@ impl Config {
     pub fn new(scene: &str, tracer: TracerSpec, refl_depth: u32, s: Sizing) -> Config {
         Config {
             scene: scene.into(),
+            overrides: Overrides::default(),
             tracer,
             refl_depth,
             width: s.width,
@@ -131,13 +160,50 @@ impl Config {
             warmup: s.warmup,
         }
     }
+    /// `tracer` on `scene` at `width`×`height`, `frames` frames after `warmup`, camera and
+    /// objects fixed (every frame at angle 0: nothing moves, nothing is rebuilt).
+    pub fn fixed(
+        scene: &str,
+        tracer: TracerSpec,
+        (width, height): (u32, u32),
+        s: Sizing,
+    ) -> Config {
+        Config {
+            width,
+            height,
+            angles: vec![0.0; s.angles as usize],
+            ..Config::new(scene, tracer, 0, s)
+        }
+    }
+    /// The same configuration with the square's subdivision `level`.
+    pub fn with_level(self, level: u32) -> Config {
+        Config {
+            overrides: Overrides { level: Some(level) },
+            ..self
+        }
+    }
     /// "bunny", the scene file's stem.
     pub fn scene_name(&self) -> &str {
         self.scene.strip_suffix(".toml").unwrap_or(&self.scene)
     }
+    /// "bunny", "square level 3": the scene with its overrides.
+    pub fn scene_label(&self) -> String {
+        match self.overrides.level {
+            Some(l) => format!("{} level {l}", self.scene_name()),
+            None => self.scene_name().to_string(),
+        }
+    }
     /// "bunny, grid exact 24³".
     pub fn label(&self) -> String {
-        format!("{}, {}", self.scene_name(), self.tracer.label())
+        format!("{}, {}", self.scene_label(), self.tracer.label())
+    }
+    /// "square-level-3_bvh-sah": a file-name friendly label.
+    pub fn slug(&self) -> String {
+        format!(
+            "{}_{}",
+            self.scene_label().replace(' ', "-"),
+            self.tracer.slug()
+        )
     }
     pub fn frames(&self) -> u64 {
         self.warmup as u64 + self.angles.len() as u64
@@ -182,5 +248,22 @@ mod tests {
             (spec.label(), spec.slug()),
             ("grid thesis 24³".into(), "grid-thesis-24".into())
         );
+        let bvh = TracerSpec::Bvh {
+            variant: BvhVariant::Sah,
+        };
+        assert_eq!(
+            (bvh.label(), bvh.slug()),
+            ("bvh sah".into(), "bvh-sah".into())
+        );
+        assert_eq!((bvh.variant_label(), bvh.grid()), (Some("sah"), None));
+        let c = Config::fixed("square.toml", bvh, (320, 240), Sizing::quick(3, 1)).with_level(2);
+        assert_eq!(
+            (c.label(), c.slug()),
+            (
+                "square level 2, bvh sah".into(),
+                "square-level-2_bvh-sah".into()
+            )
+        );
+        assert_eq!((c.angles, c.refl_depth, c.width), (vec![0.0; 3], 0, 320));
     }
 }

@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result};
 
 use super::args::Rotation;
-use super::config::variant_name;
 use super::outcome::{FrameRecord, Outcome};
 use super::stats::Stats;
 
@@ -42,9 +41,10 @@ fn strings(names: &[&str]) -> Vec<String> {
     names.iter().map(|s| s.to_string()).collect()
 }
 
-const COMMON_HEADER: [&str; 11] = [
+const COMMON_HEADER: [&str; 12] = [
     "protocol",
     "scene",
+    "level",
     "triangles",
     "lights",
     "tracer",
@@ -58,7 +58,8 @@ const COMMON_HEADER: [&str; 11] = [
 
 fn common_columns(protocol: &str, o: &Outcome, rotate: Rotation) -> Vec<String> {
     let c = &o.config;
-    let variant = c.tracer.variant().map(variant_name).unwrap_or("");
+    let variant = c.tracer.variant_label().unwrap_or("");
+    let level = c.overrides.level.map(|l| l.to_string());
     let resolution = c.tracer.resolution().map(|r| r.to_string());
     let rotation = match rotate {
         Rotation::Objects => "objects",
@@ -67,6 +68,7 @@ fn common_columns(protocol: &str, o: &Outcome, rotate: Rotation) -> Vec<String> 
     vec![
         protocol.to_string(),
         c.scene_name().to_string(),
+        level.unwrap_or_default(),
         o.triangles.to_string(),
         o.lights.to_string(),
         c.tracer.name().to_string(),

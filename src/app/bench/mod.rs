@@ -57,6 +57,7 @@ pub mod outcome;
 pub mod plots;
 pub mod protocol;
 pub mod published;
+pub mod published_wagner;
 pub mod report;
 pub mod runner;
 pub mod stats;
@@ -64,6 +65,8 @@ pub mod sweep;
 pub mod thesis_5_1;
 pub mod thesis_5_2;
 pub mod thesis_5_3;
+pub mod wagner;
+pub mod wagner_report;
 
 use std::time::Instant;
 
@@ -84,6 +87,8 @@ pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
         ProtocolId::KleeTable3 => &klee::KLEE_TABLE3,
         ProtocolId::KleeFig12 => &klee::KLEE_FIG12,
         ProtocolId::KleeFig13 => &klee::KLEE_FIG13,
+        ProtocolId::WagnerA1 => &wagner::WAGNER_A1,
+        ProtocolId::WagnerA2 => &wagner::WAGNER_A2,
     }
 }
 

@@ -89,8 +89,10 @@ fn failures(outcomes: &[Outcome]) -> String {
     for o in outcomes.iter().filter(|o| o.error.is_some()) {
         let _ = writeln!(
             s,
-            "- **{} failed** after {} measured frames: `{}`",
+            "- **{} at {}×{} failed** after {} measured frames: `{}`",
             o.config.label(),
+            o.config.width,
+            o.config.height,
             o.frames.len(),
             o.error.as_deref().unwrap_or("")
         );

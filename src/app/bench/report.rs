@@ -19,13 +19,17 @@ const MULLER: &str = "Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL
                       shaders and a per-frame uniform grid*), ch. 5";
 const KLEE: &str = "Klee 2016 (B.Sc. thesis, *Darstellung von Halbschatten durch Verwendung des \
                     \"Cascaded Linespace\"-Verfahrens*), ch. 5";
+const WAGNER: &str = "Wagner 2018 (B.Sc. thesis, *Potenzialanalyse der GPU-Beschleunigung beim \
+                      Raytracing*), ch. 5 and appendix A";
 
 /// Write `<out>/report.md`.
 pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf> {
     // the sources whose protocols ran: the Müller-specific settings only where they apply
-    let muller = sections.iter().any(|x| x.protocol.starts_with("thesis-"));
-    let klee = sections.iter().any(|x| x.protocol.starts_with("klee-"));
-    let mut s = heading(muller || !klee, klee, &bench.machine, wall_s);
+    let ran = |prefix: &str| sections.iter().any(|x| x.protocol.starts_with(prefix));
+    let (muller, klee, wagner) = (ran("thesis-"), ran("klee-"), ran("wagner-"));
+    let sources = [(muller, MULLER), (klee, KLEE), (wagner, WAGNER)];
+    let cited: Vec<&str> = sources.iter().filter(|s| s.0).map(|s| s.1).collect();
+    let mut s = heading(&cited, &bench.machine, wall_s);
     s.push_str(&machine(&bench.machine, muller));
     if muller {
         s.push_str(&muller_settings(&bench.args));
@@ -38,17 +42,18 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
     Ok(path)
 }
 
-/// The title, what the report compares, the command, the date and the wall time.
-fn heading(muller: bool, klee: bool, m: &Machine, wall_s: f64) -> String {
-    let (mut sources, mut cited) = (Vec::new(), Vec::new());
-    if muller {
-        sources.push("Müller 2015, ch. 5");
-        cited.push(MULLER);
-    }
-    if klee {
-        sources.push("Klee 2016, ch. 5");
-        cited.push(KLEE);
-    }
+/// The title, what the report compares (the works `cited`), the command, the date and the wall
+/// time.
+fn heading(cited: &[&str], m: &Machine, wall_s: f64) -> String {
+    // "Müller 2015, ch. 5": the citation up to its title
+    let sources: Vec<String> = cited
+        .iter()
+        .map(|c| {
+            let (author, rest) = c.split_once(" (").unwrap_or((c, ""));
+            let chapter = rest.rsplit_once("*), ").map_or("", |r| r.1);
+            format!("{author}, {chapter}")
+        })
+        .collect();
     let mut s = String::new();
     let _ = writeln!(s, "# {}, replicated with gpgpu-rt\n", sources.join("; "));
     let _ = writeln!(
@@ -185,7 +190,7 @@ fn tracer_settings(a: &BenchArgs) -> String {
         "tiles of at most this many pixels squared"
     };
     let (voxel_default, ray_default) = grid_list_defaults();
-    let ray = match a.ray_array_length.or(ray_default) {
+    let ray = match a.grid.ray_array_length.or(ray_default) {
         Some(r) => r.to_string(),
         None => "3·N (Listing 17)".to_string(),
     };
@@ -195,7 +200,7 @@ fn tracer_settings(a: &BenchArgs) -> String {
          - Grid list lengths of the thesis variant: voxel_array_length {}, ray_array_length {ray} \
          (`--voxel-array-length`, `--ray-array-length`).\n",
         a.tile,
-        a.voxel_array_length.unwrap_or(voxel_default),
+        a.grid.voxel_array_length.unwrap_or(voxel_default),
     )
 }
 

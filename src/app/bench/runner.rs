@@ -12,9 +12,9 @@ use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::adapter::{Gpu, RayTracer};
+use super::adapter::{Gpu, RayTracer, BVH_VARIANTS};
 use super::args::{BenchArgs, Rotation, Scale};
-use super::config::{Config, GridVariant, Sizing};
+use super::config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
 use super::csv_files;
 use super::machine::Machine;
 use super::outcome::{FrameRecord, Outcome};
@@ -27,7 +27,7 @@ pub struct Bench {
     pub machine: Machine,
     pub scenes_dir: PathBuf,
     pub out: PathBuf,
-    scenes: HashMap<String, Scene>,
+    scenes: HashMap<(String, Overrides), Scene>,
     progress: bool,
 }
 
@@ -75,7 +75,7 @@ impl Bench {
 
     /// The grid resolutions to measure: `--grid-res` or the protocol's list for the scale.
     pub fn grid_resolutions(&self, quick: &[u32], full: &[u32]) -> Vec<u32> {
-        match (&self.args.grid_res, self.args.scale) {
+        match (&self.args.grid.grid_res, self.args.scale) {
             (Some(r), _) => r.clone(),
             (None, Scale::Quick) => quick.to_vec(),
             (None, Scale::Full) => full.to_vec(),
@@ -85,19 +85,55 @@ impl Bench {
     /// The grid variants to measure: `--variants` or both.
     pub fn variants(&self) -> Vec<GridVariant> {
         self.args
+            .grid
             .variants
             .clone()
             .unwrap_or_else(|| vec![GridVariant::Thesis, GridVariant::Exact])
     }
 
+    /// The image sizes to measure: `--sizes`, else `--width`×`--height` (each defaulting to
+    /// the first size of the list), else the protocol's list for the scale.
+    pub fn sizes(&self, quick: &[(u32, u32)], full: &[(u32, u32)]) -> Vec<(u32, u32)> {
+        let list = match self.args.scale {
+            Scale::Quick => quick,
+            Scale::Full => full,
+        };
+        match (&self.args.wagner.sizes, self.args.width, self.args.height) {
+            (Some(s), _, _) => s.clone(),
+            (None, None, None) => list.to_vec(),
+            (None, w, h) => vec![(w.unwrap_or(list[0].0), h.unwrap_or(list[0].1))],
+        }
+    }
+
+    /// The square's subdivision levels to measure: `--levels` or the protocol's for the scale.
+    pub fn levels(&self, quick: &[u32], full: &[u32]) -> Vec<u32> {
+        match (&self.args.wagner.levels, self.args.scale) {
+            (Some(l), _) => l.clone(),
+            (None, Scale::Quick) => quick.to_vec(),
+            (None, Scale::Full) => full.to_vec(),
+        }
+    }
+
+    /// The BVH variants to measure: `--bvh-variants` or those this build has.
+    pub fn bvh_variants(&self) -> Vec<BvhVariant> {
+        let given = self.args.wagner.bvh_variants.clone();
+        given.unwrap_or_else(|| BVH_VARIANTS.to_vec())
+    }
+
     /// Load a scene of the scenes folder (once).
     pub fn scene(&mut self, name: &str) -> Result<&Scene> {
-        if !self.scenes.contains_key(name) {
+        self.scene_with(name, Overrides::default())
+    }
+
+    /// Load a scene of the scenes folder with some procedural sizes replaced (once).
+    pub fn scene_with(&mut self, name: &str, overrides: Overrides) -> Result<&Scene> {
+        let key = (name.to_string(), overrides);
+        if !self.scenes.contains_key(&key) {
             let path = self.scenes_dir.join(name);
-            let scene = Scene::load(&path)?;
-            self.scenes.insert(name.to_string(), scene);
+            let scene = Scene::load_with(&path, &overrides)?;
+            self.scenes.insert(key.clone(), scene);
         }
-        Ok(&self.scenes[name])
+        Ok(&self.scenes[&key])
     }
 
     fn progress_bar(&self, len: u64, prefix: &str) -> ProgressBar {
@@ -124,7 +160,7 @@ impl Bench {
     /// its error and the others go on; a missing scene fails the whole protocol at once.
     pub fn measure(&mut self, protocol: &str, configs: &[Config]) -> Result<Vec<Outcome>> {
         for c in configs {
-            self.scene(&c.scene)?;
+            self.scene_with(&c.scene, c.overrides)?;
             if c.angles.is_empty() {
                 bail!("{protocol}: configuration {} has no angles", c.label());
             }
@@ -134,10 +170,10 @@ impl Bench {
             .with_context(|| format!("cannot create {}", frames_dir.display()))?;
         let pb = self.progress_bar(configs.iter().map(Config::frames).sum(), protocol);
         let mut outcomes = Vec::with_capacity(configs.len());
-        for c in configs {
+        for (c, png) in configs.iter().zip(first_frame_pngs(protocol, configs)) {
             pb.set_message(c.label());
             let before = pb.position();
-            let outcome = self.run_config(protocol, c, &pb);
+            let outcome = self.run_config(c, png, &pb);
             pb.set_position(before + c.frames());
             let line = outcome.summary_line();
             pb.suspend(|| eprintln!("{protocol}: {line}"));
@@ -148,8 +184,9 @@ impl Bench {
         Ok(outcomes)
     }
 
-    fn run_config(&self, protocol: &str, c: &Config, pb: &ProgressBar) -> Outcome {
-        let scene = &self.scenes[&c.scene];
+    /// Measure `c`, its first frame written to `png` (relative to the output folder).
+    fn run_config(&self, c: &Config, png: PathBuf, pb: &ProgressBar) -> Outcome {
+        let scene = &self.scenes[&(c.scene.clone(), c.overrides)];
         let mut outcome = Outcome {
             config: c.clone(),
             triangles: scene.triangle_count(),
@@ -159,7 +196,7 @@ impl Bench {
             error: None,
             image: None,
         };
-        if let Err(e) = self.render_config(protocol, c, scene, pb, &mut outcome) {
+        if let Err(e) = self.render_config(c, scene, png, pb, &mut outcome) {
             outcome.error = Some(format!("{e:#}"));
         }
         outcome
@@ -167,9 +204,9 @@ impl Bench {
 
     fn render_config(
         &self,
-        protocol: &str,
         c: &Config,
         scene: &Scene,
+        first_png: PathBuf,
         pb: &ProgressBar,
         out: &mut Outcome,
     ) -> Result<()> {
@@ -184,7 +221,7 @@ impl Bench {
         }
         for (i, &angle) in c.angles.iter().enumerate() {
             let camera = turntable.turn(&mut tracer, angle)?;
-            let image = (i == 0).then(|| first_frame_png(protocol, c));
+            let image = (i == 0).then(|| first_png.clone());
             let png = image.as_ref().map(|rel| self.out.join(rel));
             let stats = tracer
                 .render(&camera, png.as_deref())
@@ -199,10 +236,18 @@ impl Bench {
     }
 }
 
-/// Where the first measured frame of `c` goes, relative to the output folder.
-fn first_frame_png(protocol: &str, c: &Config) -> PathBuf {
-    let name = format!("{}_{}.png", c.scene_name(), c.tracer.slug());
-    PathBuf::from("frames").join(protocol).join(name)
+/// Where the first measured frame of each configuration goes, relative to the output folder:
+/// `frames/<protocol>/<scene>_<tracer>.png`, with `_<W>x<H>` where configurations differ only
+/// in their image size.
+fn first_frame_pngs(protocol: &str, configs: &[Config]) -> Vec<PathBuf> {
+    let slugs: Vec<String> = configs.iter().map(Config::slug).collect();
+    let shared = |s: &String| slugs.iter().filter(|t| *t == s).count() > 1;
+    let names = configs.iter().zip(&slugs).map(|(c, s)| match shared(s) {
+        true => format!("{s}_{}x{}.png", c.width, c.height),
+        false => format!("{s}.png"),
+    });
+    let dir = PathBuf::from("frames").join(protocol);
+    names.map(|n| dir.join(n)).collect()
 }
 
 /// "The scene rotated through 360°": its objects turned about the vertical axis through the
