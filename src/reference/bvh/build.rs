@@ -1,6 +1,7 @@
 //! The binned SAH build of [`super::Bvh`] (Wald 2007, Wagner's [13]; the cost of eq. 4.1).
 //!
-//! Every node bins its triangles' centroids into [`BINS`] bins per axis, all three axes in one
+//! Every node bins its triangles' centroids into [`BINS`] bins per axis (as many as it has
+//! triangles when they are fewer), all three axes in one
 //! pass, and the partition that follows the split also measures both children (bounds and
 //! centroid bounds), so every node reads its triangles twice. The triangles are partitioned
 //! in place (bounds and id together, in SIMD boxes, so every pass reads memory in order).
@@ -149,15 +150,19 @@ impl Extent {
 struct Binning {
     lo: Vec3A,
     scale: Vec3A,
+    /// bins per axis: [`BINS`], or as many as triangles in a smaller node
+    bins: usize,
 }
 
 impl Binning {
-    /// Over the (doubled) centroid bounds `c`; an axis without extent gets scale 0 (one bin).
-    fn over(c: &Bx) -> Binning {
+    /// `count` triangles over the (doubled) centroid bounds `c`; an axis without extent gets
+    /// scale 0 (one bin).
+    fn over(c: &Bx, count: usize) -> Binning {
+        let bins = count.clamp(2, BINS);
         let extent = c.hi - c.lo;
         let scale = |e: f32| {
             if e > 0.0 && e.is_finite() {
-                BINS as f32 / e
+                bins as f32 / e
             } else {
                 0.0
             }
@@ -165,13 +170,14 @@ impl Binning {
         Binning {
             lo: c.lo,
             scale: Vec3A::new(scale(extent.x), scale(extent.y), scale(extent.z)),
+            bins,
         }
     }
 
     /// The bins of `p` on the three axes.
     fn bins(&self, p: &Prim) -> [usize; 3] {
         let b = (p.centroid2() - self.lo) * self.scale;
-        [b.x, b.y, b.z].map(|f| (f as usize).min(BINS - 1))
+        [b.x, b.y, b.z].map(|f| (f as usize).min(self.bins - 1))
     }
 
     fn bin_serial(&self, prims: &[Prim]) -> Bins {
@@ -222,12 +228,12 @@ fn best_split(bins: &Bins, binning: &Binning) -> Option<Split> {
         // right-to-left sweep: the cost of every right side
         let mut right = [(0.0f32, 0usize); BINS];
         let mut acc = Bin::EMPTY;
-        for k in (1..BINS).rev() {
+        for k in (1..binning.bins).rev() {
             acc.merge(&bins[k]);
             right[k] = (acc.cost(), acc.count);
         }
         let mut left = Bin::EMPTY;
-        for k in 1..BINS {
+        for k in 1..binning.bins {
             left.merge(&bins[k - 1]);
             if left.count == 0 || right[k].1 == 0 {
                 continue;
@@ -294,7 +300,7 @@ fn subtree(prims: &mut [Prim], offset: usize, node: Extent, depth: u32) -> Tree 
         return leaf;
     }
     let (mid, axis, sides) = if depth < SAH_DEPTH {
-        let binning = Binning::over(&node.centroids2);
+        let binning = Binning::over(&node.centroids2, prims.len());
         match best_split(&binning.bin_all(prims), &binning) {
             // Listing 4.4: split only where it pays (unless the node is too large for a leaf)
             Some(s) if s.cost < node.cost() || prims.len() > MAX_LEAF => {
@@ -330,18 +336,29 @@ fn subtree(prims: &mut [Prim], offset: usize, node: Extent, depth: u32) -> Tree 
 }
 
 /// Reorder `prims` so that those for which `left` holds come first; their number and the
-/// extents of both sides.
+/// extents of both sides (measured as each triangle is classified, once).
 fn partition(prims: &mut [Prim], left: impl Fn(&Prim) -> bool) -> (usize, [Extent; 2]) {
     let (mut i, mut j) = (0, prims.len());
+    let mut sides = [Bx::EMPTY, Bx::EMPTY, Bx::EMPTY, Bx::EMPTY];
     while i < j {
-        if left(&prims[i]) {
+        let p = prims[i];
+        let side = if left(&p) {
             i += 1;
+            0
         } else {
             j -= 1;
             prims.swap(i, j);
-        }
+            2
+        };
+        sides[side].grow(&p.bounds);
+        sides[side + 1].grow_point(p.centroid2());
     }
-    (i, [Extent::of(&prims[..i]), Extent::of(&prims[i..])])
+    let extent = |k: usize, count| Extent {
+        bounds: sides[k],
+        centroids2: sides[k + 1],
+        count,
+    };
+    (i, [extent(0, i), extent(2, prims.len() - i)])
 }
 
 /// Sort `prims` by centroid on the widest centroid axis (then by id); the middle, the axis

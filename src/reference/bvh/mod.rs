@@ -267,21 +267,31 @@ fn safe_inverse(rd: Vec3) -> Vec3 {
 /// The miss links of every node for every octant: the depth-first order of that octant (the
 /// near child of every split first) continues after a node's subtree at its miss link.
 fn miss_links(nodes: &[Node]) -> Vec<i32> {
-    let mut links = vec![END; OCTANTS * nodes.len()];
-    for octant in 0..OCTANTS {
-        // (node, its miss link): the far child's miss link is its parent's, the near
-        // child's is the far child
-        let mut todo = vec![(0usize, END)];
-        while let Some((n, miss)) = todo.pop() {
-            links[OCTANTS * n + octant] = miss;
-            let node = &nodes[n];
-            if !node.is_leaf() {
-                let down = (octant >> node.axis()) & 1;
-                let near = node.first as usize + down;
-                let far = node.first as usize + 1 - down;
-                todo.push((far, miss));
-                todo.push((near, far as i32));
-            }
+    use rayon::prelude::*;
+    let per_octant: Vec<Vec<i32>> = (0..OCTANTS)
+        .into_par_iter()
+        .map(|octant| octant_links(nodes, octant))
+        .collect();
+    (0..OCTANTS * nodes.len())
+        .map(|k| per_octant[k % OCTANTS][k / OCTANTS])
+        .collect()
+}
+
+/// The miss link of every node in the depth-first order of one octant.
+fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
+    let mut links = vec![END; nodes.len()];
+    // (node, its miss link): the far child's miss link is its parent's, the near child's is
+    // the far child
+    let mut todo = vec![(0usize, END)];
+    while let Some((n, miss)) = todo.pop() {
+        links[n] = miss;
+        let node = &nodes[n];
+        if !node.is_leaf() {
+            let down = (octant >> node.axis()) & 1;
+            let near = node.first as usize + down;
+            let far = node.first as usize + 1 - down;
+            todo.push((far, miss));
+            todo.push((near, far as i32));
         }
     }
     links
