@@ -194,8 +194,10 @@ def measure(scene, a, work):
     stats_file = d / "stats.json"
     ray_tracer = not soft_shadow_scene(scene)
     # the soft-shadow pipeline: its first hits only (one frame, one light sample)
-    pipeline_args = (["--tracer", "bvh", "--refl-depth", "0", "--frames", a.frames]
-                     if ray_tracer else ["--light-samples", "1x1"])
+    # Wagner's megakernel has no reflection passes to turn off
+    no_reflection = ["--refl-depth", "0"] if a.bvh_variant == "sah" else []
+    pipeline_args = (["--tracer", "bvh", "--bvh-variant", a.bvh_variant, *no_reflection,
+                      "--frames", a.frames] if ray_tracer else ["--light-samples", "1x1"])
     cmd = ["render", scene, *pipeline_args, "--width", a.size,
            "--height", a.size, "--aov-dir", d, "--stats", stats_file, "-o", d / "image.png"]
     gpgpu_rt(a.bin, *cmd)
@@ -207,15 +209,20 @@ def measure(scene, a, work):
     emb = Embree(tris, a.robust, a.threads)
     r = {"scene": str(scene.relative_to(ROOT) if scene.is_relative_to(ROOT) else scene),
          "size": f"{a.size}×{a.size}", "triangles": len(tris), "tracer": stats["tracer"],
+         "variant": a.bvh_variant if ray_tracer else None,
          "embree_build_ms": emb.build_ms, "embree_upload_ms": emb.upload_ms,
          "embree_build_cores": emb.build_cores,
          "bvh_build_ms": stats.get("bvh_build_ms"), "gl_renderer": stats["renderer"],
          "primary": primary(emb, aov, tris, a.repeats)}
     if ray_tracer:
-        r["primary"]["ours_ms"] = stats["gpu_ms"]["intersect1"]
+        # the megakernel times primary rays and feelers together: agreement only
+        timed = a.bvh_variant == "sah"
+        if timed:
+            r["primary"]["ours_ms"] = stats["gpu_ms"]["intersect1"]
         if info["lights"] > 0:
             r["feelers"] = feelers(emb, aov, info, a.repeats)
-            r["feelers"]["ours_ms"] = stats["gpu_ms"]["intersect2"]
+            if timed:
+                r["feelers"]["ours_ms"] = stats["gpu_ms"]["intersect2"]
     return r
 
 
@@ -236,13 +243,21 @@ def rate_cells(m, threads):
     return [fmt(e1), fmt(en), fmt(ours), fmt(ours / en if ours else None, 3)]
 
 
+def label(r):
+    """Why a row has no speed of ours: the soft-shadow G-buffer, or Wagner's megakernel."""
+    if "ours_ms" in r["primary"]:
+        return ""
+    return " (megakernel)" if r["variant"] == "wagner" else " (G-buffer)"
+
+
 def report(results, a, command, load):
     th = a.threads
     flags = "robust (RTC_SCENE_FLAG_ROBUST)" if a.robust else "default flags (not robust)"
     cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text()
                 .splitlines() if line.startswith("model name")), platform.processor())
     lines = [
-        "# Embree as the peer of `--tracer bvh`: the same rays on the same machine", "",
+        f"# Embree as the peer of `--tracer bvh --bvh-variant {a.bvh_variant}`: the same rays on "
+        "the same machine", "",
         *([f"**{a.note}**", ""] if a.note else []),
         f"- command: `{command}`",
         f"- date: {datetime.date.today().isoformat()}; machine: {cpu}, {os.cpu_count()} cores "
@@ -263,7 +278,7 @@ def report(results, a, command, load):
     for r in results:
         m = r["primary"]
         lines.append("| " + " | ".join([
-            f"`{r['scene']}`" + ("" if "ours_ms" in m else " (G-buffer)"), r["size"],
+            f"`{r['scene']}`" + label(r), r["size"],
             str(r["triangles"]), fmt(r["embree_build_ms"], 1), fmt(r["bvh_build_ms"], 1),
             *rate_cells(m, th), f"{m['agree_pct']:.4f} / {m['agree_ties_pct']:.4f}"]) + " |")
     lines += ["", "## Shadow feelers (any hit, intersect2)", "",
@@ -309,6 +324,9 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--robust", action="store_true", help="Embree's robust mode (slower)")
     ap.add_argument("--min-agreement", type=float, default=99.9)
+    ap.add_argument("--bvh-variant", choices=["sah", "wagner"], default="sah",
+                    help="wagner: Wagner 2018's megakernel (agreement only: it times primary "
+                    "rays and feelers as one kernel)")
     ap.add_argument("--out", type=Path, default=ROOT / "docs/results/embree_peer.md")
     ap.add_argument("--work", type=Path, help="keep the AOVs here (default: a temporary folder)")
     ap.add_argument("--note", default="", help="a line printed above the tables")
