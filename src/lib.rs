@@ -4,6 +4,7 @@
 pub mod accel;
 pub mod frame;
 pub mod gl;
+pub mod limits;
 pub mod output;
 pub mod pipeline;
 pub mod reference;

@@ -456,3 +456,108 @@ fn options_of_the_other_pipeline_are_refused() {
     let o = with(&["--tile", "64", "--frames", "2", "--light-samples", "2x2"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// A PNG whose header claims `w`×`h` pixels, with a few bytes of image data: a decoder that
+/// believed it would allocate w·h·3 bytes.
+fn png_claiming(w: u32, h: u32) -> Vec<u8> {
+    fn chunk(kind: &[u8], data: &[u8]) -> Vec<u8> {
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        out.extend_from_slice(&body);
+        out.extend_from_slice(&crc32(&body).to_be_bytes());
+        out
+    }
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 2, 0, 0, 0]);
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(
+        b"IDAT",
+        &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+    ));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}
+
+#[test]
+fn counts_beyond_their_bounds_are_refused_with_the_bound() {
+    let scene = format!("{}/scenes/cow.toml", env!("CARGO_MANIFEST_DIR"));
+    for (args, needles) in [
+        (
+            vec!["--refl-depth", "4294967295"],
+            ["--refl-depth", "0..=16"],
+        ),
+        (vec!["--frames", "100001"], ["--frames", "1..=100000"]),
+        (vec!["--width", "16385"], ["--width", "1..=16384"]),
+        (vec!["--grid", "1025"], ["--grid", "1 to 1024"]),
+        (
+            vec!["--voxel-array-length", "65537"],
+            ["--voxel-array-length", "1..=65536"],
+        ),
+    ] {
+        let mut all = vec!["render", scene.as_str(), "-o", "/dev/null"];
+        all.extend(args);
+        assert_fails(&run(&all), &needles);
+    }
+    assert_fails(
+        &run(&["bench", "thesis-5.1", "--angles", "3601"]),
+        &["--angles", "1..=3600"],
+    );
+    // the bounds are said in --help
+    let help = String::from_utf8_lossy(&run(&["render", "--help"]).stdout).into_owned();
+    for said in [
+        "0 to 16",
+        "1 to 16384",
+        "1 to 100000",
+        "1 to 1024",
+        "1 to 65536",
+    ] {
+        assert!(help.contains(said), "render --help lacks {said:?}");
+    }
+
+    // a scene file: the limit with file and line
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let head = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n";
+    let bad = d.join("deep.toml");
+    std::fs::write(
+        &bad,
+        format!("{head}[render]\nrefl_depth = 17\n[[object]]\ntype = \"floor\"\n"),
+    )
+    .unwrap();
+    assert_fails(
+        &run(&["info", bad.to_str().unwrap()]),
+        &["deep.toml:4", "refl_depth", "0 to 16"],
+    );
+
+    // a small file that claims a 20000×20000 texture is refused before it is decoded
+    std::fs::write(d.join("big.png"), png_claiming(20000, 20000)).unwrap();
+    let tex = d.join("tex.toml");
+    std::fs::write(
+        &tex,
+        format!("{head}[[object]]\ntype = \"floor\"\ntexture = \"big.png\"\n"),
+    )
+    .unwrap();
+    let start = std::time::Instant::now();
+    assert_fails(
+        &run(&["info", tex.to_str().unwrap()]),
+        &["tex.toml:5", "big.png", "16384x16384"],
+    );
+    assert!(start.elapsed().as_secs() < 10, "refused without decoding");
+}

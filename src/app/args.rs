@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use gpgpu_rt::accel::{GridOptions, GridVariant};
+use gpgpu_rt::limits;
 use gpgpu_rt::pipeline::softshadow::SoftShadowOptions;
 use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
 
@@ -31,9 +32,10 @@ impl std::str::FromStr for GridResolution {
             return Ok(GridResolution::Auto);
         }
         match s.parse::<u32>() {
-            Ok(n) if n > 0 => Ok(GridResolution::N(n)),
+            Ok(n) if limits::GRID_RES.contains(&n) => Ok(GridResolution::N(n)),
             _ => Err(format!(
-                "`{s}` is neither `auto` nor a positive voxel count per axis"
+                "`{s}` is neither `auto` nor a voxel count per axis from 1 to {}",
+                limits::GRID_RES.end()
             )),
         }
     }
@@ -42,18 +44,19 @@ impl std::str::FromStr for GridResolution {
 /// The grid tracer's command-line options (`render`, `view`, `bench`).
 #[derive(Debug, Clone, clap::Args)]
 pub struct GridArgs {
-    /// Grid resolution N (N³ voxels), or `auto`: N = cbrt(triangles / 5), within 4..=64.
+    /// Grid resolution N (N³ voxels, N from 1 to 1024), or `auto`: N = cbrt(triangles / 5),
+    /// within 4..=64.
     #[arg(long, default_value = "auto", value_name = "N|auto")]
     pub grid: GridResolution,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
     pub grid_variant: GridVariant,
-    /// Thesis variant: triangle ids per voxel list (Listing 17: 512).
-    #[arg(long, default_value_t = 512, value_name = "L")]
+    /// Thesis variant: triangle ids per voxel list, 1 to 65536 (Listing 17: 512).
+    #[arg(long, default_value_t = 512, value_name = "L", value_parser = limits::parser(limits::VOXEL_ARRAY_LENGTH))]
     pub voxel_array_length: u32,
-    /// Thesis variant: voxel ids per ray list (default 3·N, as Listing 17).
-    #[arg(long, value_name = "R")]
+    /// Thesis variant: voxel ids per ray list, 1 to 65536 (default 3·N, as Listing 17).
+    #[arg(long, value_name = "R", value_parser = limits::parser(limits::RAY_ARRAY_LENGTH))]
     pub ray_array_length: Option<u32>,
 }
 

@@ -12,11 +12,11 @@ use crate::args::{GpuArgs, GridArgs, SoftShadowArgs};
 use gpgpu_rt::accel::{BvhVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::output;
 use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::SoftShadowRenderer;
 use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::scene::{Scene, ShadowMode};
+use gpgpu_rt::{limits, output};
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -25,11 +25,11 @@ pub struct RenderArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "out.png")]
     output: PathBuf,
-    /// Image width (default: the scene's render.width).
-    #[arg(long)]
+    /// Image width, 1 to 16384 (default: the scene's render.width).
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     width: Option<u32>,
-    /// Image height (default: the scene's render.height).
-    #[arg(long)]
+    /// Image height, 1 to 16384 (default: the scene's render.height).
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     height: Option<u32>,
     /// The accelerator of Müller 2015's four-kernel pipeline: `bvh` (ours: an SAH BVH, the
     /// fastest), `base` (the thesis' base tracer, every ray against every triangle) or `grid`
@@ -41,8 +41,9 @@ pub struct RenderArgs {
     /// shadows, no reflection).
     #[arg(long, value_enum, default_value = "sah")]
     bvh_variant: BvhVariant,
-    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
-    #[arg(long)]
+    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
+    /// scene's).
+    #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
     refl_depth: Option<u32>,
     /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
     #[arg(long, value_enum, default_value = "bits")]
@@ -57,9 +58,9 @@ pub struct RenderArgs {
     /// Write the statistics of the frame as JSON.
     #[arg(long, value_name = "FILE.json")]
     stats: Option<PathBuf>,
-    /// Render the frame this many times and report the last (the first ones warm up:
-    /// shader compilation on first use, caches).
-    #[arg(long, default_value_t = 1, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// Render the frame this many times (1 to 100000) and report the last (the first ones
+    /// warm up: shader compilation on first use, caches).
+    #[arg(long, default_value_t = 1, value_name = "N", value_parser = limits::parser(limits::FRAMES))]
     frames: u32,
     #[command(flatten)]
     grid: GridArgs,

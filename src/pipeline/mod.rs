@@ -60,6 +60,13 @@ pub fn ray_tracer(
     shaders: &ShaderSource,
     options: raytrace::RenderOptions,
 ) -> Result<Box<dyn Renderer>> {
+    use crate::limits::{check, IMAGE_SIDE, REFL_DEPTH};
+    check("the image width", options.width, &IMAGE_SIDE).map_err(anyhow::Error::msg)?;
+    check("the image height", options.height, &IMAGE_SIDE).map_err(anyhow::Error::msg)?;
+    check("the reflection depth", options.refl_depth, &REFL_DEPTH).map_err(anyhow::Error::msg)?;
+    if let Some(n) = options.grid.resolution {
+        check("the grid resolution", n, &crate::limits::GRID_RES).map_err(anyhow::Error::msg)?;
+    }
     if options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner {
         let o = wagner2018::WagnerOptions::of(&options);
         let r = wagner2018::WagnerRenderer::new(gl, info, scene, shaders, o)?;

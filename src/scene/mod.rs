@@ -97,6 +97,29 @@ impl Object {
     }
 }
 
+/// Decode a texture within [`crate::limits::TEXTURE_SIDE`] texels a side and
+/// [`crate::limits::TEXTURE_BYTES`] bytes of memory (a small file can claim a huge image).
+fn decode_texture(path: &Path) -> Result<image::RgbaImage, String> {
+    use crate::limits::{TEXTURE_BYTES, TEXTURE_SIDE};
+    let mut reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| e.to_string())?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(TEXTURE_SIDE);
+    limits.max_image_height = Some(TEXTURE_SIDE);
+    limits.max_alloc = Some(TEXTURE_BYTES);
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| match e {
+        image::ImageError::Limits(_) => format!(
+            "{e} (textures may be at most {TEXTURE_SIDE}x{TEXTURE_SIDE} texels and take at most \
+             {} MiB to decode)",
+            TEXTURE_BYTES >> 20
+        ),
+        e => e.to_string(),
+    })?;
+    Ok(img.to_rgba8())
+}
+
 /// Rendering settings a scene file may give; the command line overrides them.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
@@ -125,21 +148,23 @@ fn light_samples<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, 
 }
 
 impl RenderSettings {
-    /// Sizes positive, colours finite, the shadow offset finite and >= 0.
-    fn validate(&self) -> Result<(), &'static str> {
-        if self.width == 0 || self.height == 0 {
-            return Err("render.width and render.height must be positive");
-        }
+    /// Sizes and the reflection depth within [`crate::limits`], colours finite, the shadow
+    /// offset finite and >= 0.
+    fn validate(&self) -> Result<(), String> {
+        use crate::limits::{check, IMAGE_SIDE, REFL_DEPTH};
+        check("render.width", self.width, &IMAGE_SIDE)?;
+        check("render.height", self.height, &IMAGE_SIDE)?;
+        check("render.refl_depth", self.refl_depth, &REFL_DEPTH)?;
         if !self
             .background
             .iter()
             .chain(&self.ambient)
             .all(|v| v.is_finite())
         {
-            return Err("render.background and render.ambient must be finite");
+            return Err("render.background and render.ambient must be finite".into());
         }
         if !self.shadow_offset.is_finite() || self.shadow_offset < 0.0 {
-            return Err("render.shadow_offset must be finite and >= 0");
+            return Err("render.shadow_offset must be finite and >= 0".into());
         }
         Ok(())
     }
@@ -304,7 +329,7 @@ impl Scene {
             None => (RenderSettings::default(), None),
         };
         let render_error = |m: &str| SceneError::at(path, render_line, m.into());
-        settings.validate().map_err(render_error)?;
+        settings.validate().map_err(|m| render_error(&m))?;
         let lights = src.check_all(file.light, LightDef::light)?;
         let area_lights = src.check_all(file.area_light, AreaLightDef::area_light)?;
         if settings.shadows.is_some() && area_lights.is_empty() {
@@ -349,9 +374,9 @@ impl Scene {
         if let Some(i) = self.textures.iter().position(|(p, _)| p == path) {
             return Ok(i as u32);
         }
-        let img = image::open(path)
-            .map_err(|e| ObjectError::Here(format!("cannot load texture {}: {e}", path.display())))?
-            .to_rgba8();
+        let img = decode_texture(path).map_err(|e| {
+            ObjectError::Here(format!("cannot load texture {}: {e}", path.display()))
+        })?;
         self.textures.push((path.to_path_buf(), img));
         Ok(self.textures.len() as u32 - 1)
     }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
+use gpgpu_rt::limits;
 
 use super::config::{BvhVariant, GridVariant};
 
@@ -74,17 +75,20 @@ pub struct BenchArgs {
     /// Output folder for the CSVs, plots and report.md (created if missing).
     #[arg(long, value_name = "DIR", default_value = "bench-results")]
     pub out: PathBuf,
-    /// Image width (default: 64 quick, 512 full; the thesis does not state its size).
-    #[arg(long)]
+    /// Image width, 1 to 16384 (default: 64 quick, 512 full; the thesis does not state its
+    /// size).
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     pub width: Option<u32>,
-    /// Image height (default: 64 quick, 512 full).
-    #[arg(long)]
+    /// Image height, 1 to 16384 (default: 64 quick, 512 full).
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     pub height: Option<u32>,
-    /// Number of rotation angles, evenly spaced over 360° (default: the protocol's for the scale).
-    #[arg(long, value_name = "N")]
+    /// Number of rotation angles, 1 to 3600, evenly spaced over 360° (default: the protocol's
+    /// for the scale).
+    #[arg(long, value_name = "N", value_parser = limits::parser(limits::ANGLES))]
     pub angles: Option<u32>,
-    /// Warm-up frames per configuration, not counted (default: the protocol's for the scale).
-    #[arg(long, value_name = "N")]
+    /// Warm-up frames per configuration, 0 to 1000, not counted (default: the protocol's for
+    /// the scale).
+    #[arg(long, value_name = "N", value_parser = limits::parser(limits::WARMUP))]
     pub warmup: Option<u32>,
     #[command(flatten)]
     pub grid: GridArgs,
@@ -115,16 +119,18 @@ pub struct BenchArgs {
 #[derive(clap::Args, Debug, Clone)]
 pub struct GridArgs {
     /// Grid resolutions N (N³ voxels), comma-separated (default: the protocol's for the scale).
-    #[arg(long, value_delimiter = ',', value_name = "N,N,...")]
+    #[arg(long, value_delimiter = ',', value_name = "N,N,...", value_parser = limits::parser(limits::GRID_RES))]
     pub grid_res: Option<Vec<u32>>,
     /// Grid variants to measure, comma-separated (default: both).
     #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
     pub variants: Option<Vec<GridVariant>>,
-    /// Thesis grid variant: triangle ids per voxel list (default: the tracer's, Listing 17: 512).
-    #[arg(long, value_name = "L")]
+    /// Thesis grid variant: triangle ids per voxel list, 1 to 65536 (default: the tracer's,
+    /// Listing 17: 512).
+    #[arg(long, value_name = "L", value_parser = limits::parser(limits::VOXEL_ARRAY_LENGTH))]
     pub voxel_array_length: Option<u32>,
-    /// Thesis grid variant: voxel ids per ray list (default: the tracer's, 3·N as Listing 17).
-    #[arg(long, value_name = "R")]
+    /// Thesis grid variant: voxel ids per ray list, 1 to 65536 (default: the tracer's, 3·N as
+    /// Listing 17).
+    #[arg(long, value_name = "R", value_parser = limits::parser(limits::RAY_ARRAY_LENGTH))]
     pub ray_array_length: Option<u32>,
 }
 
@@ -153,29 +159,23 @@ pub const MAX_LEVEL: u32 = 12;
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let parsed = s.split_once(['x', 'X', '×']).and_then(|(w, h)| {
         let (w, h) = (w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?);
-        (w > 0 && h > 0).then_some((w, h))
+        let side = &limits::IMAGE_SIDE;
+        (side.contains(&w) && side.contains(&h)).then_some((w, h))
     });
-    parsed.ok_or_else(|| format!("{s:?} is not an image size WxH with W, H ≥ 1, e.g. 640x480"))
+    parsed.ok_or_else(|| {
+        format!(
+            "{s:?} is not an image size WxH with W, H from 1 to {}, e.g. 640x480",
+            limits::IMAGE_SIDE.end()
+        )
+    })
 }
 
 impl BenchArgs {
     /// Refuse values no protocol can use, naming the option.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("--width", self.width),
-            ("--height", self.height),
-            ("--voxel-array-length", self.grid.voxel_array_length),
-            ("--ray-array-length", self.grid.ray_array_length),
-        ] {
-            if v == Some(0) {
-                bail!("{name} must be at least 1");
-            }
-        }
-        if self.angles == Some(0) {
-            bail!("--angles must be at least 1");
-        }
+        // the ranges of single values are the parsers' (gpgpu_rt::limits)
         if let Some(r) = &self.grid.grid_res {
-            if r.is_empty() || r.contains(&0) {
+            if r.is_empty() {
                 bail!("--grid-res needs resolutions of at least 1, e.g. --grid-res 8,16,24");
             }
         }

@@ -41,6 +41,7 @@ use winit::window::WindowId;
 
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::limits;
 use gpgpu_rt::scene::{Camera, Scene};
 
 use design::Design;
@@ -62,11 +63,12 @@ const WATCH_INTERVAL: Duration = Duration::from_millis(200);
 pub struct ViewArgs {
     /// Scene file (TOML), e.g. scenes/teapot1.toml.
     pub scene: PathBuf,
-    /// Render width in pixels (default: the scene's render.width); the window opens at this size.
-    #[arg(long)]
+    /// Render width in pixels, 1 to 16384 (default: the scene's render.width); the window
+    /// opens at this size.
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     pub width: Option<u32>,
-    /// Render height in pixels (default: the scene's render.height).
-    #[arg(long)]
+    /// Render height in pixels, 1 to 16384 (default: the scene's render.height).
+    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     pub height: Option<u32>,
     /// The tracer to start with (T switches).
     #[arg(long, value_enum, default_value = "bvh")]
@@ -75,8 +77,9 @@ pub struct ViewArgs {
     /// switches).
     #[arg(long, value_enum, default_value = "sah")]
     pub bvh_variant: BvhVariant,
-    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8 (default: the scene's).
-    #[arg(long)]
+    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
+    /// scene's).
+    #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
     pub refl_depth: Option<u32>,
     /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
     #[arg(long, value_enum, default_value = "bits")]
@@ -98,9 +101,10 @@ pub struct ViewArgs {
     /// Save the window's last frame (see --frames) to this PNG and exit.
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
-    /// Render N frames, then exit (after saving --screenshot); default with --screenshot: 1.
-    #[arg(long, value_name = "N")]
-    pub frames: Option<u64>,
+    /// Render N frames (1 to 100000), then exit (after saving --screenshot); default with
+    /// --screenshot: 1.
+    #[arg(long, value_name = "N", value_parser = limits::parser(limits::FRAMES))]
+    pub frames: Option<u32>,
     /// With --glsl-dir: count --frames only from the first successful reload of an edited
     /// kernel (capture the effect of an edit from a script).
     #[arg(long)]
@@ -112,9 +116,6 @@ pub struct ViewArgs {
 
 /// Open the viewer and run it until the window closes (or --frames are done).
 pub fn run(mut args: ViewArgs) -> Result<()> {
-    if args.frames == Some(0) {
-        bail!("--frames must be at least 1");
-    }
     if args.wait_reload && args.glsl_dir.is_none() {
         bail!("--wait-reload needs --glsl-dir (the kernels it watches)");
     }
@@ -257,7 +258,11 @@ impl App {
         App {
             design: Design::new(args.tracer, options, args.soft.clone(), &scene),
             camera: scene.camera,
-            frames: FrameCount::new(args.frames, args.screenshot.is_some(), args.wait_reload),
+            frames: FrameCount::new(
+                args.frames.map(u64::from),
+                args.screenshot.is_some(),
+                args.wait_reload,
+            ),
             args,
             scene,
             shaders,
