@@ -1,4 +1,4 @@
-// Exact grid, pass 1 of 3: count — ours, after Müller 2015 ch. 3.2 (rebuilt every frame on
+// Exact grid, pass 1 of 4: count — ours, after Müller 2015 ch. 3.2 (rebuilt every frame on
 // the GPU, one invocation per triangle like the build kernel of Listing 19). Every triangle
 // adds 1 to the count of every voxel it overlaps (triangle/box test, not only its edges).
 layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;

@@ -1,6 +1,7 @@
-// Exact grid, pass 3 of 3: fill — ours. Every triangle writes its id into the compact list of
+// Exact grid, pass 3 of 4: fill — ours. Every triangle writes its id into the compact list of
 // every voxel it overlaps (the same test as count.comp): position voxelStart[v] plus a
-// per-voxel cursor claimed with atomicAdd. The lists need no fixed capacity and never drop.
+// per-voxel cursor claimed with atomicAdd. The lists need no fixed capacity and never drop;
+// order.comp then sorts each by triangle id.
 layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;
 
 #define SCENE_QUALIFIER readonly
@@ -12,7 +13,7 @@ layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;
 
 layout(std430, binding = SSBO_VOXEL_START) readonly buffer VoxelStart { uint voxelStart[]; };
 layout(std430, binding = SSBO_VOXEL_FILL) coherent buffer VoxelFill { uint voxelFill[]; };
-layout(std430, binding = SSBO_VOXEL_TRIS) writeonly buffer VoxelTris { int voxelTris[]; };
+layout(std430, binding = SSBO_VOXEL_TRIS_FILLED) writeonly buffer VoxelTris { int voxelTris[]; };
 
 uint truncated = 0u;
 int currentTriangle = -1;

@@ -1,4 +1,4 @@
-// Exact grid, pass 2 of 3: exclusive prefix sum of the voxel counts — ours. The start of every
+// Exact grid, pass 2 of 4: exclusive prefix sum of the voxel counts — ours. The start of every
 // voxel's compact list: voxelStart[v] = sum of voxelCount[u] for u < v. Three phases:
 //   scanPhase 0: every work group scans 1024 counts in shared memory, its total -> blockSums
 //   scanPhase 1: one invocation scans the block totals (<= 2048 of them) and writes the total

@@ -39,25 +39,28 @@ pub const ENTRY: Entry = Entry {
 };
 
 /// The compact lists: voxelCount (references per voxel), voxelStart (their prefix sum),
-/// voxelFill (the fill pass's cursor), blockSums and gridTotal (the prefix sum's), voxelTris
-/// (the references, grown to the count of every build).
+/// voxelFill (the fill pass's cursor), blockSums and gridTotal (the prefix sum's),
+/// voxelTrisFilled (the references as filled) and voxelTris (ordered by id; both grown to the
+/// count of every build).
 struct Lists {
     voxel_count: Ssbo,
     voxel_start: Ssbo,
     voxel_fill: Ssbo,
     block_sums: Ssbo,
     grid_total: Ssbo,
+    voxel_tris_filled: Ssbo,
     voxel_tris: Ssbo,
 }
 
 impl Lists {
-    fn all(&self) -> [(&Ssbo, u32); 6] {
+    fn all(&self) -> [(&Ssbo, u32); 7] {
         [
             (&self.voxel_count, ssbo::VOXEL_COUNT),
             (&self.voxel_start, ssbo::VOXEL_START),
             (&self.voxel_fill, ssbo::VOXEL_FILL),
             (&self.block_sums, ssbo::BLOCK_SUMS),
             (&self.grid_total, ssbo::GRID_TOTAL),
+            (&self.voxel_tris_filled, ssbo::VOXEL_TRIS_FILLED),
             (&self.voxel_tris, ssbo::VOXEL_TRIS),
         ]
     }
@@ -76,6 +79,7 @@ pub struct ExactGrid {
     count: Kernel,
     scan: Kernel,
     fill: Kernel,
+    order: Kernel,
     intersect1: Kernel,
     intersect2: Kernel,
     lists: Lists,
@@ -98,6 +102,7 @@ impl ExactGrid {
             block_sums: ssbo("blockSums", 4 * n3.div_ceil(1024))?,
             grid_total: ssbo("gridTotal", 16)?,
             // grown to the number of references on the first build
+            voxel_tris_filled: ssbo("voxelTrisFilled", 4 * scene.triangle_count())?,
             voxel_tris: ssbo("voxelTris", 4 * scene.triangle_count())?,
         };
         Ok(Box::new(ExactGrid {
@@ -106,6 +111,7 @@ impl ExactGrid {
             count: b.kernel("exact_grid/count.comp", &defs, "grid_count")?,
             scan: b.kernel("exact_grid/scan.comp", &defs, "grid_scan")?,
             fill: b.kernel("exact_grid/fill.comp", &defs, "grid_fill")?,
+            order: b.kernel("exact_grid/order.comp", &[], "grid_order")?,
             intersect1: b.kernel("exact_grid/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("exact_grid/intersect2.comp", &defs, "intersect2")?,
             lists,
@@ -129,13 +135,28 @@ impl ExactGrid {
         }
     }
 
+    /// Sort every voxel's list by triangle id (`glsl/exact_grid/order.comp`).
+    fn order(&self, f: &mut FrameContext, total: u32) {
+        let k = &self.order;
+        k.use_program();
+        k.set_i32("referenceCount", total as i32);
+        k.set_i32("voxelTotal", self.frame.voxels() as i32);
+        k.dispatch_1d(f.timers, total.div_ceil(128).max(1));
+    }
+
     /// Make room for `total` references (half again as many, so a moving scene rarely
     /// reallocates).
     fn reserve(&mut self, total: usize) -> Result<()> {
         if 4 * total > self.lists.voxel_tris.bytes {
             let bytes = (4 * total + 4 * total / 2).max(16);
-            self.lists.voxel_tris.delete(&self.gl);
-            self.lists.voxel_tris = Ssbo::new(&self.gl, "voxelTris", bytes, None, self.max_ssbo)?;
+            let l = &mut self.lists;
+            for (b, name) in [
+                (&mut l.voxel_tris_filled, "voxelTrisFilled"),
+                (&mut l.voxel_tris, "voxelTris"),
+            ] {
+                b.delete(&self.gl);
+                *b = Ssbo::new(&self.gl, name, bytes, None, self.max_ssbo)?;
+            }
         }
         Ok(())
     }
@@ -175,10 +196,11 @@ impl Accelerator for ExactGrid {
         let total = self.lists.grid_total.read_u32(gl)[0] as usize;
         self.refs = total as u64;
         self.reserve(total)?;
-        self.lists.voxel_tris.bind(gl, ssbo::VOXEL_TRIS);
+        self.lists.bind(gl);
         self.fill.use_program();
         self.frame.set_uniforms(&self.fill);
         self.fill.dispatch_1d(f.timers, tri_groups);
+        self.order(f, total as u32);
         Ok(())
     }
 
@@ -197,10 +219,16 @@ impl Accelerator for ExactGrid {
     }
 
     fn stats(&self, stats: &mut FrameStats) {
-        let build: f64 = ["grid_clear", "grid_count", "grid_scan", "grid_fill"]
-            .iter()
-            .filter_map(|k| stats.gpu_ms.get(*k))
-            .sum();
+        let build: f64 = [
+            "grid_clear",
+            "grid_count",
+            "grid_scan",
+            "grid_fill",
+            "grid_order",
+        ]
+        .iter()
+        .filter_map(|k| stats.gpu_ms.get(*k))
+        .sum();
         let bytes: usize = self.lists.all().iter().map(|(b, _)| b.bytes).sum();
         let f = &mut stats.facts;
         f.insert("grid_resolution".into(), json!(self.frame.n));

@@ -45,6 +45,8 @@ slot_table! {
         BLOCK_SUMS = 13,
         GRID_TOTAL = 14,
         VOXEL_TRIS = 15,
+        /// the lists as the fill pass leaves them, before the order pass
+        VOXEL_TRIS_FILLED = 16,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,
