@@ -63,7 +63,7 @@ fn list_bounds(tris: &[[Vec3; 3]], ids: &[u32]) -> Aabb {
 
 /// Eq. 4.1 of a list of triangles.
 fn sah(tris: &[[Vec3; 3]], ids: &[u32]) -> f64 {
-    list_bounds(tris, ids).half_area() * ids.len() as f64
+    list_bounds(tris, ids).half_area_f64() * ids.len() as f64
 }
 
 fn centre(t: &[Vec3; 3], axis: usize) -> f32 {

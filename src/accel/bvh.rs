@@ -35,13 +35,7 @@ pub const ENTRY: Entry = Entry {
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes, miss links, leaf triangles.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     let leaf_triangles = bvh.leaf_triangles();
-    let data = |name, format, texel_bytes, bytes: &[u8], unit| TexelData {
-        name,
-        format,
-        texel_bytes,
-        bytes: bytes.to_vec().into(),
-        unit,
-    };
+    let data = TexelData::new;
     TextureBuffers::upload(
         gl,
         [

@@ -289,6 +289,25 @@ pub struct TexelData<'a> {
     pub unit: u32,
 }
 
+impl TexelData<'static> {
+    /// `bytes` (copied) as texels of `format` (`texel_bytes` each), for sampler slot `unit`.
+    pub fn new(
+        name: &'static str,
+        format: u32,
+        texel_bytes: usize,
+        bytes: &[u8],
+        unit: u32,
+    ) -> Self {
+        TexelData {
+            name,
+            format,
+            texel_bytes,
+            bytes: bytes.to_vec().into(),
+            unit,
+        }
+    }
+}
+
 /// Texture buffers uploaded and bound together (a design's data structure).
 pub struct TextureBuffers(Vec<(TextureBuffer, u32)>);
 

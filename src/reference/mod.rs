@@ -3,6 +3,7 @@
 //! arithmetic and the same pass structure as the kernels. It is the oracle of the tests: the
 //! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
 
+pub mod aabb;
 pub mod brute_force;
 pub mod bvh;
 pub mod exact_grid;

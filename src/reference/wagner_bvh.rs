@@ -46,6 +46,8 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use glam::Vec3;
 
+pub use super::aabb::Aabb;
+
 /// Listing 4.3, line 5: a list of fewer boxes than this is a leaf.
 pub const LEAF_BELOW: usize = 4;
 /// The deepest node (the root at depth 0) a build may make: the traversal keeps at most one
@@ -53,54 +55,18 @@ pub const LEAF_BELOW: usize = 4;
 /// tree is refused.
 pub const MAX_DEPTH: u32 = 64;
 
-/// An axis-aligned box.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Aabb {
-    pub lo: Vec3,
-    pub hi: Vec3,
-}
-
-impl Aabb {
-    pub const EMPTY: Aabb = Aabb {
-        lo: Vec3::splat(f32::INFINITY),
-        hi: Vec3::splat(f32::NEG_INFINITY),
-    };
-
-    pub fn of_triangle(t: &[Vec3; 3]) -> Aabb {
-        Aabb {
-            lo: t[0].min(t[1]).min(t[2]),
-            hi: t[0].max(t[1]).max(t[2]),
+/// Centre and half extent as the kernel's box (Listing 4.5's `ac` and `h`), in f32, the
+/// half extent rounded up until centre ± half covers the box: the box the GPU tests is
+/// never smaller than the bounds of its triangles.
+pub fn centre_half(b: &Aabb) -> (Vec3, Vec3) {
+    let c = 0.5 * (b.lo + b.hi);
+    let mut h = 0.5 * (b.hi - b.lo);
+    for a in 0..3 {
+        while c[a] - h[a] > b.lo[a] || c[a] + h[a] < b.hi[a] {
+            h[a] = h[a].next_up();
         }
     }
-
-    pub fn grow(&mut self, o: &Aabb) {
-        self.lo = self.lo.min(o.lo);
-        self.hi = self.hi.max(o.hi);
-    }
-
-    /// xdim·ydim + ydim·zdim + zdim·xdim: eq. 4.1 without the triangle count (0 when empty).
-    pub fn half_area(&self) -> f64 {
-        let d = (self.hi - self.lo).max(Vec3::ZERO).as_dvec3();
-        d.x * d.y + d.y * d.z + d.z * d.x
-    }
-
-    pub fn contains(&self, o: &Aabb) -> bool {
-        self.lo.cmple(o.lo).all() && o.hi.cmple(self.hi).all()
-    }
-
-    /// Centre and half extent as the kernel's box (Listing 4.5's `ac` and `h`), in f32, the
-    /// half extent rounded up until centre ± half covers the box: the box the GPU tests is
-    /// never smaller than the bounds of its triangles.
-    pub fn centre_half(&self) -> (Vec3, Vec3) {
-        let c = 0.5 * (self.lo + self.hi);
-        let mut h = 0.5 * (self.hi - self.lo);
-        for a in 0..3 {
-            while c[a] - h[a] > self.lo[a] || c[a] + h[a] < self.hi[a] {
-                h[a] = h[a].next_up();
-            }
-        }
-        (c, h)
-    }
+    (c, h)
 }
 
 /// A node of the hierarchy.
@@ -242,7 +208,7 @@ impl Builder {
             bounds.grow(&self.boxes[i as usize]);
         }
         let index = self.nodes.len() as u32;
-        let (centre, half) = bounds.centre_half();
+        let (centre, half) = centre_half(&bounds);
         self.nodes.push(Node {
             bounds,
             centre,
@@ -272,7 +238,7 @@ impl Builder {
     /// Listing 4.4: the split of least SAH(left) + SAH(right) below SAH(list), over every
     /// distance of every axis; `None`: no better split.
     fn find_best_split(&self, list: &mut [u32], bounds: &Aabb) -> Option<Split> {
-        let mut minimum_cost = bounds.half_area() * list.len() as f64;
+        let mut minimum_cost = bounds.half_area_f64() * list.len() as f64;
         let mut best = None;
         for axis in 0..3 {
             self.sort_by_centre(list, axis);
@@ -293,7 +259,7 @@ impl Builder {
         let mut acc = Aabb::EMPTY;
         for k in (1..n).rev() {
             acc.grow(&self.boxes[sorted[k] as usize]);
-            right[k] = acc.half_area() * (n - k) as f64;
+            right[k] = acc.half_area_f64() * (n - k) as f64;
         }
         let mut best: Option<Split> = None;
         let mut left = Aabb::EMPTY;
@@ -307,7 +273,7 @@ impl Builder {
             if at <= below {
                 continue;
             }
-            let cost = left.half_area() * k as f64 + right[k];
+            let cost = left.half_area_f64() * k as f64 + right[k];
             if cost < best.map_or(minimum_cost, |b| b.cost) {
                 best = Some(Split {
                     axis,
@@ -330,7 +296,7 @@ impl Builder {
     }
 
     fn stats(&self, start: Instant) -> WagnerStats {
-        let root_area = self.nodes.first().map_or(0.0, |n| n.bounds.half_area());
+        let root_area = self.nodes.first().map_or(0.0, |n| n.bounds.half_area_f64());
         let mut s = WagnerStats {
             nodes: self.nodes.len(),
             depth: self.depth,
@@ -339,7 +305,7 @@ impl Builder {
         };
         for n in &self.nodes {
             let area = if root_area > 0.0 {
-                n.bounds.half_area() / root_area
+                n.bounds.half_area_f64() / root_area
             } else {
                 1.0
             };

@@ -30,6 +30,7 @@ use std::ops::ControlFlow;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+pub use super::aabb::Aabb;
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 mod build;
@@ -78,40 +79,6 @@ impl Node {
     /// An inner node's split axis: its left child lies on the low side.
     pub fn axis(&self) -> usize {
         (-1 - self.meta).clamp(0, 2) as usize
-    }
-}
-
-/// An axis-aligned box.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Aabb {
-    pub lo: Vec3,
-    pub hi: Vec3,
-}
-
-impl Aabb {
-    pub const EMPTY: Aabb = Aabb {
-        lo: Vec3::splat(f32::INFINITY),
-        hi: Vec3::splat(f32::NEG_INFINITY),
-    };
-
-    pub fn grow(&mut self, o: &Aabb) {
-        self.lo = self.lo.min(o.lo);
-        self.hi = self.hi.max(o.hi);
-    }
-
-    pub(super) fn grow_point(&mut self, p: Vec3) {
-        self.lo = self.lo.min(p);
-        self.hi = self.hi.max(p);
-    }
-
-    /// Half the surface area (eq. 4.1 without the triangle count); 0 for an empty box.
-    pub fn half_area(&self) -> f32 {
-        let d = (self.hi - self.lo).max(Vec3::ZERO);
-        d.x * d.y + d.y * d.z + d.z * d.x
-    }
-
-    pub fn contains(&self, o: &Aabb) -> bool {
-        self.lo.cmple(o.lo).all() && o.hi.cmple(self.hi).all()
     }
 }
 
