@@ -427,6 +427,9 @@ int traverse()
                         ivec3 c;
                         c[k] = slice; c[u] = cu; c[v] = cv;
                         uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
+                        // Algorithm 1 line 24 lists nodes with geometry *and* children; ours
+                        // lists leaves too (their triangles are tested below), and the list is
+                        // taken last-in-first-out (nodelist_index counts down)
                         if ((node.r & GEOMETRY_BIT) != 0u) {
                             int i = stack[depth].nodelist_index++;
                             stack[depth].nodelist[i] = node;
@@ -639,7 +642,10 @@ void main()
             float s = lit / float(NUM_RAYS);
             imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
             if (lastBatch) {
-                // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
+                // Fig. 7 multiplies the shadow value into the diffuse colour; ours lights it
+                // with the light's colour and N·L plus the ambient light (not the thesis'
+                // plain product): diffuse · (ambient + light · s · max(N·L, 0)), back into the
+                // diffuse texture
                 vec4 diffuse = imageLoad(diffuseTexture, storePos);
                 vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
                 vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
