@@ -25,7 +25,10 @@ void testTriangle(int i, int n, vec3 ro, vec3 rd, int lastTriID,
 }
 
 // Listing 12: iteration over all triangles of the scene, TRIANGLES_PER_ITERATION at a time
-// (see loopLimit in common/intersect.glsl)
+// (see loopLimit in common/intersect.glsl). Listing 12 steps i by 3 over the vertices, so its
+// triID is the index of the triangle's first vertex; ours counts triangles: triID = the
+// triangle's index (its vertices are 3·triID + 0, 1, 2), as the AOVs and export-triangles
+// number them.
 void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
                 inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 {

@@ -1,4 +1,5 @@
 // Ray/triangle intersection, Algorithm 1 of Müller 2015 (ch. 2.1, after Purcell et al.):
+// intersectTriangle (two misprints of the printed algorithm corrected, see below);
 // the Möller–Trumbore test. No determinant epsilon, as in the thesis: a ray parallel to the
 // triangle gives det = 0, 1/det = inf and comparisons that fail, i.e. no hit.
 // Returns true for a hit with t > 0 and the barycentric (u, v).
@@ -11,7 +12,12 @@ bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
     float det = dot(edge1, pvec);
     float invDet = 1.0 / det;
     vec3 tvec = r0 - v0;
+    // the thesis prints u = det⁻¹ · (tvec × pvec), a cross product where a scalar is meant:
+    // Möller and Trumbore's dot product
     u = invDet * dot(tvec, pvec);
+    // the thesis prints qvec = tvec × pvec; with that qvec, v and t are not the barycentric
+    // coordinate and the distance (qvec ⊥ pvec). Möller and Trumbore's qvec = tvec × edge1
+    // makes v = det⁻¹ · (rd · qvec) and t = det⁻¹ · (edge2 · qvec) right (Cramer's rule)
     vec3 qvec = cross(tvec, edge1);
     v = invDet * dot(rd, qvec);
     t = invDet * dot(edge2, qvec);

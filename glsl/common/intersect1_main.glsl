@@ -22,7 +22,10 @@ void trace(ivec2 storePos)
     vec4 dirTri = imageLoad(rayDirTexture, storePos);
     float rayState = originState.w;
     if (rayState <= 0.0) {
-        // inactive ray: an empty colour buffer (weight -1), nothing for shading to add
+        // inactive ray: an empty colour buffer, nothing for shading to add. Ours: weight -1
+        // marks it; the thesis' shading skips an empty colour buffer (ch. 4.1.3, "sofern
+        // dieser nicht leer ist") without saying how it is marked, and a weight of 0 is a
+        // real one (a perfect mirror)
         imageStore(colorBufferTexture, storePos, vec4(0.0, 0.0, 0.0, -1.0));
         return;
     }

@@ -9,7 +9,10 @@
 // the surface — shadow without a test. The 0.02 offset (SHADOW_OFFSET) is the thesis'
 // correction for smoother transitions between the shadow and the lighting. The flag goes into
 // the shadow texture: one RGBA channel per light (the thesis, lights 0..3) or one bit per
-// light in an RGBA32UI texture (SHADOW_BITS, the bitwise flags of ch. 5).
+// light in an RGBA32UI texture (SHADOW_BITS, the bitwise flags of ch. 5). Flags are only ever
+// set here, so the host clears the shadow texture before every pass (ch. 3.1.3 clears the
+// textures once a frame, which would let a reflection pass inherit the flags of the pass
+// before it); see RayTracer::pass in src/pipeline/raytrace/mod.rs.
 
 uniform int lightSource;
 

@@ -1,5 +1,7 @@
-// 3D-DDA through the exact grid (Amanatides & Woo 1987; the per-ray grid walk of Purcell et
-// al., seed 004) — ours, replacing the thesis' traversal kernel and per-ray voxel lists: the
+// 3D-DDA through the exact grid (Amanatides & Woo, "A Fast Voxel Traversal Algorithm for Ray
+// Tracing", 1987; the per-ray grid walk of Purcell et al., "Ray Tracing on Programmable Graphics
+// Hardware", 2002, and of the streaming GPU ray tracer with a uniform grid and proximity clouds
+// that builds on it) — ours, replacing the thesis' traversal kernel and per-ray voxel lists: the
 // intersection kernels walk the grid themselves, voxel by voxel in ray order.
 
 layout(std430, binding = SSBO_VOXEL_COUNT) readonly buffer VoxelCount { uint voxelCount[]; };

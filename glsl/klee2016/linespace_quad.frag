@@ -1,4 +1,4 @@
-// Screen-filling quad, fragment stage — Klee 2016, ch. 4.1 (Fig. 7, third phase): the
+// Screen-filling triangle, fragment stage — Klee 2016, ch. 4.1 (Fig. 7, third phase): the
 // diffuse texture (shadow value already multiplied in by the compute pass) is read as a
 // sampler2D and every pixel written to the framebuffer (headless: an FBO read back into the PNG).
 in vec2 texCoord;

@@ -1,5 +1,5 @@
-// Screen-filling quad, vertex stage — Klee 2016, ch. 4.1 (Fig. 7, third phase): one triangle
-// that covers the viewport, from gl_VertexID (no vertex buffer).
+// Screen-filling triangle (the thesis: a quad), vertex stage — Klee 2016, ch. 4.1 (Fig. 7,
+// third phase): one triangle that covers the viewport, from gl_VertexID (no vertex buffer).
 out vec2 texCoord;
 
 void main()

@@ -13,8 +13,9 @@
 //                              same line-space termination (Table 3).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
-// it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it. The shadow value (fraction of unblocked rays) goes to
-// shadowTexture and, multiplied into the diffuse colour, back into the diffuse texture.
+// it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it.
+// The shadow value (fraction of unblocked rays) goes to shadowTexture and, multiplied into
+// the diffuse colour, back into the diffuse texture.
 // loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total — and it
 // runs 8 invocations as one SIMD vector whose loops iterate while any lane is active, so the
 // budget is spent by the vector, not by one pixel. Two guards: every loop iteration here is
@@ -37,15 +38,20 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #define LOOP_BUDGET 60000u
 #define INF uintBitsToFloat(0x7F800000u)
 
-layout(rgba32f, binding = IMAGE_GBUFFER_POSITION) uniform readonly image2D positionTexture;  // xyz, w: 1 = geometry
-layout(rgba32f, binding = IMAGE_GBUFFER_NORMAL) uniform readonly image2D normalTexture;    // xyz (facing the camera)
-layout(rgba32f, binding = IMAGE_GBUFFER_DIFFUSE) uniform image2D diffuseTexture;            // rgb diffuse colour
-layout(rgba32f, binding = IMAGE_SHADOW_VALUE) uniform image2D shadowTexture;   // r: shadow value, g: lit rays
-layout(r32ui, binding = IMAGE_LINESPACE) uniform readonly uimage3D linespaceTexture;  // Listing 3
+// the G-buffer: position (xyz, w: 1 = geometry), normal (xyz, facing the camera), diffuse (rgb)
+layout(rgba32f, binding = IMAGE_GBUFFER_POSITION) uniform readonly image2D positionTexture;
+layout(rgba32f, binding = IMAGE_GBUFFER_NORMAL) uniform readonly image2D normalTexture;
+layout(rgba32f, binding = IMAGE_GBUFFER_DIFFUSE) uniform image2D diffuseTexture;
+// r: shadow value, g: lit rays
+layout(rgba32f, binding = IMAGE_SHADOW_VALUE) uniform image2D shadowTexture;
+// the line spaces, packed as Listing 3
+layout(r32ui, binding = IMAGE_LINESPACE) uniform readonly uimage3D linespaceTexture;
 // The node pool (Fig. 8–9): texture buffer, red = flags | child group << 2, green = line space.
 layout(binding = SAMPLER_NODE_POOL) uniform usamplerBuffer nodePool;
 layout(std430, binding = SSBO_TRI_VERTEX) readonly buffer TriangleBuffer { vec4 triVertex[]; };
-layout(std430, binding = SSBO_LEAF_TRIANGLES) readonly buffer LeafTriangleBuffer { uint leafTriangles[]; };
+layout(std430, binding = SSBO_LEAF_TRIANGLES) readonly buffer LeafTriangleBuffer {
+    uint leafTriangles[];
+};
 
 uniform vec3 minBound;       // ntree.minBound
 uniform float invNodeSize;   // ntree.invNodeSize (1 / edge of a child of the root)
@@ -92,6 +98,11 @@ struct Stack
     float u_min, u_max, v_min, v_max;
 } stack[NUM_MAX_DEPTH];
 
+// Listing 2. corner_dir: ours are the vectors from the origin to the light's corners (t = 1 at
+// the light, in N-tree units), not normalised to k = 1 as the thesis says — the slice ranges
+// (sliceRange, sliceUV) divide by the k component where they need it. destination: written
+// (the light's centre, as the text says; Algorithm 1 line 6 prints light_dir) but never read:
+// the thesis uses it for the end index, which here follows from the corner rays and tEnd.
 struct Shaft {
     vec3 origin;
     vec3 destination;
@@ -209,6 +220,8 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
     int s = startFace, e = endFace;
     int cs = startDim.x + N * startDim.y, ce = endDim.x + N * endDim.y;
     if (s > e) { int t = s; s = e; e = t; t = cs; cs = ce; ce = t; }
+    // the 15 side pairs (s, e), s < e, numbered row by row: row s starts after the
+    // 5 + 4 + … + (6 − s) pairs of the rows before it, s·(11 − s)/2 (6 sides: 11 = 2·6 − 1)
     int pair = s * (11 - s) / 2 + (e - s - 1);
     int entry_num = pair * N * N * N * N + cs * N * N + ce;
     linespaceLookups++;
@@ -414,6 +427,9 @@ int traverse()
                         ivec3 c;
                         c[k] = slice; c[u] = cu; c[v] = cv;
                         uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
+                        // Algorithm 1 line 24 lists nodes with geometry *and* children; ours
+                        // lists leaves too (their triangles are tested below), and the list is
+                        // taken last-in-first-out (nodelist_index counts down)
                         if ((node.r & GEOMETRY_BIT) != 0u) {
                             int i = stack[depth].nodelist_index++;
                             stack[depth].nodelist[i] = node;
@@ -433,6 +449,11 @@ int traverse()
                 if ((node.r & CHILDREN_BIT) == 0u) {
                     leafTests(node, childStart, depth + 1);
                 } else {
+                    // Algorithm 1 line 32 prints "if ISINTERSECTION then continue" (skip the
+                    // node when a ray hits geometry in its line space); the prose says the
+                    // opposite — a hit means the children are traversed, an empty shaft is
+                    // skipped (Empty-Space-Skipping). We follow the prose: descend only when
+                    // isIntersection is true
                     bool inside = nearOrigin(childStart);
                     bool descend;
                     if (inside) {
@@ -621,7 +642,10 @@ void main()
             float s = lit / float(NUM_RAYS);
             imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
             if (lastBatch) {
-                // Fig. 7: the shadow value times the diffuse colour, back into the diffuse texture
+                // Fig. 7 multiplies the shadow value into the diffuse colour; ours lights it
+                // with the light's colour and N·L plus the ambient light (not the thesis'
+                // plain product): diffuse · (ambient + light · s · max(N·L, 0)), back into the
+                // diffuse texture
                 vec4 diffuse = imageLoad(diffuseTexture, storePos);
                 vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
                 vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));

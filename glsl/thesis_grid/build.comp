@@ -17,11 +17,15 @@ layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;
 #include "../common/grid.glsl"
 
 // The thesis' block names (Listing 19), though VerticesInVoxel holds triangle ids (N³ lists of
-// voxel_array_length) and ContainedVertices the fill level of each voxel's list.
+// voxel_array_length) and ContainedVertices the fill level of each voxel's list. Bindings
+// from src/gl/slots.rs: VerticesInVoxel 10 as Listing 19, ContainedVertices 11 where Listing 19
+// has 12 (ours puts rayslist at 12 and raycontains at 13, the four lists in a row).
 layout(std430, binding = SSBO_VOXELSLIST) coherent buffer VerticesInVoxel { int voxelslist[]; };
 layout(std430, binding = SSBO_VOXELCONTAINS) coherent buffer ContainedVertices { int voxelcontains[]; };
 
-// the triangle of this thread (Listing 19 stores 3·id, the index of its first vertex)
+// the triangle of this thread. Listing 19 has triID = 3 * gl_GlobalInvocationID.x, the index
+// of its first vertex (as Listing 12's triID = i); ours is the triangle's index, as in every
+// kernel here, in the AOVs (triangle_id.npy) and in export-triangles
 int triID = int(gl_GlobalInvocationID.x);
 uint dropped = 0u;
 uint truncated = 0u;

@@ -19,6 +19,10 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
 {
     int threadID = storePos.y * imageSize(rayOriginTexture).x + storePos.x;
     int start = threadID * ray_array_length;
+    // one past the ray's last voxel: Listing 22 loops `j <= voxellist_last` (and `i <=
+    // vertexlist_last` below), which reads one entry past the stored ones (a -1 of the
+    // re-initialised list, or the next list's first entry when the list is full); ours, `<`,
+    // reads exactly the stored entries
     int voxellist_last = start + raycontains[threadID];
     int j = start;
     for (; j < voxellist_last; j++) {
@@ -34,6 +38,10 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
                 if (tri == lastTriID) continue;
                 float t, u, v;
                 tests++;
+                // ours: equal distances go to the lower triangle id (Listing 22 does not say).
+                // The build fills a voxel's list in no fixed order (atomicCompSwap), so
+                // without it a tie would pick a triangle at random; with it, as Listing 12's
+                // loop in id order
                 if (intersectTriangle(ro, rd, vertex[3 * tri].xyz, vertex[3 * tri + 1].xyz,
                                       vertex[3 * tri + 2].xyz, t, u, v)
                     && (t < t_min || (t == t_min && tri < triID))) {

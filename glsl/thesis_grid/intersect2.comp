@@ -16,6 +16,7 @@ bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTri
 {
     int threadID = storePos.y * imageSize(rayOriginTexture).x + storePos.x;
     int start = threadID * ray_array_length;
+    // `<`, not Listing 22's `<=` (see thesis_grid/intersect1.comp)
     int voxellist_last = start + raycontains[threadID];
     int j = start;
     bool shadow = false;

@@ -31,10 +31,15 @@ uint overflows = 0u;
 uint truncated = 0u;
 
 // Listing 21: store a voxel id in the ray's list (empty voxels are skipped by the caller)
+// Two deviations: the listing's overflow check `voxelListCounter <= ray_array_length` lets
+// one entry past the list be written (into the next ray's list); ours is `<`. And the listing
+// increments voxelListCounter even when the list is full, so raycontains would count voxels
+// that were never stored and Listing 22 would read past the list; ours counts stored voxels
+// only and the dropped ones in ray_list_overflows.
 void storeVoxelID(int voxID)
 {
     if (voxID >= 0) {
-        // catch an overflow of the list (the listing's `<=` wrote one entry too many)
+        // catch an overflow of the list
         if (voxelListCounter < ray_array_length) {
             int i = start + voxelListCounter;
             rayslist[i] = voxID;
@@ -76,8 +81,8 @@ void walkRay(ivec2 storePos)
     vec2 span = clipToGrid(rog, rdg);
     float t0 = max(span.x, 0.0), t1 = min(span.y, tEnd);
     if (t0 > t1) return;
-    vec3 a = rog + t0 * rdg, b = rog + t1 * rdg;
-    traverseConnection(a, b, clampVoxel(getVoxel(a)), clampVoxel(getVoxel(b)));
+    vec3 p0 = rog + t0 * rdg, p1 = rog + t1 * rdg;
+    traverseConnection(p0, p1, clampVoxel(getVoxel(p0)), clampVoxel(getVoxel(p1)));
 }
 
 void main()
@@ -88,7 +93,10 @@ void main()
         int threadID = storePos.y * imageSize(rayOriginTexture).x + storePos.x;
         start = threadID * ray_array_length;
         walkRay(storePos);
-        // the fill level of the ray's list
+        // the fill level of the ray's list. The thesis re-initialises rayslist and raycontains
+        // before every traversal (ch. 3.2.4); ours does not clear rayslist: raycontains is
+        // written for every pixel (0 for an inactive ray) and the intersection kernels read
+        // only the entries below it, so stale entries are never read
         raycontains[threadID] = voxelListCounter;
     }
     countAdd(0, overflows);

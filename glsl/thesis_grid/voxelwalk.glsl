@@ -8,18 +8,20 @@
 // at most N crossings per axis
 #define MAX_CROSSINGS (3 * voxel_amount + 3)
 
-// Walk the grid-space segment a -> b, starting in voxel vox_min and ending in vox_max
-// (both inside the grid). The start voxel is stored first, as the thesis does separately.
-void traverseConnection(vec3 a, vec3 b, ivec3 vox_min, ivec3 vox_max)
+// Walk the grid-space segment p0 -> p1 (the thesis' r0 and r(t_max); t_max = 1), starting in
+// voxel vox_min and ending in vox_max (both inside the grid). The start voxel is stored first,
+// as the thesis does separately. Algorithm 2's `a` (2 / voxel_amount, the voxel edge) is
+// vx_edge here (Listing 19's name).
+void traverseConnection(vec3 p0, vec3 p1, ivec3 vox_min, ivec3 vox_max)
 {
     float t_list[MAX_CROSSINGS];
     int dimension[MAX_CROSSINGS];
     int count = 0;
-    vec3 rd = b - a;
+    vec3 rd = p1 - p0;
     const float t_max = 1.0;
 
     // Algorithm 2, once per coordinate axis: the parameters t of the crossings with the voxel
-    // planes x = i·a - 1 between the start and the end voxel
+    // planes x = i·a - 1 (a = vx_edge) between the start and the end voxel
     for (int d = 0; d < 3; d++) {
         if (rd[d] == 0.0) continue;
         int direction = rd[d] > 0.0 ? 1 : -1;
@@ -27,7 +29,9 @@ void traverseConnection(vec3 a, vec3 b, ivec3 vox_min, ivec3 vox_max)
         int j = vox_max[d];
         if (rd[d] > 0.0) { i++; j++; }
         while (i != j && count < MAX_CROSSINGS) {
-            float t = (float(i) * vx_edge - 1.0 - a[d]) / rd[d];
+            // Algorithm 2 prints t = (i·a − 1 − rd_x) / rd_x: the ray's origin, not its
+            // direction, is subtracted (solving r0_x + t·rd_x = i·a − 1 for t, Fig. 11)
+            float t = (float(i) * vx_edge - 1.0 - p0[d]) / rd[d];
             // Algorithm 2 keeps t <= t_max; the planes between the start and the end voxel
             // are all crossed, so a t rounded just above t_max is clamped, not dropped (else
             // the walk would end one voxel short)
@@ -36,6 +40,8 @@ void traverseConnection(vec3 a, vec3 b, ivec3 vox_min, ivec3 vox_max)
                 dimension[count] = d;
                 count++;
             }
+            // Algorithm 2 prints i = i + direction·a; i counts planes, a is a length: the next
+            // plane is i + direction
             i += direction;
         }
     }

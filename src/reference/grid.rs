@@ -173,18 +173,20 @@ impl GridSpace {
         }
     }
 
-    /// Algorithms 2 and 3: the voxels the segment a -> b passes, in order, from vox_min to
+    /// Algorithms 2 and 3: the voxels the segment p0 -> p1 passes, in order, from vox_min to
     /// vox_max (start voxel first). Equal crossing parameters (the segment passes a voxel edge
     /// or corner, Fig. 13): the moves along axes with positive direction are made together
-    /// first, then those with negative direction.
+    /// first, then those with negative direction. Algorithm 2's `a` is the voxel edge
+    /// (`vx_edge`); its printed `t = (i·a − 1 − rd_x)/rd_x` and `i = i + direction·a` are
+    /// corrected as in `glsl/thesis_grid/voxelwalk.glsl` (origin p0, step 1).
     pub fn traverse_connection(
         &self,
-        a: Vec3,
-        b: Vec3,
+        p0: Vec3,
+        p1: Vec3,
         vox_min: IVec3,
         vox_max: IVec3,
     ) -> Vec<IVec3> {
-        let rd = b - a;
+        let rd = p1 - p0;
         let t_max = 1.0f32;
         let mut list: Vec<(f32, usize)> = Vec::new();
         for d in 0..3 {
@@ -198,7 +200,7 @@ impl GridSpace {
                 j += 1;
             }
             while i != j {
-                let t = (i as f32 * self.vx_edge() - 1.0 - a[d]) / rd[d];
+                let t = (i as f32 * self.vx_edge() - 1.0 - p0[d]) / rd[d];
                 if i >= 0 {
                     list.push((t.min(t_max), d));
                 }

@@ -275,7 +275,9 @@ impl RayTracer {
         k.set_vec4("backgroundColor", self.lighting.background, 1.0);
         k.set_i32("storePrimaryHit", (pass == 0) as i32);
         k.dispatch_pixels(f.timers, f.pixels);
-        // the shadow flags of this pass
+        // the shadow flags of this pass: cleared before every pass (the thesis, ch. 3.1.3,
+        // clears the textures once a frame; intersect2 only sets flags, so a reflection pass
+        // would inherit the flags of the pass before it)
         self.images.shadow.clear(&self.gl);
         for light in 0..self.lighting.lights {
             let k = self.accel.any_hit(&mut f, light);
