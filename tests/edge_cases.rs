@@ -236,3 +236,141 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
         assert!(tied.iter().all(|&k| k > 40), "{name}: {tied:?} tied pixels");
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// shadow feelers: from the offset to the light
+
+/// A floor of 32×32 quads at y = 0, a point light at (0, 1, 0), `shadow_offset = 0.5`, and
+/// four occluders (all small triangles, so that the thesis grid's edge-only lists hold them):
+/// - beyond the light: a 6×6-quad roof at y = 1.5 that every visible floor point's feeler would
+///   meet past the light (the camera looks past it);
+/// - just before the light: a triangle at y = 0.85 (its shadow lands near (1, 0, 1)), and
+///   just beyond it a small cap at y = 1.1 that all feelers would meet: a BVH puts the two in
+///   one leaf whose box holds the light, so the bound on t is what keeps the cap out (a walk
+///   that skips boxes beyond the light never sees the roof);
+/// - nearer than the offset: a triangle at y = 0.25 that the feelers from the floor beyond it
+///   meet at t ≈ 0.4 < 0.5;
+/// - just beyond the offset: a triangle at y = 0.35 met at t ≈ 0.6 > 0.5.
+fn light_scene(dir: &Path) -> Scene {
+    let mut grid = |y: f32, x0: f32, z0: f32, x1: f32, z1: f32, n: usize| {
+        let mut s = String::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, z) = (
+                    x0 + (x1 - x0) * i as f32 / n as f32,
+                    z0 + (z1 - z0) * j as f32 / n as f32,
+                );
+                s += &format!("v {x:?} {y:?} {z:?}\n");
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let k = j * (n + 1) + i + 1;
+                let (a, b, c, d) = (k, k + 1, k + n + 2, k + n + 1);
+                s += &format!("f {a} {d} {c}\nf {a} {c} {b}\n");
+            }
+        }
+        s
+    };
+    let floor = grid(0.0, -3.0, -3.0, 3.0, 3.0, 32);
+    let roof = grid(1.5, -1.5, -1.5, 1.5, 0.9, 6);
+    let small = |c: Vec3, r: f32| {
+        tri_obj([
+            c + Vec3::new(-r, 0.0, -r),
+            c + Vec3::new(-r, 0.0, r),
+            c + Vec3::new(r, 0.0, 0.0),
+        ])
+    };
+    let objects = vec![
+        (floor, [0.8, 0.8, 0.8]),
+        (roof, [0.8, 0.2, 0.2]),
+        (small(Vec3::new(0.15, 0.85, 0.15), 0.04), [0.2, 0.8, 0.2]),
+        (small(Vec3::new(0.0, 1.1, 0.0), 0.2), [0.8, 0.2, 0.8]),
+        (small(Vec3::new(0.0, 0.25, 1.0), 0.35), [0.2, 0.2, 0.8]),
+        (small(Vec3::new(0.75, 0.35, 0.5), 0.25), [0.8, 0.8, 0.2]),
+    ];
+    let head = "[camera]\nposition = [0.0, 3.0, 4.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 50.0\n\
+                [render]\nambient = [0.2, 0.2, 0.2]\nshadow_offset = 0.5\n\
+                [[light]]\nposition = [0.0, 1.0, 0.0]\n";
+    scene_of(dir, head, &objects)
+}
+
+/// What the feeler from `p` (on triangle `skip`) to `light` meets, in f64: `None` if some
+/// triangle is met within 1e-3 of one of its edges or within 1e-3 of the offset or the light
+/// (too close to call); else the distances of the triangles met, beyond t = 0.05 (the floor's
+/// neighbours of `skip` lie at t ≈ 0).
+fn feeler(p: Vec3, light: Vec3, skip: usize, tris: &[[Vec3; 3]], offset: f64) -> Option<Vec<f64>> {
+    let (o, to) = (p.as_dvec3(), light.as_dvec3() - p.as_dvec3());
+    let (d, dist) = (to.normalize(), to.length());
+    let mut met = Vec::new();
+    for (j, t) in tris.iter().enumerate() {
+        let Some((tj, u, v)) = line_hit(o, d, t) else {
+            continue;
+        };
+        if j == skip || tj < 0.05 {
+            continue;
+        }
+        let inside = u.min(v).min(1.0 - u - v);
+        if inside.abs() < 1e-3 {
+            return None;
+        }
+        if inside > 0.0 {
+            if (tj - offset).abs() < 1e-3 || (tj - dist).abs() < 1e-3 {
+                return None;
+            }
+            met.push(tj / dist);
+        }
+    }
+    Some(met)
+}
+
+#[test]
+fn shadow_feelers_run_from_the_offset_to_the_light_on_every_tracer() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = light_scene(dir.path());
+    let tris = scene.world_triangles();
+    let floor = 2 * 32 * 32;
+    let light = scene.lights[0].position;
+    let offset = scene.settings.shadow_offset as f64;
+    let ctx = context();
+    for (name, opts) in every_tracer(8) {
+        let gpu = render(&ctx, &scene, opts);
+        let a = gpu.aovs.as_ref().unwrap();
+        let shadow = a.shadow.as_ref().unwrap();
+        // pixels on the floor whose feeler meets: only the roof beyond the light, the occluder
+        // just before the light, only the one nearer than the offset, the one beyond it
+        let (mut beyond, mut before, mut under, mut over) = (0, 0, 0, 0);
+        for i in 0..shadow.len() {
+            let id = a.triangle_id[i];
+            if id < 0 || id as usize >= floor {
+                continue;
+            }
+            let p = Vec3::from(a.ray_origin[i]) + a.hit_t[i] * Vec3::from(a.ray_direction[i]);
+            let Some(met) = feeler(p, light, id as usize, &tris, offset) else {
+                continue;
+            };
+            let dist = (light - p).length() as f64;
+            let blocked = met.iter().any(|&s| s * dist > offset && s < 1.0);
+            assert_eq!(
+                shadow[i] == 0.0,
+                blocked,
+                "{name}: pixel {i} at {p}: feeler meets {met:?} (fractions of the way to the light), \
+                 shadow share {}",
+                shadow[i]
+            );
+            beyond += (met.iter().all(|&s| s > 1.0) && !met.is_empty()) as usize;
+            before += met.iter().any(|&s| s > 0.8 && s < 1.0) as usize;
+            under += (!blocked && met.iter().any(|&s| s * dist < offset)) as usize;
+            over += met.iter().any(|&s| s * dist > offset && s < 0.5) as usize;
+        }
+        eprintln!("{name}: beyond {beyond}, before the light {before}, under the offset {under}, over it {over}");
+        assert!(beyond > 1000, "{name}: {beyond} feelers meet the roof");
+        for (k, what) in [
+            (before, "before the light"),
+            (under, "under"),
+            (over, "over"),
+        ] {
+            assert!(k > 10, "{name}: {k} pixels with an occluder {what}");
+        }
+    }
+}
