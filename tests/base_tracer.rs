@@ -30,14 +30,12 @@ fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
     let cpu = render_cpu(&scene, &opts);
     assert_eq!(cpu.intersect1_tests, (w * h) as u64 * 69451);
     assert_close(&gpu, &cpu, "bunny");
-    // shadow feelers: any-hit with early exit; the counts agree with the reference up to the
-    // few pixels whose decisions differ in the last bits
+    // shadow feelers: any-hit with early exit over the triangles in id order, on the GPU as on
+    // the CPU, so the counts are equal (they were equal before, under a 1 % tolerance that let
+    // a planted 1.1 % change of the shadow offset through)
     let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
     assert!(g2 > 0);
-    assert!(
-        (g2 as f64 - c2 as f64).abs() <= 0.01 * c2 as f64,
-        "intersect2 {g2} vs {c2}"
-    );
+    assert_eq!(g2, c2, "intersect2 tests");
     for k in [
         "eye_ray_generation",
         "intersect1",

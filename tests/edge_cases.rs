@@ -217,12 +217,12 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
         };
         // every pixel clearly inside a group: the lowest id there, on the GPU and the CPU
         let mut tied = [0usize; 3];
-        for i in 0..a.triangle_id.len() {
+        for (i, &cpu_id) in cpu_ids.iter().enumerate() {
             let (o, d) = (Vec3::from(a.ray_origin[i]), Vec3::from(a.ray_direction[i]));
             let Some(Some(want)) = lowest_containing(o, d, &ties) else {
                 continue;
             };
-            for (side, got) in [("GPU", a.triangle_id[i]), ("CPU", cpu_ids[i])] {
+            for (side, got) in [("GPU", a.triangle_id[i]), ("CPU", cpu_id)] {
                 assert_eq!(got, want, "{name}: {side}: pixel {i}");
             }
             // a pixel inside two triangles of the group
@@ -252,7 +252,7 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
 ///   meet at t ≈ 0.4 < 0.5;
 /// - just beyond the offset: a triangle at y = 0.35 met at t ≈ 0.6 > 0.5.
 fn light_scene(dir: &Path) -> Scene {
-    let mut grid = |y: f32, x0: f32, z0: f32, x1: f32, z1: f32, n: usize| {
+    let grid = |y: f32, x0: f32, z0: f32, x1: f32, z1: f32, n: usize| {
         let mut s = String::new();
         for j in 0..=n {
             for i in 0..=n {
@@ -340,7 +340,7 @@ fn shadow_feelers_run_from_the_offset_to_the_light_on_every_tracer() {
         // pixels on the floor whose feeler meets: only the roof beyond the light, the occluder
         // just before the light, only the one nearer than the offset, the one beyond it
         let (mut beyond, mut before, mut under, mut over) = (0, 0, 0, 0);
-        for i in 0..shadow.len() {
+        for (i, &share) in shadow.iter().enumerate() {
             let id = a.triangle_id[i];
             if id < 0 || id as usize >= floor {
                 continue;
@@ -352,11 +352,11 @@ fn shadow_feelers_run_from_the_offset_to_the_light_on_every_tracer() {
             let dist = (light - p).length() as f64;
             let blocked = met.iter().any(|&s| s * dist > offset && s < 1.0);
             assert_eq!(
-                shadow[i] == 0.0,
+                share == 0.0,
                 blocked,
                 "{name}: pixel {i} at {p}: feeler meets {met:?} (fractions of the way to the light), \
                  shadow share {}",
-                shadow[i]
+                share
             );
             beyond += (met.iter().all(|&s| s > 1.0) && !met.is_empty()) as usize;
             before += met.iter().any(|&s| s > 0.8 && s < 1.0) as usize;

@@ -121,7 +121,8 @@ fn floor_is_a_closed_grid_of_quads() {
         );
         (g.x.round() as i32, g.z.round() as i32)
     };
-    let mut edges: HashMap<((i32, i32), (i32, i32)), i32> = HashMap::new();
+    type Edge = ((i32, i32), (i32, i32));
+    let mut edges: HashMap<Edge, i32> = HashMap::new();
     let mut area = 0.0f64;
     for t in mesh.positions.chunks(3) {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
