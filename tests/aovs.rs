@@ -152,3 +152,111 @@ fn shadow_aov_is_the_share_of_unblocked_lights() {
         }
     }
 }
+
+/// Four tilted triangles of different sizes, each its own OBJ (so its vertex normals are its
+/// face normal), none mirrored by another: top left big, bottom right small, and two between.
+/// Their normals have three different components, so swapped channels show.
+fn tilted_scene(dir: &std::path::Path) -> gpgpu_rt::scene::Scene {
+    let tris: [[[f32; 3]; 3]; 4] = [
+        [[-2.0, 0.2, 0.0], [-0.4, 1.8, -0.6], [-1.8, 1.9, 0.5]],
+        [[0.6, -1.0, 0.3], [1.6, -1.9, -0.2], [1.5, -0.6, 0.4]],
+        [[-0.9, -1.6, -0.8], [0.3, -0.4, 0.1], [-1.2, -0.2, 0.6]],
+        [[0.2, 0.3, 0.9], [1.9, 0.5, -0.7], [0.8, 1.7, 0.2]],
+    ];
+    let mut toml =
+        "[camera]\nposition = [0.3, 0.4, 6.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\
+                    [[light]]\nposition = [2.0, 3.0, 4.0]\n"
+            .to_string();
+    for (k, t) in tris.iter().enumerate() {
+        let obj: String = t
+            .iter()
+            .map(|v| format!("v {:?} {:?} {:?}\n", v[0], v[1], v[2]))
+            .collect();
+        std::fs::write(dir.join(format!("t{k}.obj")), obj + "f 1 2 3\n").unwrap();
+        toml += &format!("[[object]]\ntype = \"obj\"\npath = \"t{k}.obj\"\n");
+    }
+    std::fs::write(dir.join("scene.toml"), toml).unwrap();
+    gpgpu_rt::scene::Scene::load(&dir.join("scene.toml")).unwrap()
+}
+
+/// What each AOV means, on an asymmetric scene, for the four-kernel pipeline and Wagner's:
+/// `triangle_id` is the triangle the CPU camera's ray of that image row and column meets first
+/// (cast here in f64: so rows and columns are in image order), `hit_t` the distance along the
+/// pixel's ray to that triangle's plane, `normal` that triangle's face normal (up to its sign).
+#[test]
+fn aovs_mean_the_first_triangle_its_distance_and_its_normal() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tilted_scene(dir.path());
+    let tris = scene.world_triangles();
+    let ctx = context();
+    let (w, h) = (48u32, 40u32);
+    for variant in [accel::BvhVariant::Sah, accel::BvhVariant::Wagner] {
+        let opts = RenderOptions {
+            bvh_variant: variant,
+            ..bvh_options(w, h)
+        };
+        let shaders = gpgpu_rt::gl::ShaderSource::default();
+        let mut r =
+            gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
+                .unwrap();
+        let f = r.render(&scene.camera).unwrap();
+        let a = f.aovs.as_ref().unwrap();
+        let cam = scene.camera.rays(w, h);
+        let mut seen = [0usize; 4];
+        for row in 0..h {
+            for x in 0..w {
+                let i = (row * w + x) as usize;
+                let (o, d) = cam.primary_ray(x, h - 1 - row);
+                let (o, d) = (o.as_dvec3(), d.as_dvec3());
+                // the first triangle along the CPU's ray, unless it passes near an edge
+                let mut first: Option<(f64, usize)> = None;
+                let mut near_edge = false;
+                for (k, t) in tris.iter().enumerate() {
+                    let [p0, p1, p2] = t.map(|v| v.as_dvec3());
+                    let (e1, e2) = (p1 - p0, p2 - p0);
+                    let n = e1.cross(e2);
+                    let tt = n.dot(p0 - o) / n.dot(d);
+                    let (u, v, _) = on_triangle((o + tt * d).as_vec3(), t);
+                    let inside = u.min(v).min(1.0 - u - v);
+                    near_edge |= inside.abs() < 1e-3;
+                    if inside > 0.0 && tt > 0.0 && first.is_none_or(|(ft, _)| tt < ft) {
+                        first = Some((tt, k));
+                    }
+                }
+                if near_edge {
+                    continue;
+                }
+                let id = a.triangle_id[i];
+                assert_eq!(
+                    id,
+                    first.map_or(-1, |(_, k)| k as i32),
+                    "{variant:?}: pixel ({x}, {row})"
+                );
+                let Some((_, k)) = first else { continue };
+                seen[k] += 1;
+                // hit_t: along the GPU's own ray to the triangle's plane
+                let [p0, p1, p2] = tris[k].map(|v| v.as_dvec3());
+                let n = (p1 - p0).cross(p2 - p0).normalize();
+                let (go, gd) = (
+                    Vec3::from(a.ray_origin[i]).as_dvec3(),
+                    Vec3::from(a.ray_direction[i]).as_dvec3(),
+                );
+                let want_t = n.dot(p0 - go) / n.dot(gd);
+                let t = a.hit_t[i] as f64;
+                assert!(
+                    (t - want_t).abs() < 1e-5 * want_t,
+                    "{variant:?}: pixel ({x}, {row}): hit_t {t} vs {want_t}"
+                );
+                // normal: the face normal, either way round
+                let got = Vec3::from(a.normal[i]).as_dvec3();
+                let d = (got - n).length().min((got + n).length());
+                assert!(
+                    d < 1e-5,
+                    "{variant:?}: pixel ({x}, {row}): normal {got} vs face normal {n} of {k}"
+                );
+            }
+        }
+        eprintln!("{variant:?}: pixels per triangle {seen:?}");
+        assert!(seen.iter().all(|&s| s > 20), "{variant:?}: {seen:?}");
+    }
+}
