@@ -470,7 +470,8 @@ fn soft_shadow_kernel_edit_reloads_live() {
 #[test]
 fn bad_view_input_fails_cleanly() {
     // no display needed: these fail before a window is opened
-    let run = |args: &[&str]| {
+    // exit status 1 for bad input, 2 for a command line clap refuses (a value out of its range)
+    let run_status = |args: &[&str], status: i32| {
         let out = Command::new(BIN)
             .current_dir(root())
             .arg("view")
@@ -479,14 +480,16 @@ fn bad_view_input_fails_cleanly() {
             .unwrap();
         assert_eq!(
             out.status.code(),
-            Some(1),
+            Some(status),
             "{args:?}: {}",
             text(&out.stderr)
         );
         text(&out.stderr)
     };
+    let run = |args: &[&str]| run_status(args, 1);
     assert!(run(&["scenes/missing.toml"]).contains("missing.toml"));
-    assert!(run(&["scenes/teapot1.toml", "--frames", "0"]).contains("--frames"));
+    let e = run_status(&["scenes/teapot1.toml", "--frames", "0"], 2);
+    assert!(e.contains("--frames") && e.contains("1..=100000"), "{e}");
     assert!(run(&["scenes/teapot1.toml", "--wait-reload", "--frames", "1"]).contains("--glsl-dir"));
     assert!(run(&["scenes/teapot1.toml", "--screenshot", "x.jpg"]).contains(".png"));
     assert!(run(&["scenes/teapot1.toml", "--glsl-dir", "no/such/dir"]).contains("no/such/dir"));
