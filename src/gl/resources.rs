@@ -289,21 +289,29 @@ pub struct TexelData<'a> {
     pub unit: u32,
 }
 
-impl TexelData<'static> {
-    /// `bytes` (copied) as texels of `format` (`texel_bytes` each), for sampler slot `unit`.
+impl<'a> TexelData<'a> {
+    /// `bytes` (borrowed) as texels of `format` (`texel_bytes` each), for sampler slot `unit`.
     pub fn new(
         name: &'static str,
         format: u32,
         texel_bytes: usize,
-        bytes: &[u8],
+        bytes: &'a [u8],
         unit: u32,
     ) -> Self {
         TexelData {
             name,
             format,
             texel_bytes,
-            bytes: bytes.to_vec().into(),
+            bytes: bytes.into(),
             unit,
+        }
+    }
+
+    /// The same data, owning its bytes (to outlive the buffer it was made from).
+    pub fn into_owned(self) -> TexelData<'static> {
+        TexelData {
+            bytes: self.bytes.into_owned().into(),
+            ..self
         }
     }
 }

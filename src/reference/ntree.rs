@@ -153,14 +153,10 @@ pub fn shaft_hits_box(a: &Aabb, b: &Aabb, c: &Aabb) -> bool {
     tl < th
 }
 
-/// The line space of a node from the geometry flags of its N³ children (index x + N(y + Nz)):
-/// one bit per pair of boundary cells, 32 to a word. Hierarchical: a shaft between two
-/// rectangles of cells contains the shafts of all pairs of cells in them, so a child that
-/// misses the big shaft misses all the small ones; the rectangles are halved until single
-/// cells remain (the thesis ORs one mask per filled child, Fig. 5 — the bits are the same).
-pub fn build_linespace(n: u32, filled: &[bool]) -> Vec<u32> {
+/// The boxes of the filled ones of N³ children (index x + N(y + Nz)), in index order.
+fn filled_cells(n: u32, filled: &[bool]) -> Vec<Aabb> {
     let nn = n as usize;
-    let children: Vec<Aabb> = (0..nn * nn * nn)
+    (0..nn * nn * nn)
         .filter(|&i| filled[i])
         .map(|i| {
             Aabb::cell(
@@ -169,7 +165,16 @@ pub fn build_linespace(n: u32, filled: &[bool]) -> Vec<u32> {
                 (i / (nn * nn)) as u32,
             )
         })
-        .collect();
+        .collect()
+}
+
+/// The line space of a node from the geometry flags of its N³ children (index x + N(y + Nz)):
+/// one bit per pair of boundary cells, 32 to a word. Hierarchical: a shaft between two
+/// rectangles of cells contains the shafts of all pairs of cells in them, so a child that
+/// misses the big shaft misses all the small ones; the rectangles are halved until single
+/// cells remain (the thesis ORs one mask per filled child, Fig. 5 — the bits are the same).
+pub fn build_linespace(n: u32, filled: &[bool]) -> Vec<u32> {
+    let children = filled_cells(n, filled);
     let mut words = vec![0u32; linespace_words(n)];
     if children.is_empty() {
         return words;
@@ -260,18 +265,8 @@ fn subdivide(
 /// The brute-force line space: every entry against every filled child (the tests' oracle for
 /// [`build_linespace`]).
 pub fn build_linespace_brute_force(n: u32, filled: &[bool]) -> Vec<u32> {
-    let nn = n as usize;
     let mut words = vec![0u32; linespace_words(n)];
-    let children: Vec<Aabb> = (0..nn * nn * nn)
-        .filter(|&i| filled[i])
-        .map(|i| {
-            Aabb::cell(
-                (i % nn) as u32,
-                ((i / nn) % nn) as u32,
-                (i / (nn * nn)) as u32,
-            )
-        })
-        .collect();
+    let children = filled_cells(n, filled);
     for s in 0..FACES {
         for e in 0..FACES {
             if s == e {

@@ -24,7 +24,6 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Result};
 use glam::{Mat4, Vec3};
-use glow::HasContext;
 use serde_json::json;
 
 use self::gbuffer::GBuffer;
@@ -130,20 +129,12 @@ pub struct SoftShadowRenderer {
     last: Option<(Camera, FrameStats)>,
 }
 
-/// Pack the tree's line spaces into the 3D texture layout of Listing 3 and check the node
-/// pool against the texture-buffer limit.
-fn pack(gl: &Gl, info: &GlInfo, tree: &NTree) -> Result<PackedLinespaces> {
+/// Pack the tree's line spaces into the 3D texture layout of Listing 3 (the node pool's
+/// texture buffer checks its own limit when it is made).
+fn pack(info: &GlInfo, tree: &NTree) -> Result<PackedLinespaces> {
     let words = ntree::linespace_words(tree.n);
     let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
     let packed = ntree::pack_linespaces(&tree.linespaces, words, tree.linespace_count, max_dim)?;
-    // SAFETY: a limit query on a current context.
-    let max_tb = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
-    if tree.nodes.len() as i64 > max_tb {
-        bail!(
-            "the node pool has {} nodes, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max_tb} texels",
-            tree.nodes.len()
-        );
-    }
     log::info!(
         "N-tree N={} depth={}: {} node groups, {} leaves, {} line spaces ({} bytes), built in {:.0} + {:.0} ms",
         tree.n,
@@ -190,7 +181,7 @@ impl SoftShadowRenderer {
             bail!("width and height must be positive");
         }
         let pixels = PixelGrid::new(options.width, options.height, options.tile)?;
-        let packed = pack(&gl, info, &tree)?;
+        let packed = pack(info, &tree)?;
         let samples = (options.samples_u, options.samples_v);
         let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples)?;
         let (w, h) = (options.width, options.height);

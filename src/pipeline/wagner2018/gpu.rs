@@ -26,7 +26,9 @@ pub struct SceneTextures {
 fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TexelData<'static>; 6] {
     let vertices: Vec<Vec3> = bvh.triangles.iter().flatten().copied().collect();
     let tri_ids: Vec<i32> = bvh.tri_ids.iter().map(|&i| i as i32).collect();
-    let data = TexelData::new;
+    let data = |name, format, texel_bytes, bytes: &[u8], unit| {
+        TexelData::new(name, format, texel_bytes, bytes, unit).into_owned()
+    };
     let float4 = |name, v: &[Vec3], unit| {
         let texels = float4(v);
         data(name, glow::RGBA32F, 16, bytemuck::cast_slice(&texels), unit)
