@@ -23,7 +23,9 @@ void traverseConnection(vec3 p0, vec3 p1, ivec3 vox_min, ivec3 vox_max)
     // Algorithm 2, once per coordinate axis: the parameters t of the crossings with the voxel
     // planes x = i·a - 1 (a = vx_edge) between the start and the end voxel
     for (int d = 0; d < 3; d++) {
-        if (rd[d] == 0.0) continue;
+        // ours: `!(x > 0 || x < 0)` skips a NaN component as well as 0 (the loop below ends
+        // because i moves towards j, which holds for every finite rd; a NaN would walk i away)
+        if (!(rd[d] > 0.0 || rd[d] < 0.0)) continue;
         int direction = rd[d] > 0.0 ? 1 : -1;
         int i = vox_min[d];
         int j = vox_max[d];

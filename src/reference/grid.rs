@@ -190,7 +190,8 @@ impl GridSpace {
         let t_max = 1.0f32;
         let mut list: Vec<(f32, usize)> = Vec::new();
         for d in 0..3 {
-            if rd[d] == 0.0 {
+            // a NaN component is skipped as 0 is (as the kernel: voxelwalk.glsl)
+            if rd[d] == 0.0 || rd[d].is_nan() {
                 continue;
             }
             let direction = if rd[d] > 0.0 { 1 } else { -1 };

@@ -63,7 +63,7 @@ impl WagnerCamera {
         let r = camera.rays(width, height);
         WagnerCamera {
             position: r.cam_position,
-            direction: r.cam_img_position - r.cam_position,
+            direction: r.cam_img_offset,
             x_direction: r.cam_width.normalize(),
             y_direction: r.cam_height.normalize(),
             x_scale: r.cam_width.length() * width as f32,

@@ -36,6 +36,11 @@ fn default_near() -> f32 {
 pub struct CameraRays {
     pub cam_position: Vec3,
     pub cam_img_position: Vec3,
+    /// `cam_img_position − cam_position`, computed in f64 and rounded once: the rays'
+    /// directions are built from it, not from the difference of two rounded world positions
+    /// (which loses the image plane entirely once the camera's coordinates exceed about
+    /// `near / 2⁻²³`, e.g. 0.05 / 1.2e-7 ≈ 4e5 with the default near distance).
+    pub cam_img_offset: Vec3,
     pub cam_width: Vec3,
     pub cam_height: Vec3,
     pub width: u32,
@@ -97,6 +102,7 @@ impl Camera {
         CameraRays {
             cam_position: f(pos),
             cam_img_position: f(top_left),
+            cam_img_offset: f(top_left - pos),
             cam_width: f(right * (2.0 * half_w / width as f64)),
             cam_height: f(-up * (2.0 * half_h / height as f64)),
             width,
@@ -106,15 +112,16 @@ impl Camera {
 }
 
 impl CameraRays {
-    /// The primary ray of pixel (x, y), y = 0 the bottom row, exactly as Listing 11 computes it
-    /// in f32 (the CPU reference uses this; the kernel does the same arithmetic).
+    /// The primary ray of pixel (x, y), y = 0 the bottom row, exactly as the eye-ray kernel
+    /// computes it in f32 (the CPU reference uses this): the origin on the image plane as
+    /// Listing 11, the direction from the camera-relative offset (see `cam_img_offset`).
     pub fn primary_ray(&self, x: u32, y: u32) -> (Vec3, Vec3) {
         let xf = x as f32;
         let yf = y as f32;
-        let pixel = self.cam_img_position
-            + (xf + 0.5) * self.cam_width
-            + (self.height as f32 - yf - 0.5) * self.cam_height;
-        (pixel, (pixel - self.cam_position).normalize())
+        let across =
+            (xf + 0.5) * self.cam_width + (self.height as f32 - yf - 0.5) * self.cam_height;
+        let pixel = self.cam_img_position + across;
+        (pixel, (self.cam_img_offset + across).normalize())
     }
 }
 

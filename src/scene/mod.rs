@@ -3,6 +3,7 @@
 //! with a transform and a material. See `scenes/*.toml` and the README for the format.
 
 pub mod camera;
+pub mod magnitudes;
 pub mod mesh;
 pub mod shadows;
 pub mod shapes;
@@ -367,6 +368,7 @@ impl Scene {
             })?;
             scene.objects.push(object);
         }
+        magnitudes::check(&scene)?;
         Ok(scene)
     }
 

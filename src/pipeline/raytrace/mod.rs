@@ -256,8 +256,8 @@ impl RayTracer {
     fn eye_rays(&mut self, cam: &CameraRays) {
         let k = &self.kernels.eye_ray_generation;
         k.use_program();
-        k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
         k.set_vec4("camImgPosition", cam.cam_img_position.into(), 1.0);
+        k.set_vec4("camImgOffset", cam.cam_img_offset.into(), 0.0);
         k.set_vec4("camWidth", cam.cam_width.into(), 0.0);
         k.set_vec4("camHeight", cam.cam_height.into(), 0.0);
         k.dispatch_pixels(&mut self.timers, self.pixels);
