@@ -50,10 +50,12 @@ pub struct ThesisGrid {
     frame: GridFrame,
     triangles: usize,
     build: Kernel,
+    order: Kernel,
     traversal: Kernel,
     intersect1: Kernel,
     intersect2: Kernel,
-    /// VerticesInVoxel in the thesis' GLSL, though it holds triangle ids (Listing 19)
+    /// VerticesInVoxel in the thesis' GLSL, though it holds triangle ids (Listing 19); in
+    /// ascending triangle id once the order pass has run
     voxelslist: Ssbo,
     /// ContainedVertices in the thesis' GLSL: the fill level of every voxel list
     voxelcontains: Ssbo,
@@ -83,6 +85,7 @@ impl ThesisGrid {
             gl: b.gl.clone(),
             triangles: scene.triangle_count(),
             build: b.kernel("thesis_grid/build.comp", &defs, "build")?,
+            order: b.kernel("thesis_grid/order.comp", &defs, "grid_order")?,
             traversal: b.kernel("thesis_grid/traversal.comp", &defs, "traversal")?,
             intersect1: b.kernel("thesis_grid/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("thesis_grid/intersect2.comp", &defs, "intersect2")?,
@@ -115,6 +118,16 @@ impl ThesisGrid {
         k.dispatch_pixels(f.timers, f.pixels);
     }
 
+    /// The order pass (`glsl/thesis_grid/order.comp`): every voxel's list sorted in place into
+    /// ascending triangle id, so that shadow feelers test the same triangles in every run.
+    fn order_lists(&self, f: &mut FrameContext) {
+        let k = &self.order;
+        k.use_program();
+        let voxels = self.frame.voxels() as u32;
+        k.set_i32("voxelTotal", voxels as i32);
+        k.dispatch_1d(f.timers, voxels.div_ceil(64));
+    }
+
     /// The voxel lists of the last build read back (triangle ids in storage order) and the
     /// mapping used. For tests and inspection.
     pub fn read_lists(&self, gl: &Gl) -> (Vec<Vec<i32>>, GridMapping) {
@@ -134,7 +147,8 @@ impl ThesisGrid {
 impl Accelerator for ThesisGrid {
     fn build(&mut self, f: &mut FrameContext) -> Result<()> {
         self.frame.update(f.models);
-        // Fig. 15: empty the lists, then the build kernel, every frame
+        // Fig. 15: empty the lists, then the build kernel, every frame; then the order pass
+        // (ours) sorts every list
         let (gl, list, contains) = (f.gl, &self.voxelslist, &self.voxelcontains);
         f.timers.time(gl, "grid_clear", || {
             list.clear_u32(gl, u32::MAX); // -1
@@ -145,6 +159,7 @@ impl Accelerator for ThesisGrid {
         self.frame.set_uniforms(&self.build);
         self.build
             .dispatch_1d(f.timers, (self.triangles as u32).div_ceil(128));
+        self.order_lists(f);
         Ok(())
     }
 
@@ -163,7 +178,7 @@ impl Accelerator for ThesisGrid {
     }
 
     fn stats(&self, stats: &mut FrameStats) {
-        let build: f64 = ["grid_clear", "build"]
+        let build: f64 = ["grid_clear", "build", "grid_order"]
             .iter()
             .filter_map(|k| stats.gpu_ms.get(*k))
             .sum();
