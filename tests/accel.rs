@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::{GridOptions, GridVariant, REGISTRY};
+use gpgpu_rt::accel::{GridOptions, REGISTRY};
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
