@@ -68,6 +68,7 @@ fn every_kernel_compiles_without_warnings() {
             samples_v: 2,
             ntree_n: 10,
             ntree_depth: 3,
+            shading: Default::default(),
             width: 8,
             height: 8,
             tile: 0,

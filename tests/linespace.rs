@@ -6,7 +6,7 @@ mod common;
 use glam::Vec3;
 use gpgpu_rt::frame::{Aovs, FrameStats};
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::ntree::{
     self, build_linespace, build_linespace_brute_force, entry_index, face_rect, get_bit,
@@ -224,6 +224,7 @@ fn opts(mode: ShadowMode, s: u32, w: u32) -> SoftShadowOptions {
         samples_v: s,
         ntree_n: 10,
         ntree_depth: 3,
+        shading: Default::default(),
         width: w,
         height: w,
         tile: 32,
@@ -572,4 +573,55 @@ fn scene_file_soft_shadow_defaults() {
     let e = Scene::load(&p).unwrap_err();
     assert_eq!(e.line, Some(5), "{e}");
     assert!(e.to_string().contains("area_light"), "{e}");
+}
+
+/// `--klee-shading fig7` is Fig. 7's product: every pixel's colour is its shadow value times
+/// the diffuse colour of its surface (one of the scene's three), black in full shadow; the
+/// default (`lit`) is not.
+#[test]
+fn fig7_shading_is_the_shadow_value_times_the_diffuse_colour() {
+    let ctx = common::context();
+    let scene = common::load("bunny_area.toml");
+    let shaders = ShaderSource::default();
+    let diffuse = [
+        Vec3::splat(0.75),
+        Vec3::splat(0.6),
+        Vec3::new(0.85, 0.8, 0.7),
+    ];
+    let mut off = [0usize; 2];
+    for (k, shading) in [KleeShading::Fig7, KleeShading::Lit]
+        .into_iter()
+        .enumerate()
+    {
+        let o = SoftShadowOptions {
+            shading,
+            ..opts(ShadowMode::Exact, 2, 48)
+        };
+        let mut r =
+            SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, o).unwrap();
+        let f = render(&mut r, &scene.camera).unwrap();
+        let (mut hits, mut dark) = (0, 0);
+        for (i, p) in f.gbuffer_position.iter().enumerate() {
+            if p[3] <= 0.0 {
+                continue;
+            }
+            hits += 1;
+            let (s, c) = (f.shadow[i], Vec3::from_slice(&f.color[i][..3]));
+            let fits = diffuse
+                .iter()
+                .any(|d| (c - s * *d).abs().max_element() < 1e-5);
+            off[k] += !fits as usize;
+            dark += (s == 0.0) as usize;
+        }
+        assert!(
+            hits > 1000 && dark > 20,
+            "{shading:?}: {hits} hits, {dark} in full shadow"
+        );
+    }
+    assert_eq!(off[0], 0, "fig7: pixels not s · diffuse");
+    assert!(
+        off[1] > 1000,
+        "lit: only {} pixels differ from s · diffuse",
+        off[1]
+    );
 }

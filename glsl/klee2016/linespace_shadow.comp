@@ -60,6 +60,7 @@ uniform vec3 lightEdgeU;
 uniform vec3 lightEdgeV;
 uniform vec3 lightColor;
 uniform vec3 ambient;
+uniform int fig7Shading;     // 1: Fig. 7's s · diffuse (--klee-shading fig7); 0: ours (lit)
 uniform float shadowOffset;
 uniform int tex_x_res;
 uniform int tex_y_res;
@@ -642,13 +643,15 @@ void main()
             float s = lit / float(NUM_RAYS);
             imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
             if (lastBatch) {
-                // Fig. 7 multiplies the shadow value into the diffuse colour; ours lights it
-                // with the light's colour and N·L plus the ambient light (not the thesis'
-                // plain product): diffuse · (ambient + light · s · max(N·L, 0)), back into the
-                // diffuse texture
+                // Fig. 7 multiplies the shadow value into the diffuse colour (fig7Shading);
+                // ours, the default, lights it with the light's colour and N·L plus the ambient
+                // light: diffuse · (ambient + light · s · max(N·L, 0)). Back into the diffuse
+                // texture either way
                 vec4 diffuse = imageLoad(diffuseTexture, storePos);
                 vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
-                vec3 c = diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
+                vec3 c = fig7Shading != 0
+                    ? s * diffuse.rgb
+                    : diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
                 imageStore(diffuseTexture, storePos, vec4(c, 1.0));
             }
         } else {

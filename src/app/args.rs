@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use gpgpu_rt::accel::{GridOptions, GridVariant};
 use gpgpu_rt::limits;
-use gpgpu_rt::pipeline::softshadow::SoftShadowOptions;
+use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions};
 use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
 
 #[derive(clap::Args)]
@@ -94,6 +94,10 @@ pub struct SoftShadowArgs {
     /// Levels of the N-tree including the root (3 in the thesis; 3 or 4).
     #[arg(long, default_value_t = 3, value_name = "D")]
     pub ntree_depth: u32,
+    /// How the shadow value s lights a pixel: `lit` (ours: diffuse · (ambient + light · s ·
+    /// N·L)) or `fig7` (Klee 2016's Fig. 7: s · diffuse).
+    #[arg(long, value_enum, default_value_t = KleeShading::Lit)]
+    pub klee_shading: KleeShading,
 }
 
 impl SoftShadowArgs {
@@ -123,6 +127,7 @@ impl SoftShadowArgs {
             samples_v: self.samples().1,
             ntree_n: self.ntree_n,
             ntree_depth: self.ntree_depth,
+            shading: self.klee_shading,
             width,
             height,
             tile,

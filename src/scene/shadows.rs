@@ -36,6 +36,20 @@ impl ShadowMode {
     }
 }
 
+/// `render --klee-shading`: how the shadow value lights a pixel (phase 2 of Fig. 7).
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum KleeShading {
+    /// Ours: diffuse · (ambient + light colour · s · max(N·L, 0)), N·L towards the light's
+    /// centre: the light's colour and angle show, and a fully shadowed pixel keeps the ambient.
+    #[default]
+    Lit,
+    /// Fig. 7 as printed: the shadow value s times the diffuse colour (black in full shadow).
+    Fig7,
+}
+
 /// Parse `UxV` (e.g. `5x5`) light samples.
 pub fn parse_samples(s: &str) -> Result<(u32, u32), String> {
     let (a, b) = s

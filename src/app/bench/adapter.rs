@@ -140,6 +140,7 @@ impl SoftShadows {
             samples_v: 2,
             ntree_n: 10,
             ntree_depth: 3,
+            shading: Default::default(),
             width: s.width,
             height: s.height,
             tile,

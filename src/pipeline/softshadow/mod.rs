@@ -34,6 +34,7 @@ use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
 use crate::reference::ntree::{self, NTree, PackedLinespaces};
+pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 
 pub use crate::scene::shadows::parse_samples;
@@ -52,6 +53,8 @@ pub struct SoftShadowOptions {
     pub height: u32,
     /// Dispatch the shadow pass in tiles of at most tile×tile pixels (0: one dispatch).
     pub tile: u32,
+    /// How the shadow value lights a pixel (ours, or Fig. 7's product).
+    pub shading: KleeShading,
 }
 
 /// The scene's single area light (the thesis lights with one).
@@ -195,6 +198,7 @@ impl SoftShadowRenderer {
                 light,
                 ambient: scene.settings.ambient,
                 shadow_offset: scene.settings.shadow_offset,
+                shading: options.shading,
             },
             scene: ShadowScene {
                 tree,

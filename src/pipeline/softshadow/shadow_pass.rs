@@ -11,7 +11,7 @@ use glam::Vec3;
 use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
-use super::SoftShadowOptions;
+use super::{KleeShading, SoftShadowOptions};
 use crate::gl::resources::{GpuTimers, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
@@ -80,6 +80,7 @@ pub struct ShadowUniforms {
     pub light: AreaLight,
     pub ambient: [f32; 3],
     pub shadow_offset: f32,
+    pub shading: KleeShading,
 }
 
 pub struct ShadowPass {
@@ -185,6 +186,7 @@ impl ShadowPass {
         k.set_vec3("lightColor", u.light.color.to_array());
         k.set_vec3("ambient", u.ambient);
         k.set_f32("shadowOffset", u.shadow_offset);
+        k.set_i32("fig7Shading", (u.shading == KleeShading::Fig7) as i32);
         let [x, y, ls_y] = self.texture_layout;
         k.set_i32("tex_x_res", x as i32);
         k.set_i32("tex_y_res", y as i32);
