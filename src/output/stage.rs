@@ -1,0 +1,162 @@
+//! All-or-nothing writing: every output is written to a temporary file beside its target and
+//! flushed to disk; only when all were written are they renamed over their targets. A staging
+//! dropped before [`Staging::commit`] removes its temporary files and the folders it made.
+
+use std::fs::{self, File};
+use std::io::{BufWriter, Cursor, Seek, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, Context as _, Result};
+use tempfile::NamedTempFile;
+
+use super::check::{is_stream, parent_of};
+
+/// Where an encoder writes: a file or a buffer (image encoders want to seek).
+pub trait WriteSeek: Write + Seek {}
+impl<T: Write + Seek> WriteSeek for T {}
+
+enum Staged {
+    /// A regular file: its complete new content in a temporary file beside it.
+    Temp { tmp: NamedTempFile, target: PathBuf },
+    /// A device or pipe (`/dev/stdout`): written in place at the commit, from memory.
+    Stream { bytes: Vec<u8>, target: PathBuf },
+}
+
+/// The outputs of one command, written but not yet in place.
+#[derive(Default)]
+pub struct Staging {
+    staged: Vec<Staged>,
+    /// Folders made for the outputs, outermost first; removed again unless committed.
+    created: Vec<PathBuf>,
+}
+
+impl Staging {
+    pub fn new() -> Staging {
+        Staging::default()
+    }
+
+    /// Make `dir` and its missing ancestors (remembered, to remove them if nothing is
+    /// committed).
+    pub fn create_folder(&mut self, dir: &Path) -> Result<()> {
+        let missing: Vec<&Path> = dir.ancestors().take_while(|d| !d.exists()).collect();
+        for d in missing.into_iter().rev() {
+            if d.as_os_str().is_empty() {
+                continue;
+            }
+            fs::create_dir(d)
+                .with_context(|| format!("cannot create the folder {}", d.display()))?;
+            self.created.push(d.to_path_buf());
+        }
+        Ok(())
+    }
+
+    /// Write `target`'s new content with `encode`, into a temporary file beside it (or into
+    /// memory for a device or pipe). Errors name `target`.
+    pub fn file(
+        &mut self,
+        target: &Path,
+        encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
+    ) -> Result<()> {
+        let named = || format!("cannot write {}", target.display());
+        let target = through_link(target);
+        if is_stream(&target) {
+            let mut buf = Cursor::new(Vec::new());
+            encode(&mut buf).with_context(named)?;
+            let bytes = buf.into_inner();
+            self.staged.push(Staged::Stream { bytes, target });
+            return Ok(());
+        }
+        let tmp = temp_beside(&target).with_context(named)?;
+        let mut w = BufWriter::new(tmp.as_file());
+        encode(&mut w).with_context(named)?;
+        w.flush().with_context(named)?;
+        drop(w);
+        // on disk now, so that a full disk fails here and not after the rename
+        tmp.as_file().sync_all().with_context(named)?;
+        self.staged.push(Staged::Temp { tmp, target });
+        Ok(())
+    }
+
+    /// Put every staged file in place: the devices and pipes first (they cannot be undone,
+    /// and if one fails no regular file has been replaced), then the renames.
+    pub fn commit(mut self) -> Result<()> {
+        let staged = std::mem::take(&mut self.staged);
+        let (streams, temps): (Vec<_>, Vec<_>) = staged
+            .into_iter()
+            .partition(|s| matches!(s, Staged::Stream { .. }));
+        for s in streams {
+            if let Staged::Stream { bytes, target } = s {
+                write_stream(&target, &bytes)?;
+            }
+        }
+        for t in temps {
+            if let Staged::Temp { tmp, target } = t {
+                tmp.persist(&target)
+                    .map_err(|e| anyhow!(e.error))
+                    .with_context(|| format!("cannot replace {}", target.display()))?;
+            }
+        }
+        self.created.clear();
+        Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        // the temporary files first (removed as they drop), then the folders made for them
+        self.staged.clear();
+        for d in self.created.iter().rev() {
+            let _ = fs::remove_dir(d);
+        }
+    }
+}
+
+/// The file a symbolic link `path` points to (written there, the link kept), else `path`.
+fn through_link(path: &Path) -> PathBuf {
+    let link = fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink());
+    match link.then(|| fs::canonicalize(path)) {
+        Some(Ok(p)) => p,
+        _ => path.to_path_buf(),
+    }
+}
+
+/// A temporary file `.NAME.XXXXXX.tmp` beside `target`, with `target`'s permissions if it
+/// exists, else those of a new file (0666 less the umask).
+fn temp_beside(target: &Path) -> Result<NamedTempFile> {
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".tmp");
+    if let Ok(m) = fs::metadata(target) {
+        b.permissions(m.permissions());
+    } else {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            b.permissions(fs::Permissions::from_mode(0o666));
+        }
+    }
+    let dir = parent_of(target);
+    b.tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))
+}
+
+fn write_stream(target: &Path, bytes: &[u8]) -> Result<()> {
+    let named = || format!("cannot write {}", target.display());
+    let mut f = File::options()
+        .write(true)
+        .open(target)
+        .with_context(named)?;
+    f.write_all(bytes).with_context(named)?;
+    f.flush().with_context(named)
+}
+
+/// Write the single file `target` with `encode`: into a temporary file, then renamed over it.
+pub fn write_file(
+    target: &Path,
+    encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
+) -> Result<()> {
+    let mut s = Staging::new();
+    s.file(target, encode)?;
+    s.commit()
+}
