@@ -233,6 +233,18 @@ fn a_failing_aov_dir_leaves_the_old_png_and_no_temporary_files() {
         let o = render(&teapot(), &["-o", s(&png), "--aov-dir", s(&aov)]);
         assert_fails(&o, &["--aov-dir", "stats.json", "is not a folder"]);
     }
+    // a folder that takes no new files, even for root (Linux' /proc)
+    let o = render(
+        &teapot(),
+        &["-o", s(&png), "--aov-dir", "/proc/gpgpu-rt-aov"],
+    );
+    assert_fails(
+        &o,
+        &[
+            "--aov-dir /proc/gpgpu-rt-aov",
+            "cannot create files in /proc",
+        ],
+    );
     // --stats in a folder that does not exist, or that is a folder
     let o = render(
         &teapot(),
@@ -241,6 +253,13 @@ fn a_failing_aov_dir_leaves_the_old_png_and_no_temporary_files() {
     assert_fails(&o, &["--stats", "none", "does not exist"]);
     let o = render(&teapot(), &["-o", s(&png), "--stats", s(&d.join("aov"))]);
     assert_fails(&o, &["--stats", "is a folder"]);
+    // a read-only file is not replaced (the rename would succeed)
+    let stats = d.join("stats.json");
+    let mut ro = std::fs::metadata(&stats).unwrap().permissions();
+    ro.set_readonly(true);
+    std::fs::set_permissions(&stats, ro).unwrap();
+    let o = render(&teapot(), &["-o", s(&png), "--stats", s(&stats)]);
+    assert_fails(&o, &["--stats", "stats.json", "is read-only"]);
     assert_unchanged(&old);
     assert_eq!(listing(d), before);
 }

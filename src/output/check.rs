@@ -133,6 +133,8 @@ fn check_one(t: &Target) -> Result<()> {
     match fs::metadata(&t.path) {
         Ok(m) if m.is_dir() => bail!("{}: is a folder, not a file", t.name()),
         Ok(m) if !m.is_file() => return Ok(()), // a device or a pipe: written in place
+        // renaming over it would succeed: its mode is the owner's wish to keep it
+        Ok(m) if m.permissions().readonly() => bail!("{}: is read-only, not replaced", t.name()),
         _ => {}
     }
     check_extension(t)?;
