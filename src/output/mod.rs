@@ -9,7 +9,8 @@
 //!    [`scene_inputs`]);
 //! 2. write each file to a temporary file beside it, flushed to disk ([`Staging::file`]);
 //! 3. rename them all over their targets only when all were written ([`Staging::commit`]): a
-//!    failure leaves the old files as they were and no temporary file behind.
+//!    failure leaves the old files as they were and no temporary file behind (a rename that
+//!    fails after others puts their old files back).
 //!
 //! Errors name the file. A device or pipe (`/dev/stdout`) is written in place, after every
 //! regular file was written and before any is renamed.

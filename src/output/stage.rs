@@ -89,15 +89,52 @@ impl Staging {
                 write_stream(&target, &bytes)?;
             }
         }
-        for t in temps {
-            if let Staged::Temp { tmp, target } = t {
-                tmp.persist(&target)
-                    .map_err(|e| anyhow!(e.error))
-                    .with_context(|| format!("cannot replace {}", target.display()))?;
-            }
-        }
+        let temps = temps.into_iter().filter_map(|t| match t {
+            Staged::Temp { tmp, target } => Some((tmp, target)),
+            Staged::Stream { .. } => None,
+        });
+        rename_all(temps.collect())?;
         self.created.clear();
         Ok(())
+    }
+}
+
+/// Rename every temporary file over its target. The old files are kept as hard links until all
+/// renames succeeded; if one fails, the targets renamed before it get their old files back (or
+/// are removed where there was none).
+fn rename_all(temps: Vec<(NamedTempFile, PathBuf)>) -> Result<()> {
+    let mut done: Vec<(PathBuf, Option<NamedTempFile<()>>)> = Vec::new();
+    for (tmp, target) in temps {
+        let old = keep_old(&target);
+        if let Err(e) = tmp.persist(&target) {
+            roll_back(done);
+            let e = anyhow!(e.error);
+            return Err(e.context(format!("cannot replace {}", target.display())));
+        }
+        done.push((target, old));
+    }
+    Ok(()) // the old files' links are removed as they drop
+}
+
+/// A hard link `.NAME.XXXXXX.old` to the file `target` (none where it does not exist or the
+/// file system has no hard links).
+fn keep_old(target: &Path) -> Option<NamedTempFile<()>> {
+    let name = target.file_name()?.to_string_lossy();
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".old");
+    let link = |p: &Path| fs::hard_link(target, p);
+    fs::metadata(target).ok().filter(|m| m.is_file())?;
+    b.make_in(parent_of(target), link).ok()
+}
+
+/// Put the old files of `done` back (best effort: this runs after an error).
+fn roll_back(done: Vec<(PathBuf, Option<NamedTempFile<()>>)>) {
+    for (target, old) in done.into_iter().rev() {
+        let _ = match old {
+            Some(old) => old.persist(&target).map(|_| ()).map_err(|e| e.error),
+            None => fs::remove_file(&target),
+        };
     }
 }
 
@@ -159,4 +196,37 @@ pub fn write_file(
     let mut s = Staging::new();
     s.file(target, encode)?;
     s.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rename that fails (a folder appeared at the second target after staging) puts the first
+    /// target's old file back and removes the new file where there was none.
+    #[test]
+    fn a_failed_rename_restores_the_renamed_files() {
+        let d = tempfile::tempdir().unwrap();
+        let (a, b, c) = (
+            d.path().join("a.txt"),
+            d.path().join("b.txt"),
+            d.path().join("c.txt"),
+        );
+        fs::write(&a, "old a").unwrap();
+        let mut s = Staging::new();
+        for p in [&a, &c, &b] {
+            s.file(p, |w| Ok(w.write_all(b"new")?)).unwrap();
+        }
+        fs::create_dir_all(b.join("in-the-way")).unwrap();
+        let e = s.commit().unwrap_err();
+        assert!(format!("{e:#}").contains("cannot replace"), "{e:#}");
+        assert_eq!(fs::read_to_string(&a).unwrap(), "old a");
+        assert!(!c.exists());
+        let mut names: Vec<_> = fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["a.txt", "b.txt"]);
+    }
 }
