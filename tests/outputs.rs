@@ -302,6 +302,10 @@ fn a_render_replaces_all_its_outputs() {
     let d = dir.path();
     let old = old_outputs(d);
     std::fs::remove_file(d.join("out.png")).unwrap(); // a new file
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |f: &str| std::fs::metadata(d.join(f)).unwrap().permissions().mode() & 0o777;
+    let group_only = std::fs::Permissions::from_mode(0o640);
+    std::fs::set_permissions(d.join("stats.json"), group_only).unwrap();
     let args = ["-o", "out.png", "--aov-dir", "aov", "--stats", "stats.json"];
     let o = Command::new(BIN)
         .current_dir(d)
@@ -319,13 +323,36 @@ fn a_render_replaces_all_its_outputs() {
         );
     }
     assert_eq!(listing(d), listing_of_outputs());
-    // a new file gets the usual permissions (not the 0600 of a temporary file)
-    use std::os::unix::fs::PermissionsExt;
-    let mode = std::fs::metadata(d.join("out.png"))
-        .unwrap()
-        .permissions()
-        .mode();
-    assert_eq!(mode & 0o044, 0o044, "readable by others: {mode:o}");
+    // a new file gets the usual permissions (not the 0600 of a temporary file), a replaced file
+    // keeps its own
+    assert_eq!(mode("out.png") & 0o044, 0o044, "readable by others");
+    assert_eq!(mode("stats.json"), 0o640);
+}
+
+#[test]
+fn stats_to_dev_stdout_are_written_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let png = d.join("out.png");
+    let args = ["-o", s(&png), "--stats", "/dev/stdout"];
+    // a pipe
+    let o = render(&teapot(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(doc["width"], 32);
+    // a file the shell redirected stdout to
+    let captured = d.join("captured.json");
+    let o = Command::new(BIN)
+        .args(["render", s(&teapot()), "--width", "32", "--height", "32"])
+        .args(args)
+        .stdout(std::fs::File::create(&captured).unwrap())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&captured).unwrap()).unwrap();
+    assert_eq!(doc["height"], 32);
+    assert_eq!(listing(d), ["captured.json", "out.png"]);
 }
 
 fn listing_of_outputs() -> Vec<String> {

@@ -88,10 +88,11 @@ pub fn parent_of(path: &Path) -> &Path {
     }
 }
 
-/// A file that exists and is neither a regular file nor a folder: a device or a pipe
-/// (`/dev/stdout`, `/dev/full`), written in place since there is nothing to keep.
+/// A file under `/dev/` (`/dev/stdout` even when it is redirected to a file, `/dev/full`), or
+/// one that exists and is neither a regular file nor a folder (a pipe): written in place, since
+/// there is nothing to keep.
 pub fn is_stream(path: &Path) -> bool {
-    fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+    path.starts_with("/dev/") || fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
 /// Check `targets`, each alone and against each other, before anything is rendered.
@@ -130,9 +131,11 @@ pub fn refuse_inputs(targets: &[Target], inputs: &[Input]) -> Result<()> {
 }
 
 fn check_one(t: &Target) -> Result<()> {
+    if is_stream(&t.path) {
+        return Ok(());
+    }
     match fs::metadata(&t.path) {
         Ok(m) if m.is_dir() => bail!("{}: is a folder, not a file", t.name()),
-        Ok(m) if !m.is_file() => return Ok(()), // a device or a pipe: written in place
         // renaming over it would succeed: its mode is the owner's wish to keep it
         Ok(m) if m.permissions().readonly() => bail!("{}: is read-only, not replaced", t.name()),
         _ => {}

@@ -58,14 +58,15 @@ impl Staging {
         encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
     ) -> Result<()> {
         let named = || format!("cannot write {}", target.display());
-        let target = through_link(target);
-        if is_stream(&target) {
+        if is_stream(target) {
+            let target = target.to_path_buf();
             let mut buf = Cursor::new(Vec::new());
             encode(&mut buf).with_context(named)?;
             let bytes = buf.into_inner();
             self.staged.push(Staged::Stream { bytes, target });
             return Ok(());
         }
+        let target = through_link(target);
         let tmp = temp_beside(&target).with_context(named)?;
         let mut w = BufWriter::new(tmp.as_file());
         encode(&mut w).with_context(named)?;
@@ -164,18 +165,19 @@ fn temp_beside(target: &Path) -> Result<NamedTempFile> {
     let prefix = format!(".{name}.");
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".tmp");
-    if let Ok(m) = fs::metadata(target) {
-        b.permissions(m.permissions());
-    } else {
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            b.permissions(fs::Permissions::from_mode(0o666));
-        }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(fs::Permissions::from_mode(0o666));
     }
     let dir = parent_of(target);
-    b.tempfile_in(dir)
-        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))
+    let tmp = b
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    if let Ok(m) = fs::metadata(target) {
+        tmp.as_file().set_permissions(m.permissions())?;
+    }
+    Ok(tmp)
 }
 
 fn write_stream(target: &Path, bytes: &[u8]) -> Result<()> {
