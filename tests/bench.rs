@@ -339,8 +339,14 @@ fn bad_bench_options_fail_with_a_message() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
+    let below_file = file.join("out");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (vec![], "PROTOCOL"),
+        // checked before the GPU is opened: --out is made when missing, below a folder only
+        (
+            vec!["thesis-5.1", "--out", below_file.to_str().unwrap()],
+            "a-file is not a folder",
+        ),
         (vec!["thesis-9"], "thesis-5.1"),
         (vec!["thesis-5.1", "--scale", "huge"], "quick"),
         (

@@ -491,7 +491,12 @@ fn bad_view_input_fails_cleanly() {
     let e = run_status(&["scenes/teapot1.toml", "--frames", "0"], 2);
     assert!(e.contains("--frames") && e.contains("1..=100000"), "{e}");
     assert!(run(&["scenes/teapot1.toml", "--wait-reload", "--frames", "1"]).contains("--glsl-dir"));
-    assert!(run(&["scenes/teapot1.toml", "--screenshot", "x.jpg"]).contains(".png"));
+    // the formats of `render -o`: PNG or JPEG, said in the message
+    let e = run(&["scenes/teapot1.toml", "--screenshot", "x.bmp"]);
+    assert!(
+        e.contains("x.bmp") && e.contains(".png, .jpg or .jpeg"),
+        "{e}"
+    );
     assert!(run(&["scenes/teapot1.toml", "--glsl-dir", "no/such/dir"]).contains("no/such/dir"));
     // soft shadows need an area light: render's message, before a window is opened
     let e = run(&["scenes/teapot1.toml", "--shadows", "linespace"]);

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{bail, Result};
 use clap::parser::ValueSource;
 use clap::ArgMatches;
 use serde_json::json;
@@ -12,6 +12,7 @@ use crate::args::{GpuArgs, GridArgs, SoftShadowArgs};
 use gpgpu_rt::accel::{BvhVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::output::{Format, Staging, Target};
 use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::SoftShadowRenderer;
 use gpgpu_rt::pipeline::{self, Renderer};
@@ -22,7 +23,7 @@ use gpgpu_rt::{limits, output};
 pub struct RenderArgs {
     /// Scene file (TOML), e.g. scenes/teapot1.toml.
     scene: PathBuf,
-    /// Output PNG.
+    /// Output image: PNG, or JPEG for a name ending in .jpg or .jpeg.
     #[arg(short, long, default_value = "out.png")]
     output: PathBuf,
     /// Image width, 1 to 16384 (default: the scene's render.width).
@@ -220,7 +221,25 @@ pub fn stats_doc(ctx: &GlContext, scene: &Scene, r: &dyn Renderer, f: &Frame) ->
     doc
 }
 
-/// The PNG, the AOVs (`--aov-dir`) and the statistics (`--stats`) of `frame`.
+/// The output files of a render: the image, the AOVs (`--aov-dir`), the statistics (`--stats`).
+fn targets(args: &RenderArgs) -> Vec<Target> {
+    let mut t = vec![Target::file("-o", &args.output, Format::Image)];
+    if let Some(dir) = &args.aov_dir {
+        t.extend(Target::in_folder(
+            "--aov-dir",
+            dir,
+            &output::AOV_FILES,
+            Format::Npy,
+        ));
+    }
+    if let Some(path) = &args.stats {
+        t.push(Target::file("--stats", path, Format::Json));
+    }
+    t
+}
+
+/// The image, the AOVs (`--aov-dir`) and the statistics (`--stats`) of `frame`: all of them
+/// or, when one cannot be written, none (the old files stay as they were).
 fn write_outputs(
     args: &RenderArgs,
     ctx: &GlContext,
@@ -228,16 +247,19 @@ fn write_outputs(
     r: &dyn Renderer,
     frame: &Frame,
 ) -> Result<()> {
-    output::write_png(&args.output, frame)?;
+    let mut s = Staging::new();
+    let img = output::frame_image(frame);
+    s.file(&args.output, |w| {
+        output::encode_image(&img, &args.output, w)
+    })?;
     if let (Some(dir), Some(aovs)) = (&args.aov_dir, &frame.aovs) {
-        output::write_aovs(dir, frame.width, frame.height, aovs)?;
+        output::stage_aovs(&mut s, dir, frame.width, frame.height, aovs)?;
     }
     if let Some(path) = &args.stats {
         let doc = stats_doc(ctx, scene, r, frame);
-        std::fs::write(path, serde_json::to_string_pretty(&doc)? + "\n")
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        output::stage_text(&mut s, path, &(serde_json::to_string_pretty(&doc)? + "\n"))?;
     }
-    Ok(())
+    s.commit()
 }
 
 /// What was rendered, in one line on stderr.
@@ -281,7 +303,10 @@ fn summary(
 
 /// `render`: load, check the options, render `--frames` frames, write the last.
 pub fn run(mut args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
+    let targets = targets(&args);
+    output::check(&targets)?;
     let scene = Scene::load(&args.scene)?;
+    output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     let shaders = ShaderSource::from_dir(args.gpu.glsl_dir.clone())?;
     args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
     refuse_other_pipeline(&args, &scene, matches)?;
@@ -302,7 +327,10 @@ pub fn run(mut args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
 
 /// `export-triangles`: the scene's world-space triangles as f32 [T,3,3].
 pub fn export_triangles(scene: &Path, out: &Path) -> Result<()> {
+    let targets = [Target::file("-o", out, Format::Npy)];
+    output::check(&targets)?;
     let scene = Scene::load(scene)?;
+    output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     let tris = scene.world_triangles();
     output::write_npy(
         out,

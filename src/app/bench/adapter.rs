@@ -112,7 +112,7 @@ impl RayTracer {
             return self.0.draw(camera);
         };
         let frame = self.0.render(camera)?;
-        gpgpu_rt::output::write_png(path, &frame)?;
+        gpgpu_rt::output::write_image(path, &frame)?;
         Ok(frame.stats)
     }
 }

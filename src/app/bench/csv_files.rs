@@ -4,7 +4,7 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 
 use super::args::Rotation;
 use super::outcome::{FrameRecord, Outcome};
@@ -27,14 +27,15 @@ pub fn write(out: &Path, protocol: &str, outcomes: &[Outcome], rotate: Rotation)
 
 /// Write `rows` under `header` to `path`.
 pub fn write_rows(path: &Path, header: &[String], rows: &[Vec<String>]) -> Result<()> {
-    let mut w =
-        csv::Writer::from_path(path).with_context(|| format!("cannot write {}", path.display()))?;
-    w.write_record(header)?;
-    for row in rows {
-        w.write_record(row)?;
-    }
-    w.flush()
-        .with_context(|| format!("cannot write {}", path.display()))
+    gpgpu_rt::output::write_file(path, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(header)?;
+        for row in rows {
+            w.write_record(row)?;
+        }
+        w.flush()?;
+        Ok(())
+    })
 }
 
 fn strings(names: &[&str]) -> Vec<String> {

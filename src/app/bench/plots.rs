@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
-use anyhow::{anyhow, Context as _, Result};
+use anyhow::{anyhow, Result};
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -401,8 +401,7 @@ pub fn save(path: &Path, panel_w: u32, panel_h: u32, charts: &[Chart]) -> Result
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
-    img.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    gpgpu_rt::output::write_file(path, |w| gpgpu_rt::output::encode_image(&img, path, w))
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 
 use super::adapter::grid_list_defaults;
 use super::args::{BenchArgs, Rotation, Scale};
@@ -38,7 +38,7 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         s.push_str(&section(sec));
     }
     let path = bench.out.join("report.md");
-    std::fs::write(&path, s).with_context(|| format!("cannot write {}", path.display()))?;
+    gpgpu_rt::output::write_file(&path, |w| Ok(w.write_all(s.as_bytes())?))?;
     Ok(path)
 }
 

@@ -36,9 +36,8 @@ impl Bench {
         args.validate()?;
         let scenes_dir = find_scenes_dir(args.scenes.as_deref())?;
         let out = args.out.clone();
-        if out.exists() && !out.is_dir() {
-            bail!("--out {}: exists and is not a folder", out.display());
-        }
+        // before the GPU is opened: a folder, or one that can be made, that takes new files
+        gpgpu_rt::output::check_folder("--out", &out)?;
         std::fs::create_dir_all(&out)
             .with_context(|| format!("cannot create the output folder {}", out.display()))?;
         let gpu = Gpu::open(args.device, args.glsl_dir.clone())?;

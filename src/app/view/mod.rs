@@ -42,6 +42,7 @@ use winit::window::WindowId;
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::limits;
+use gpgpu_rt::output::{self, Format, Target};
 use gpgpu_rt::scene::{Camera, Scene};
 
 use design::Design;
@@ -52,7 +53,8 @@ use renderer::{
 };
 use watch::GlslWatcher;
 use window::{
-    compile_quad_program, fit_viewport, read_back_buffer, save_png, GlWindow, ScreenQuad, Viewport,
+    compile_quad_program, fit_viewport, read_back_buffer, save_image, GlWindow, ScreenQuad,
+    Viewport,
 };
 
 /// How often `--glsl-dir` is polled for changes.
@@ -98,7 +100,8 @@ pub struct ViewArgs {
     /// Load the kernels from this directory and reload them whenever a file in it changes.
     #[arg(long, value_name = "DIR")]
     pub glsl_dir: Option<PathBuf>,
-    /// Save the window's last frame (see --frames) to this PNG and exit.
+    /// Save the window's last frame (see --frames) to this image and exit: PNG, or JPEG for a
+    /// name ending in .jpg or .jpeg (as `render -o`).
     #[arg(long, value_name = "FILE.png")]
     pub screenshot: Option<PathBuf>,
     /// Render N frames (1 to 100000), then exit (after saving --screenshot); default with
@@ -122,19 +125,13 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     if args.wait_reload && args.frames.is_none() && args.screenshot.is_none() {
         bail!("--wait-reload needs --frames or --screenshot (what to do after the reload)");
     }
-    if let Some(p) = &args.screenshot {
-        let ext = p
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase());
-        if ext.as_deref() != Some("png") {
-            bail!(
-                "--screenshot {}: the file name must end in .png",
-                p.display()
-            );
-        }
-    }
+    // the same image formats as `render -o`, checked before a window is opened
+    let targets: Vec<Target> = (args.screenshot.iter())
+        .map(|p| Target::file("--screenshot", p, Format::Image))
+        .collect();
+    output::check(&targets)?;
     let scene = Scene::load(&args.scene)?;
+    output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     // as `render`: the scene file's render.shadows and render.light_samples by default
     args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
     if args.soft.shadows.is_some() {
@@ -615,7 +612,7 @@ impl App {
             )
         };
         gpgpu_rt::gl::check_error(&running.window.gl, "reading the frame back")?;
-        save_png(path, w, h, &pixels)?;
+        save_image(path, w, h, &pixels)?;
         println!(
             "screenshot: {} ({w}x{h}, frame {}, {from})",
             path.display(),

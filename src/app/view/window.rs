@@ -7,7 +7,7 @@
 use std::num::NonZeroU32;
 use std::sync::Arc;
 
-use anyhow::{anyhow, Context as _, Result};
+use anyhow::{anyhow, Result};
 use glow::HasContext;
 use glutin::config::{ColorBufferType, Config, ConfigTemplateBuilder};
 use glutin::context::{
@@ -24,6 +24,7 @@ use winit::window::Window;
 
 use gpgpu_rt::gl::context::{load_gl, query_info};
 use gpgpu_rt::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
+use gpgpu_rt::output;
 
 /// A window with a current GL 4.5 core context. Drop GL objects made on `gl` first.
 pub struct GlWindow {
@@ -403,14 +404,14 @@ pub fn read_back_buffer(gl: &Gl, rect: Viewport) -> Vec<u8> {
     read_pixels(gl, rect)
 }
 
-/// Save RGBA8 pixels (rows bottom first, as GL reads them) as an RGB PNG, top row first.
-pub fn save_png(path: &std::path::Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
+/// Save RGBA8 pixels (rows bottom first, as GL reads them) as an RGB image (PNG, or JPEG by the
+/// extension), top row first, replacing `path` only when complete.
+pub fn save_image(path: &std::path::Path, width: u32, height: u32, pixels: &[u8]) -> Result<()> {
     let img = image::RgbImage::from_fn(width, height, |x, y| {
         let i = (((height - 1 - y) * width + x) * 4) as usize;
         image::Rgb([pixels[i], pixels[i + 1], pixels[i + 2]])
     });
-    img.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    output::write_file(path, |w| output::encode_image(&img, path, w))
 }
 
 #[cfg(test)]

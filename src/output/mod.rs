@@ -1,0 +1,119 @@
+//! Writing results: the colour image, the NumPy AOVs, the statistics JSON, and every other file
+//! a command writes (the bench's CSVs, plots and report, the viewer's screenshots).
+//!
+//! Every command that writes files goes through this module:
+//!
+//! 1. [`check`] its output paths before any GPU work ([`Target`]: a format the command writes,
+//!    a folder that exists and takes new files, no two outputs at the same file) and
+//!    [`refuse_inputs`] (no output at the scene file, a model or a texture it reads:
+//!    [`scene_inputs`]);
+//! 2. write each file to a temporary file beside it, flushed to disk ([`Staging::file`]);
+//! 3. rename them all over their targets only when all were written ([`Staging::commit`]): a
+//!    failure leaves the old files as they were and no temporary file behind (a rename that
+//!    fails after others puts their old files back).
+//!
+//! Errors name the file. A device or pipe (`/dev/stdout`) is written in place, after every
+//! regular file was written and before any is renamed.
+
+mod check;
+mod inputs;
+mod stage;
+
+use std::path::Path;
+
+use anyhow::Result;
+use npyz::WriterBuilder;
+
+use crate::frame::{Aovs, Frame};
+
+pub use check::{check, check_folder, parent_of, refuse_inputs, same_file, Format, Input, Target};
+pub use inputs::scene_inputs;
+pub use stage::{write_file, Staging, WriteSeek};
+
+/// The files of `--aov-dir` (`shadow.npy` only where the renderer has it).
+pub const AOV_FILES: [&str; 6] = [
+    "ray_origin.npy",
+    "ray_direction.npy",
+    "hit_t.npy",
+    "triangle_id.npy",
+    "normal.npy",
+    "shadow.npy",
+];
+
+/// The colour as 8-bit RGB (clamped to [0, 1], no gamma, as the thesis displays it).
+pub fn frame_image(frame: &Frame) -> image::RgbImage {
+    image::RgbImage::from_fn(frame.width, frame.height, |x, y| {
+        let c = frame.color[(y * frame.width + x) as usize];
+        image::Rgb([0, 1, 2].map(|k| (c[k].clamp(0.0, 1.0) * 255.0).round() as u8))
+    })
+}
+
+/// Encode `img` for `path`: JPEG for `.jpg`/`.jpeg`, else PNG.
+pub fn encode_image(img: &image::RgbImage, path: &Path, mut w: &mut dyn WriteSeek) -> Result<()> {
+    let format = match image::ImageFormat::from_path(path) {
+        Ok(image::ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
+        _ => image::ImageFormat::Png,
+    };
+    img.write_to(&mut w, format)?;
+    Ok(())
+}
+
+/// The frame's colour to `path` (PNG or JPEG by the extension), replacing it only when
+/// complete.
+pub fn write_image(path: &Path, frame: &Frame) -> Result<()> {
+    let img = frame_image(frame);
+    write_file(path, |w| encode_image(&img, path, w))
+}
+
+/// Encode one array as `.npy` with the given shape.
+pub fn encode_npy<T: npyz::AutoSerialize + Copy>(
+    w: &mut dyn WriteSeek,
+    shape: &[u64],
+    data: impl IntoIterator<Item = T>,
+) -> Result<()> {
+    let mut npy = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(w)
+        .begin_nd()?;
+    npy.extend(data)?;
+    npy.finish()?;
+    Ok(())
+}
+
+/// Write one array to the `.npy` file `path`, replacing it only when complete.
+pub fn write_npy<T: npyz::AutoSerialize + Copy>(
+    path: &Path,
+    shape: &[u64],
+    data: impl IntoIterator<Item = T>,
+) -> Result<()> {
+    write_file(path, |w| encode_npy(w, shape, data))
+}
+
+/// Stage the text `text` as `path`.
+pub fn stage_text(s: &mut Staging, path: &Path, text: &str) -> Result<()> {
+    s.file(path, |w| Ok(w.write_all(text.as_bytes())?))
+}
+
+/// Stage the AOVs of the GUIDE in `dir` (made if missing): ray_origin, ray_direction (f32
+/// `[H,W,3]`), hit_t (f32 `[H,W]`, +inf on a miss), triangle_id (i32 `[H,W]`, -1 on a miss),
+/// normal (f32 `[H,W,3]`), and shadow (f32 `[H,W]`, the fraction of unblocked shadow rays)
+/// where the renderer has it; row 0 = top.
+pub fn stage_aovs(s: &mut Staging, dir: &Path, width: u32, height: u32, a: &Aovs) -> Result<()> {
+    s.create_folder(dir)?;
+    let (h, w) = (height as u64, width as u64);
+    let flat3 = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
+    let [origin, direction, hit_t, triangle_id, normal, shadow] = AOV_FILES.map(|f| dir.join(f));
+    s.file(&origin, |o| encode_npy(o, &[h, w, 3], flat3(&a.ray_origin)))?;
+    s.file(&direction, |o| {
+        encode_npy(o, &[h, w, 3], flat3(&a.ray_direction))
+    })?;
+    s.file(&hit_t, |o| encode_npy(o, &[h, w], a.hit_t.iter().copied()))?;
+    let ids = a.triangle_id.iter().copied();
+    s.file(&triangle_id, |o| encode_npy(o, &[h, w], ids))?;
+    s.file(&normal, |o| encode_npy(o, &[h, w, 3], flat3(&a.normal)))?;
+    if let Some(v) = &a.shadow {
+        s.file(&shadow, |o| encode_npy(o, &[h, w], v.iter().copied()))?;
+    }
+    Ok(())
+}

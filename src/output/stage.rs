@@ -1,0 +1,234 @@
+//! All-or-nothing writing: every output is written to a temporary file beside its target and
+//! flushed to disk; only when all were written are they renamed over their targets. A staging
+//! dropped before [`Staging::commit`] removes its temporary files and the folders it made.
+
+use std::fs::{self, File};
+use std::io::{BufWriter, Cursor, Seek, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, Context as _, Result};
+use tempfile::NamedTempFile;
+
+use super::check::{is_stream, parent_of};
+
+/// Where an encoder writes: a file or a buffer (image encoders want to seek).
+pub trait WriteSeek: Write + Seek {}
+impl<T: Write + Seek> WriteSeek for T {}
+
+enum Staged {
+    /// A regular file: its complete new content in a temporary file beside it.
+    Temp { tmp: NamedTempFile, target: PathBuf },
+    /// A device or pipe (`/dev/stdout`): written in place at the commit, from memory.
+    Stream { bytes: Vec<u8>, target: PathBuf },
+}
+
+/// The outputs of one command, written but not yet in place.
+#[derive(Default)]
+pub struct Staging {
+    staged: Vec<Staged>,
+    /// Folders made for the outputs, outermost first; removed again unless committed.
+    created: Vec<PathBuf>,
+}
+
+impl Staging {
+    pub fn new() -> Staging {
+        Staging::default()
+    }
+
+    /// Make `dir` and its missing ancestors (remembered, to remove them if nothing is
+    /// committed).
+    pub fn create_folder(&mut self, dir: &Path) -> Result<()> {
+        let missing: Vec<&Path> = dir.ancestors().take_while(|d| !d.exists()).collect();
+        for d in missing.into_iter().rev() {
+            if d.as_os_str().is_empty() {
+                continue;
+            }
+            fs::create_dir(d)
+                .with_context(|| format!("cannot create the folder {}", d.display()))?;
+            self.created.push(d.to_path_buf());
+        }
+        Ok(())
+    }
+
+    /// Write `target`'s new content with `encode`, into a temporary file beside it (or into
+    /// memory for a device or pipe). Errors name `target`.
+    pub fn file(
+        &mut self,
+        target: &Path,
+        encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
+    ) -> Result<()> {
+        let named = || format!("cannot write {}", target.display());
+        if is_stream(target) {
+            let target = target.to_path_buf();
+            let mut buf = Cursor::new(Vec::new());
+            encode(&mut buf).with_context(named)?;
+            let bytes = buf.into_inner();
+            self.staged.push(Staged::Stream { bytes, target });
+            return Ok(());
+        }
+        let target = through_link(target);
+        let tmp = temp_beside(&target).with_context(named)?;
+        let mut w = BufWriter::new(tmp.as_file());
+        encode(&mut w).with_context(named)?;
+        w.flush().with_context(named)?;
+        drop(w);
+        // on disk now, so that a full disk fails here and not after the rename
+        tmp.as_file().sync_all().with_context(named)?;
+        self.staged.push(Staged::Temp { tmp, target });
+        Ok(())
+    }
+
+    /// Put every staged file in place: the devices and pipes first (they cannot be undone,
+    /// and if one fails no regular file has been replaced), then the renames.
+    pub fn commit(mut self) -> Result<()> {
+        let staged = std::mem::take(&mut self.staged);
+        let (streams, temps): (Vec<_>, Vec<_>) = staged
+            .into_iter()
+            .partition(|s| matches!(s, Staged::Stream { .. }));
+        for s in streams {
+            if let Staged::Stream { bytes, target } = s {
+                write_stream(&target, &bytes)?;
+            }
+        }
+        let temps = temps.into_iter().filter_map(|t| match t {
+            Staged::Temp { tmp, target } => Some((tmp, target)),
+            Staged::Stream { .. } => None,
+        });
+        rename_all(temps.collect())?;
+        self.created.clear();
+        Ok(())
+    }
+}
+
+/// Rename every temporary file over its target. The old files are kept as hard links until all
+/// renames succeeded; if one fails, the targets renamed before it get their old files back (or
+/// are removed where there was none).
+fn rename_all(temps: Vec<(NamedTempFile, PathBuf)>) -> Result<()> {
+    let mut done: Vec<(PathBuf, Option<NamedTempFile<()>>)> = Vec::new();
+    for (tmp, target) in temps {
+        let old = keep_old(&target);
+        if let Err(e) = tmp.persist(&target) {
+            roll_back(done);
+            let e = anyhow!(e.error);
+            return Err(e.context(format!("cannot replace {}", target.display())));
+        }
+        done.push((target, old));
+    }
+    Ok(()) // the old files' links are removed as they drop
+}
+
+/// A hard link `.NAME.XXXXXX.old` to the file `target` (none where it does not exist or the
+/// file system has no hard links).
+fn keep_old(target: &Path) -> Option<NamedTempFile<()>> {
+    let name = target.file_name()?.to_string_lossy();
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".old");
+    let link = |p: &Path| fs::hard_link(target, p);
+    fs::metadata(target).ok().filter(|m| m.is_file())?;
+    b.make_in(parent_of(target), link).ok()
+}
+
+/// Put the old files of `done` back (best effort: this runs after an error).
+fn roll_back(done: Vec<(PathBuf, Option<NamedTempFile<()>>)>) {
+    for (target, old) in done.into_iter().rev() {
+        let _ = match old {
+            Some(old) => old.persist(&target).map(|_| ()).map_err(|e| e.error),
+            None => fs::remove_file(&target),
+        };
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        // the temporary files first (removed as they drop), then the folders made for them
+        self.staged.clear();
+        for d in self.created.iter().rev() {
+            let _ = fs::remove_dir(d);
+        }
+    }
+}
+
+/// The file a symbolic link `path` points to (written there, the link kept), else `path`.
+fn through_link(path: &Path) -> PathBuf {
+    let link = fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink());
+    match link.then(|| fs::canonicalize(path)) {
+        Some(Ok(p)) => p,
+        _ => path.to_path_buf(),
+    }
+}
+
+/// A temporary file `.NAME.XXXXXX.tmp` beside `target`, with `target`'s permissions if it
+/// exists, else those of a new file (0666 less the umask).
+fn temp_beside(target: &Path) -> Result<NamedTempFile> {
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(fs::Permissions::from_mode(0o666));
+    }
+    let dir = parent_of(target);
+    let tmp = b
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    if let Ok(m) = fs::metadata(target) {
+        tmp.as_file().set_permissions(m.permissions())?;
+    }
+    Ok(tmp)
+}
+
+fn write_stream(target: &Path, bytes: &[u8]) -> Result<()> {
+    let named = || format!("cannot write {}", target.display());
+    let mut f = File::options()
+        .write(true)
+        .open(target)
+        .with_context(named)?;
+    f.write_all(bytes).with_context(named)?;
+    f.flush().with_context(named)
+}
+
+/// Write the single file `target` with `encode`: into a temporary file, then renamed over it.
+pub fn write_file(
+    target: &Path,
+    encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
+) -> Result<()> {
+    let mut s = Staging::new();
+    s.file(target, encode)?;
+    s.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rename that fails (a folder appeared at the second target after staging) puts the first
+    /// target's old file back and removes the new file where there was none.
+    #[test]
+    fn a_failed_rename_restores_the_renamed_files() {
+        let d = tempfile::tempdir().unwrap();
+        let (a, b, c) = (
+            d.path().join("a.txt"),
+            d.path().join("b.txt"),
+            d.path().join("c.txt"),
+        );
+        fs::write(&a, "old a").unwrap();
+        let mut s = Staging::new();
+        for p in [&a, &c, &b] {
+            s.file(p, |w| Ok(w.write_all(b"new")?)).unwrap();
+        }
+        fs::create_dir_all(b.join("in-the-way")).unwrap();
+        let e = s.commit().unwrap_err();
+        assert!(format!("{e:#}").contains("cannot replace"), "{e:#}");
+        assert_eq!(fs::read_to_string(&a).unwrap(), "old a");
+        assert!(!c.exists());
+        let mut names: Vec<_> = fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["a.txt", "b.txt"]);
+    }
+}
