@@ -3,12 +3,10 @@
 
 mod common;
 
-use common::copy_dir;
+use common::{copy_dir, run, stderr};
 
 use std::path::Path;
-use std::process::{Command, Output};
-
-const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
+use std::process::Output;
 
 fn scene(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -16,17 +14,6 @@ fn scene(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn read_npy_f32(p: &Path) -> (Vec<u64>, Vec<f32>) {

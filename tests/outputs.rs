@@ -4,21 +4,12 @@
 
 mod common;
 
+use common::{run, stderr};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 /// `o` failed, its message holds every one of `needles`.
 fn assert_fails(o: &Output, needles: &[&str]) -> String {

@@ -186,3 +186,16 @@ pub fn assert_same_image(base: &Frame, other: &Frame, what: &str) {
         "{what}: colours differ by {colour_diff}"
     );
 }
+
+/// The `gpgpu-rt` binary run with `args`, its exit status and output kept.
+pub fn run(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// The standard error of a run, as text.
+pub fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
