@@ -33,7 +33,8 @@ pub struct RenderArgs {
     height: Option<u32>,
     /// The accelerator of Müller 2015's four-kernel pipeline: `bvh` (ours: an SAH BVH, the
     /// fastest), `base` (the thesis' base tracer, every ray against every triangle) or `grid`
-    /// (the thesis' uniform grid, see --grid-variant).
+    /// (the thesis' uniform grid, see --grid-variant); or `stream`, seed 004's streaming tracer
+    /// (fragment-program kernels, a static grid, occlusion-query halting).
     #[arg(long, value_enum, default_value = "bvh")]
     tracer: TracerKind,
     /// With --tracer bvh: `sah` (ours, in the four-kernel pipeline) or `wagner` (Wagner 2018
@@ -105,6 +106,9 @@ fn refuse_other_pipeline(
             "grid_variant",
             "voxel_array_length",
             "ray_array_length",
+            "proximity_clouds",
+            "stream_steps",
+            "stream_max_calls",
         ]);
         if !ray_tracer_only.is_empty() {
             let (does, an_option) = verb(&ray_tracer_only);

@@ -10,6 +10,7 @@ pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
 pub mod ntree;
+pub mod stream_grid;
 pub mod thesis_grid;
 pub mod wagner2018;
 pub mod wagner_bvh;
