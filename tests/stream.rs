@@ -170,19 +170,64 @@ fn first_hits_and_counts_equal_the_cpu_twin_on_cubic_and_non_cubic_grids() {
     check_against_twin(&ctx, &sphere, options(64, [9, 9, 9], true));
 }
 
+/// A floor of 8×8 quads at y = 0 under a light at y = 1; a blocker at y = 0.6 over one part,
+/// a roof at y = 1.3 beyond the light over another (it must not shadow: "any intersection
+/// closer than the light"). On a 3×3×3 grid the roof shares its cells with the light.
+fn light_scene(dir: &std::path::Path) -> Scene {
+    let quad = |y: f32, x0: f32, z0: f32, x1: f32, z1: f32, n: usize| {
+        let mut s = String::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let x = x0 + (x1 - x0) * i as f32 / n as f32;
+                let z = z0 + (z1 - z0) * j as f32 / n as f32;
+                s += &format!("v {x:?} {y:?} {z:?}\n");
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let k = j * (n + 1) + i + 1;
+                s += &format!(
+                    "f {k} {} {}\nf {k} {} {}\n",
+                    k + n + 1,
+                    k + n + 2,
+                    k + n + 2,
+                    k + 1
+                );
+            }
+        }
+        s
+    };
+    let objects = [
+        quad(0.0, -2.0, -2.0, 2.0, 2.0, 8),
+        quad(0.6, -1.0, 0.3, 0.0, 1.0, 1),
+        quad(1.3, 0.2, -1.5, 1.5, 1.5, 2),
+    ];
+    let mut toml = "[camera]\nposition = [0.0, 3.0, 4.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+                    [render]\nambient = [0.2, 0.2, 0.2]\nshadow_offset = 0.01\n\
+                    [[light]]\nposition = [0.0, 1.0, 0.0]\n"
+        .to_string();
+    for (k, obj) in objects.iter().enumerate() {
+        std::fs::write(dir.join(format!("o{k}.obj")), obj).unwrap();
+        toml +=
+            &format!("[[object]]\ntype = \"obj\"\npath = \"o{k}.obj\"\ncolor = [0.8, 0.7, 0.6]\n");
+    }
+    std::fs::write(dir.join("scene.toml"), toml).unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap()
+}
+
 /// Shadow rays: every primary hit's feeler towards the light (where the light lies in front
-/// of the surface) walked by the CPU twin from the GPU's hit, with the GPU's arithmetic; the
-/// shadow-ray test count and the cells entered by both kinds of rays equal the GPU's.
-#[test]
-fn shadow_ray_counts_equal_the_cpu_twin() {
-    let ctx = context();
-    let scene = load("cow.toml");
-    let o = options(64, [20, 20, 20], false);
-    let (f, grid) = render(&ctx, &scene, o);
+/// of the surface) walked by the CPU twin from the GPU's hit, with the GPU's arithmetic. Every
+/// pixel is lit on the GPU exactly where the twin's feeler is unblocked (lit: brighter than
+/// the ambient term alone, checked where the light's cosine exceeds 0.01), and the shadow-ray
+/// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`].
+fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
+    let (f, grid) = render(ctx, scene, options(64, dims, false));
     let a = f.aovs.as_ref().unwrap();
+    let attr = scene.world_attributes();
+    let ambient = Vec3::from(scene.settings.ambient);
     let light = scene.lights[0].position;
     let mut counts = WalkCounts::default();
-    let mut shadow_tests = 0;
+    let (mut shadow_tests, mut lit, mut dark) = (0, 0, 0);
     for (i, r) in primary_rays(&f).iter().enumerate() {
         add(&mut counts, grid.trace(r, None, false).1);
         let id = a.triangle_id[i];
@@ -203,11 +248,22 @@ fn shadow_ray_counts_equal_the_cpu_twin() {
             skip: id,
             limit: distance,
         };
-        let (_, c) = grid.trace(&feeler, Some(scene.settings.shadow_offset), false);
+        let (blocker, c) = grid.trace(&feeler, Some(scene.settings.shadow_offset), false);
         shadow_tests += c.tests;
         add(&mut counts, c);
+        let ambient_only = ambient * attr.colors[3 * id as usize];
+        let gpu_lit = (Vec3::from_slice(&f.color[i][..3]) - ambient_only).max_element() > 1e-4;
+        if n.dot(l) > 0.01 {
+            assert_eq!(gpu_lit, blocker.is_none(), "pixel {i}: lit");
+            (lit, dark) = if gpu_lit {
+                (lit + 1, dark)
+            } else {
+                (lit, dark + 1)
+            };
+        }
     }
-    assert!(shadow_tests > 0);
+    eprintln!("{lit} lit, {dark} in shadow");
+    assert!(lit > 100 && dark > 20, "{lit} lit, {dark} in shadow");
     let (gs, gc) = (
         f.stats.triangle_tests["shadow"],
         f.stats.events["cells_visited"],
@@ -218,6 +274,14 @@ fn shadow_ray_counts_equal_the_cpu_twin() {
     );
     assert!(gs.abs_diff(shadow_tests) as f64 <= COUNT_REL * shadow_tests as f64);
     assert!(gc.abs_diff(counts.cells) as f64 <= COUNT_REL * counts.cells as f64);
+}
+
+#[test]
+fn shadows_equal_the_cpu_twin() {
+    let ctx = context();
+    check_shadows(&ctx, &load("cow.toml"), [20, 20, 20]);
+    let dir = tempfile::tempdir().unwrap();
+    check_shadows(&ctx, &light_scene(dir.path()), [3, 3, 3]);
 }
 
 /// Proximity clouds skip empty cells but change no pixel: colours (with shadows and two
@@ -293,6 +357,6 @@ fn the_occlusion_query_halts_after_many_bounded_calls() {
     assert_eq!(big.stats.triangle_tests, small.stats.triangle_tests);
     o.max_calls = 3;
     let mut r = renderer(&ctx, &scene, o);
-    let e = r.render(&scene.camera).err().expect("a capped frame fails");
+    let e = r.render(&scene.camera).expect_err("a capped frame fails");
     assert!(e.to_string().contains("still walking"), "{e}");
 }
