@@ -50,8 +50,9 @@ bool stepCell(vec3 o, vec3 d, inout ivec3 cell, inout vec3 tMax)
 
 // jumpCloud: out of the cube of cells within Chebyshev distance dist - 1 of the current cell
 // (all empty, by the distance's definition), where the ray leaves it: along the exit axis the
-// first cell beyond the cube's face, along the others the exit point's cell clamped into the
-// cube. False when that lies beyond the ray's limit or the grid.
+// first cell beyond the cube's face, along the others the exit point's cell (within the
+// cube's range), placed by the same plane parameters the DDA steps by. False when that lies
+// beyond the ray's limit or the grid.
 bool jumpCloud(vec3 o, vec3 d, float limit, float dist, inout ivec3 cell, inout vec3 tMax)
 {
     ivec3 lo = max(cell - ivec3(int(dist) - 1), ivec3(0));
@@ -62,6 +63,16 @@ bool jumpCloud(vec3 o, vec3 d, float limit, float dist, inout ivec3 cell, inout 
     if (exitT > limit) return false;
     int a = minAxis(tBox);
     ivec3 c = clamp(ivec3(floor((o + exitT * d - gridMin) / cellSize)), lo, hi);
+    for (int b = 0; b < 3; ++b) {
+        // the exit point's cell as the DDA's own plane parameters place it: not past a plane
+        // the ray crosses after exitT, not before one it crossed earlier (floor() may round
+        // across a plane the point lies on)
+        if (b == a || d[b] == 0.0) continue;
+        int s = d[b] > 0.0 ? 1 : -1;
+        if (planeT(o, d, b, c[b] - s) > exitT) c[b] -= s;
+        else if (planeT(o, d, b, c[b]) < exitT) c[b] += s;
+        c[b] = clamp(c[b], lo[b], hi[b]);
+    }
     c[a] = far[a] + (d[a] > 0.0 ? 1 : -1);
     if (!insideGrid(c)) return false;
     cell = c;

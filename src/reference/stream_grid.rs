@@ -287,7 +287,7 @@ impl StreamGrid {
     /// jumpCloud: leave the cube of cells within Chebyshev distance `dist − 1` of the current
     /// cell (all empty) where the ray leaves it; false when that is beyond the grid or the
     /// ray's limit. The exit axis' cell is the first beyond the cube's face; the others are
-    /// the exit point's, clamped into the cube.
+    /// the exit point's (within the cube's range), placed by the DDA's plane parameters.
     fn jump(&self, r: &StreamRay, w: &mut Walk, dist: u32) -> bool {
         let rad = IVec3::splat(dist as i32 - 1);
         let lo = (w.cell - rad).max(IVec3::ZERO);
@@ -309,6 +309,17 @@ impl StreamGrid {
             .floor()
             .as_ivec3();
         let mut cell = p.clamp(lo, hi);
+        for b in (0..3).filter(|&b| b != a && r.d[b] != 0.0) {
+            // the exit point's cell as the DDA's plane parameters place it (floor() may round
+            // across a plane the point lies on)
+            let s = if r.d[b] > 0.0 { 1 } else { -1 };
+            if self.bx.plane_t(r.o, r.d, b, cell[b] - s) > exit {
+                cell[b] -= s;
+            } else if self.bx.plane_t(r.o, r.d, b, cell[b]) < exit {
+                cell[b] += s;
+            }
+            cell[b] = cell[b].clamp(lo[b], hi[b]);
+        }
         cell[a] = far[a] + if r.d[a] > 0.0 { 1 } else { -1 };
         if self.bx.index(cell).is_none() {
             return false;
