@@ -391,3 +391,77 @@ fn colours_with_shadows_and_reflections_equal_the_cpu_twin() {
         assert_eq!(off, 0, "{off} pixels off, by up to {max}");
     }
 }
+
+/// The command line: the statistics of a stream render (the paper's M beside the bytes
+/// uploaded, the calls, the per-kernel times), and bad options refused with their names.
+#[test]
+fn the_command_line_reports_and_refuses() {
+    let bin = env!("CARGO_BIN_EXE_gpgpu-rt");
+    let dir = tempfile::tempdir().unwrap();
+    let scene = common::scene_path("cow.toml");
+    let run = |extra: &[&str]| {
+        let mut c = std::process::Command::new(bin);
+        c.arg("render")
+            .arg(&scene)
+            .args(["--width", "16", "--height", "16", "-o"]);
+        c.arg(dir.path().join("x.png")).args(extra);
+        c.output().unwrap()
+    };
+    let stats = dir.path().join("s.json");
+    let out = run(&[
+        "--tracer",
+        "stream",
+        "--grid",
+        "5x7x3",
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(doc["grid_dims"], serde_json::json!([5, 7, 3]));
+    assert_eq!(
+        doc["grid_paper_bytes"],
+        serde_json::json!(96 * 5804 + 16 * 5 * 7 * 3)
+    );
+    assert!(doc["grid_bytes"].as_u64().unwrap() > 96 * 5804);
+    assert!(doc["kernel_calls"].as_u64().unwrap() >= 2);
+    assert!(doc["gpu_ms"]["traverse_intersect"].as_f64().unwrap() > 0.0);
+    for (args, says) in [
+        (&["--tracer", "stream", "--grid", "14x16"][..], "GXxGYxGZ"),
+        (
+            &["--tracer", "grid", "--proximity-clouds"],
+            "--tracer stream only",
+        ),
+        (
+            &["--tracer", "base", "--stream-steps", "8"],
+            "--stream-steps",
+        ),
+        (&["--tracer", "stream", "--tile", "64"], "--tile"),
+        (
+            &["--tracer", "stream", "--stream-steps", "5000"],
+            "1..=4096",
+        ),
+        (
+            &[
+                "--tracer",
+                "stream",
+                "--stream-steps",
+                "1",
+                "--stream-max-calls",
+                "2",
+            ],
+            "still walking",
+        ),
+    ] {
+        let out = run(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(says),
+            "{args:?}: {err}"
+        );
+    }
+}

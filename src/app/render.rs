@@ -126,6 +126,7 @@ fn refuse_other_pipeline(
         }
     } else {
         refuse_for_bvh_variant(args, &given)?;
+        refuse_for_stream(args, &given)?;
         let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
         if !soft_only.is_empty() {
             bail!(
@@ -158,6 +159,41 @@ fn refuse_for_bvh_variant(args: &RenderArgs, given: &dyn Fn(&[&str]) -> Vec<Stri
                 not_wagner.join(", ")
             );
         }
+    }
+    Ok(())
+}
+
+/// The streaming tracer's options only with `--tracer stream`, and the options of Müller's
+/// pipeline that it has no use for (its grid is always exact, it has no shadow-flag texture and
+/// no tiles) refused with it.
+fn refuse_for_stream(args: &RenderArgs, given: &dyn Fn(&[&str]) -> Vec<String>) -> Result<()> {
+    let stream_only = given(&["stream_steps", "stream_max_calls"]);
+    if args.tracer != TracerKind::Stream && !stream_only.is_empty() {
+        bail!(
+            "{} {} to --tracer stream only (this render uses --tracer {})",
+            stream_only.join(", "),
+            if stream_only.len() == 1 {
+                "applies"
+            } else {
+                "apply"
+            },
+            args.tracer.name()
+        );
+    }
+    let not_stream = given(&[
+        "grid_variant",
+        "voxel_array_length",
+        "ray_array_length",
+        "shadow_flags",
+        "tile",
+    ]);
+    if args.tracer == TracerKind::Stream && !not_stream.is_empty() {
+        let (does, an_option) = verb(&not_stream);
+        bail!(
+            "{} {does} not apply: {an_option} of the compute pipelines, and --tracer stream renders \
+             with seed 004's fragment programs (its own grid, no tiles, no shadow-flag texture)",
+            not_stream.join(", ")
+        );
     }
     Ok(())
 }
