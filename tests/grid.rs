@@ -360,6 +360,7 @@ fn thesis_grid_counts_what_its_fixed_lists_drop() {
             resolution: Some(8),
             voxel_array_length: 16,
             ray_array_length: Some(2),
+            ..GridOptions::default()
         },
         ..options(24, 24, 0)
     };

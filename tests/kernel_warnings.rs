@@ -12,6 +12,7 @@ use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, ShaderSource};
 use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
 use gpgpu_rt::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::ShadowMode;
@@ -53,6 +54,21 @@ fn every_kernel_compiles_without_warnings() {
     };
     let mut r = WagnerRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
         .expect("Wagner 2018's renderer");
+    r.render(&scene.camera).expect("frame");
+
+    // the streaming tracer of seed 004: its six fragment programs, with a reflection bounce
+    let opts = StreamOptions {
+        width: 8,
+        height: 8,
+        refl_depth: 1,
+        dims: None,
+        proximity_clouds: true,
+        steps_per_call: 16,
+        max_calls: 10_000,
+        aovs: true,
+    };
+    let mut r = StreamRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
+        .expect("the streaming tracer");
     r.render(&scene.camera).expect("frame");
 
     // the soft shadows: G-buffer, the three shadow modes, the quad

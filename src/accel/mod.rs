@@ -102,6 +102,10 @@ pub enum TracerKind {
     /// A BVH built on the CPU with the SAH, rebuilt when an object moved (ours, after Wagner
     /// 2018 ch. 3.2, 4.2); the grid options are ignored.
     Bvh,
+    /// The streaming ray tracer of seed 004: fragment-program kernels over a viewport-sized
+    /// quad, a static grid built once on the CPU, an occlusion query as the halting condition
+    /// (`pipeline::stream`; its own pipeline).
+    Stream,
 }
 
 impl TracerKind {
@@ -111,6 +115,7 @@ impl TracerKind {
             TracerKind::Base => "base",
             TracerKind::Grid => "grid",
             TracerKind::Bvh => "bvh",
+            TracerKind::Stream => "stream",
         }
     }
 }
@@ -164,6 +169,17 @@ pub struct GridOptions {
     /// Listing 17: 512) and ray_array_length (voxel ids per ray; `None`: 3·N as Listing 17).
     pub voxel_array_length: u32,
     pub ray_array_length: Option<u32>,
+    /// The streaming tracer's grid, gx×gy×gz cells (`--grid 14x16x14`); `None`: `resolution`
+    /// on every axis, or the paper's 3·∛n with neither.
+    pub axes: Option<[u32; 3]>,
+    /// The streaming tracer: skip empty cells by their proximity-cloud distances
+    /// (`--proximity-clouds`).
+    pub proximity_clouds: bool,
+    /// The streaming tracer: steps (triangle tests or cell moves) per traverse call.
+    pub stream_steps: u32,
+    /// The streaming tracer: the most traverse calls per traversal (rays still walking then
+    /// are counted in `truncated_rays` and the frame refused).
+    pub stream_max_calls: u32,
 }
 
 impl Default for GridOptions {
@@ -173,6 +189,10 @@ impl Default for GridOptions {
             resolution: None,
             voxel_array_length: 512,
             ray_array_length: None,
+            axes: None,
+            proximity_clouds: false,
+            stream_steps: 64,
+            stream_max_calls: 10_000,
         }
     }
 }

@@ -18,11 +18,13 @@ pub struct GpuArgs {
     pub glsl_dir: Option<PathBuf>,
 }
 
-/// `--grid N|auto`.
+/// `--grid N|GXxGYxGZ|auto`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum GridResolution {
     Auto,
     N(u32),
+    /// gx×gy×gz cells (the streaming tracer's grid need not be cubic: `14x16x14`)
+    Axes([u32; 3]),
 }
 
 impl std::str::FromStr for GridResolution {
@@ -30,6 +32,19 @@ impl std::str::FromStr for GridResolution {
     fn from_str(s: &str) -> Result<Self, String> {
         if s == "auto" {
             return Ok(GridResolution::Auto);
+        }
+        let in_range = |n: &u32| limits::GRID_RES.contains(n);
+        if s.contains('x') {
+            let axes: Vec<Option<u32>> = s.split('x').map(|a| a.parse().ok()).collect();
+            return match axes[..] {
+                [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(in_range) => {
+                    Ok(GridResolution::Axes([x, y, z]))
+                }
+                _ => Err(format!(
+                    "`{s}` is not GXxGYxGZ with three cell counts from 1 to {}",
+                    limits::GRID_RES.end()
+                )),
+            };
         }
         match s.parse::<u32>() {
             Ok(n) if limits::GRID_RES.contains(&n) => Ok(GridResolution::N(n)),
@@ -45,9 +60,22 @@ impl std::str::FromStr for GridResolution {
 #[derive(Debug, Clone, clap::Args)]
 pub struct GridArgs {
     /// Grid resolution N (N³ voxels, N from 1 to 1024), or `auto`: N = cbrt(triangles / 5),
-    /// within 4..=64.
-    #[arg(long, default_value = "auto", value_name = "N|auto")]
+    /// within 4..=64 (--tracer stream: 3·∛triangles per axis, as seed 004). --tracer stream
+    /// also takes GXxGYxGZ cells, e.g. 14x16x14.
+    #[arg(long, default_value = "auto", value_name = "N|GXxGYxGZ|auto")]
     pub grid: GridResolution,
+    /// --tracer stream: skip empty cells by their proximity-cloud distance (Chebyshev
+    /// distance, in cells, to the nearest non-empty cell).
+    #[arg(long)]
+    pub proximity_clouds: bool,
+    /// --tracer stream: steps (one triangle test or one move to the next cell) per call of
+    /// the traverse kernel, 1 to 4096.
+    #[arg(long, default_value_t = 64, value_name = "N", value_parser = limits::parser(limits::STREAM_STEPS))]
+    pub stream_steps: u32,
+    /// --tracer stream: traverse calls per traversal at most, 1 to 1000000 (rays still
+    /// walking then make the frame fail).
+    #[arg(long, default_value_t = 10_000, value_name = "N", value_parser = limits::parser(limits::STREAM_CALLS))]
+    pub stream_max_calls: u32,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
@@ -65,11 +93,18 @@ impl GridArgs {
         GridOptions {
             variant: self.grid_variant,
             resolution: match self.grid {
-                GridResolution::Auto => None,
                 GridResolution::N(n) => Some(n),
+                _ => None,
+            },
+            axes: match self.grid {
+                GridResolution::Axes(a) => Some(a),
+                _ => None,
             },
             voxel_array_length: self.voxel_array_length,
             ray_array_length: self.ray_array_length,
+            proximity_clouds: self.proximity_clouds,
+            stream_steps: self.stream_steps,
+            stream_max_calls: self.stream_max_calls,
         }
     }
 }

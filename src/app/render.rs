@@ -34,7 +34,8 @@ pub struct RenderArgs {
     height: Option<u32>,
     /// The accelerator of Müller 2015's four-kernel pipeline: `bvh` (ours: an SAH BVH, the
     /// fastest), `base` (the thesis' base tracer, every ray against every triangle) or `grid`
-    /// (the thesis' uniform grid, see --grid-variant).
+    /// (the thesis' uniform grid, see --grid-variant); or `stream`, seed 004's streaming tracer
+    /// (fragment-program kernels, a static grid, occlusion-query halting).
     #[arg(long, value_enum, default_value = "bvh")]
     tracer: TracerKind,
     /// With --tracer bvh: `sah` (ours, in the four-kernel pipeline) or `wagner` (Wagner 2018
@@ -106,6 +107,9 @@ fn refuse_other_pipeline(
             "grid_variant",
             "voxel_array_length",
             "ray_array_length",
+            "proximity_clouds",
+            "stream_steps",
+            "stream_max_calls",
         ]);
         if !ray_tracer_only.is_empty() {
             let (does, an_option) = verb(&ray_tracer_only);
@@ -123,6 +127,7 @@ fn refuse_other_pipeline(
         }
     } else {
         refuse_for_bvh_variant(args, &given)?;
+        refuse_for_stream(args, &given)?;
         let soft_only = given(&["light_samples", "ntree_n", "ntree_depth"]);
         if !soft_only.is_empty() {
             bail!(
@@ -155,6 +160,41 @@ fn refuse_for_bvh_variant(args: &RenderArgs, given: &dyn Fn(&[&str]) -> Vec<Stri
                 not_wagner.join(", ")
             );
         }
+    }
+    Ok(())
+}
+
+/// The streaming tracer's options only with `--tracer stream`, and the options of Müller's
+/// pipeline that it has no use for (its grid is always exact, it has no shadow-flag texture and
+/// no tiles) refused with it.
+fn refuse_for_stream(args: &RenderArgs, given: &dyn Fn(&[&str]) -> Vec<String>) -> Result<()> {
+    let stream_only = given(&["stream_steps", "stream_max_calls"]);
+    if args.tracer != TracerKind::Stream && !stream_only.is_empty() {
+        bail!(
+            "{} {} to --tracer stream only (this render uses --tracer {})",
+            stream_only.join(", "),
+            if stream_only.len() == 1 {
+                "applies"
+            } else {
+                "apply"
+            },
+            args.tracer.name()
+        );
+    }
+    let not_stream = given(&[
+        "grid_variant",
+        "voxel_array_length",
+        "ray_array_length",
+        "shadow_flags",
+        "tile",
+    ]);
+    if args.tracer == TracerKind::Stream && !not_stream.is_empty() {
+        let (does, an_option) = verb(&not_stream);
+        bail!(
+            "{} {does} not apply: {an_option} of the compute pipelines, and --tracer stream renders \
+             with seed 004's fragment programs (its own grid, no tiles, no shadow-flag texture)",
+            not_stream.join(", ")
+        );
     }
     Ok(())
 }

@@ -130,6 +130,14 @@ impl Kernel {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_2_i32(self.loc(name), v[0], v[1]) };
     }
+    pub fn set_ivec3(&self, name: &str, v: [i32; 3]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_3_i32(self.loc(name), v[0], v[1], v[2]) };
+    }
+    pub fn set_vec2(&self, name: &str, v: [f32; 2]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe { self.gl.uniform_2_f32(self.loc(name), v[0], v[1]) };
+    }
     pub fn set_vec3(&self, name: &str, v: [f32; 3]) {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_3_f32_slice(self.loc(name), &v) };

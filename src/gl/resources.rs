@@ -431,3 +431,87 @@ impl GpuTimers {
         }
     }
 }
+
+/// A 3D texture of RGB32F texels read with `texelFetch` through a `sampler3D` (nearest
+/// filtering, one level): the cells and the triangle data of seed 004's grid (Fig. 3).
+pub struct Texture3d {
+    pub texture: glow::Texture,
+    pub size: [u32; 3],
+    pub bytes: usize,
+}
+
+impl Texture3d {
+    /// Upload `texels` (x fastest, then y, then z; `size` = texels per axis) after checking
+    /// every side against `GL_MAX_3D_TEXTURE_SIZE`; `name` is for the message.
+    pub fn rgb32f(gl: &Gl, name: &str, size: [u32; 3], texels: &[[f32; 3]]) -> Result<Texture3d> {
+        // SAFETY: a limit query on a current context.
+        let max = unsafe { gl.get_parameter_i32(glow::MAX_3D_TEXTURE_SIZE) } as u32;
+        if size.iter().any(|&s| s == 0 || s > max) {
+            bail!(
+                "3D texture `{name}` of {}x{}x{} texels: every side must lie in 1..={max} \
+                 (GL_MAX_3D_TEXTURE_SIZE of this GL implementation)",
+                size[0],
+                size[1],
+                size[2]
+            );
+        }
+        let n = (size[0] * size[1] * size[2]) as usize;
+        if texels.len() != n {
+            bail!(
+                "3D texture `{name}`: {} texels for {n} places",
+                texels.len()
+            );
+        }
+        // SAFETY: texture creation and upload on a current context; the slice holds n texels.
+        unsafe {
+            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
+            gl.bind_texture(glow::TEXTURE_3D, Some(texture));
+            gl.tex_storage_3d(
+                glow::TEXTURE_3D,
+                1,
+                glow::RGB32F,
+                size[0] as i32,
+                size[1] as i32,
+                size[2] as i32,
+            );
+            for p in [glow::TEXTURE_MIN_FILTER, glow::TEXTURE_MAG_FILTER] {
+                gl.tex_parameter_i32(glow::TEXTURE_3D, p, glow::NEAREST as i32);
+            }
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
+            gl.tex_sub_image_3d(
+                glow::TEXTURE_3D,
+                0,
+                0,
+                0,
+                0,
+                size[0] as i32,
+                size[1] as i32,
+                size[2] as i32,
+                glow::RGB,
+                glow::FLOAT,
+                glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(texels))),
+            );
+            gl.bind_texture(glow::TEXTURE_3D, None);
+            Ok(Texture3d {
+                texture,
+                size,
+                bytes: 12 * n,
+            })
+        }
+    }
+
+    /// Bind to texture unit `unit` (a `sampler3D` with `layout(binding = unit)`).
+    pub fn bind(&self, gl: &Gl, unit: u32) {
+        // SAFETY: binding our own texture to a texture unit.
+        unsafe {
+            gl.active_texture(glow::TEXTURE0 + unit);
+            gl.bind_texture(glow::TEXTURE_3D, Some(self.texture));
+            gl.active_texture(glow::TEXTURE0);
+        }
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        // SAFETY: deleting our own texture.
+        unsafe { gl.delete_texture(self.texture) };
+    }
+}

@@ -103,6 +103,27 @@ slot_table! {
         WAGNER_VERTICES = 4,
         WAGNER_NORMALS = 5,
         WAGNER_COLORS = 6,
+        /// the streaming tracer of seed 004 (glsl/stream/): the ray textures (Fig. 1) and the
+        /// eye or reflection ray's hit record
+        STREAM_RAY_ORIGIN = 0,
+        STREAM_RAY_DIR = 1,
+        STREAM_HIT = 2,
+        /// ... the grid and the triangles in texture memory (Fig. 3): cells (3D), references
+        /// (a texture buffer), triangle vertices and normals (3D, 4 depth slices)
+        STREAM_CELLS = 3,
+        STREAM_REFS = 4,
+        STREAM_TRI_VERTEX = 5,
+        STREAM_TRI_NORMAL = 6,
+        /// ... the traversal state set a traverse call reads (Fig. 2's three textures)
+        STREAM_READ_TMAX = 7,
+        STREAM_READ_CELL = 8,
+        STREAM_READ_HIT = 9,
+        /// ... both sets' ray state and hit record, for the early-Z pass, the hit record and
+        /// the shading
+        STREAM_STATE_A = 10,
+        STREAM_STATE_B = 11,
+        STREAM_HIT_A = 12,
+        STREAM_HIT_B = 13,
     }
 }
 

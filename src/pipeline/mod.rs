@@ -6,9 +6,11 @@
 //! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`raytrace`] | `glsl/mueller2015/` | every one of [`crate::accel::REGISTRY`] |
 //! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`softshadow`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
 //! | one kernel per pixel (primary ray, BVH walk, Lambert, hard shadow) | Wagner 2018 | [`wagner2018`] | `glsl/wagner2018/` | its BVH in three textures (`--tracer bvh --bvh-variant wagner`) |
+//! | fragment programs over a viewport-sized quad, traversal looped until an occlusion query counts no fragment | seed 004 | [`stream`] | `glsl/stream/` | its static grid in textures, proximity clouds (`--tracer stream`) |
 
 pub mod raytrace;
 pub mod softshadow;
+pub mod stream;
 pub mod wagner2018;
 
 use std::sync::Arc;
@@ -71,6 +73,18 @@ pub fn ray_tracer(
         let o = wagner2018::WagnerOptions::of(&options);
         let r = wagner2018::WagnerRenderer::new(gl, info, scene, shaders, o)?;
         return Ok(Box::new(r));
+    }
+    if options.tracer == TracerKind::Stream {
+        let o = stream::StreamOptions::of(&options);
+        return Ok(Box::new(stream::StreamRenderer::new(
+            gl, info, scene, shaders, o,
+        )?));
+    }
+    if options.grid.axes.is_some() || options.grid.proximity_clouds {
+        anyhow::bail!(
+            "--grid GXxGYxGZ and --proximity-clouds apply to --tracer stream only (the compute \
+             grids are cubic and do not skip empty cells yet)"
+        );
     }
     let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;
     Ok(Box::new(r))

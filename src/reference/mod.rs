@@ -10,6 +10,8 @@ pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
 pub mod ntree;
+pub mod stream_grid;
+pub mod stream_shading;
 pub mod thesis_grid;
 pub mod wagner2018;
 pub mod wagner_bvh;

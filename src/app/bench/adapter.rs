@@ -71,6 +71,7 @@ fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)
         resolution: Some(resolution),
         voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
         ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
+        ..d
     };
     Ok((TracerKind::Grid, grid))
 }

@@ -1,0 +1,114 @@
+// The static grid and the triangles in texture memory — seed 004, ch. 3, Fig. 3 ("grid data
+// layout with two levels of indirection"), and the 3D-DDA of Amanatides and Woo that walks it.
+// The CPU twin of every function here is in src/reference/stream_grid.rs (same f32 arithmetic,
+// same order), the tests' oracle.
+//
+// cells:      3D texture, RGB32F, one texel per grid cell: R the pointer to the cell's first
+//             reference, G the number of references, B the proximity-cloud distance (in cells,
+//             Chebyshev metric; 0 for a non-empty cell)
+// references: the tightly packed lists, one texel (R32F) per reference: a triangle id, i.e.
+//             the (x, y) of the triangle's texels in the two triangle textures
+// triVertex:  3D texture RGB32F, 4 depth slices: v0, edge1, edge2, diffuse colour
+// triNormal:  3D texture RGB32F, 4 depth slices: n0, n1, n2, (reflectivity, 0, 0)
+//             ("edge1 and edge2 are stored instead of v1 and v2, to save the GPU two vector
+//             subtractions every ray-triangle intersection test", ch. 3)
+layout(binding = SAMPLER_STREAM_CELLS) uniform sampler3D cells;
+layout(binding = SAMPLER_STREAM_REFS) uniform samplerBuffer references;
+layout(binding = SAMPLER_STREAM_TRI_VERTEX) uniform sampler3D triVertex;
+layout(binding = SAMPLER_STREAM_TRI_NORMAL) uniform sampler3D triNormal;
+
+uniform vec3 gridMin;
+uniform vec3 gridMax;
+uniform vec3 cellSize;
+uniform ivec3 gridSize;
+// the width of the triangle textures: triangle id -> (x, y)
+uniform int triTextureWidth;
+
+// +infinity (GLSL has no literal for it)
+#define INF uintBitsToFloat(0x7F800000u)
+
+// the ray state in the w channel of Fig. 2's first texture
+#define RAY_ACTIVE 1.0
+#define RAY_DONE 2.0
+
+ivec2 triTexel(int id)
+{
+    return ivec2(id % triTextureWidth, id / triTextureWidth);
+}
+
+vec3 triangleVertex(int id, int slice)
+{
+    return texelFetch(triVertex, ivec3(triTexel(id), slice), 0).rgb;
+}
+
+vec3 triangleNormal(int id, int slice)
+{
+    return texelFetch(triNormal, ivec3(triTexel(id), slice), 0).rgb;
+}
+
+// Möller and Trumbore (ch. 3: "the fastest known single sided algorithm") with the stored
+// edges: the same arithmetic as Algorithm 1 of glsl/common/intersect.glsl given v1 - v0 and
+// v2 - v0, so the distances equal the other tracers'.
+bool intersectStored(vec3 r0, vec3 rd, int id, out float t, out float u, out float v)
+{
+    vec3 v0 = triangleVertex(id, 0);
+    vec3 edge1 = triangleVertex(id, 1);
+    vec3 edge2 = triangleVertex(id, 2);
+    vec3 pvec = cross(rd, edge2);
+    float det = dot(edge1, pvec);
+    float invDet = 1.0 / det;
+    vec3 tvec = r0 - v0;
+    u = invDet * dot(tvec, pvec);
+    vec3 qvec = cross(tvec, edge1);
+    v = invDet * dot(rd, qvec);
+    t = invDet * dot(edge2, qvec);
+    return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
+}
+
+// clipToBox: (enter, exit) of o + t·d inside the grid's box; enter > exit when it misses.
+vec2 clipToBox(vec3 o, vec3 d)
+{
+    float enter = -INF, exitT = INF;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.0) {
+            if (o[a] < gridMin[a] || o[a] > gridMax[a]) return vec2(INF, -INF);
+            continue;
+        }
+        float t0 = (gridMin[a] - o[a]) / d[a];
+        float t1 = (gridMax[a] - o[a]) / d[a];
+        enter = max(enter, min(t0, t1));
+        exitT = min(exitT, max(t0, t1));
+    }
+    return vec2(enter, exitT);
+}
+
+// planeT: where o + t·d leaves cell column k of axis a (+inf for d = 0).
+float planeT(vec3 o, vec3 d, int a, int k)
+{
+    if (d[a] == 0.0) return INF;
+    int up = d[a] > 0.0 ? 1 : 0;
+    return (gridMin[a] + float(k + up) * cellSize[a] - o[a]) / d[a];
+}
+
+vec3 tMaxOf(vec3 o, vec3 d, ivec3 c)
+{
+    return vec3(planeT(o, d, 0, c.x), planeT(o, d, 1, c.y), planeT(o, d, 2, c.z));
+}
+
+// cellOf: the cell of p, clamped into the grid.
+ivec3 cellOf(vec3 p)
+{
+    return clamp(ivec3(floor((p - gridMin) / cellSize)), ivec3(0), gridSize - 1);
+}
+
+bool insideGrid(ivec3 c)
+{
+    return all(greaterThanEqual(c, ivec3(0))) && all(lessThan(c, gridSize));
+}
+
+// the axis of the smallest component (ties: x, then y, then z)
+int minAxis(vec3 t)
+{
+    float m = min(t.x, min(t.y, t.z));
+    return t.x == m ? 0 : (t.y == m ? 1 : 2);
+}

@@ -1,0 +1,37 @@
+// The masking kernel — seed 004, ch. 3, the optimisations: "During the execution of an
+// additional kernel (right after the ray generator, but suppressed in figure 1) rays that are
+// known not needing further processing (eg. rays missed the scene AABB, shadow rays for rays not
+// intersecting any objects) are masked out as soon as possible, and excluded from further
+// calculations."
+// Writes the first state set of Fig. 2: a masked ray is RAY_DONE with an empty hit record (the
+// early-Z pass then culls it from every traverse call); an active ray gets the start of its
+// 3D-DDA (Amanatides and Woo): the cell where it enters the grid and tMax, no triangles
+// processed, no hit yet.
+#include "grid.glsl"
+#include "rays.glsl"
+#include "counters.glsl"
+
+// 1: the rays are shadow rays (rayDirection.w is their limit, not a weight)
+uniform int shadowRays;
+
+layout(location = 0) out vec4 outTMax;
+layout(location = 1) out vec4 outCell;
+layout(location = 2) out vec4 outHit;
+
+void main()
+{
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 o = texelFetch(rayOrigin, px, 0), d = texelFetch(rayDirection, px, 0);
+    float limit = shadowRays != 0 ? d.w : INF;
+    outTMax = vec4(0.0, 0.0, 0.0, RAY_DONE);
+    outCell = vec4(0.0);
+    outHit = vec4(0.0, 0.0, INF, -1.0);
+    if (d.w <= 0.0) return;
+    vec2 span = clipToBox(o.xyz, d.xyz);
+    float t0 = max(span.x, 0.0);
+    if (t0 > min(span.y, limit)) return;
+    ivec3 cell = cellOf(o.xyz + t0 * d.xyz);
+    outTMax = vec4(tMaxOf(o.xyz, d.xyz, cell), RAY_ACTIVE);
+    outCell = vec4(vec3(cell), 0.0);
+    countAdd(COUNTER_CELLS_VISITED, 1u);
+}

@@ -1,0 +1,461 @@
+//! The static uniform grid of the streaming ray tracer (seed 004, ch. 3 and Fig. 3) and its CPU
+//! twin: built once on the CPU ("precomputed offline on the main processor"), with per cell a
+//! pointer into the tightly packed reference list, the count of references and the
+//! proximity-cloud distance; walked with the 3D-DDA of Amanatides and Woo exactly as
+//! `glsl/stream/grid.glsl` walks it (the same f32 arithmetic, the same order of cells and of
+//! triangle tests), so the tests can hold the GPU's hits and counts against it.
+//!
+//! Unlike Müller's grids (`reference::grid`), this grid lives in world space: its box is the
+//! scene's bounds, slightly enlarged, cut into gx×gy×gz cells that need not be cubes
+//! (`--grid 14x16x14`).
+
+use glam::{IVec3, UVec3, Vec3};
+
+use super::grid::tri_box_overlap;
+use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
+
+/// Ray state of the traversal (Fig. 2, `tMax`'s w channel): still walking.
+pub const ACTIVE: f32 = 1.0;
+/// Ray state: finished (hit found, walk left the grid, or masked out).
+pub const DONE: f32 = 2.0;
+
+/// The grid's box and its cells: what `glsl/stream/grid.glsl` gets as uniforms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridBox {
+    /// the box's minimum corner (`gridMin`)
+    pub min: Vec3,
+    /// `gridMin + cellSize · gridSize`, in f32 (`gridMax`)
+    pub max: Vec3,
+    /// the edge lengths of a cell (`cellSize`)
+    pub cell: Vec3,
+    /// cells per axis (`gridSize`)
+    pub dims: UVec3,
+}
+
+impl GridBox {
+    /// The box over `lo..hi` (the scene's bounds), enlarged by 10⁻³ of its largest extent on
+    /// every side so that no triangle lies on its faces and a flat scene gets a thickness.
+    pub fn new(lo: Vec3, hi: Vec3, dims: UVec3) -> GridBox {
+        let pad = (hi - lo).max_element().max(1e-6) * 1e-3;
+        let (min, max) = (lo - pad, hi + pad);
+        let cell = (max - min) / dims.as_vec3();
+        GridBox {
+            min,
+            max: min + cell * dims.as_vec3(),
+            cell,
+            dims,
+        }
+    }
+
+    pub fn cell_count(&self) -> usize {
+        (self.dims.x * self.dims.y * self.dims.z) as usize
+    }
+
+    /// The index of cell `c` (x fastest), `None` outside the grid.
+    pub fn index(&self, c: IVec3) -> Option<usize> {
+        let d = self.dims.as_ivec3();
+        let inside = c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
+        inside.then(|| ((c.z * d.y + c.y) * d.x + c.x) as usize)
+    }
+
+    /// clipToBox: the parameter interval (enter, exit) of o + t·d inside the box; empty when
+    /// enter > exit. An axis with d = 0 clips nothing if o lies within its slab.
+    pub fn clip(&self, o: Vec3, d: Vec3) -> (f32, f32) {
+        let (mut enter, mut exit) = (f32::NEG_INFINITY, f32::INFINITY);
+        for a in 0..3 {
+            if d[a] == 0.0 {
+                if o[a] < self.min[a] || o[a] > self.max[a] {
+                    return (f32::INFINITY, f32::NEG_INFINITY);
+                }
+                continue;
+            }
+            let t0 = (self.min[a] - o[a]) / d[a];
+            let t1 = (self.max[a] - o[a]) / d[a];
+            enter = enter.max(t0.min(t1));
+            exit = exit.min(t0.max(t1));
+        }
+        (enter, exit)
+    }
+
+    /// planeT: the parameter at which o + t·d leaves cell column `k` of axis `a` (the cell
+    /// plane beyond it in the direction of travel); +∞ for d = 0.
+    pub fn plane_t(&self, o: Vec3, d: Vec3, a: usize, k: i32) -> f32 {
+        if d[a] == 0.0 {
+            return f32::INFINITY;
+        }
+        let up = if d[a] > 0.0 { 1 } else { 0 };
+        (self.min[a] + (k + up) as f32 * self.cell[a] - o[a]) / d[a]
+    }
+
+    /// cellOf: the cell of point p, clamped into the grid.
+    pub fn cell_of(&self, p: Vec3) -> IVec3 {
+        let c = ((p - self.min) / self.cell).floor().as_ivec3();
+        c.clamp(IVec3::ZERO, self.dims.as_ivec3() - 1)
+    }
+
+    /// tMax of cell `c`: per axis the parameter of the next cell plane.
+    pub fn t_max(&self, o: Vec3, d: Vec3, c: IVec3) -> Vec3 {
+        Vec3::new(
+            self.plane_t(o, d, 0, c.x),
+            self.plane_t(o, d, 1, c.y),
+            self.plane_t(o, d, 2, c.z),
+        )
+    }
+}
+
+/// `--grid auto`: the paper's heuristic g = 3·∛n cells per axis (ch. 4), within 1..=1024.
+pub fn auto_dims(triangles: usize) -> UVec3 {
+    UVec3::splat(((3.0 * (triangles as f64).cbrt()).round() as u32).clamp(1, 1024))
+}
+
+/// The grid of Fig. 3: per cell (pointer, count, proximity distance), the references tightly
+/// packed, and the triangles (v0, edge1, edge2) they point to.
+pub struct StreamGrid {
+    pub bx: GridBox,
+    /// per cell: index of its first reference in `refs`, and their count
+    pub cells: Vec<(u32, u32)>,
+    /// triangle ids, per cell ascending, cells in index order
+    pub refs: Vec<u32>,
+    /// per cell: the Chebyshev distance in cells to the nearest non-empty cell (0: non-empty)
+    pub proximity: Vec<u32>,
+    /// world-space triangles in id order
+    pub triangles: Vec<[Vec3; 3]>,
+}
+
+/// The cells a triangle overlaps (triangle/box separating axes, boxes enlarged by 10⁻⁴ of a
+/// cell so that nothing on a cell face is lost), in index order.
+fn overlapped_cells(bx: &GridBox, t: &[Vec3; 3]) -> Vec<usize> {
+    let margin = bx.cell * 1e-4;
+    let lo = bx.cell_of(t[0].min(t[1]).min(t[2]) - margin);
+    let hi = bx.cell_of(t[0].max(t[1]).max(t[2]) + margin);
+    let half = bx.cell * 0.5 + margin;
+    let mut out = Vec::new();
+    for z in lo.z..=hi.z {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                let c = IVec3::new(x, y, z);
+                let centre = bx.min + (c.as_vec3() + 0.5) * bx.cell;
+                if tri_box_overlap(centre, half, *t) {
+                    out.push(bx.index(c).expect("clamped"));
+                }
+            }
+        }
+    }
+    out
+}
+
+impl StreamGrid {
+    /// Register every triangle in the cells it overlaps, pack the lists, compute the
+    /// proximity distances.
+    pub fn build(triangles: Vec<[Vec3; 3]>, bounds: (Vec3, Vec3), dims: UVec3) -> StreamGrid {
+        let bx = GridBox::new(bounds.0, bounds.1, dims);
+        let mut lists = vec![Vec::new(); bx.cell_count()];
+        for (id, t) in triangles.iter().enumerate() {
+            for c in overlapped_cells(&bx, t) {
+                lists[c].push(id as u32);
+            }
+        }
+        let mut cells = Vec::with_capacity(lists.len());
+        let mut refs = Vec::new();
+        for l in &lists {
+            cells.push((refs.len() as u32, l.len() as u32));
+            refs.extend_from_slice(l);
+        }
+        let filled: Vec<bool> = lists.iter().map(|l| !l.is_empty()).collect();
+        StreamGrid {
+            proximity: chebyshev_distances(dims, &filled),
+            bx,
+            cells,
+            refs,
+            triangles,
+        }
+    }
+
+    /// The paper's storage estimate M = 96·n + 16·gx·gy·gz bytes (ch. 4).
+    pub fn paper_bytes(&self) -> u64 {
+        96 * self.triangles.len() as u64 + 16 * self.bx.cell_count() as u64
+    }
+}
+
+/// The 26 neighbour offsets (dz, dy, dx) before a cell in x-fastest scan order.
+fn causal_neighbours() -> Vec<IVec3> {
+    let mut v = Vec::new();
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let o = IVec3::new(dx, dy, dz);
+                if (dz, dy, dx) < (0, 0, 0) {
+                    v.push(o);
+                }
+            }
+        }
+    }
+    v
+}
+
+/// Proximity clouds (Cohen and Sheffer 1994) in the Chebyshev (L∞) metric: for every cell the
+/// distance, in cells, to the nearest cell with `filled` set — by the two-pass chamfer
+/// transform with unit weights over the 26-neighbourhood (Rosenfeld and Pfaltz), which is
+/// exact for L∞. An empty grid gets the largest side everywhere.
+pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
+    let d = dims.as_ivec3();
+    let far = dims.max_element();
+    let mut dist: Vec<u32> = filled.iter().map(|&f| if f { 0 } else { far }).collect();
+    let idx = |c: IVec3| ((c.z * d.y + c.y) * d.x + c.x) as usize;
+    let inside = |c: IVec3| c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
+    let back = causal_neighbours();
+    let cells: Vec<IVec3> = (0..d.z)
+        .flat_map(|z| (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z))))
+        .collect();
+    let mut relax = |c: IVec3, offsets: &mut dyn Iterator<Item = IVec3>| {
+        let mut best = dist[idx(c)];
+        for o in offsets {
+            if inside(c + o) {
+                best = best.min(dist[idx(c + o)] + 1);
+            }
+        }
+        dist[idx(c)] = best;
+    };
+    for &c in &cells {
+        relax(c, &mut back.iter().copied());
+    }
+    for &c in cells.iter().rev() {
+        relax(c, &mut back.iter().map(|o| -*o));
+    }
+    dist.into_iter().map(|v| v.min(far)).collect()
+}
+
+/// What a walk counted: triangle tests, cells entered, proximity-cloud jumps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct WalkCounts {
+    pub tests: u64,
+    pub cells: u64,
+    pub jumps: u64,
+}
+
+/// One ray's walk state: Fig. 2's cell and tMax (the triangles processed are the loop's).
+struct Walk {
+    cell: IVec3,
+    t_max: Vec3,
+}
+
+/// A ray as the traversal kernel reads it: origin, direction, the triangle to skip (the one
+/// it starts on), and its t limit (the light for a shadow ray, +∞ else).
+#[derive(Debug, Clone, Copy)]
+pub struct StreamRay {
+    pub o: Vec3,
+    pub d: Vec3,
+    pub skip: i32,
+    pub limit: f32,
+}
+
+impl StreamGrid {
+    /// The masking kernel's start of a walk (`glsl/stream/mask.frag`): `None` for a ray that
+    /// misses the box (or whose box segment begins beyond its limit).
+    fn begin(&self, r: &StreamRay) -> Option<Walk> {
+        let (enter, exit) = self.bx.clip(r.o, r.d);
+        let t0 = enter.max(0.0);
+        if t0 > exit.min(r.limit) {
+            return None;
+        }
+        let cell = self.bx.cell_of(r.o + t0 * r.d);
+        Some(Walk {
+            cell,
+            t_max: self.bx.t_max(r.o, r.d, cell),
+        })
+    }
+
+    /// stepCell: into the next cell along the axis of the smallest tMax (ties: x, y, z);
+    /// false when the walk left the grid.
+    fn step(&self, r: &StreamRay, w: &mut Walk) -> bool {
+        let exit = w.t_max.min_element();
+        let a = if w.t_max.x == exit {
+            0
+        } else if w.t_max.y == exit {
+            1
+        } else {
+            2
+        };
+        w.cell[a] += if r.d[a] > 0.0 { 1 } else { -1 };
+        if self.bx.index(w.cell).is_none() {
+            return false;
+        }
+        w.t_max[a] = self.bx.plane_t(r.o, r.d, a, w.cell[a]);
+        true
+    }
+
+    /// jumpCloud: leave the cube of cells within Chebyshev distance `dist − 1` of the current
+    /// cell (all empty) where the ray leaves it; false when that is beyond the grid or the
+    /// ray's limit. The exit axis' cell is the first beyond the cube's face; the others are
+    /// the exit point's (within the cube's range), placed by the DDA's plane parameters.
+    fn jump(&self, r: &StreamRay, w: &mut Walk, dist: u32) -> bool {
+        let rad = IVec3::splat(dist as i32 - 1);
+        let lo = (w.cell - rad).max(IVec3::ZERO);
+        let hi = (w.cell + rad).min(self.bx.dims.as_ivec3() - 1);
+        let far = IVec3::select(r.d.cmpgt(Vec3::ZERO), hi, lo);
+        let t_box = self.bx.t_max(r.o, r.d, far);
+        let exit = t_box.min_element();
+        if exit > r.limit {
+            return false;
+        }
+        let a = if t_box.x == exit {
+            0
+        } else if t_box.y == exit {
+            1
+        } else {
+            2
+        };
+        let p = ((r.o + exit * r.d - self.bx.min) / self.bx.cell)
+            .floor()
+            .as_ivec3();
+        let mut cell = p.clamp(lo, hi);
+        for b in (0..3).filter(|&b| b != a && r.d[b] != 0.0) {
+            // the exit point's cell as the DDA's plane parameters place it (floor() may round
+            // across a plane the point lies on)
+            let s = if r.d[b] > 0.0 { 1 } else { -1 };
+            if self.bx.plane_t(r.o, r.d, b, cell[b] - s) > exit {
+                cell[b] -= s;
+            } else if self.bx.plane_t(r.o, r.d, b, cell[b]) < exit {
+                cell[b] += s;
+            }
+            cell[b] = cell[b].clamp(lo[b], hi[b]);
+        }
+        cell[a] = far[a] + if r.d[a] > 0.0 { 1 } else { -1 };
+        if self.bx.index(cell).is_none() {
+            return false;
+        }
+        *w = Walk {
+            cell,
+            t_max: self.bx.t_max(r.o, r.d, cell),
+        };
+        true
+    }
+
+    /// Walk ray `r` as the traverse-and-intersect kernel does: closest hit (ties: the lower
+    /// id), or with `any_hit` the first hit within (offset, limit). Returns the hit and the
+    /// counts.
+    pub fn trace(
+        &self,
+        r: &StreamRay,
+        any_hit: Option<f32>,
+        proximity: bool,
+    ) -> (Option<Hit>, WalkCounts) {
+        let mut n = WalkCounts::default();
+        let mut best: Option<Hit> = None;
+        let Some(mut w) = self.begin(r) else {
+            return (None, n);
+        };
+        loop {
+            n.cells += 1;
+            let cell = self.bx.index(w.cell).expect("inside");
+            let (first, count) = self.cells[cell];
+            let list = &self.refs[first as usize..(first + count) as usize];
+            if let Some(offset) = any_hit {
+                if let Some(h) = self.first_blocker(r, list, offset, &mut n.tests) {
+                    return (Some(h), n);
+                }
+            } else {
+                let ids = list.iter().map(|&i| i as usize);
+                closest_among(
+                    &mut best,
+                    &self.triangles,
+                    ids,
+                    (r.o, r.d, r.skip),
+                    &mut n.tests,
+                );
+            }
+            let exit = w.t_max.min_element();
+            if best.is_some_and(|b| b.t <= exit) || exit > r.limit {
+                return (best, n);
+            }
+            let dist = self.proximity[cell];
+            let moved = if proximity && count == 0 && dist >= 2 {
+                n.jumps += 1;
+                self.jump(r, &mut w, dist)
+            } else {
+                self.step(r, &mut w)
+            };
+            if !moved {
+                return (best, n);
+            }
+        }
+    }
+
+    /// The first triangle of `list` (in order, the ray's own skipped) hit within
+    /// (offset, limit): the shadow ray's any hit.
+    fn first_blocker(
+        &self,
+        r: &StreamRay,
+        list: &[u32],
+        offset: f32,
+        tests: &mut u64,
+    ) -> Option<Hit> {
+        for &id in list.iter().filter(|&&i| i as i32 != r.skip) {
+            *tests += 1;
+            let v = &self.triangles[id as usize];
+            if let Some((t, u, vv)) = intersect_triangle(r.o, r.d, v[0], v[1], v[2]) {
+                if t > offset && t < r.limit {
+                    let id = id as usize;
+                    return Some(Hit { t, id, u, v: vv });
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The grid as a [`CpuAccelerator`] (closest hits and shadow feelers, without proximity
+/// clouds — they change the counts, not the hits).
+impl CpuAccelerator for StreamGrid {
+    fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
+        let r = StreamRay {
+            o: ro,
+            d: rd,
+            skip: last,
+            limit: f32::INFINITY,
+        };
+        let (h, n) = self.trace(&r, None, false);
+        (h, n.tests)
+    }
+
+    fn occluded(&self, f: &Feeler) -> (bool, u64) {
+        let r = StreamRay {
+            o: f.ro,
+            d: f.rd,
+            skip: f.last,
+            limit: f.light_distance,
+        };
+        let (h, n) = self.trace(&r, Some(f.offset), false);
+        (h.is_some(), n.tests)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The distance field against its definition, on a small grid with a few filled cells.
+    #[test]
+    fn chebyshev_transform_equals_brute_force() {
+        let dims = UVec3::new(7, 5, 6);
+        let n = (dims.x * dims.y * dims.z) as usize;
+        let mut filled = vec![false; n];
+        for i in [3usize, 77, 150, 151, 209] {
+            filled[i] = true;
+        }
+        let d = dims.as_ivec3();
+        let pos = |i: usize| {
+            let i = i as i32;
+            IVec3::new(i % d.x, (i / d.x) % d.y, i / (d.x * d.y))
+        };
+        let got = chebyshev_distances(dims, &filled);
+        for (i, g) in got.iter().enumerate() {
+            let want = (0..n)
+                .filter(|&j| filled[j])
+                .map(|j| (pos(i) - pos(j)).abs().max_element() as u32)
+                .min()
+                .unwrap();
+            assert_eq!(*g, want, "cell {:?}", pos(i));
+        }
+    }
+}
