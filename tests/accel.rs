@@ -53,9 +53,20 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
         eprintln!("{}: {c:?}", entry.label);
         assert!(c.hits > 400, "{}: {} hits", entry.label, c.hits);
         assert_eq!(c.id_mismatches, 0, "{}: first hits differ", entry.label);
-        assert!(c.max_t_rel < 1e-5, "{}: hit distances differ", entry.label);
+        // measured (llvmpipe, 2026-11-23): distances within 3.9e-7 relative, colours within
+        // 5.2e-6 (the rounding of fused multiply-adds); was 1e-5 and no pixel off by 0.02
+        let tol = SAME_ARITHMETIC;
+        assert!(
+            c.max_t_rel <= tol.t_rel,
+            "{}: hit distances differ",
+            entry.label
+        );
         // same shadows, same colours
-        assert_eq!(c.color_outliers, 0.0, "{}: colours differ", entry.label);
+        assert!(
+            c.max_color_diff <= tol.max_color,
+            "{}: colours differ",
+            entry.label
+        );
         let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
         let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
         eprintln!(
@@ -69,10 +80,11 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
         } else {
             // the thesis grid fills a voxel's list in the order its atomics give (Listing 21),
             // so a shadow feeler meets its first occluder after more or fewer tests than the
-            // twin's ascending lists (measured on this frame: 52,793 vs 52,741, 0.1 %); the
-            // answers are the same
+            // twin's ascending lists; the answers are the same. Measured on this frame: 52,793
+            // vs 52,741 (0.10 %, an earlier kernel), 46,777 vs 46,761 (0.034 %, 2026-11-23);
+            // the bound is twice the larger (was 0.5 %)
             let d = (g2 as f64 - c2 as f64).abs() / c2 as f64;
-            assert!(d < 0.005, "{}: intersect2 tests {g2} vs {c2}", entry.label);
+            assert!(d < 0.002, "{}: intersect2 tests {g2} vs {c2}", entry.label);
         }
     }
 }
