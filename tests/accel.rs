@@ -53,9 +53,20 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
         eprintln!("{}: {c:?}", entry.label);
         assert!(c.hits > 400, "{}: {} hits", entry.label, c.hits);
         assert_eq!(c.id_mismatches, 0, "{}: first hits differ", entry.label);
-        assert!(c.max_t_rel < 1e-5, "{}: hit distances differ", entry.label);
+        // measured (llvmpipe, 2026-11-23): distances within 3.9e-7 relative, colours within
+        // 5.2e-6 (the rounding of fused multiply-adds); was 1e-5 and no pixel off by 0.02
+        let tol = SAME_ARITHMETIC;
+        assert!(
+            c.max_t_rel <= tol.t_rel,
+            "{}: hit distances differ",
+            entry.label
+        );
         // same shadows, same colours
-        assert_eq!(c.color_outliers, 0.0, "{}: colours differ", entry.label);
+        assert!(
+            c.max_color_diff <= tol.max_color,
+            "{}: colours differ",
+            entry.label
+        );
         let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
         let (g2, c2) = (gpu.stats.triangle_tests["intersect2"], cpu.intersect2_tests);
         eprintln!(

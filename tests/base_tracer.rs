@@ -63,10 +63,9 @@ fn teapot_with_two_reflection_passes_matches_reference() {
     // reflected rays were traced: more intersect1 tests than one per pixel and triangle
     let (g1, c1) = (gpu.stats.triangle_tests["intersect1"], cpu.intersect1_tests);
     assert!(g1 > 64 * 48 * 14592, "no reflection pass ran: {g1}");
-    assert!(
-        (g1 as f64 - c1 as f64).abs() <= 0.005 * c1 as f64,
-        "intersect1 {g1} vs {c1}"
-    );
+    // the same rays in the same passes test every triangle: equal (measured 50,298,249 on
+    // both; was: within 0.5 %)
+    assert_eq!(g1, c1, "intersect1 tests");
     // the reflective teapot shows the floor: its pixels differ from a render without reflection
     let flat = render_gpu(&ctx, &scene, options(64, 48, 0));
     let changed = gpu
@@ -211,7 +210,19 @@ fn textured_object_is_sampled_like_the_reference() {
     let opts = options(64, 64, 0);
     let gpu = render_gpu(&ctx, &scene, opts.clone());
     let cpu = render_cpu(&scene, &opts);
-    let c = assert_close(&gpu, &cpu, "textured quad");
+    // the GPU's sampler filters with its own fixed-point weights, the CPU's bilinear lookup
+    // in f32: measured (llvmpipe, 2026-11-23) colours within 4.96e-3 at worst and 1.11e-3 on
+    // average (was: 0.02 in 1 % of the pixels, 0.005 on average); ids and distances as always
+    let c = assert_close_within(
+        &gpu,
+        &cpu,
+        "textured quad",
+        Tolerance {
+            max_color: 6e-3,
+            mean_color: 1.5e-3,
+            ..SAME_ARITHMETIC
+        },
+    );
     assert!(c.hits > 1000);
     // the texture is really there: many distinct colours on the quad
     let mut distinct: Vec<[u8; 3]> = gpu
@@ -238,7 +249,11 @@ fn counts_past_two_to_the_32_carry_into_the_high_word() {
     use glow::HasContext;
     let dir = tempfile::tempdir().unwrap();
     let glsl = dir.path().join("glsl");
-    copy_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"), &glsl);
+    // the kernels the library would use (GPGPU_RT_GLSL_DIR, as scripts/mutants.sh sets it)
+    let kernels = ShaderSource::default()
+        .effective_dir()
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"));
+    copy_dir(&kernels, &glsl);
     std::fs::write(
         glsl.join("counter_probe.comp"),
         "layout(local_size_x = 64) in;\n#include \"common/counters.glsl\"\nuniform int perInvocation;\n\
@@ -279,7 +294,8 @@ fn counts_past_two_to_the_32_carry_into_the_high_word() {
             );
             gl.delete_buffer(b);
         }
-        let got = ((back[1] as u64) << 32) | back[0] as u64;
+        // read as every pipeline reads its counters
+        let got = gpgpu_rt::pipeline::counter_value(&back, 0);
         assert_eq!(got, start + 16 * 64 * per as u64, "from {start:#x}");
     }
 }

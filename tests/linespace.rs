@@ -277,15 +277,15 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             }
         }
         assert!(hits > 1500, "{hits} pixels hit geometry");
-        assert!(
-            off * 100 <= hits,
+        // the CPU twin reads the same G-buffer and runs the kernel's arithmetic: measured
+        // (llvmpipe, 2026-11-23) no pixel differs and the triangle tests are equal in all
+        // three modes (398,484 / 283,991 / 292,060); was: 1 % of the pixels, tests within 2 %
+        assert_eq!(
+            off, 0,
             "{mode:?}: {off} of {hits} pixels differ between GPU and CPU"
         );
         let gpu_tests = f.stats.total_triangle_tests();
-        assert!(
-            (gpu_tests as f64 - cpu_tests as f64).abs() <= 0.02 * cpu_tests as f64 + 100.0,
-            "{mode:?}: triangle tests GPU {gpu_tests} CPU {cpu_tests}"
-        );
+        assert_eq!(gpu_tests, cpu_tests, "{mode:?}: triangle tests GPU vs CPU");
         assert!(f.stats.events["linespace_lookups"] > 0);
         shadows.push((
             f.shadow.clone(),
@@ -315,8 +315,9 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             }
         }
     }
-    assert!(
-        same * 100 >= hit_px * 97,
+    // measured (llvmpipe, 2026-11-23): all 2,294 pixels agree (was: 97 % required)
+    assert_eq!(
+        same, hit_px,
         "CPU primary hits agree with the G-buffer at {same} of {hit_px} pixels"
     );
     let (exact, pos, nrm) = &shadows[0];
@@ -336,28 +337,29 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             wrong += 1;
         }
     }
-    assert!(
-        wrong * 100 <= checked.len(),
+    // measured: 0 of 255 (was: 1 % allowed)
+    assert_eq!(
+        wrong,
+        0,
         "exact vs brute force: {wrong} of {} pixels differ",
         checked.len()
     );
     // the line space only adds occluders (a set bit may be an empty part of the shaft), never
     // removes them: linespace <= exact, and the packet and the DDA decide alike
+    // (measured: none lighter, none differing; was: 0.5 % and 1 % allowed)
     let brighter = hit.iter().filter(|&&i| ls[i] > exact[i] + 1e-6).count();
-    assert!(
-        brighter * 200 <= hit.len(),
+    assert_eq!(
+        brighter, 0,
         "{brighter} pixels lighter with the line space than exact"
     );
     let dda_off = hit
         .iter()
         .filter(|&&i| (dda[i] - ls[i]).abs() > 1e-6)
         .count();
-    assert!(
-        dda_off * 100 <= hit.len(),
-        "{dda_off} pixels differ between packet and DDA"
-    );
+    assert_eq!(dda_off, 0, "{dda_off} pixels differ between packet and DDA");
     let mean = hit.iter().map(|&i| (ls[i] - exact[i]).abs()).sum::<f32>() / hit.len() as f32;
-    assert!(mean <= 0.1, "mean |linespace - exact| = {mean}");
+    // the conservative shafts' darkening: measured 0.038 on average (was: 0.1 allowed)
+    assert!(mean <= 0.05, "mean |linespace - exact| = {mean}");
     let penumbra = hit
         .iter()
         .filter(|&&i| exact[i] > 0.0 && exact[i] < 1.0)
@@ -371,10 +373,8 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         .unwrap();
     let ls10 = render(&mut r, &scene.camera).unwrap();
     let off = cpu_mismatches(&r, &ls10, ShadowMode::Linespace, &hit);
-    assert!(
-        off * 100 <= hit.len(),
-        "10x10: {off} pixels differ between GPU and CPU"
-    );
+    // measured: 0 (was: 1 % allowed)
+    assert_eq!(off, 0, "10x10: {off} pixels differ between GPU and CPU");
     // llvmpipe ends loops after 65535 iterations per SIMD vector: `exact` with 100 rays on the
     // bunny reaches that there (8-lane vectors); the frame is then rendered again with the rays
     // in batches — whatever the GL implementation, the frame comes out right
@@ -418,6 +418,76 @@ fn cpu_mismatches(r: &SoftShadowRenderer, f: &SoftFrame, mode: ShadowMode, hit: 
             (s - f.shadow[i]).abs() > 1e-6
         })
         .count()
+}
+
+/// A floor under a 1×1 area light at y = 2, a small occluder at y = 1 between them, and a
+/// large roof at y = 2.001, just beyond the light (closer than an N-tree leaf is wide, so the
+/// traversals meet it in the leaves they visit): shadow rays run from the surface to the light
+/// samples only, so the roof shadows nothing (issue 16, class 2, for the soft shadows).
+fn roof_scene(dir: &std::path::Path) -> Scene {
+    let quad = |y: f32, h: f32| {
+        format!(
+            "v {} {y} {}\nv {h} {y} {}\nv {h} {y} {h}\nv {} {y} {h}\n",
+            -h, -h, -h, -h
+        )
+    };
+    let obj = format!(
+        "{}{}f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n",
+        quad(2.001, 4.0),
+        quad(1.0, 0.3)
+    );
+    std::fs::write(dir.join("occluders.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        "[camera]\nposition = [0.0, 1.6, 2.8]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 45.0\n\
+         [render]\nshadow_offset = 0.002\n\
+         [[area_light]]\ncorner = [-0.5, 2.0, -0.5]\nedge_u = [1.0, 0.0, 0.0]\nedge_v = [0.0, 0.0, 1.0]\n\
+         [[object]]\ntype = \"floor\"\nsize = 4.0\nquads = 4\n\
+         [[object]]\ntype = \"obj\"\npath = \"occluders.obj\"\n",
+    )
+    .unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap()
+}
+
+#[test]
+fn occluders_beyond_the_area_light_shadow_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = roof_scene(dir.path());
+    let ctx = common::context();
+    let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
+    let shaders = ShaderSource::default();
+    let mut r = SoftShadowRenderer::with_tree(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &shaders,
+        opts(ShadowMode::Exact, 3, 48),
+        tree,
+    )
+    .unwrap();
+    for mode in [
+        ShadowMode::Exact,
+        ShadowMode::Linespace,
+        ShadowMode::LinespaceDda,
+    ] {
+        r.reconfigure(&shaders, mode, 3, 3).unwrap();
+        let f = render(&mut r, &scene.camera).unwrap();
+        let hit: Vec<usize> = (0..f.shadow.len())
+            .filter(|&i| f.gbuffer_position[i][3] > 0.0)
+            .collect();
+        let off = cpu_mismatches(&r, &f, mode, &hit);
+        assert_eq!(off, 0, "{mode:?}: GPU vs CPU");
+        if mode != ShadowMode::Exact {
+            // the line space's conservative shafts count the roof's cells next to the light
+            // as blocking (measured: no pixel fully lit): that is the line space, not a bug
+            continue;
+        }
+        let lit = hit.iter().filter(|&&i| f.shadow[i] == 1.0).count();
+        let shadowed = hit.iter().filter(|&&i| f.shadow[i] < 1.0).count();
+        // most of the floor sees the whole light; the small occluder's shadow is there
+        assert!(lit * 2 > hit.len(), "{lit} of {} lit", hit.len());
+        assert!(shadowed > 20, "{shadowed} shadowed");
+    }
 }
 
 #[test]

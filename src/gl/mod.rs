@@ -8,4 +8,4 @@ pub mod slots;
 
 pub use context::{check_error, Gl, GlContext, GlInfo};
 pub use kernel::{Kernel, PixelGrid};
-pub use program::{compile_program, Defines, ShaderSource};
+pub use program::{compile_program, Defines, ShaderSource, GLSL_DIR_ENV};

@@ -19,6 +19,10 @@ use super::context::Gl;
 /// of the folder: see `build.rs`).
 pub const EMBEDDED: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/embedded_glsl.rs"));
 
+/// The environment variable that, when no `--glsl-dir` is given, names a folder to read the
+/// kernels from instead of the embedded copies.
+pub const GLSL_DIR_ENV: &str = "GPGPU_RT_GLSL_DIR";
+
 /// Where kernel sources come from.
 #[derive(Debug, Clone, Default)]
 pub struct ShaderSource {
@@ -36,9 +40,20 @@ impl ShaderSource {
         Ok(ShaderSource { dir })
     }
 
+    /// The folder the kernels are read from: `dir`, else the environment variable
+    /// [`GLSL_DIR_ENV`] when set and non-empty (so that a test binary or the CLI runs edited
+    /// kernels without recompiling, e.g. for `scripts/mutants.sh`), else none (embedded).
+    pub fn effective_dir(&self) -> Option<PathBuf> {
+        self.dir.clone().or_else(|| {
+            std::env::var_os(GLSL_DIR_ENV)
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+        })
+    }
+
     /// The text of one kernel file.
     pub fn read(&self, name: &str) -> Result<String> {
-        match &self.dir {
+        match &self.effective_dir() {
             Some(dir) => {
                 let path = dir.join(name);
                 std::fs::read_to_string(&path)
@@ -53,7 +68,7 @@ impl ShaderSource {
     }
 
     fn display_name(&self, name: &str) -> String {
-        match &self.dir {
+        match &self.effective_dir() {
             Some(dir) => dir.join(name).display().to_string(),
             None => format!("glsl/{name}"),
         }

@@ -23,6 +23,12 @@ use crate::frame::{Frame, FrameStats};
 use crate::gl::{Gl, GlInfo, ShaderSource};
 use crate::scene::{Camera, Scene};
 
+/// Counter `slot` of a counter buffer read back as u32 words: the 64-bit count of
+/// `glsl/common/counters.glsl`, low word at `2·slot`, high word (its carries) at `2·slot + 1`.
+pub fn counter_value(raw: &[u32], slot: usize) -> u64 {
+    raw[2 * slot] as u64 | ((raw[2 * slot + 1] as u64) << 32)
+}
+
 /// A pipeline with its scene on the GPU, ready to render frames.
 pub trait Renderer {
     /// The design's name in the statistics: "base", "grid", "linespace".

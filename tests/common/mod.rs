@@ -72,6 +72,8 @@ pub struct Comparison {
     pub max_t_rel: f32,
     /// mean over pixels and channels of |gpu - cpu| colour
     pub mean_color_diff: f32,
+    /// largest |gpu - cpu| of any channel of any pixel
+    pub max_color_diff: f32,
     /// share of pixels with any channel off by more than 0.02
     pub color_outliers: f32,
     pub hits: usize,
@@ -86,6 +88,7 @@ pub fn compare(gpu: &Frame, cpu: &ReferenceFrame) -> Comparison {
         id_mismatches: 0,
         max_t_rel: 0.0,
         mean_color_diff: 0.0,
+        max_color_diff: 0.0,
         color_outliers: 0.0,
         hits: 0,
     };
@@ -116,28 +119,65 @@ pub fn compare(gpu: &Frame, cpu: &ReferenceFrame) -> Comparison {
         if worst > 0.02 {
             outliers += 1;
         }
+        c.max_color_diff = c.max_color_diff.max(worst);
     }
     c.mean_color_diff = (sum / (3 * n) as f64) as f32;
     c.color_outliers = outliers as f32 / n as f32;
     c
 }
 
-/// The tolerances all GPU/CPU comparisons use: f32 on two implementations may flip a ray that
-/// grazes a shared triangle edge, so a few ids may differ (at most 0.5 % of the pixels); where
-/// the ids agree the hit distances agree to 1e-4 relative; colours differ by at most 0.005 on
-/// average and by more than 0.02 in at most 1 % of the pixels (the pixels whose ids or shadow
-/// decisions differ).
+/// Tolerances of a GPU/CPU image comparison. The first hits must be the same triangles in
+/// every pixel; hit distances and colours differ by the rounding of two implementations of the
+/// same arithmetic (the GPU compiler may contract a·b + c into one fused multiply-add, the CPU
+/// does not), so those bounds sit just above the noise measured on the tests' frames.
+#[derive(Debug, Clone, Copy)]
+pub struct Tolerance {
+    /// largest relative hit-distance difference
+    pub t_rel: f32,
+    /// largest colour difference of any channel of any pixel
+    pub max_color: f32,
+    /// largest mean colour difference
+    pub mean_color: f32,
+}
+
+/// Measured (Mesa llvmpipe, 2026-11-23) over the seven frames of `base_tracer.rs`, `bvh.rs`
+/// and `grid.rs` that use it: 0 differing ids, hit distances within 5.7e-7 relative, colours
+/// within 2.3e-8 on average and 3.6e-6 at worst (5.2e-6 on the cow of `accel.rs`; formerly
+/// allowed: 0.5 % of the ids, 1e-4, 0.005 mean and 1 % of the pixels off by 0.02).
+pub const SAME_ARITHMETIC: Tolerance = Tolerance {
+    t_rel: 2e-6,
+    max_color: 1e-5,
+    mean_color: 1e-6,
+};
+
+/// Compare with [`SAME_ARITHMETIC`].
 pub fn assert_close(gpu: &Frame, cpu: &ReferenceFrame, what: &str) -> Comparison {
+    assert_close_within(gpu, cpu, what, SAME_ARITHMETIC)
+}
+
+/// The same first triangle in every pixel, distances and colours within `tol`.
+pub fn assert_close_within(
+    gpu: &Frame,
+    cpu: &ReferenceFrame,
+    what: &str,
+    tol: Tolerance,
+) -> Comparison {
     let c = compare(gpu, cpu);
     eprintln!("{what}: {c:?}");
     assert!(c.hits > 0, "{what}: the image shows no geometry");
+    assert_eq!(c.id_mismatches, 0, "{what}: triangle ids differ: {c:?}");
     assert!(
-        c.id_mismatches as f32 <= 0.005 * c.pixels as f32,
-        "{what}: triangle ids differ: {c:?}"
+        c.max_t_rel <= tol.t_rel,
+        "{what}: hit distances differ: {c:?}"
     );
-    assert!(c.max_t_rel < 1e-4, "{what}: hit distances differ: {c:?}");
-    assert!(c.mean_color_diff < 0.005, "{what}: colours differ: {c:?}");
-    assert!(c.color_outliers < 0.01, "{what}: colours differ: {c:?}");
+    assert!(
+        c.max_color_diff <= tol.max_color,
+        "{what}: colours differ: {c:?}"
+    );
+    assert!(
+        c.mean_color_diff <= tol.mean_color,
+        "{what}: colours differ: {c:?}"
+    );
     c
 }
 

@@ -300,7 +300,7 @@ impl RayTracer {
             ..Default::default()
         };
         for (i, name) in COUNTERS.iter().enumerate() {
-            let v = raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32);
+            let v = super::counter_value(&raw, i);
             if TRIANGLE_TEST_COUNTERS.contains(name) {
                 stats.triangle_tests.insert(name.to_string(), v);
             } else if *name == "truncated_rays" {

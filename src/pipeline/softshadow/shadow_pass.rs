@@ -237,7 +237,7 @@ impl ShadowPass {
         }
         let raw = counters.read_u32(&self.gl);
         ShadowCounts(std::array::from_fn(|i| {
-            raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32)
+            crate::pipeline::counter_value(&raw, i)
         }))
     }
 

@@ -298,7 +298,7 @@ impl WagnerRenderer {
     /// The counters, timers and facts of the frame.
     fn frame_stats(&mut self) -> FrameStats {
         let raw = self.counters.read_u32(&self.gl);
-        let count = |i: usize| raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32);
+        let count = |i: usize| super::counter_value(&raw, i);
         let mut stats = FrameStats {
             gpu_ms: self.timers.resolve(&self.gl),
             truncated_rays: count(3),
