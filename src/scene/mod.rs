@@ -2,10 +2,15 @@
 //! objects (OBJ and PLY files, or the procedural `teapot`, `floor`, `sphere` and `square`), each
 //! with a transform and a material. See `scenes/*.toml` and the README for the format.
 
+pub mod bpt;
+pub mod budget;
 pub mod camera;
 pub mod mesh;
+pub mod obj;
+pub mod ply;
 pub mod shadows;
 pub mod shapes;
+pub mod validate;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -365,8 +370,11 @@ impl Scene {
                 ObjectError::Here(m) => src.error_at(type_line, m),
                 ObjectError::File(e) => e,
             })?;
+            validate::object(&object, scene.materials.len())
+                .map_err(|m| src.error_at(type_line, m))?;
             scene.objects.push(object);
         }
+        validate::scene(&scene).map_err(|m| SceneError::at(path, None, m))?;
         Ok(scene)
     }
 
@@ -397,15 +405,15 @@ impl Scene {
     ) -> Result<Object, ObjectError> {
         let base = def.base_material()?;
         def.check_type_keys()?;
+        def.check_numbers()?;
         let texture = match &def.texture {
             Some(t) => Some(self.load_texture(&dir.join(t.get_ref()))?),
             None => None,
         };
         let mut mesh = self.object_mesh(dir, &def, Material { texture, ..base })?;
         if let Some(size) = def.fit {
-            fit(&mut mesh, size);
+            fit(&mut mesh, size)?;
         }
-        def.check_numbers()?;
         let model = def.model_matrix()?;
         let kind = def.kind.get_ref();
         Ok(Object {
@@ -451,7 +459,7 @@ impl Scene {
         material: Material,
         def: &ObjectDef,
     ) -> Result<Mesh, ObjectError> {
-        let obj = mesh::load_obj(path).map_err(ObjectError::File)?;
+        let obj = obj::load_obj(path).map_err(ObjectError::File)?;
         let mut ids = Vec::new();
         for m in &obj.materials {
             let texture = match (material.texture, &m.texture) {
@@ -476,15 +484,23 @@ impl Scene {
     }
 }
 
-/// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`.
-fn fit(mesh: &mut Mesh, size: f32) {
+/// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`; an error for
+/// an object without extent (all vertices in one point) or one whose scale overflows f32.
+fn fit(mesh: &mut Mesh, size: f32) -> Result<(), ObjectError> {
     let (lo, hi) = mesh.bounds();
     let extent = (hi - lo).max_element();
     let center = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
     let s = size / extent;
+    if !(extent > 0.0 && s.is_finite() && center.is_finite()) {
+        return Err(ObjectError::Here(format!(
+            "fit = {size} needs an object that extends in some direction; this one's largest \
+             extent is {extent} (from {lo} to {hi})"
+        )));
+    }
     mesh.positions
         .iter_mut()
         .for_each(|p| *p = (*p - center) * s);
+    Ok(())
 }
 
 impl ObjectDef {
@@ -518,7 +534,7 @@ impl ObjectDef {
 
     fn ply_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
         let path = self.model_path(dir, "model.ply.gz")?;
-        let mut mesh = mesh::load_ply(&path).map_err(ObjectError::File)?;
+        let mut mesh = ply::load_ply(&path).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::splat(0.8)));
         Ok(mesh)
     }
@@ -529,7 +545,7 @@ impl ObjectDef {
         let n = procedural_size("tessellation", self.shape.tessellation, 10, 1, |n| {
             32 * 2 * n * n
         })?;
-        let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
+        let mut mesh = bpt::teapot(&path, n).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
         Ok(mesh)
     }
@@ -711,7 +727,8 @@ fn procedural_size(
     Ok(value)
 }
 
-/// `triangles`, which the sizes `sizes` give, must be at most [`MAX_PROCEDURAL_TRIANGLES`].
+/// `triangles`, which the sizes `sizes` give, must be at most [`MAX_PROCEDURAL_TRIANGLES`] and
+/// fit the host's memory ([`budget::check_triangles`]), checked before the mesh is built.
 fn at_most_triangles(sizes: &str, triangles: u64) -> Result<(), ObjectError> {
     if triangles > MAX_PROCEDURAL_TRIANGLES {
         return Err(ObjectError::Here(format!(
@@ -719,7 +736,7 @@ fn at_most_triangles(sizes: &str, triangles: u64) -> Result<(), ObjectError> {
              {MAX_PROCEDURAL_TRIANGLES}"
         )));
     }
-    Ok(())
+    budget::check_triangles(sizes, triangles).map_err(ObjectError::Here)
 }
 
 /// World-space vertex attributes of the whole scene: one triangle soup whose

@@ -9,7 +9,7 @@ use glow::HasContext;
 
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
-use crate::scene::Scene;
+use crate::scene::{budget, Scene};
 
 /// SSBO binding points of the scene, shared with `glsl/common/scene.glsl`.
 pub use crate::gl::slots::ssbo as binding;
@@ -149,9 +149,6 @@ fn vertex_arrays(
 /// The SSBOs the kernels read: per vertex and per light, filled by the transform pass, and the
 /// materials (reflection, specular, shininess, texture layer or -1), uploaded here.
 fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
-    let triangles = scene.triangle_count();
-    let vertices = 3 * triangles;
-    let lights = scene.lights.len().max(1);
     let materials: Vec<[f32; 4]> = scene
         .materials
         .iter()
@@ -161,25 +158,53 @@ fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
         })
         .collect();
     let material_bytes: &[u8] = bytemuck::cast_slice(&materials);
-    let buffers = [
-        (binding::VERTEX, "vertex", 16 * vertices, None),
-        (binding::NORMAL, "normals", 16 * vertices, None),
-        (binding::COLOR, "colors", 16 * vertices, None),
-        (binding::TEXCOORD, "texcoords", 8 * vertices, None),
-        (binding::TRI_MATERIAL, "triMaterial", 4 * triangles, None),
-        (
-            binding::MATERIAL,
-            "material",
-            material_bytes.len(),
-            Some(material_bytes),
-        ),
-        (binding::LIGHT_POS, "lightPos", 16 * lights, None),
-        (binding::LIGHT_COLOR, "lightColor", 16 * lights, None),
-    ];
-    buffers
+    ssbo_sizes(scene)
         .into_iter()
-        .map(|(b, name, bytes, data)| Ok((b, Ssbo::new(gl, name, bytes, data, max)?)))
+        .map(|(b, name, bytes)| {
+            let data = (b == binding::MATERIAL).then_some(material_bytes);
+            Ok((b, Ssbo::new(gl, name, bytes, data, max)?))
+        })
         .collect()
+}
+
+/// Binding, name and bytes of every scene SSBO.
+fn ssbo_sizes(scene: &Scene) -> [(u32, &'static str, usize); 8] {
+    let triangles = scene.triangle_count();
+    let vertices = 3 * triangles;
+    let lights = scene.lights.len().max(1);
+    [
+        (binding::VERTEX, "vertex", 16 * vertices),
+        (binding::NORMAL, "normals", 16 * vertices),
+        (binding::COLOR, "colors", 16 * vertices),
+        (binding::TEXCOORD, "texcoords", 8 * vertices),
+        (binding::TRI_MATERIAL, "triMaterial", 4 * triangles),
+        (binding::MATERIAL, "material", 16 * scene.materials.len()),
+        (binding::LIGHT_POS, "lightPos", 16 * lights),
+        (binding::LIGHT_COLOR, "lightColor", 16 * lights),
+    ]
+}
+
+/// Every buffer the upload will make, estimated before any is made: each SSBO within
+/// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, the vertex arrays (host copy and VBOs) within the host's
+/// memory.
+pub fn check_sizes(info: &GlInfo, scene: &Scene) -> Result<()> {
+    let triangles = scene.triangle_count();
+    for (_, name, bytes) in ssbo_sizes(scene) {
+        if bytes as i64 > info.max_ssbo_block_size {
+            bail!(
+                "{}: {triangles} triangles need {} in the scene buffer `{name}`, more than \
+                 GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {} of this GL implementation",
+                scene.path.display(),
+                budget::human(bytes as u64),
+                budget::human(info.max_ssbo_block_size as u64),
+            );
+        }
+    }
+    // the vertex data on the host and in the VBOs: 3 positions, normals, colours (12 bytes),
+    // texture coordinates (8) and material ids (4) per triangle, twice
+    let bytes = 2 * 3 * (12 + 12 + 12 + 8 + 4) * triangles as u64;
+    budget::check_host(&format!("uploading {triangles} triangles"), bytes)
+        .map_err(|m| anyhow!("{}: {m}", scene.path.display()))
 }
 
 /// An FBO with a 1×1 renderbuffer for the transform pass' (discarded) points.
@@ -210,6 +235,9 @@ impl GpuScene {
         shaders: &ShaderSource,
     ) -> Result<GpuScene> {
         check_device(info, scene)?;
+        crate::scene::validate::scene(scene)
+            .map_err(|m| anyhow!("{}: {m}", scene.path.display()))?;
+        check_sizes(info, scene)?;
         let data = VertexData::of(scene);
         let program = Kernel::program(
             gl,
