@@ -261,7 +261,7 @@ fn bad_input_fails_with_file_and_line() {
     .unwrap();
     assert_fails(
         &run(&["info", bad.to_str().unwrap()]),
-        &["bad.toml:1", "finite"],
+        &["bad.toml:2", "finite"],
     );
     // a vertex with nan
     std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n").unwrap();

@@ -367,3 +367,214 @@ fn the_upload_check_catches_scenes_built_by_code() {
         );
     }
 }
+
+// ---- class 6: messages that name the right thing ----
+
+#[test]
+fn too_many_lights_suggests_bits_only_where_bits_would_hold_them() {
+    use gpgpu_rt::pipeline::raytrace::{too_many_lights, ShadowFlags};
+    let d = tempfile::tempdir().unwrap();
+    let mut scene = load(d.path(), "[[object]]\ntype = \"floor\"\nquads = 1\n", &[]).unwrap();
+    let light = gpgpu_rt::scene::Light {
+        position: glam::Vec3::Y,
+        color: glam::Vec3::ONE,
+    };
+    scene.lights = vec![light.clone(); 6];
+    let m = too_many_lights(&scene, ShadowFlags::Rgba);
+    assert!(
+        m.contains("6 lights") && m.contains("use --shadow-flags bits"),
+        "{m}"
+    );
+    scene.lights = vec![light; 200];
+    for flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
+        let m = too_many_lights(&scene, flags);
+        assert!(!m.contains("use --shadow-flags bits"), "{m}");
+        assert!(
+            m.contains("200 lights") && m.contains("fewer lights"),
+            "{m}"
+        );
+    }
+    // through the command line: 200 lights with bits
+    let lights: String = (0..200)
+        .map(|i| format!("[[light]]\nposition = [{i}, 3, 0]\n"))
+        .collect();
+    let s = d.path().join("l.toml");
+    std::fs::write(&s, format!("{HEAD}{lights}[[object]]\ntype = \"floor\"\n")).unwrap();
+    let out = d.path().join("o.png");
+    let args = ["render", s.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    let o = run(
+        &[
+            &args[..],
+            &["--width", "8", "--height", "8", "--shadow-flags", "bits"],
+        ]
+        .concat(),
+        None,
+        60,
+    );
+    assert_fails(
+        &o,
+        &[
+            "200 lights",
+            "--shadow-flags bits holds at most 128",
+            "fewer lights",
+        ],
+    );
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("use --shadow-flags bits"));
+}
+
+#[test]
+fn camera_and_render_errors_cite_the_keys_line() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = |camera: &str, render: &str| {
+        format!(
+            "# a comment\n[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n{camera}\n\
+             [render]\nwidth = 8\n{render}\n[[object]]\ntype = \"floor\"\n"
+        )
+    };
+    let path = d.path().join("c.toml");
+    for (camera, render, line, needle) in [
+        ("up = [0, 0, 0]", "", 5, "camera.up is the zero vector"),
+        ("up = [0, 2, 6]", "", 5, "parallel"),
+        ("fov_y = 180", "", 5, "camera.fov_y"),
+        ("near = -1", "", 5, "camera.near"),
+        ("near = nan", "", 5, "camera.near must be finite"),
+        ("", "ambient = [0, inf, 0]", 8, "render.ambient"),
+        ("", "refl_depth = 99", 8, "render.refl_depth"),
+        ("", "shadow_offset = -1", 8, "render.shadow_offset"),
+    ] {
+        std::fs::write(&path, scene(camera, render)).unwrap();
+        let e = Scene::load(&path).unwrap_err();
+        assert_eq!(e.line, Some(line), "{e}");
+        assert!(e.message.contains(needle), "{e}");
+        assert!(
+            !(needle.contains("zero") && e.message.contains("parallel")),
+            "{e}"
+        );
+    }
+    // a key given before others: its own line, not the header's
+    std::fs::write(
+        &path,
+        "[camera]\nposition = [0, nan, 3]\nlook_at = [0, 0, 0]\n[[object]]\ntype = \"floor\"\n",
+    )
+    .unwrap();
+    assert_eq!(Scene::load(&path).unwrap_err().line, Some(2));
+    std::fs::write(
+        &path,
+        "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 1, 3]\n[[object]]\ntype = \"floor\"\n",
+    )
+    .unwrap();
+    assert_eq!(Scene::load(&path).unwrap_err().line, Some(3));
+}
+
+#[test]
+fn gl_allocation_errors_say_what_and_how_large() {
+    let m = gpgpu_rt::gl::alloc_error(0x0505, "the shader storage buffer `vertex`", 3 << 30);
+    assert!(m.contains("GL_OUT_OF_MEMORY (0x0505)"), "{m}");
+    assert!(
+        m.contains("`vertex`") && m.contains("3.0 GiB") && m.contains("3221225472 bytes"),
+        "{m}"
+    );
+    let m = gpgpu_rt::gl::alloc_error(0x0501, "x", 16);
+    assert!(
+        m.contains("GL_INVALID_VALUE (0x0501)") && m.contains("16 bytes"),
+        "{m}"
+    );
+    // a real one: llvmpipe's textures live in the process' memory; with 6 GB of address space
+    // a 16384² RGBA32F image (4 GiB) fails
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let cow = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cow.toml");
+    let cmd = format!(
+        "ulimit -v 6000000; exec '{BIN}' render '{}' -o '{}' --width 16384 --height 16384 --tracer base",
+        cow.display(),
+        d.path().join("o.png").display()
+    );
+    let o = Command::new("bash").args(["-c", &cmd]).output().unwrap();
+    assert_fails(&o, &["GL_OUT_OF_MEMORY (0x0505)", "16384x16384", "4.0 GiB"]);
+}
+
+#[test]
+fn obj_faces_of_fewer_than_three_vertices_and_lines_only_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    for (body, line, needle) in [
+        (
+            "f 1 2 3\nf 1 2\n",
+            "o.obj:5",
+            "at least 3 vertices, this has 2",
+        ),
+        ("f 1\n", "o.obj:4", "this has 1"),
+        ("f\n", "o.obj:4", "this has 0"),
+    ] {
+        let obj = format!("{v}{body}");
+        refused(
+            d.path(),
+            &obj_body("o.obj"),
+            &[("o.obj", &obj)],
+            line,
+            &[needle],
+        );
+    }
+    for body in ["l 1 2 3\n", "p 1 2 3\n", "l 1 2\np 3\n", ""] {
+        let obj = format!("{v}{body}");
+        refused(
+            d.path(),
+            &obj_body("o.obj"),
+            &[("o.obj", &obj)],
+            "o.obj",
+            &["no faces"],
+        );
+    }
+    // lines beside faces are dropped, not made triangles
+    let obj = format!("{v}l 1 2\nf 1 2 3\nl 2 3 1\np 1\n");
+    let s = load(d.path(), &obj_body("o.obj"), &[("o.obj", &obj)]).unwrap();
+    assert_eq!(s.triangle_count(), 1);
+}
+
+#[test]
+fn mtl_files_missing_or_broken_are_named_with_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    let obj = "# model\nmtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    refused(
+        d.path(),
+        &obj_body("o.obj"),
+        &[("o.obj", obj)],
+        "o.obj:2",
+        &["gone.mtl"],
+    );
+    let obj = "mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    for (mtl, line, needle) in [
+        ("newmtl a\nKd 0.5 oops 0.5\n", "m.mtl:2", "Kd"),
+        ("newmtl a\nKd 0.5 0.5\n", "m.mtl:2", "Kd"),
+        ("newmtl a\nNs\n", "m.mtl:2", "Ns"),
+        ("newmtl\n", "m.mtl:1", "newmtl"),
+    ] {
+        let files = [("o.obj", obj), ("m.mtl", mtl)];
+        refused(d.path(), &obj_body("o.obj"), &files, line, &[needle]);
+    }
+    let files = [("o.obj", obj), ("m.mtl", "newmtl a\nKd 0.2 0.4 0.6\n")];
+    let s = load(d.path(), &obj_body("o.obj"), &files).unwrap();
+    assert_eq!(s.objects[0].mesh.colors[0], glam::Vec3::new(0.2, 0.4, 0.6));
+}
+
+#[test]
+fn viewer_errors_do_not_print_a_dependencys_source_path() {
+    let o = Command::new(BIN)
+        .args([
+            "view",
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scenes/cow.toml")
+                .display()
+                .to_string(),
+        ])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    assert_fails(&o, &["cannot connect to a window system", "DISPLAY"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!e.contains(".rs:") && !e.contains(".cargo"), "{e}");
+}

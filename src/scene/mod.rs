@@ -155,21 +155,24 @@ fn light_samples<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, 
 impl RenderSettings {
     /// Sizes and the reflection depth within [`crate::limits`], colours finite, the shadow
     /// offset finite and >= 0.
-    fn validate(&self) -> Result<(), String> {
+    /// An error names the key it is about (for its line).
+    fn validate(&self) -> Result<(), (&'static str, String)> {
         use crate::limits::{check, IMAGE_SIDE, REFL_DEPTH};
-        check("render.width", self.width, &IMAGE_SIDE)?;
-        check("render.height", self.height, &IMAGE_SIDE)?;
-        check("render.refl_depth", self.refl_depth, &REFL_DEPTH)?;
-        if !self
-            .background
-            .iter()
-            .chain(&self.ambient)
-            .all(|v| v.is_finite())
-        {
-            return Err("render.background and render.ambient must be finite".into());
+        for (key, value, range) in [
+            ("width", self.width, &IMAGE_SIDE),
+            ("height", self.height, &IMAGE_SIDE),
+            ("refl_depth", self.refl_depth, &REFL_DEPTH),
+        ] {
+            check(&format!("render.{key}"), value, range).map_err(|m| (key, m))?;
+        }
+        for (key, c) in [("background", self.background), ("ambient", self.ambient)] {
+            if !c.iter().all(|v| v.is_finite()) {
+                return Err((key, format!("render.{key} must be finite")));
+            }
         }
         if !self.shadow_offset.is_finite() || self.shadow_offset < 0.0 {
-            return Err("render.shadow_offset must be finite and >= 0".into());
+            let m = "render.shadow_offset must be finite and >= 0".to_string();
+            return Err(("shadow_offset", m));
         }
         Ok(())
     }
@@ -328,13 +331,20 @@ impl Scene {
         let src = SceneText { path, text };
         let mut file = src.deserialize()?;
         overrides.apply(path, &mut file.object)?;
-        let camera = src.check(file.camera, |c| c.validate().map(|()| c))?;
-        let (settings, render_line) = match file.render {
-            Some(r) => (*r.get_ref(), Some(line_of(text, r.span().start))),
+        let camera = *file.camera.get_ref();
+        camera
+            .validate()
+            .map_err(|(key, m)| src.key_error("camera", file.camera.span().start, key, m))?;
+        let (settings, render_at) = match file.render {
+            Some(r) => (*r.get_ref(), Some(r.span().start)),
             None => (RenderSettings::default(), None),
         };
+        let render_line = render_at.map(|at| line_of(text, at));
         let render_error = |m: &str| SceneError::at(path, render_line, m.into());
-        settings.validate().map_err(|m| render_error(&m))?;
+        settings.validate().map_err(|(key, m)| match render_at {
+            Some(at) => src.key_error("render", at, key, m),
+            None => render_error(&m),
+        })?;
         let lights = src.check_all(file.light, LightDef::light)?;
         let area_lights = src.check_all(file.area_light, AreaLightDef::area_light)?;
         if settings.shadows.is_some() && area_lights.is_empty() {
@@ -771,11 +781,12 @@ impl SceneText<'_> {
         SceneError::at(self.path, Some(line_of(self.text, byte)), message)
     }
 
-    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
-    /// naming the key's line (found in the text of that object's table).
-    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
-        let start = self.text[..type_at].rfind("[[object]]").unwrap_or(0);
-        let (mut at, mut offset) = (type_at, start);
+    /// The byte where `key = …` starts in the table whose header `header` (e.g. `[camera]`)
+    /// is the last that starts before byte `inside`.
+    fn key_at(&self, header: &str, inside: usize, key: &str) -> Option<usize> {
+        let end = (inside + header.len()).min(self.text.len());
+        let start = self.text.get(..end)?.rfind(header)?;
+        let mut offset = start;
         for line in self.text[start..].split_inclusive('\n') {
             let t = line.trim_start();
             if offset > start && t.starts_with('[') {
@@ -783,12 +794,25 @@ impl SceneText<'_> {
             }
             if let Some((name, _)) = t.split_once('=') {
                 if name.trim().trim_matches('"') == key {
-                    at = offset;
-                    break;
+                    return Some(offset);
                 }
             }
             offset += line.len();
         }
+        None
+    }
+
+    /// An error about `key` of the `[table]` around byte `inside`, at the key's line (the
+    /// table's when the key is not written: a default).
+    fn key_error(&self, table: &str, inside: usize, key: &str, message: String) -> SceneError {
+        let at = self.key_at(&format!("[{table}]"), inside, key);
+        self.error_at(at.unwrap_or(inside), message)
+    }
+
+    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
+    /// naming the key's line (found in the text of that object's table).
+    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
+        let at = self.key_at("[[object]]", type_at, key).unwrap_or(type_at);
         self.error_at(
             at,
             format!(

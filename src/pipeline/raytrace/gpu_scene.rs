@@ -37,6 +37,7 @@ fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
         let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
         gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, data, glow::STATIC_DRAW);
+        crate::gl::check_alloc(gl, "a vertex buffer of the scene", data.len() as u64)?;
         Ok(b)
     }
 }
@@ -365,6 +366,8 @@ fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Textur
             glow::UNSIGNED_BYTE,
             glow::PixelUnpackData::Slice(Some(&data)),
         );
+        let what = format!("{} texture layers of {w}x{h}", layers.len());
+        crate::gl::check_alloc(gl, &what, data.len() as u64)?;
         for (p, v) in [
             (glow::TEXTURE_MIN_FILTER, glow::LINEAR),
             (glow::TEXTURE_MAG_FILTER, glow::LINEAR),
