@@ -246,7 +246,7 @@ fn bad_input_fails_with_file_and_line() {
         ),
         (
             "[render]\nambient = [nan, 0, 0]\n[[object]]\ntype = \"floor\"\n",
-            4,
+            5,
             "finite",
         ),
     ] {
