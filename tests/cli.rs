@@ -543,7 +543,7 @@ fn counts_beyond_their_bounds_are_refused_with_the_bound() {
     .unwrap();
     assert_fails(
         &run(&["info", bad.to_str().unwrap()]),
-        &["deep.toml:4", "refl_depth", "0 to 16"],
+        &["deep.toml:5", "refl_depth", "0 to 16"],
     );
 
     // a small file that claims a 20000×20000 texture is refused before it is decoded

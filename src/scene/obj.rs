@@ -97,9 +97,10 @@ fn check_elements(path: &Path, text: &str) -> Result<String, SceneError> {
     }
     if let Some((l, tag)) = dropped.first() {
         log::warn!(
-            "{}:{l}: {} line and point elements (`l`, `p`) dropped, first a `{tag}`: they have no surface to render",
+            "{}:{l}: `{tag}` and {} more `l`/`p` lines dropped: lines and points have no \
+             surface to render",
             path.display(),
-            dropped.len()
+            dropped.len() - 1
         );
     }
     Ok(out)

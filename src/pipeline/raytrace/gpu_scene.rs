@@ -334,9 +334,24 @@ impl GpuScene {
     }
 }
 
+/// The texture layers (every texture resized to the largest sides, at most
+/// GL_MAX_TEXTURE_SIZE) and their upload copy within the host's memory, before they are made.
+fn check_texture_memory(info: &GlInfo, scene: &Scene) -> Result<()> {
+    let max = info.max_texture_size.max(1) as u64;
+    let side = |f: fn(&image::RgbaImage) -> u32| {
+        let most = scene.textures.iter().map(|(_, t)| f(t) as u64).max();
+        most.unwrap_or(1).min(max)
+    };
+    let layers = scene.textures.len().max(1) as u64;
+    let bytes = 2 * 4 * layers * side(|t| t.width()) * side(|t| t.height());
+    budget::check_host(&format!("{layers} texture layers"), bytes)
+        .map_err(|m| anyhow!("{}: {m}", scene.path.display()))
+}
+
 /// All textures as layers of one RGBA8 2D array texture (bilinear, repeat), sampled by
 /// intersect1 with the material's layer. A scene without textures gets one white texel.
 fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Texture> {
+    check_texture_memory(info, scene)?;
     let (w, h, layers) = scene.texture_layers(info.max_texture_size as u32);
     if layers.len() > info.max_array_texture_layers.max(1) as usize {
         bail!(
