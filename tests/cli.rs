@@ -233,7 +233,7 @@ fn bad_input_fails_with_file_and_line() {
         ),
         (
             "[render]\nambient = [nan, 0, 0]\n[[object]]\ntype = \"floor\"\n",
-            4,
+            5,
             "finite",
         ),
     ] {
@@ -248,7 +248,7 @@ fn bad_input_fails_with_file_and_line() {
     .unwrap();
     assert_fails(
         &run(&["info", bad.to_str().unwrap()]),
-        &["bad.toml:1", "finite"],
+        &["bad.toml:2", "finite"],
     );
     // a vertex with nan
     std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n").unwrap();
@@ -530,7 +530,7 @@ fn counts_beyond_their_bounds_are_refused_with_the_bound() {
     .unwrap();
     assert_fails(
         &run(&["info", bad.to_str().unwrap()]),
-        &["deep.toml:4", "refl_depth", "0 to 16"],
+        &["deep.toml:5", "refl_depth", "0 to 16"],
     );
 
     // a small file that claims a 20000×20000 texture is refused before it is decoded

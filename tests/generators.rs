@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use glam::Vec3;
-use gpgpu_rt::scene::mesh::{floor, teapot};
+use gpgpu_rt::scene::bpt::teapot;
+use gpgpu_rt::scene::mesh::floor;
 
 /// Newell's patches in the `.bpt` format, z up, as the generator reads them.
 fn patches() -> Vec<[Vec3; 16]> {

@@ -465,3 +465,39 @@ fn the_command_line_reports_and_refuses() {
         );
     }
 }
+
+/// A ray straight at a lone small triangle across empty cells: every proximity-cloud jump
+/// must stop short of the cell that holds it (a jump one cell too far along the ray skips
+/// it: the mutant `stream-cloud-cube-too-large`, which the dense scenes above do not reveal).
+#[test]
+fn a_jump_never_passes_the_nearest_non_empty_cell() {
+    let ctx = context();
+    let dir = tempfile::tempdir().unwrap();
+    let tri = |c: [f32; 3]| {
+        let [x, y, z] = c;
+        format!(
+            "v {x} {} {}\nv {x} {} {}\nv {x} {y} {}\nf 1 2 3\n",
+            y - 0.05,
+            z - 0.05,
+            y + 0.05,
+            z - 0.05,
+            z + 0.05
+        )
+    };
+    let mut toml = "[camera]\nposition = [-3.0, 0.0, 0.0]\nlook_at = [1.0, 0.0, 0.0]\n\
+                    fov_y = 6.0\n[[light]]\nposition = [-3.0, 0.5, 0.0]\n"
+        .to_string();
+    for (k, c) in [[1.0, 0.0, 0.0], [-1.0, 1.5, 1.5]].into_iter().enumerate() {
+        std::fs::write(dir.path().join(format!("t{k}.obj")), tri(c)).unwrap();
+        toml += &format!("[[object]]\ntype = \"obj\"\npath = \"t{k}.obj\"\n");
+    }
+    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
+    let scene = Scene::load(&dir.path().join("scene.toml")).unwrap();
+    let (plain, _) = render(&ctx, &scene, options(32, [16, 16, 16], false));
+    let (pc, _) = render(&ctx, &scene, options(32, [16, 16, 16], true));
+    let ids = |f: &Frame| f.aovs.as_ref().unwrap().triangle_id.clone();
+    let hits = ids(&plain).iter().filter(|&&t| t == 0).count();
+    assert!(hits > 10, "the target covers {hits} pixels");
+    assert!(pc.stats.events["cloud_jumps"] > 0, "no jump");
+    assert_eq!(ids(&plain), ids(&pc), "first hits with proximity clouds");
+}

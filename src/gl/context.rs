@@ -354,12 +354,52 @@ impl Gl {
     }
 }
 
+/// The name of a `glGetError` code.
+pub fn gl_error_name(code: u32) -> &'static str {
+    match code {
+        glow::INVALID_ENUM => "GL_INVALID_ENUM",
+        glow::INVALID_VALUE => "GL_INVALID_VALUE",
+        glow::INVALID_OPERATION => "GL_INVALID_OPERATION",
+        glow::INVALID_FRAMEBUFFER_OPERATION => "GL_INVALID_FRAMEBUFFER_OPERATION",
+        glow::OUT_OF_MEMORY => "GL_OUT_OF_MEMORY",
+        glow::STACK_UNDERFLOW => "GL_STACK_UNDERFLOW",
+        glow::STACK_OVERFLOW => "GL_STACK_OVERFLOW",
+        _ => "GL error",
+    }
+}
+
 /// Check `glGetError` after a step and name the step.
 pub fn check_error(gl: &Gl, what: &str) -> Result<()> {
     // SAFETY: glGetError on a current context.
     let err = unsafe { gl.get_error() };
     if err != glow::NO_ERROR {
-        return Err(anyhow!("GL error 0x{err:04x} after {what}")).context("OpenGL call failed");
+        let name = gl_error_name(err);
+        return Err(anyhow!("{name} (0x{err:04x}) after {what}")).context("OpenGL call failed");
     }
     Ok(())
+}
+
+/// Check `glGetError` right after allocating `what` of `bytes`: an error, above all
+/// GL_OUT_OF_MEMORY, says what was being allocated and how large.
+pub fn check_alloc(gl: &Gl, what: &str, bytes: u64) -> Result<()> {
+    // SAFETY: glGetError on a current context.
+    let err = unsafe { gl.get_error() };
+    if err == glow::NO_ERROR {
+        return Ok(());
+    }
+    Err(anyhow!("{}", alloc_error(err, what, bytes)))
+}
+
+/// The message of [`check_alloc`] for the error `err`.
+pub fn alloc_error(err: u32, what: &str, bytes: u64) -> String {
+    let size = crate::scene::budget::human(bytes);
+    let name = gl_error_name(err);
+    if err == glow::OUT_OF_MEMORY {
+        format!(
+            "{name} (0x{err:04x}): the GL implementation has no memory for {what} of {size} \
+             ({bytes} bytes); use a smaller scene or image"
+        )
+    } else {
+        format!("{name} (0x{err:04x}) while allocating {what} of {size} ({bytes} bytes)")
+    }
 }

@@ -6,6 +6,6 @@ pub mod program;
 pub mod resources;
 pub mod slots;
 
-pub use context::{check_error, Gl, GlContext, GlInfo};
+pub use context::{alloc_error, check_alloc, check_error, gl_error_name, Gl, GlContext, GlInfo};
 pub use kernel::{Kernel, PixelGrid};
 pub use program::{compile_program, Defines, ShaderSource, GLSL_DIR_ENV};

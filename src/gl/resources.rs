@@ -56,6 +56,8 @@ impl Ssbo {
                 glow::DYNAMIC_STORAGE_BIT,
             );
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+            let what = format!("the shader storage buffer `{name}`");
+            super::check_alloc(gl, &what, bytes as u64)?;
             Ok(Ssbo {
                 buffer,
                 bytes,
@@ -110,6 +112,13 @@ impl Image2d {
             let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_2D, Some(texture));
             gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
+            let texel = match format {
+                glow::R32UI | glow::R32F | glow::RGBA8 => 4,
+                glow::RG32UI | glow::RG32F => 8,
+                _ => 16,
+            };
+            let what = format!("a {width}x{height} image texture");
+            super::check_alloc(gl, &what, width as u64 * height as u64 * texel)?;
             gl.tex_parameter_i32(
                 glow::TEXTURE_2D,
                 glow::TEXTURE_MIN_FILTER,
@@ -247,6 +256,8 @@ impl TextureBuffer {
             gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
             gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, &padded, glow::STATIC_DRAW);
             gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+            let what = format!("the texture buffer `{name}`");
+            super::check_alloc(gl, &what, padded.len() as u64)?;
             let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
             gl.tex_buffer(format, buffer);

@@ -48,27 +48,43 @@ pub struct CameraRays {
 }
 
 impl Camera {
-    pub fn validate(&self) -> Result<(), String> {
+    /// Every key usable; an error names the key it is about (for its line) and says why.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
         let p = Vec3::from(self.position);
         let l = Vec3::from(self.look_at);
         let up = Vec3::from(self.up);
-        if !(p.is_finite() && l.is_finite() && up.is_finite() && self.fov_y.is_finite()) {
-            return Err("camera: position, look_at, up and fov_y must be finite".into());
+        for (key, finite) in [
+            ("position", p.is_finite()),
+            ("look_at", l.is_finite()),
+            ("up", up.is_finite()),
+            ("fov_y", self.fov_y.is_finite()),
+            ("near", self.near.is_finite()),
+        ] {
+            if !finite {
+                return Err((key, format!("camera.{key} must be finite")));
+            }
         }
         if (l - p).length() <= 0.0 {
-            return Err("camera.look_at equals camera.position".into());
+            return Err(("look_at", "camera.look_at equals camera.position".into()));
+        }
+        if up.length() <= 0.0 {
+            return Err(("up", "camera.up is the zero vector".into()));
         }
         if (l - p).normalize().cross(up.normalize_or_zero()).length() < 1e-6 {
-            return Err("camera.up is parallel to the viewing direction".into());
-        }
-        if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
-            return Err(format!(
-                "camera.fov_y = {} must lie in (0, 180) degrees",
-                self.fov_y
+            return Err((
+                "up",
+                "camera.up is parallel to the viewing direction".into(),
             ));
         }
-        if self.near.is_nan() || self.near <= 0.0 {
-            return Err(format!("camera.near = {} must be positive", self.near));
+        if !(self.fov_y > 0.0 && self.fov_y < 180.0) {
+            let m = format!("camera.fov_y = {} must lie in (0, 180) degrees", self.fov_y);
+            return Err(("fov_y", m));
+        }
+        if self.near <= 0.0 {
+            return Err((
+                "near",
+                format!("camera.near = {} must be positive", self.near),
+            ));
         }
         Ok(())
     }

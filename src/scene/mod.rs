@@ -2,11 +2,16 @@
 //! objects (OBJ and PLY files, or the procedural `teapot`, `floor`, `sphere` and `square`), each
 //! with a transform and a material. See `scenes/*.toml` and the README for the format.
 
+pub mod bpt;
+pub mod budget;
 pub mod camera;
 pub mod magnitudes;
 pub mod mesh;
+pub mod obj;
+pub mod ply;
 pub mod shadows;
 pub mod shapes;
+pub mod validate;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -151,21 +156,24 @@ fn light_samples<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<(u32, 
 impl RenderSettings {
     /// Sizes and the reflection depth within [`crate::limits`], colours finite, the shadow
     /// offset finite and >= 0.
-    fn validate(&self) -> Result<(), String> {
+    /// An error names the key it is about (for its line).
+    fn validate(&self) -> Result<(), (&'static str, String)> {
         use crate::limits::{check, IMAGE_SIDE, REFL_DEPTH};
-        check("render.width", self.width, &IMAGE_SIDE)?;
-        check("render.height", self.height, &IMAGE_SIDE)?;
-        check("render.refl_depth", self.refl_depth, &REFL_DEPTH)?;
-        if !self
-            .background
-            .iter()
-            .chain(&self.ambient)
-            .all(|v| v.is_finite())
-        {
-            return Err("render.background and render.ambient must be finite".into());
+        for (key, value, range) in [
+            ("width", self.width, &IMAGE_SIDE),
+            ("height", self.height, &IMAGE_SIDE),
+            ("refl_depth", self.refl_depth, &REFL_DEPTH),
+        ] {
+            check(&format!("render.{key}"), value, range).map_err(|m| (key, m))?;
+        }
+        for (key, c) in [("background", self.background), ("ambient", self.ambient)] {
+            if !c.iter().all(|v| v.is_finite()) {
+                return Err((key, format!("render.{key} must be finite")));
+            }
         }
         if !self.shadow_offset.is_finite() || self.shadow_offset < 0.0 {
-            return Err("render.shadow_offset must be finite and >= 0".into());
+            let m = "render.shadow_offset must be finite and >= 0".to_string();
+            return Err(("shadow_offset", m));
         }
         Ok(())
     }
@@ -324,13 +332,20 @@ impl Scene {
         let src = SceneText { path, text };
         let mut file = src.deserialize()?;
         overrides.apply(path, &mut file.object)?;
-        let camera = src.check(file.camera, |c| c.validate().map(|()| c))?;
-        let (settings, render_line) = match file.render {
-            Some(r) => (*r.get_ref(), Some(line_of(text, r.span().start))),
+        let camera = *file.camera.get_ref();
+        camera
+            .validate()
+            .map_err(|(key, m)| src.key_error("camera", file.camera.span().start, key, m))?;
+        let (settings, render_at) = match file.render {
+            Some(r) => (*r.get_ref(), Some(r.span().start)),
             None => (RenderSettings::default(), None),
         };
+        let render_line = render_at.map(|at| line_of(text, at));
         let render_error = |m: &str| SceneError::at(path, render_line, m.into());
-        settings.validate().map_err(|m| render_error(&m))?;
+        settings.validate().map_err(|(key, m)| match render_at {
+            Some(at) => src.key_error("render", at, key, m),
+            None => render_error(&m),
+        })?;
         let lights = src.check_all(file.light, LightDef::light)?;
         let area_lights = src.check_all(file.area_light, AreaLightDef::area_light)?;
         if settings.shadows.is_some() && area_lights.is_empty() {
@@ -366,8 +381,11 @@ impl Scene {
                 ObjectError::Here(m) => src.error_at(type_line, m),
                 ObjectError::File(e) => e,
             })?;
+            validate::object(&object, scene.materials.len())
+                .map_err(|m| src.error_at(type_line, m))?;
             scene.objects.push(object);
         }
+        validate::scene(&scene).map_err(|m| SceneError::at(path, None, m))?;
         magnitudes::check(&scene)?;
         Ok(scene)
     }
@@ -399,15 +417,15 @@ impl Scene {
     ) -> Result<Object, ObjectError> {
         let base = def.base_material()?;
         def.check_type_keys()?;
+        def.check_numbers()?;
         let texture = match &def.texture {
             Some(t) => Some(self.load_texture(&dir.join(t.get_ref()))?),
             None => None,
         };
         let mut mesh = self.object_mesh(dir, &def, Material { texture, ..base })?;
         if let Some(size) = def.fit {
-            fit(&mut mesh, size);
+            fit(&mut mesh, size)?;
         }
-        def.check_numbers()?;
         let model = def.model_matrix()?;
         let kind = def.kind.get_ref();
         Ok(Object {
@@ -453,7 +471,7 @@ impl Scene {
         material: Material,
         def: &ObjectDef,
     ) -> Result<Mesh, ObjectError> {
-        let obj = mesh::load_obj(path).map_err(ObjectError::File)?;
+        let obj = obj::load_obj(path).map_err(ObjectError::File)?;
         let mut ids = Vec::new();
         for m in &obj.materials {
             let texture = match (material.texture, &m.texture) {
@@ -478,15 +496,23 @@ impl Scene {
     }
 }
 
-/// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`.
-fn fit(mesh: &mut Mesh, size: f32) {
+/// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`; an error for
+/// an object without extent (all vertices in one point) or one whose scale overflows f32.
+fn fit(mesh: &mut Mesh, size: f32) -> Result<(), ObjectError> {
     let (lo, hi) = mesh.bounds();
     let extent = (hi - lo).max_element();
     let center = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
     let s = size / extent;
+    if !(extent > 0.0 && s.is_finite() && center.is_finite()) {
+        return Err(ObjectError::Here(format!(
+            "fit = {size} needs an object that extends in some direction; this one's largest \
+             extent is {extent} (from {lo} to {hi})"
+        )));
+    }
     mesh.positions
         .iter_mut()
         .for_each(|p| *p = (*p - center) * s);
+    Ok(())
 }
 
 impl ObjectDef {
@@ -520,7 +546,7 @@ impl ObjectDef {
 
     fn ply_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
         let path = self.model_path(dir, "model.ply.gz")?;
-        let mut mesh = mesh::load_ply(&path).map_err(ObjectError::File)?;
+        let mut mesh = ply::load_ply(&path).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::splat(0.8)));
         Ok(mesh)
     }
@@ -531,7 +557,7 @@ impl ObjectDef {
         let n = procedural_size("tessellation", self.shape.tessellation, 10, 1, |n| {
             32 * 2 * n * n
         })?;
-        let mut mesh = mesh::teapot(&path, n).map_err(ObjectError::File)?;
+        let mut mesh = bpt::teapot(&path, n).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
         Ok(mesh)
     }
@@ -713,7 +739,8 @@ fn procedural_size(
     Ok(value)
 }
 
-/// `triangles`, which the sizes `sizes` give, must be at most [`MAX_PROCEDURAL_TRIANGLES`].
+/// `triangles`, which the sizes `sizes` give, must be at most [`MAX_PROCEDURAL_TRIANGLES`] and
+/// fit the host's memory ([`budget::check_triangles`]), checked before the mesh is built.
 fn at_most_triangles(sizes: &str, triangles: u64) -> Result<(), ObjectError> {
     if triangles > MAX_PROCEDURAL_TRIANGLES {
         return Err(ObjectError::Here(format!(
@@ -721,7 +748,7 @@ fn at_most_triangles(sizes: &str, triangles: u64) -> Result<(), ObjectError> {
              {MAX_PROCEDURAL_TRIANGLES}"
         )));
     }
-    Ok(())
+    budget::check_triangles(sizes, triangles).map_err(ObjectError::Here)
 }
 
 /// World-space vertex attributes of the whole scene: one triangle soup whose
@@ -756,11 +783,12 @@ impl SceneText<'_> {
         SceneError::at(self.path, Some(line_of(self.text, byte)), message)
     }
 
-    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
-    /// naming the key's line (found in the text of that object's table).
-    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
-        let start = self.text[..type_at].rfind("[[object]]").unwrap_or(0);
-        let (mut at, mut offset) = (type_at, start);
+    /// The byte where `key = …` starts in the table whose header `header` (e.g. `[camera]`)
+    /// is the last that starts before byte `inside`.
+    fn key_at(&self, header: &str, inside: usize, key: &str) -> Option<usize> {
+        let end = (inside + header.len()).min(self.text.len());
+        let start = self.text.get(..end)?.rfind(header)?;
+        let mut offset = start;
         for line in self.text[start..].split_inclusive('\n') {
             let t = line.trim_start();
             if offset > start && t.starts_with('[') {
@@ -768,12 +796,25 @@ impl SceneText<'_> {
             }
             if let Some((name, _)) = t.split_once('=') {
                 if name.trim().trim_matches('"') == key {
-                    at = offset;
-                    break;
+                    return Some(offset);
                 }
             }
             offset += line.len();
         }
+        None
+    }
+
+    /// An error about `key` of the `[table]` around byte `inside`, at the key's line (the
+    /// table's when the key is not written: a default).
+    fn key_error(&self, table: &str, inside: usize, key: &str, message: String) -> SceneError {
+        let at = self.key_at(&format!("[{table}]"), inside, key);
+        self.error_at(at.unwrap_or(inside), message)
+    }
+
+    /// The error for the unknown `key` of the `[[object]]` whose `type` is at byte `type_at`,
+    /// naming the key's line (found in the text of that object's table).
+    fn unknown_object_key(&self, type_at: usize, key: &str) -> SceneError {
+        let at = self.key_at("[[object]]", type_at, key).unwrap_or(type_at);
         self.error_at(
             at,
             format!(

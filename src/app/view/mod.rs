@@ -158,6 +158,7 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
         );
     }
     let event_loop = EventLoop::new().map_err(|e| {
+        let e = plain(&e);
         anyhow!(
             "cannot connect to a window system: {e}\n(`view` needs an X11 display — DISPLAY; on a \
              headless machine run it under `xvfb-run -a`, or render to a file with `gpgpu-rt render`)"
@@ -167,7 +168,7 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     let run = event_loop.run_app(&mut app);
     // GL objects go while the context still exists
     app.running = None;
-    run.map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    run.map_err(|e| anyhow!("the window's event loop failed: {}", plain(&e)))?;
     app.result
 }
 
@@ -746,5 +747,38 @@ mod tests {
     fn digits_are_grouped() {
         assert_eq!(group_digits(0), "0");
         assert_eq!(group_digits(1234567), "1\u{202f}234\u{202f}567");
+    }
+}
+
+/// A window-system library's error without the source location it may carry (winit's
+/// `OsError` prints `os error at /…/winit-0.30.13/src/platform_impl/linux/mod.rs:765: …`): a
+/// user's message names what failed, not a dependency's source file.
+pub fn plain(e: &dyn std::fmt::Display) -> String {
+    let msg = e.to_string();
+    let mut out = String::new();
+    let mut rest = msg.as_str();
+    while let Some(i) = rest.find(".rs:") {
+        let digits = rest[i + 4..].bytes().take_while(u8::is_ascii_digit).count();
+        if digits == 0 {
+            out.push_str(&rest[..i + 4]);
+            rest = &rest[i + 4..];
+            continue;
+        }
+        let start = rest[..i].rfind(char::is_whitespace).map_or(0, |k| k + 1);
+        let before = rest[..start].trim_end();
+        out.push_str(before.strip_suffix(" at").unwrap_or(before));
+        rest = &rest[i + 4 + digits..];
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod plain_tests {
+    #[test]
+    fn source_locations_are_dropped() {
+        let m = "os error at /root/.cargo/registry/src/x/winit-0.30.13/src/platform_impl/linux/mod.rs:765: no DISPLAY";
+        assert_eq!(super::plain(&m), "os error: no DISPLAY");
+        assert_eq!(super::plain(&"a file.rs: fine"), "a file.rs: fine");
     }
 }

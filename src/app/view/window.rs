@@ -74,7 +74,12 @@ fn open_window(
                 .min_by_key(config_rank)
                 .expect("glutin offers at least one config")
         })
-        .map_err(|e| anyhow!("cannot open a window with an OpenGL config: {e}"))?;
+        .map_err(|e| {
+            anyhow!(
+                "cannot open a window with an OpenGL config: {}",
+                super::plain(&e)
+            )
+        })?;
     let window = window.ok_or_else(|| anyhow!("the window system gave no window"))?;
     Ok((window, config))
 }
@@ -103,7 +108,12 @@ fn window_surface(
             .display()
             .create_window_surface(config, &surface_attributes)
     }
-    .map_err(|e| anyhow!("cannot create a GL surface for the window: {e}"))
+    .map_err(|e| {
+        anyhow!(
+            "cannot create a GL surface for the window: {}",
+            super::plain(&e)
+        )
+    })
 }
 
 impl GlWindow {
@@ -117,7 +127,7 @@ impl GlWindow {
         let (window, config) = open_window(event_loop, title, width, height)?;
         let handle = window
             .window_handle()
-            .map_err(|e| anyhow!("no native window handle: {e}"))?
+            .map_err(|e| anyhow!("no native window handle: {}", super::plain(&e)))?
             .as_raw();
         let display = config.display();
         let attributes = ContextAttributesBuilder::new()
@@ -126,15 +136,22 @@ impl GlWindow {
             .with_debug(gpgpu_rt::gl::context::gl_debug_requested())
             .build(Some(handle));
         // SAFETY: the config belongs to this display; the handle is the window's.
-        let context = unsafe { display.create_context(&config, &attributes) }
-            .map_err(|e| anyhow!("cannot create an OpenGL 4.5 core context for the window: {e}"))?;
+        let context = unsafe { display.create_context(&config, &attributes) }.map_err(|e| {
+            anyhow!(
+                "cannot create an OpenGL 4.5 core context for the window: {}",
+                super::plain(&e)
+            )
+        })?;
         let surface = window_surface(&window, handle, &config, (width, height))?;
-        let context = context
-            .make_current(&surface)
-            .map_err(|e| anyhow!("cannot make the window's GL context current: {e}"))?;
+        let context = context.make_current(&surface).map_err(|e| {
+            anyhow!(
+                "cannot make the window's GL context current: {}",
+                super::plain(&e)
+            )
+        })?;
         // No vsync: the viewer measures frames per second of the tracer, not of the display.
         if let Err(e) = surface.set_swap_interval(&context, SwapInterval::DontWait) {
-            log::info!("cannot turn vsync off: {e}");
+            log::info!("cannot turn vsync off: {}", super::plain(&e));
         }
         // SAFETY: the context is current; symbols come from its display.
         let gl = unsafe {
@@ -179,22 +196,28 @@ impl GlWindow {
         #[allow(irrefutable_let_patterns)]
         if let PossiblyCurrentContext::Egl(c) = &self.context {
             if let Err(e) = c.make_current_surfaceless() {
-                log::info!("cannot make the context current without a surface: {e}");
+                log::info!(
+                    "cannot make the context current without a surface: {}",
+                    super::plain(&e)
+                );
             }
         }
     }
 
     /// Before drawing to the window: its surface current again.
     pub fn begin_present(&self) -> Result<()> {
-        self.context
-            .make_current(&self.surface)
-            .map_err(|e| anyhow!("cannot make the window's GL context current: {e}"))
+        self.context.make_current(&self.surface).map_err(|e| {
+            anyhow!(
+                "cannot make the window's GL context current: {}",
+                super::plain(&e)
+            )
+        })
     }
 
     pub fn swap(&self) -> Result<()> {
         self.surface
             .swap_buffers(&self.context)
-            .map_err(|e| anyhow!("swapping the window's buffers failed: {e}"))
+            .map_err(|e| anyhow!("swapping the window's buffers failed: {}", super::plain(&e)))
     }
 }
 

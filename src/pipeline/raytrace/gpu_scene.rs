@@ -9,7 +9,7 @@ use glow::HasContext;
 
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
-use crate::scene::Scene;
+use crate::scene::{budget, Scene};
 
 /// SSBO binding points of the scene, shared with `glsl/common/scene.glsl`.
 pub use crate::gl::slots::ssbo as binding;
@@ -37,6 +37,7 @@ fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
         let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
         gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
         gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, data, glow::STATIC_DRAW);
+        crate::gl::check_alloc(gl, "a vertex buffer of the scene", data.len() as u64)?;
         Ok(b)
     }
 }
@@ -149,9 +150,6 @@ fn vertex_arrays(
 /// The SSBOs the kernels read: per vertex and per light, filled by the transform pass, and the
 /// materials (reflection, specular, shininess, texture layer or -1), uploaded here.
 fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
-    let triangles = scene.triangle_count();
-    let vertices = 3 * triangles;
-    let lights = scene.lights.len().max(1);
     let materials: Vec<[f32; 4]> = scene
         .materials
         .iter()
@@ -161,25 +159,53 @@ fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
         })
         .collect();
     let material_bytes: &[u8] = bytemuck::cast_slice(&materials);
-    let buffers = [
-        (binding::VERTEX, "vertex", 16 * vertices, None),
-        (binding::NORMAL, "normals", 16 * vertices, None),
-        (binding::COLOR, "colors", 16 * vertices, None),
-        (binding::TEXCOORD, "texcoords", 8 * vertices, None),
-        (binding::TRI_MATERIAL, "triMaterial", 4 * triangles, None),
-        (
-            binding::MATERIAL,
-            "material",
-            material_bytes.len(),
-            Some(material_bytes),
-        ),
-        (binding::LIGHT_POS, "lightPos", 16 * lights, None),
-        (binding::LIGHT_COLOR, "lightColor", 16 * lights, None),
-    ];
-    buffers
+    ssbo_sizes(scene)
         .into_iter()
-        .map(|(b, name, bytes, data)| Ok((b, Ssbo::new(gl, name, bytes, data, max)?)))
+        .map(|(b, name, bytes)| {
+            let data = (b == binding::MATERIAL).then_some(material_bytes);
+            Ok((b, Ssbo::new(gl, name, bytes, data, max)?))
+        })
         .collect()
+}
+
+/// Binding, name and bytes of every scene SSBO.
+fn ssbo_sizes(scene: &Scene) -> [(u32, &'static str, usize); 8] {
+    let triangles = scene.triangle_count();
+    let vertices = 3 * triangles;
+    let lights = scene.lights.len().max(1);
+    [
+        (binding::VERTEX, "vertex", 16 * vertices),
+        (binding::NORMAL, "normals", 16 * vertices),
+        (binding::COLOR, "colors", 16 * vertices),
+        (binding::TEXCOORD, "texcoords", 8 * vertices),
+        (binding::TRI_MATERIAL, "triMaterial", 4 * triangles),
+        (binding::MATERIAL, "material", 16 * scene.materials.len()),
+        (binding::LIGHT_POS, "lightPos", 16 * lights),
+        (binding::LIGHT_COLOR, "lightColor", 16 * lights),
+    ]
+}
+
+/// Every buffer the upload will make, estimated before any is made: each SSBO within
+/// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, the vertex arrays (host copy and VBOs) within the host's
+/// memory.
+pub fn check_sizes(info: &GlInfo, scene: &Scene) -> Result<()> {
+    let triangles = scene.triangle_count();
+    for (_, name, bytes) in ssbo_sizes(scene) {
+        if bytes as i64 > info.max_ssbo_block_size {
+            bail!(
+                "{}: {triangles} triangles need {} in the scene buffer `{name}`, more than \
+                 GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {} of this GL implementation",
+                scene.path.display(),
+                budget::human(bytes as u64),
+                budget::human(info.max_ssbo_block_size as u64),
+            );
+        }
+    }
+    // the vertex data on the host and in the VBOs: 3 positions, normals, colours (12 bytes),
+    // texture coordinates (8) and material ids (4) per triangle, twice
+    let bytes = 2 * 3 * (12 + 12 + 12 + 8 + 4) * triangles as u64;
+    budget::check_host(&format!("uploading {triangles} triangles"), bytes)
+        .map_err(|m| anyhow!("{}: {m}", scene.path.display()))
 }
 
 /// An FBO with a 1×1 renderbuffer for the transform pass' (discarded) points.
@@ -210,6 +236,9 @@ impl GpuScene {
         shaders: &ShaderSource,
     ) -> Result<GpuScene> {
         check_device(info, scene)?;
+        crate::scene::validate::scene(scene)
+            .map_err(|m| anyhow!("{}: {m}", scene.path.display()))?;
+        check_sizes(info, scene)?;
         let data = VertexData::of(scene);
         let program = Kernel::program(
             gl,
@@ -305,9 +334,24 @@ impl GpuScene {
     }
 }
 
+/// The texture layers (every texture resized to the largest sides, at most
+/// GL_MAX_TEXTURE_SIZE) and their upload copy within the host's memory, before they are made.
+fn check_texture_memory(info: &GlInfo, scene: &Scene) -> Result<()> {
+    let max = info.max_texture_size.max(1) as u64;
+    let side = |f: fn(&image::RgbaImage) -> u32| {
+        let most = scene.textures.iter().map(|(_, t)| f(t) as u64).max();
+        most.unwrap_or(1).min(max)
+    };
+    let layers = scene.textures.len().max(1) as u64;
+    let bytes = 2 * 4 * layers * side(|t| t.width()) * side(|t| t.height());
+    budget::check_host(&format!("{layers} texture layers"), bytes)
+        .map_err(|m| anyhow!("{}: {m}", scene.path.display()))
+}
+
 /// All textures as layers of one RGBA8 2D array texture (bilinear, repeat), sampled by
 /// intersect1 with the material's layer. A scene without textures gets one white texel.
 fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Texture> {
+    check_texture_memory(info, scene)?;
     let (w, h, layers) = scene.texture_layers(info.max_texture_size as u32);
     if layers.len() > info.max_array_texture_layers.max(1) as usize {
         bail!(
@@ -337,6 +381,8 @@ fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Textur
             glow::UNSIGNED_BYTE,
             glow::PixelUnpackData::Slice(Some(&data)),
         );
+        let what = format!("{} texture layers of {w}x{h}", layers.len());
+        crate::gl::check_alloc(gl, &what, data.len() as u64)?;
         for (p, v) in [
             (glow::TEXTURE_MIN_FILTER, glow::LINEAR),
             (glow::TEXTURE_MAG_FILTER, glow::LINEAR),

@@ -149,16 +149,7 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
         );
     }
     if scene.lights.len() > options.shadow_flags.max_lights() {
-        bail!(
-            "{}: {} lights, but --shadow-flags {} holds at most {} (use --shadow-flags bits)",
-            scene.path.display(),
-            scene.lights.len(),
-            match options.shadow_flags {
-                ShadowFlags::Rgba => "rgba",
-                ShadowFlags::Bits => "bits",
-            },
-            options.shadow_flags.max_lights()
-        );
+        bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
     let max_tex = info.max_texture_size as u32;
     let (w, h) = (options.width, options.height);
@@ -166,6 +157,27 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
         bail!("image size {w}x{h} outside 1..={max_tex} (GL_MAX_TEXTURE_SIZE)");
     }
     PixelGrid::new(w, h, options.tile)
+}
+
+/// The error for more lights than `flags` holds: it suggests the bitwise layout only where
+/// that would hold them.
+pub fn too_many_lights(scene: &Scene, flags: ShadowFlags) -> String {
+    let layout = match flags {
+        ShadowFlags::Rgba => "rgba",
+        ShadowFlags::Bits => "bits",
+    };
+    let most = flags.max_lights();
+    let lights = scene.lights.len();
+    let bits = ShadowFlags::Bits.max_lights();
+    let advice = if flags == ShadowFlags::Rgba && lights <= bits {
+        "use --shadow-flags bits".to_string()
+    } else {
+        format!("no layout holds more than {bits}: use fewer lights")
+    };
+    format!(
+        "{}: {lights} lights, but --shadow-flags {layout} holds at most {most} ({advice})",
+        scene.path.display()
+    )
 }
 
 impl RayTracer {

@@ -161,6 +161,8 @@ impl SoftShadowRenderer {
         options: SoftShadowOptions,
     ) -> Result<Self> {
         scene_light(scene)?;
+        crate::scene::validate::scene(scene)
+            .map_err(|m| anyhow::anyhow!("{}: {m}", scene.path.display()))?;
         let tree = NTree::build(
             &scene.world_triangles(),
             options.ntree_n,

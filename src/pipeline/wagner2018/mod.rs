@@ -204,6 +204,8 @@ impl WagnerRenderer {
         shaders: &ShaderSource,
         options: WagnerOptions,
     ) -> Result<WagnerRenderer> {
+        crate::scene::validate::scene(scene)
+            .map_err(|m| anyhow!("{}: {m}", scene.path.display()))?;
         let pixels = check(info, scene, &options)?;
         let lighting = lighting(scene)?;
         let kernel = Kernel::compute(

@@ -1,0 +1,117 @@
+//! Host memory that input-controlled allocations will take, estimated and checked **before**
+//! they are made (issue 14, class 1): a model file's length, the triangles a procedural
+//! object or a file gives. A refusal names the object and the limit; no input reaches an
+//! allocation failure.
+//!
+//! The limit is the host's available memory (`MemAvailable` of `/proc/meminfo`), or
+//! `GPGPU_RT_MEMORY_LIMIT` (bytes, or with a `K`, `M` or `G` suffix) when it is set; without
+//! either (not Linux) only the fixed caps apply ([`super::MAX_PROCEDURAL_TRIANGLES`]).
+
+/// Host bytes of one triangle of a [`super::Mesh`]: three positions, normals and colours of 12
+/// bytes, three texture coordinates of 8, one material id of 4.
+pub const MESH_TRIANGLE_BYTES: u64 = 3 * (12 + 12 + 12 + 8) + 4;
+
+/// Copies of the triangles made on their way to the GPU (the mesh, the world-space attributes
+/// or the vertex arrays of the upload, the world triangles of the accelerators and their
+/// CPU structures).
+pub const TRIANGLE_COPIES: u64 = 4;
+
+/// A model file read and parsed takes at most this many times its length (the text, the
+/// parser's arrays, its per-element maps for PLY).
+pub const FILE_FACTOR: u64 = 16;
+
+/// The environment variable that sets the limit instead of the host's available memory.
+pub const LIMIT_VAR: &str = "GPGPU_RT_MEMORY_LIMIT";
+
+/// The limit and where it comes from, `None` when unknown.
+pub fn host_limit() -> Option<(u64, &'static str)> {
+    if let Ok(v) = std::env::var(LIMIT_VAR) {
+        return parse_bytes(&v).map(|b| (b, LIMIT_VAR));
+    }
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some((kib.saturating_mul(1024), "the host's available memory"))
+}
+
+/// `"123"`, `"64K"`, `"512M"`, `"2G"` (powers of 1024) as bytes.
+pub fn parse_bytes(s: &str) -> Option<u64> {
+    let s = s.trim();
+    let (digits, shift) = match s.char_indices().last()? {
+        (i, 'k' | 'K') => (&s[..i], 10),
+        (i, 'm' | 'M') => (&s[..i], 20),
+        (i, 'g' | 'G') => (&s[..i], 30),
+        _ => (s, 0),
+    };
+    digits.trim().parse::<u64>().ok()?.checked_mul(1 << shift)
+}
+
+/// `bytes` as "12.3 MiB".
+pub fn human(bytes: u64) -> String {
+    let units = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < units.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{bytes} bytes")
+    } else {
+        format!("{v:.1} {}", units[u])
+    }
+}
+
+/// `what` would take `bytes` of host memory: an error when that is more than the limit.
+pub fn check_host(what: &str, bytes: u64) -> Result<(), String> {
+    check_against(what, bytes, host_limit())
+}
+
+/// [`check_host`] against a given limit (`None`: no limit known).
+pub fn check_against(what: &str, bytes: u64, limit: Option<(u64, &str)>) -> Result<(), String> {
+    match limit {
+        Some((avail, source)) if bytes > avail => Err(format!(
+            "{what} would take about {} of host memory, more than the {} of {source}",
+            human(bytes),
+            human(avail)
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `triangles` of `what`, with the copies made for the GPU, within the host's memory.
+pub fn check_triangles(what: &str, triangles: u64) -> Result<(), String> {
+    let bytes = triangles.saturating_mul(MESH_TRIANGLE_BYTES * TRIANGLE_COPIES);
+    check_host(&format!("{what}: {triangles} triangles"), bytes)
+}
+
+/// A model file of `len` bytes, read and parsed, within the host's memory.
+pub fn check_file(len: u64) -> Result<(), String> {
+    check_host(
+        &format!("reading this {} file", human(len)),
+        len.saturating_mul(FILE_FACTOR),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_and_print() {
+        assert_eq!(parse_bytes("2G"), Some(2 << 30));
+        assert_eq!(parse_bytes("64 k"), Some(64 << 10));
+        assert_eq!(parse_bytes("100"), Some(100));
+        assert_eq!(parse_bytes("x"), None);
+        assert_eq!(parse_bytes("99999999999999G"), None);
+        assert_eq!(human(3 << 29), "1.5 GiB");
+    }
+
+    #[test]
+    fn a_refusal_names_the_object_and_the_limit() {
+        let e = check_against("floor", 3 << 30, Some((1 << 30, "X"))).unwrap_err();
+        assert!(e.contains("floor") && e.contains("3.0 GiB") && e.contains("1.0 GiB of X"));
+        assert!(check_against("floor", 1 << 30, Some((1 << 30, "X"))).is_ok());
+        assert!(check_against("floor", u64::MAX, None).is_ok());
+    }
+}
