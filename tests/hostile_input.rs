@@ -557,6 +557,15 @@ fn mtl_files_missing_or_broken_are_named_with_their_line() {
     let files = [("o.obj", obj), ("m.mtl", "newmtl a\nKd 0.2 0.4 0.6\n")];
     let s = load(d.path(), &obj_body("o.obj"), &files).unwrap();
     assert_eq!(s.objects[0].mesh.colors[0], glam::Vec3::new(0.2, 0.4, 0.6));
+    // a usemtl of a name the MTL file does not define: tobj would give its faces no material
+    let files = [("o.obj", obj), ("m.mtl", "newmtl b\nKd 0.2 0.4 0.6\n")];
+    refused(
+        d.path(),
+        &obj_body("o.obj"),
+        &files,
+        "o.obj:2",
+        &["usemtl a", "b"],
+    );
 }
 
 #[test]

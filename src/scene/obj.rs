@@ -38,6 +38,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
     let faces_only = check_elements(path, &text)?;
     let (models, mtl) = read_obj(path, &faces_only)?;
     let materials = obj_materials(path, mtl)?;
+    check_usemtl(path, &faces_only, &materials)?;
     let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
     budget::check_triangles("the OBJ file's faces", triangles as u64)
         .map_err(|m| SceneError::at(path, None, m))?;
@@ -192,6 +193,38 @@ fn check_mtl(file: &Path, text: &str) -> Result<(), SceneError> {
 
 /// tobj's result for the MTL file an OBJ file names, or our error for it.
 type ObjMtl = Result<Vec<tobj::Material>, SceneError>;
+
+/// Every `usemtl NAME` of the OBJ text names a material of its MTL files: tobj gives the faces
+/// of an unknown name no material, which would lose its colour and texture without a word. An
+/// error names the OBJ file, the `usemtl` line and the name.
+fn check_usemtl(path: &Path, text: &str, materials: &[ObjMaterial]) -> Result<(), SceneError> {
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("usemtl") {
+            continue;
+        }
+        let name = words.collect::<Vec<_>>().join(" ");
+        if !materials.iter().any(|m| m.name == name) {
+            let known = materials
+                .iter()
+                .map(|m| m.name.as_str())
+                .collect::<Vec<_>>();
+            return Err(SceneError::at(
+                path,
+                Some(k + 1),
+                format!(
+                    "usemtl {name}: no material of that name in its MTL files (they define: {})",
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
 
 /// The MTL materials, texture paths relative to the OBJ file; an error when an MTL file is
 /// missing or malformed.
