@@ -60,4 +60,11 @@ mod tests {
         let e = check("refl_depth", 17, &REFL_DEPTH).unwrap_err();
         assert!(e.contains("17") && e.contains("0 to 16"), "{e}");
     }
+
+    #[test]
+    fn the_byte_limit_admits_the_largest_texture() {
+        // a texture of the largest allowed side, RGBA8, must decode within the byte limit
+        let largest = (TEXTURE_SIDE as u64).pow(2) * 4;
+        assert!(TEXTURE_BYTES >= largest, "{TEXTURE_BYTES} < {largest}");
+    }
 }
