@@ -184,7 +184,7 @@ fn the_map_covers_every_listing_the_issue_names() {
 #[test]
 fn the_checker_catches_wrong_entries() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let bad = "| X | y | `glsl/common/intersect.glsl:27-32` `intersectTriangle` |\n\
+    let bad = "| X | y | `glsl/common/intersect.glsl:12-26` `intersectTriangle` |\n\
                | X | y | `glsl/common/intersect.glsl:1-9999` `intersectTriangle` |\n\
                | X | y | `glsl/nope.glsl:1-2` `main` |\n\
                | X | y | no entry here |\n";

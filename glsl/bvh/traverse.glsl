@@ -43,9 +43,8 @@ bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float limit)
     return tNear <= tFar && tNear <= limit;
 }
 
-// Algorithm 1 of Müller 2015 (common/intersect.glsl) with the edges read from the leaf
-// triangle: the same operations on the same values as intersectTriangle(v0, v1, v2), whose
-// first two lines form edge1 = v1 − v0 and edge2 = v2 − v0.
+// Algorithm 1 of Müller 2015 with the edges read from the leaf triangle: intersectEdges of
+// common/intersect.glsl, the same operations on the same values as intersectTriangle.
 bool intersectLeafTriangle(vec3 r0, vec3 rd, int slot, out int id, out float t, out float u,
                            out float v)
 {
@@ -53,15 +52,7 @@ bool intersectLeafTriangle(vec3 r0, vec3 rd, int slot, out int id, out float t, 
     vec3 edge1 = texelFetch(bvhLeafTriangles, 3 * slot + 1).xyz;
     vec3 edge2 = texelFetch(bvhLeafTriangles, 3 * slot + 2).xyz;
     id = floatBitsToInt(v0id.w);
-    vec3 pvec = cross(rd, edge2);
-    float det = dot(edge1, pvec);
-    float invDet = 1.0 / det;
-    vec3 tvec = r0 - v0id.xyz;
-    u = invDet * dot(tvec, pvec);
-    vec3 qvec = cross(tvec, edge1);
-    v = invDet * dot(rd, qvec);
-    t = invDet * dot(edge2, qvec);
-    return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
+    return intersectEdges(r0, rd, v0id.xyz, edge1, edge2, t, u, v);
 }
 
 // true if leafHit ended the walk

@@ -3,11 +3,12 @@
 // the Möller–Trumbore test. No determinant epsilon, as in the thesis: a ray parallel to the
 // triangle gives det = 0, 1/det = inf and comparisons that fail, i.e. no hit.
 // Returns true for a hit with t > 0 and the barycentric (u, v).
-bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
-                       out float t, out float u, out float v)
+// intersectEdges is the algorithm after its first two lines (edge1 = v1 − v0, edge2 = v2 − v0),
+// for the accelerators that store the edges (the SAH BVH's leaves, seed 004's triangle
+// textures): the same operations on the same values, so every tracer finds the same distances.
+bool intersectEdges(vec3 r0, vec3 rd, vec3 v0, vec3 edge1, vec3 edge2,
+                    out float t, out float u, out float v)
 {
-    vec3 edge1 = v1 - v0;
-    vec3 edge2 = v2 - v0;
     vec3 pvec = cross(rd, edge2);
     float det = dot(edge1, pvec);
     float invDet = 1.0 / det;
@@ -22,6 +23,14 @@ bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
     v = invDet * dot(rd, qvec);
     t = invDet * dot(edge2, qvec);
     return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
+}
+
+bool intersectTriangle(vec3 r0, vec3 rd, vec3 v0, vec3 v1, vec3 v2,
+                       out float t, out float u, out float v)
+{
+    vec3 edge1 = v1 - v0;
+    vec3 edge2 = v2 - v0;
+    return intersectEdges(r0, rd, v0, edge1, edge2, t, u, v);
 }
 
 // loopLimit: Mesa's llvmpipe ends every loop of an invocation after 65535 iterations in total

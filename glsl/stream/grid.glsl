@@ -12,6 +12,8 @@
 // triNormal:  3D texture RGB32F, 4 depth slices: n0, n1, n2, (reflectivity, 0, 0)
 //             ("edge1 and edge2 are stored instead of v1 and v2, to save the GPU two vector
 //             subtractions every ray-triangle intersection test", ch. 3)
+#include "../common/intersect.glsl"
+
 layout(binding = SAMPLER_STREAM_CELLS) uniform sampler3D cells;
 layout(binding = SAMPLER_STREAM_REFS) uniform samplerBuffer references;
 layout(binding = SAMPLER_STREAM_TRI_VERTEX) uniform sampler3D triVertex;
@@ -54,15 +56,7 @@ bool intersectStored(vec3 r0, vec3 rd, int id, out float t, out float u, out flo
     vec3 v0 = triangleVertex(id, 0);
     vec3 edge1 = triangleVertex(id, 1);
     vec3 edge2 = triangleVertex(id, 2);
-    vec3 pvec = cross(rd, edge2);
-    float det = dot(edge1, pvec);
-    float invDet = 1.0 / det;
-    vec3 tvec = r0 - v0;
-    u = invDet * dot(tvec, pvec);
-    vec3 qvec = cross(tvec, edge1);
-    v = invDet * dot(rd, qvec);
-    t = invDet * dot(edge2, qvec);
-    return (u >= 0.0) && (v >= 0.0) && (u + v <= 1.0) && (t > 0.0);
+    return intersectEdges(r0, rd, v0, edge1, edge2, t, u, v);
 }
 
 // clipToBox: (enter, exit) of o + t·d inside the grid's box; enter > exit when it misses.
