@@ -80,6 +80,7 @@ fn add(a: &mut WalkCounts, b: WalkCounts) {
     a.tests += b.tests;
     a.cells += b.cells;
     a.jumps += b.jumps;
+    a.skipped += b.skipped;
 }
 
 /// Largest relative difference of GPU and CPU hit distances allowed, as tests/accel.rs: the
@@ -134,18 +135,19 @@ fn check_against_twin(ctx: &GlContext, scene: &Scene, o: StreamOptions) -> Frame
     let s = &f.stats;
     let gpu = [
         s.triangle_tests["closest"],
-        s.events["cells_visited"],
+        s.events["voxels_visited"],
         s.events["cloud_jumps"],
+        s.events["empty_cells_skipped"],
     ];
-    let cpu = [counts.tests, counts.cells, counts.jumps];
+    let cpu = [counts.tests, counts.cells, counts.jumps, counts.skipped];
     eprintln!(
         "{:?} pc {}: GPU {gpu:?} CPU {cpu:?}",
         o.dims, o.proximity_clouds
     );
-    for ((g, c), what) in gpu
-        .iter()
-        .zip(cpu)
-        .zip(["triangle tests", "cells", "jumps"])
+    for ((g, c), what) in
+        gpu.iter()
+            .zip(cpu)
+            .zip(["triangle tests", "cells", "jumps", "cells skipped"])
     {
         assert!(
             g.abs_diff(c) as f64 <= COUNT_REL * c as f64,
@@ -267,7 +269,7 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
     assert!(lit > 100 && dark > 20, "{lit} lit, {dark} in shadow");
     let (gs, gc) = (
         f.stats.triangle_tests["shadow"],
-        f.stats.events["cells_visited"],
+        f.stats.events["voxels_visited"],
     );
     eprintln!(
         "shadow tests GPU {gs} CPU {shadow_tests}, cells GPU {gc} CPU {}",
@@ -297,10 +299,23 @@ fn proximity_clouds_change_no_pixel() {
         let (plain, _) = render(&ctx, &scene, o);
         o.proximity_clouds = true;
         let (pc, _) = render(&ctx, &scene, o);
-        assert!(pc.stats.events["cloud_jumps"] > 0, "{name}: no jump");
+        let ev = |f: &Frame, k: &str| f.stats.events[k];
+        assert!(ev(&pc, "cloud_jumps") > 0, "{name}: no jump");
         assert!(
-            pc.stats.events["cells_visited"] < plain.stats.events["cells_visited"],
+            ev(&pc, "voxels_visited") < ev(&plain, "voxels_visited"),
             "{name}: skipping should enter fewer cells"
+        );
+        // every cell a jump skips is one the plain walk enters (a last jump out of the grid
+        // skips cells it does not count)
+        let (visited, skipped) = (ev(&pc, "voxels_visited"), ev(&pc, "empty_cells_skipped"));
+        assert!(
+            skipped >= ev(&pc, "cloud_jumps"),
+            "{name}: {skipped} skipped"
+        );
+        assert!(
+            visited + skipped <= ev(&plain, "voxels_visited"),
+            "{name}: {visited} entered + {skipped} skipped > {} entered without clouds",
+            ev(&plain, "voxels_visited")
         );
         assert_eq!(plain.color, pc.color, "{name}: colours");
         let ids = |f: &Frame| f.aovs.as_ref().unwrap().triangle_id.clone();

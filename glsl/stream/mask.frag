@@ -33,5 +33,5 @@ void main()
     ivec3 cell = cellOf(o.xyz + t0 * d.xyz);
     outTMax = vec4(tMaxOf(o.xyz, d.xyz, cell), RAY_ACTIVE);
     outCell = vec4(vec3(cell), 0.0);
-    countAdd(COUNTER_CELLS_VISITED, 1u);
+    countAdd(COUNTER_VOXELS_VISITED, 1u);
 }

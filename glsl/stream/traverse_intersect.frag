@@ -107,7 +107,7 @@ void main()
     ivec3 cell = ivec3(cellK.xyz);
     int k = int(cellK.w);
     float limit = anyHit != 0 ? d.w : INF;
-    uint tests = 0u, entered = 0u, jumps = 0u;
+    uint tests = 0u, entered = 0u, jumps = 0u, skipped = 0u;
     bool done = false;
     for (int i = 0; i < STEPS_PER_CALL && !done; ++i) {
         vec3 c = texelFetch(cells, cell, 0).rgb;
@@ -126,12 +126,17 @@ void main()
         }
         bool cloud = proximityClouds != 0 && c.g == 0.0 && c.b >= 2.0;
         jumps += cloud ? 1u : 0u;
+        ivec3 from = cell;
         bool moved = cloud ? jumpCloud(o.xyz, d.xyz, limit, c.b, cell, tMax)
                            : stepCell(o.xyz, d.xyz, cell, tMax);
         if (!moved) {
             done = true;
             break;
         }
+        // the empty cells the DDA would have entered on the way: one per step, |cell - from|_1
+        // steps to the landing cell (0 for a plain step)
+        ivec3 span = abs(cell - from);
+        skipped += uint(span.x + span.y + span.z) - 1u;
         k = 0;
         entered += 1u;
     }
@@ -139,6 +144,7 @@ void main()
     outCell = vec4(vec3(cell), float(k));
     outHit = hit;
     countAdd(testCounter, tests);
-    countAdd(COUNTER_CELLS_VISITED, entered);
+    countAdd(COUNTER_VOXELS_VISITED, entered);
     countAdd(COUNTER_CLOUD_JUMPS, jumps);
+    countAdd(COUNTER_EMPTY_CELLS_SKIPPED, skipped);
 }

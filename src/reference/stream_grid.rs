@@ -225,12 +225,15 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
     dist.into_iter().map(|v| v.min(far)).collect()
 }
 
-/// What a walk counted: triangle tests, cells entered, proximity-cloud jumps.
+/// What a walk counted: triangle tests, cells entered, proximity-cloud jumps, and the empty
+/// cells the jumps skipped (those the 3D-DDA would have entered between the cell a jump leaves
+/// and the one it lands in).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct WalkCounts {
     pub tests: u64,
     pub cells: u64,
     pub jumps: u64,
+    pub skipped: u64,
 }
 
 /// One ray's walk state: Fig. 2's cell and tMax (the triangles processed are the loop's).
@@ -371,7 +374,12 @@ impl StreamGrid {
             let dist = self.proximity[cell];
             let moved = if proximity && count == 0 && dist >= 2 {
                 n.jumps += 1;
-                self.jump(r, &mut w, dist)
+                let from = w.cell;
+                let landed = self.jump(r, &mut w, dist);
+                if landed {
+                    n.skipped += cells_between(from, w.cell);
+                }
+                landed
             } else {
                 self.step(r, &mut w)
             };
@@ -402,6 +410,12 @@ impl StreamGrid {
         }
         None
     }
+}
+
+/// The cells a 3D-DDA enters strictly between cells `a` and `b` of its walk: each of its
+/// steps moves one cell along one axis, so it takes |b − a|₁ steps from `a` to `b`.
+pub fn cells_between(a: IVec3, b: IVec3) -> u64 {
+    ((b - a).abs().element_sum() as u64).saturating_sub(1)
 }
 
 /// The grid as a [`CpuAccelerator`] (closest hits and shadow feelers, without proximity

@@ -45,8 +45,9 @@ use crate::scene::{Camera, Scene};
 pub const COUNTERS: &[&str] = &[
     "closest_tests",
     "shadow_tests",
-    "cells_visited",
+    "voxels_visited",
     "cloud_jumps",
+    "empty_cells_skipped",
 ];
 
 /// Options of the streaming tracer.
@@ -436,8 +437,9 @@ impl StreamRenderer {
         };
         stats.triangle_tests.insert("closest".into(), count(0));
         stats.triangle_tests.insert("shadow".into(), count(1));
-        stats.events.insert("cells_visited".into(), count(2));
+        stats.events.insert("voxels_visited".into(), count(2));
         stats.events.insert("cloud_jumps".into(), count(3));
+        stats.events.insert("empty_cells_skipped".into(), count(4));
         stats.events.insert("kernel_calls".into(), self.calls.total);
         stats
             .events
