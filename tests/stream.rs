@@ -11,7 +11,7 @@ use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::brute_force::BruteForce;
-use gpgpu_rt::reference::stream_grid::{StreamGrid, StreamRay, WalkCounts};
+use gpgpu_rt::reference::stream_grid::{Rule, StreamGrid, StreamRay, WalkCounts};
 use gpgpu_rt::reference::stream_shading::StreamShading;
 use gpgpu_rt::reference::CpuAccelerator;
 use gpgpu_rt::scene::Scene;
@@ -27,6 +27,7 @@ fn options(size: u32, dims: [u32; 3], proximity_clouds: bool) -> StreamOptions {
         proximity_clouds,
         steps_per_call: 64,
         max_calls: 10_000,
+        naive_shadows: false,
         aovs: true,
     }
 }
@@ -105,7 +106,7 @@ fn check_against_twin(ctx: &GlContext, scene: &Scene, o: StreamOptions) -> Frame
     let mut counts = WalkCounts::default();
     let (mut hits, mut max_rel) = (0, 0.0f32);
     for (i, r) in primary_rays(&f).iter().enumerate() {
-        let (hit, n) = grid.trace(r, None, o.proximity_clouds);
+        let (hit, n) = grid.trace(r, Rule::Closest, o.proximity_clouds);
         add(&mut counts, n);
         let (id, t) = hit.map_or((-1, f32::INFINITY), |h| (h.id as i32, h.t));
         assert_eq!(a.triangle_id[i], id, "pixel {i}: GPU vs CPU twin");
@@ -222,9 +223,17 @@ fn light_scene(dir: &std::path::Path) -> Scene {
 /// of the surface) walked by the CPU twin from the GPU's hit, with the GPU's arithmetic. Every
 /// pixel is lit on the GPU exactly where the twin's feeler is unblocked (lit: brighter than
 /// the ambient term alone, checked where the light's cosine exceeds 0.01), and the shadow-ray
-/// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`].
-fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
-    let (f, grid) = render(ctx, scene, options(64, dims, false));
+/// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`]. With
+/// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`).
+fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) -> Frame {
+    let mut o = options(64, dims, false);
+    o.naive_shadows = naive;
+    let (f, grid) = render(ctx, scene, o);
+    let offset = scene.settings.shadow_offset;
+    let rule = match naive {
+        true => Rule::NaiveShadow(offset),
+        false => Rule::AnyHit(offset),
+    };
     let a = f.aovs.as_ref().unwrap();
     let attr = scene.world_attributes();
     let ambient = Vec3::from(scene.settings.ambient);
@@ -232,7 +241,7 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
     let mut counts = WalkCounts::default();
     let (mut shadow_tests, mut lit, mut dark) = (0, 0, 0);
     for (i, r) in primary_rays(&f).iter().enumerate() {
-        add(&mut counts, grid.trace(r, None, false).1);
+        add(&mut counts, grid.trace(r, Rule::Closest, false).1);
         let id = a.triangle_id[i];
         if id < 0 {
             continue;
@@ -251,7 +260,7 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
             skip: id,
             limit: distance,
         };
-        let (blocker, c) = grid.trace(&feeler, Some(scene.settings.shadow_offset), false);
+        let (blocker, c) = grid.trace(&feeler, rule, false);
         shadow_tests += c.tests;
         add(&mut counts, c);
         let ambient_only = ambient * attr.colors[3 * id as usize];
@@ -277,14 +286,34 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3]) {
     );
     assert!(gs.abs_diff(shadow_tests) as f64 <= COUNT_REL * shadow_tests as f64);
     assert!(gc.abs_diff(counts.cells) as f64 <= COUNT_REL * counts.cells as f64);
+    f
 }
 
+/// The shadow rays, optimised (any hit before the light) and naive (the closest hit anywhere),
+/// against the twin; both give the same image, the naive ones with more triangle tests.
 #[test]
 fn shadows_equal_the_cpu_twin() {
     let ctx = context();
-    check_shadows(&ctx, &load("cow.toml"), [20, 20, 20]);
     let dir = tempfile::tempdir().unwrap();
-    check_shadows(&ctx, &light_scene(dir.path()), [3, 3, 3]);
+    let scenes = [
+        (load("cow.toml"), [20, 20, 20]),
+        (light_scene(dir.path()), [3, 3, 3]),
+    ];
+    for (scene, dims) in &scenes {
+        let fast = check_shadows(&ctx, scene, *dims, false);
+        let naive = check_shadows(&ctx, scene, *dims, true);
+        assert_eq!(fast.color, naive.color, "the naive shadow rays' image");
+        let tests = |f: &Frame| f.stats.triangle_tests["shadow"];
+        eprintln!(
+            "shadow tests: any hit {}, naive {}",
+            tests(&fast),
+            tests(&naive)
+        );
+        assert!(
+            tests(&naive) > tests(&fast),
+            "the naive search does more work"
+        );
+    }
 }
 
 /// Proximity clouds skip empty cells but change no pixel: colours (with shadows and two

@@ -16,6 +16,9 @@
 // the exact grid's walk (glsl/exact_grid/intersect1.comp); equal distances go to the lower id.
 // Shadow rays (anyHit): "determining any (instead of closest) intersection closer than the given
 // light source is sufficient" (ch. 3) — the first hit with shadowOffset < t < limit ends it.
+// naiveShadow (--stream-naive-shadows, for measuring that optimisation): a shadow ray searched
+// like an eye ray — the closest hit beyond shadowOffset, the walk not stopped at the light —
+// and a blocker only when that hit lies before the light (the same verdicts, more work).
 // Proximity clouds (ch. 3, Fig. 3's B channel): in an empty cell at distance dist >= 2 from the
 // nearest non-empty one, the ray jumps out of the cube of cells within dist - 1 of it, all empty.
 layout(early_fragment_tests) in;
@@ -29,6 +32,7 @@ layout(binding = SAMPLER_STREAM_READ_CELL) uniform sampler2D stateCell;
 layout(binding = SAMPLER_STREAM_READ_HIT) uniform sampler2D stateHit;
 
 uniform int anyHit;
+uniform int naiveShadow;
 uniform float shadowOffset;
 uniform int proximityClouds;
 // the counter of this call's triangle tests (closest-hit or shadow rays)
@@ -93,6 +97,7 @@ bool testTriangle(vec3 o, vec3 d, int id, float limit, inout vec4 hit)
         }
         return false;
     }
+    if (naiveShadow != 0 && t <= shadowOffset) return false;
     if (hit.w < 0.0 || t < hit.z || (t == hit.z && float(id) < hit.w)) hit = vec4(u, v, t, float(id));
     return false;
 }
@@ -140,6 +145,8 @@ void main()
         k = 0;
         entered += 1u;
     }
+    // the naive shadow ray's verdict: a blocker only before the light
+    if (done && naiveShadow != 0 && hit.z >= d.w) hit = vec4(0.0, 0.0, INF, -1.0);
     outTMax = vec4(tMax, done ? RAY_DONE : RAY_ACTIVE);
     outCell = vec4(vec3(cell), float(k));
     outHit = hit;

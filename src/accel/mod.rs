@@ -180,6 +180,9 @@ pub struct GridOptions {
     /// The streaming tracer: the most traverse calls per traversal (rays still walking then
     /// are counted in `truncated_rays` and the frame refused).
     pub stream_max_calls: u32,
+    /// The streaming tracer: shadow rays as the naive closest-hit search the paper's shadow
+    /// optimisation improves on (`--stream-naive-shadows`).
+    pub stream_naive_shadows: bool,
 }
 
 impl Default for GridOptions {
@@ -193,6 +196,7 @@ impl Default for GridOptions {
             proximity_clouds: false,
             stream_steps: 64,
             stream_max_calls: 10_000,
+            stream_naive_shadows: false,
         }
     }
 }

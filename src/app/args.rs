@@ -76,6 +76,12 @@ pub struct GridArgs {
     /// walking then make the frame fail).
     #[arg(long, default_value_t = 10_000, value_name = "N", value_parser = limits::parser(limits::STREAM_CALLS))]
     pub stream_max_calls: u32,
+    /// --tracer stream: trace shadow rays naively — the closest hit anywhere along the ray,
+    /// a blocker when it lies before the light — instead of the paper's any hit closer than
+    /// the light (seed 004, ch. 3): the same shadows, for measuring what the optimisation
+    /// saves.
+    #[arg(long)]
+    pub stream_naive_shadows: bool,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
@@ -105,6 +111,7 @@ impl GridArgs {
             proximity_clouds: self.proximity_clouds,
             stream_steps: self.stream_steps,
             stream_max_calls: self.stream_max_calls,
+            stream_naive_shadows: self.stream_naive_shadows,
         }
     }
 }

@@ -86,6 +86,9 @@ pub fn ray_tracer(
             gl, info, scene, shaders, o,
         )?));
     }
+    if options.grid.stream_naive_shadows {
+        anyhow::bail!("--stream-naive-shadows applies to --tracer stream only");
+    }
     if options.grid.axes.is_some() || options.grid.proximity_clouds {
         anyhow::bail!(
             "--grid GXxGYxGZ and --proximity-clouds apply to --tracer stream only (the compute \

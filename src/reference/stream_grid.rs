@@ -236,6 +236,18 @@ pub struct WalkCounts {
     pub skipped: u64,
 }
 
+/// What a walk looks for: the closest hit (eye and reflection rays; ties: the lower id), any
+/// hit within (offset, limit) — the paper's shadow-ray optimisation, "determining any (instead
+/// of closest) intersection closer than the given light source is sufficient" — or, the naive
+/// shadow ray it improves on, the closest hit beyond offset wherever it lies, a blocker when
+/// that is before the light (`--stream-naive-shadows`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rule {
+    Closest,
+    AnyHit(f32),
+    NaiveShadow(f32),
+}
+
 /// One ray's walk state: Fig. 2's cell and tMax (the triangles processed are the loop's).
 struct Walk {
     cell: IVec3,
@@ -334,57 +346,87 @@ impl StreamGrid {
         true
     }
 
-    /// Walk ray `r` as the traverse-and-intersect kernel does: closest hit (ties: the lower
-    /// id), or with `any_hit` the first hit within (offset, limit). Returns the hit and the
-    /// counts.
-    pub fn trace(
-        &self,
-        r: &StreamRay,
-        any_hit: Option<f32>,
-        proximity: bool,
-    ) -> (Option<Hit>, WalkCounts) {
+    /// Walk ray `r` as the traverse-and-intersect kernel does, finding what `rule` asks for.
+    /// Returns the hit and the counts.
+    pub fn trace(&self, r: &StreamRay, rule: Rule, proximity: bool) -> (Option<Hit>, WalkCounts) {
         let mut n = WalkCounts::default();
         let mut best: Option<Hit> = None;
+        // the masking kernel clips to the light; a naive shadow ray then walks on past it
         let Some(mut w) = self.begin(r) else {
             return (None, n);
+        };
+        let walk = match rule {
+            Rule::NaiveShadow(_) => StreamRay {
+                limit: f32::INFINITY,
+                ..*r
+            },
+            _ => *r,
         };
         loop {
             n.cells += 1;
             let cell = self.bx.index(w.cell).expect("inside");
             let (first, count) = self.cells[cell];
             let list = &self.refs[first as usize..(first + count) as usize];
-            if let Some(offset) = any_hit {
-                if let Some(h) = self.first_blocker(r, list, offset, &mut n.tests) {
-                    return (Some(h), n);
+            let ids = list.iter().map(|&i| i as usize);
+            match rule {
+                Rule::AnyHit(offset) => {
+                    if let Some(h) = self.first_blocker(r, list, offset, &mut n.tests) {
+                        return (Some(h), n);
+                    }
                 }
-            } else {
-                let ids = list.iter().map(|&i| i as usize);
-                closest_among(
-                    &mut best,
-                    &self.triangles,
-                    ids,
-                    (r.o, r.d, r.skip),
-                    &mut n.tests,
-                );
+                Rule::Closest => {
+                    let ray = (r.o, r.d, r.skip);
+                    closest_among(&mut best, &self.triangles, ids, ray, &mut n.tests);
+                }
+                Rule::NaiveShadow(offset) => {
+                    self.closest_beyond(&mut best, r, ids, offset, &mut n.tests);
+                }
             }
             let exit = w.t_max.min_element();
-            if best.is_some_and(|b| b.t <= exit) || exit > r.limit {
-                return (best, n);
+            if best.is_some_and(|b| b.t <= exit) || exit > walk.limit {
+                break;
             }
             let dist = self.proximity[cell];
             let moved = if proximity && count == 0 && dist >= 2 {
                 n.jumps += 1;
                 let from = w.cell;
-                let landed = self.jump(r, &mut w, dist);
+                let landed = self.jump(&walk, &mut w, dist);
                 if landed {
                     n.skipped += cells_between(from, w.cell);
                 }
                 landed
             } else {
-                self.step(r, &mut w)
+                self.step(&walk, &mut w)
             };
             if !moved {
-                return (best, n);
+                break;
+            }
+        }
+        if let Rule::NaiveShadow(_) = rule {
+            // the naive shadow ray's verdict: its closest hit lies before the light
+            best = best.filter(|h| h.t < r.limit);
+        }
+        (best, n)
+    }
+
+    /// The closest-hit rule over `ids` among the hits beyond `offset` (the ray's own triangle
+    /// skipped): the naive shadow ray's search.
+    fn closest_beyond(
+        &self,
+        best: &mut Option<Hit>,
+        r: &StreamRay,
+        ids: impl Iterator<Item = usize>,
+        offset: f32,
+        tests: &mut u64,
+    ) {
+        for id in ids.filter(|&i| i as i32 != r.skip) {
+            *tests += 1;
+            let v = &self.triangles[id];
+            let Some((t, u, vv)) = intersect_triangle(r.o, r.d, v[0], v[1], v[2]) else {
+                continue;
+            };
+            if t > offset && best.is_none_or(|b| t < b.t || (t == b.t && id < b.id)) {
+                *best = Some(Hit { t, id, u, v: vv });
             }
         }
     }
@@ -428,7 +470,7 @@ impl CpuAccelerator for StreamGrid {
             skip: last,
             limit: f32::INFINITY,
         };
-        let (h, n) = self.trace(&r, None, false);
+        let (h, n) = self.trace(&r, Rule::Closest, false);
         (h, n.tests)
     }
 
@@ -439,7 +481,7 @@ impl CpuAccelerator for StreamGrid {
             skip: f.last,
             limit: f.light_distance,
         };
-        let (h, n) = self.trace(&r, Some(f.offset), false);
+        let (h, n) = self.trace(&r, Rule::AnyHit(f.offset), false);
         (h.is_some(), n.tests)
     }
 }

@@ -6,7 +6,7 @@
 
 use glam::{Vec3, Vec4};
 
-use super::stream_grid::{StreamGrid, StreamRay};
+use super::stream_grid::{Rule, StreamGrid, StreamRay};
 use crate::scene::{Scene, WorldAttributes};
 
 /// The scene as the shading reads it.
@@ -19,6 +19,9 @@ pub struct StreamShading<'a> {
     background: Vec3,
     shadow_offset: f32,
     pub proximity_clouds: bool,
+    /// shadow rays as the naive closest-hit search (`--stream-naive-shadows`): the same
+    /// verdicts, more work
+    pub naive_shadows: bool,
 }
 
 /// GLSL's reflect(I, N).
@@ -43,6 +46,7 @@ impl<'a> StreamShading<'a> {
             background: Vec3::from(scene.settings.background),
             shadow_offset: scene.settings.shadow_offset,
             proximity_clouds,
+            naive_shadows: false,
         }
     }
 
@@ -73,10 +77,13 @@ impl<'a> StreamShading<'a> {
                 skip: id as i32,
                 limit: distance,
             };
-            let offset = Some(self.shadow_offset);
+            let rule = match self.naive_shadows {
+                true => Rule::NaiveShadow(self.shadow_offset),
+                false => Rule::AnyHit(self.shadow_offset),
+            };
             if self
                 .grid
-                .trace(&feeler, offset, self.proximity_clouds)
+                .trace(&feeler, rule, self.proximity_clouds)
                 .0
                 .is_some()
             {
@@ -95,7 +102,11 @@ impl<'a> StreamShading<'a> {
     pub fn pixel(&self, primary: StreamRay, refl_depth: u32) -> Vec4 {
         let (mut ray, mut weight, mut color) = (primary, 1.0f32, Vec3::ZERO);
         for bounce in 0..=refl_depth {
-            let Some(h) = self.grid.trace(&ray, None, self.proximity_clouds).0 else {
+            let Some(h) = self
+                .grid
+                .trace(&ray, Rule::Closest, self.proximity_clouds)
+                .0
+            else {
                 color += weight * self.background;
                 break;
             };

@@ -64,6 +64,8 @@ pub struct StreamOptions {
     pub steps_per_call: u32,
     /// traverse calls per traversal at most
     pub max_calls: u32,
+    /// shadow rays as a naive closest-hit search (`--stream-naive-shadows`)
+    pub naive_shadows: bool,
     pub aovs: bool,
 }
 
@@ -79,6 +81,7 @@ impl StreamOptions {
             proximity_clouds: g.proximity_clouds,
             steps_per_call: g.stream_steps,
             max_calls: g.stream_max_calls,
+            naive_shadows: g.stream_naive_shadows,
             aovs: o.aovs,
         }
     }
@@ -302,7 +305,9 @@ impl StreamRenderer {
         );
         let k = &self.kernels.traverse;
         self.use_kernel(k);
-        k.set_i32("anyHit", shadow as i32);
+        let naive = shadow && self.options.naive_shadows;
+        k.set_i32("anyHit", (shadow && !naive) as i32);
+        k.set_i32("naiveShadow", naive as i32);
         k.set_f32("shadowOffset", self.scene.settings.shadow_offset);
         k.set_i32("proximityClouds", self.options.proximity_clouds as i32);
         k.set_i32("testCounter", if shadow { 1 } else { 0 });
@@ -567,6 +572,7 @@ impl Renderer for StreamRenderer {
             ("proximity_clouds", json!(o.proximity_clouds)),
             ("steps_per_call", json!(o.steps_per_call)),
             ("max_calls", json!(o.max_calls)),
+            ("naive_shadows", json!(o.naive_shadows)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
