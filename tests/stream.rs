@@ -223,7 +223,8 @@ fn light_scene(dir: &std::path::Path) -> Scene {
 /// of the surface) walked by the CPU twin from the GPU's hit, with the GPU's arithmetic. Every
 /// pixel is lit on the GPU exactly where the twin's feeler is unblocked (lit: brighter than
 /// the ambient term alone, checked where the light's cosine exceeds 0.01), and the shadow-ray
-/// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`]. With
+/// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`]; the
+/// shadow AOV is 1 where lit or missed, 0 where blocked or the light is behind. With
 /// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`).
 fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) -> Frame {
     let mut o = options(64, dims, false);
@@ -240,10 +241,13 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
     let light = scene.lights[0].position;
     let mut counts = WalkCounts::default();
     let (mut shadow_tests, mut lit, mut dark) = (0, 0, 0);
+    let shares = a.shadow.as_ref().expect("the shadow AOV");
+    assert_eq!(scene.lights.len(), 1);
     for (i, r) in primary_rays(&f).iter().enumerate() {
         add(&mut counts, grid.trace(r, Rule::Closest, false).1);
         let id = a.triangle_id[i];
         if id < 0 {
+            assert_eq!(shares[i], 1.0, "pixel {i}: a miss has no shadow ray");
             continue;
         }
         let p = r.o + a.hit_t[i] * r.d;
@@ -252,6 +256,12 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
         let distance = to_light.length();
         let l = to_light / distance;
         if n.dot(l) <= 0.0 {
+            if n.dot(l) < -0.01 {
+                assert_eq!(
+                    shares[i], 0.0,
+                    "pixel {i}: a light behind counts as blocked"
+                );
+            }
             continue;
         }
         let feeler = StreamRay {
@@ -267,6 +277,10 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
         let gpu_lit = (Vec3::from_slice(&f.color[i][..3]) - ambient_only).max_element() > 1e-4;
         if n.dot(l) > 0.01 {
             assert_eq!(gpu_lit, blocker.is_none(), "pixel {i}: lit");
+            assert_eq!(
+                shares[i], gpu_lit as u32 as f32,
+                "pixel {i}: the shadow AOV"
+            );
             (lit, dark) = if gpu_lit {
                 (lit + 1, dark)
             } else {

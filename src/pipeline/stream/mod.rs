@@ -31,7 +31,7 @@ use glow::HasContext;
 use serde_json::json;
 
 use self::grid_textures::GridTextures;
-use self::targets::Targets;
+use self::targets::{AovTargets, Targets};
 use super::raytrace::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
@@ -146,6 +146,9 @@ pub struct StreamRenderer {
     timers: GpuTimers,
     query: glow::Query,
     calls: Calls,
+    /// for the shadow AOV: per pixel (GL row order), the lights whose first-bounce shadow ray
+    /// found no blocker
+    unblocked: Vec<u32>,
     last: Option<(Camera, FrameStats)>,
 }
 
@@ -216,7 +219,6 @@ impl StreamRenderer {
         // SAFETY: query creation on a current context.
         let query = unsafe { gl.create_query().map_err(|e| anyhow!(e))? };
         let r = StreamRenderer {
-            options,
             scene,
             grid,
             grid_ms,
@@ -227,7 +229,12 @@ impl StreamRenderer {
             timers: GpuTimers::default(),
             query,
             calls: Calls::default(),
+            unblocked: match options.aovs {
+                true => vec![0; options.width as usize * options.height as usize],
+                false => vec![],
+            },
             last: None,
+            options,
             gl,
         };
         check_error(&r.gl, "creating the streaming ray tracer")?;
@@ -389,12 +396,30 @@ impl StreamRenderer {
 
     /// Keep the primary rays and hits for the AOVs.
     fn keep_primary(&self) {
-        if let Some((rays, hit)) = &self.targets.primary {
+        if let Some(a) = &self.targets.primary {
             let gl = &self.gl;
-            rays.origin.copy_from(gl, &self.targets.rays[0].origin);
-            rays.direction
+            a.rays.origin.copy_from(gl, &self.targets.rays[0].origin);
+            a.rays
+                .direction
                 .copy_from(gl, &self.targets.rays[0].direction);
-            hit.copy_from(gl, &self.targets.hit);
+            a.hit.copy_from(gl, &self.targets.hit);
+        }
+    }
+
+    /// For the shadow AOV: count the pixels whose primary hit's shadow ray (the traversal just
+    /// finished) found no blocker. A pixel without a shadow ray (no hit, or the light behind
+    /// the surface: the ray generator leaves its weight 0) is not counted.
+    fn count_unblocked(&mut self) {
+        let (gl, t) = (&self.gl, &self.targets);
+        let Some(a) = &t.primary else { return };
+        t.bind_state(gl, 0);
+        self.use_kernel(&self.kernels.hit_record);
+        t.draw(gl, &mut self.timers, &self.kernels.hit_record, a.shadow_fbo);
+        t.unbind(gl);
+        let hits = a.shadow_hit.read_f32(gl);
+        let rays = t.shadow.direction.read_f32(gl);
+        for ((n, h), d) in self.unblocked.iter_mut().zip(&hits).zip(&rays) {
+            *n += (d[3] > 0.0 && h[3] == -1.0) as u32;
         }
     }
 
@@ -410,6 +435,9 @@ impl StreamRenderer {
         for light in 0..self.scene.lights.len() {
             self.generate(camera, 1, cur, 2, light);
             self.trace(2, true);
+            if bounce == 0 {
+                self.count_unblocked();
+            }
             self.shade(cur, 1, light);
         }
         if bounce < self.options.refl_depth {
@@ -425,6 +453,7 @@ impl StreamRenderer {
         self.textures.bind(gl);
         gl.clear_tex_f32(self.targets.color.texture, [0.0, 0.0, 0.0, 1.0]);
         self.calls = Calls::default();
+        self.unblocked.iter_mut().for_each(|n| *n = 0);
         self.generate(camera, 0, 1, 0, 0);
         for b in 0..=self.options.refl_depth {
             self.bounce(camera, b);
@@ -475,7 +504,7 @@ impl StreamRenderer {
     /// The AOVs of the last frame, row 0 = the top row; the normal from the hit record and
     /// the triangles' normals, as shading.frag interpolates it (no shadow AOV).
     fn aovs(&self) -> Option<Aovs> {
-        let (rays, hit) = self.targets.primary.as_ref()?;
+        let AovTargets { rays, hit, .. } = self.targets.primary.as_ref()?;
         let (w, h) = (self.options.width, self.options.height);
         let gl = &self.gl;
         let hits = flip_rows(&hit.read_f32(gl), w, h);
@@ -495,8 +524,25 @@ impl StreamRenderer {
                 .collect(),
             triangle_id: hits.iter().map(|h| h[3].max(-1.0) as i32).collect(),
             normal,
-            shadow: None,
+            shadow: Some(self.shadow_shares(&hits)),
         })
+    }
+}
+
+impl StreamRenderer {
+    /// The shadow AOV, as the ray tracer's: per pixel the share of the point lights whose
+    /// shadow ray from the primary hit is unblocked (a light behind the surface counts as
+    /// blocked); 1 where the primary ray missed or the scene has no lights. `hits`: the
+    /// primary hit records, image row order.
+    fn shadow_shares(&self, hits: &[[f32; 4]]) -> Vec<f32> {
+        let (w, h) = (self.options.width, self.options.height);
+        let lights = self.scene.lights.len();
+        let unblocked = flip_rows(&self.unblocked, w, h);
+        let share = |(n, hit): (&u32, &[f32; 4])| match lights == 0 || hit[3] < 0.0 {
+            true => 1.0,
+            false => *n as f32 / lights as f32,
+        };
+        unblocked.iter().zip(hits).map(share).collect()
     }
 }
 

@@ -35,11 +35,20 @@ pub struct Targets {
     pub hit: Image2d,
     /// the colour, accumulated by blending (rgb, 1)
     pub color: Image2d,
-    /// for the AOVs: the primary rays and their hit records
-    pub primary: Option<(Rays, Image2d)>,
+    /// for the AOVs (`--aov-dir`, tests)
+    pub primary: Option<AovTargets>,
     depth: glow::Renderbuffer,
     vao: glow::VertexArray,
     pub fbo: Framebuffers,
+}
+
+/// What the AOVs read: the primary rays and their hit records, kept from the first bounce, and
+/// one shadow ray's hit record with the FBO the hit-record kernel copies it into.
+pub struct AovTargets {
+    pub rays: Rays,
+    pub hit: Image2d,
+    pub shadow_hit: Image2d,
+    pub shadow_fbo: glow::Framebuffer,
 }
 
 /// The render-target sets.
@@ -161,7 +170,13 @@ impl Targets {
             color: framebuffer(gl, &[&color], None)?,
         };
         let primary = if aovs {
-            Some((rays(gl, w, h)?, rgba(gl, w, h)?))
+            let shadow_hit = rgba(gl, w, h)?;
+            Some(AovTargets {
+                rays: rays(gl, w, h)?,
+                hit: rgba(gl, w, h)?,
+                shadow_fbo: framebuffer(gl, &[&shadow_hit], None)?,
+                shadow_hit,
+            })
         } else {
             None
         };
@@ -250,8 +265,10 @@ impl Targets {
         for s in &self.state {
             images.extend([&s.tmax, &s.cell, &s.hit]);
         }
-        if let Some((r, h)) = &self.primary {
-            images.extend([&r.origin, &r.direction, h]);
+        if let Some(a) = &self.primary {
+            images.extend([&a.rays.origin, &a.rays.direction, &a.hit, &a.shadow_hit]);
+            // SAFETY: deleting our own FBO.
+            unsafe { gl.delete_framebuffer(a.shadow_fbo) };
         }
         images.iter().for_each(|i| i.delete(gl));
         // SAFETY: deleting our own objects.
