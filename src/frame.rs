@@ -4,10 +4,10 @@
 
 use std::collections::BTreeMap;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Statistics of one frame.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct FrameStats {
     /// Ray–triangle tests per kernel (exact 64-bit counts).
     pub triangle_tests: BTreeMap<String, u64>,

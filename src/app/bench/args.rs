@@ -7,6 +7,7 @@ use anyhow::{bail, Result};
 use gpgpu_rt::limits;
 
 use super::config::{BvhVariant, GridVariant};
+use super::shard::{parse_shard, Shard};
 
 /// The protocols `gpgpu-rt bench` knows: the command line's values (`super::protocol_of` says
 /// which protocol each one runs).
@@ -65,10 +66,15 @@ pub enum Rotation {
 
 /// `gpgpu-rt bench`'s command line.
 #[derive(clap::Args, Debug, Clone)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct BenchArgs {
+    #[command(subcommand)]
+    pub command: Option<BenchCommand>,
     /// Protocols to run, one or more.
     #[arg(required = true, value_enum, value_name = "PROTOCOL")]
     pub protocols: Vec<ProtocolId>,
+    #[command(flatten)]
+    pub split: SplitArgs,
     /// `quick`: few angles, a small image (minutes on Mesa); `full`: the thesis' protocol.
     #[arg(long, value_enum, default_value = "quick")]
     pub scale: Scale,
@@ -113,6 +119,48 @@ pub struct BenchArgs {
     /// No progress bar (it shows only on a terminal anyway).
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// A bench command line on its own, `bench` first: `bench merge` parses the shards' with it.
+#[derive(clap::Parser, Debug)]
+#[command(name = "bench")]
+pub struct Standalone {
+    #[command(flatten)]
+    pub args: BenchArgs,
+}
+
+/// How the run's units of work are divided (see `super::shard`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct SplitArgs {
+    /// Print the units of work (configurations; a Klee protocol is one unit) with their
+    /// index and stable id, one per line, and measure nothing.
+    #[arg(long, conflicts_with = "shard")]
+    pub list: bool,
+    /// Measure only the units whose index ≡ K−1 (mod N) (the `--list` index minus 1), warm-up
+    /// included, write their rows and `shard.json` into --out, and no report: `bench merge`
+    /// makes it from all N shards (one per Slurm array task: scripts/slurm-bench.sh).
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+}
+
+/// `gpgpu-rt bench`'s subcommands.
+#[derive(clap::Subcommand, Debug, Clone)]
+pub enum BenchCommand {
+    /// Merge the output folders of `bench … --shard K/N` for K = 1..N into one: the CSVs,
+    /// summaries, plots and report.md of the whole run (refused if a shard is missing or given
+    /// twice, or the folders are of different runs).
+    Merge(MergeArgs),
+}
+
+/// `gpgpu-rt bench merge DIR… --out DIR`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The shards' output folders.
+    #[arg(required = true, value_name = "DIR")]
+    pub dirs: Vec<PathBuf>,
+    /// Output folder of the merged run (created if missing; not one of the shards').
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 /// The options of the grid protocols (Müller 2015, ch. 5.2, 5.3).

@@ -18,7 +18,7 @@ use super::config::Sizing;
 use super::format::{int, num, percent, ratio, table};
 use super::klee_measure::{section, Meas, Row, Setup};
 use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
-use super::protocol::{Protocol, Section};
+use super::protocol::{Protocol, Section, Units};
 use super::runner::Bench;
 use gpgpu_rt::scene::ShadowMode;
 
@@ -107,6 +107,7 @@ pub const KLEE_TABLE1: Protocol = Protocol {
     name: "klee-table1",
     title: "primary rays: GPU rasterisation vs CPU ray casting (Klee 2016, Table 1)",
     run: |p, bench| klee(p, bench, table1),
+    units: Units::Whole,
 };
 
 /// Table 1: per scene, the G-buffer pass on the GPU and the primary rays cast on the CPU.
@@ -136,6 +137,7 @@ pub const KLEE_TABLE2: Protocol = Protocol {
     name: "klee-table2",
     title: "triangle tests vs line-space lookups, CPU, bunny, 4 rays (Klee 2016, Table 2)",
     run: |p, bench| klee(p, bench, table2),
+    units: Units::Whole,
 };
 
 /// Table 2: the bunny's 2×2 shadows on the CPU, with triangle tests and with line-space lookups.
@@ -180,6 +182,7 @@ pub const KLEE_TABLE3: Protocol = Protocol {
     name: "klee-table3",
     title: "CGT vs DDA on the CPU, bunny, 4/9/16/100 rays (Klee 2016, Table 3)",
     run: |p, bench| klee(p, bench, table3),
+    units: Units::Whole,
 };
 
 /// Table 3: the bunny's shadows on the CPU, coherent grid traversal vs 3D-DDA, 4 to 100 rays.
@@ -226,6 +229,7 @@ pub const KLEE_FIG12: Protocol = Protocol {
     name: "klee-fig12",
     title: "2×2 … 10×10 rays, CPU vs GPU, bunny (Klee 2016, Fig. 12)",
     run: |p, bench| klee(p, bench, fig12),
+    units: Units::Whole,
 };
 
 /// Fig. 12: the bunny's shadows with 2×2 … 10×10 rays on the GPU and on the CPU.
@@ -311,6 +315,7 @@ pub const KLEE_FIG13: Protocol = Protocol {
     name: "klee-fig13",
     title: "bunny vs dragon on the GPU, 2×2 … 10×10 rays (Klee 2016, Fig. 13)",
     run: |p, bench| klee(p, bench, fig13),
+    units: Units::Whole,
 };
 
 /// Fig. 13: the shadows of the bunny and of the dragon on the GPU, 2×2 … 10×10 rays.

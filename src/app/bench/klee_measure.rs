@@ -57,7 +57,7 @@ pub struct Setup {
 impl Setup {
     pub fn new(bench: &mut Bench, scene: &str, s: Sizing) -> Result<Setup> {
         let scene = bench.scene(scene)?.clone();
-        let shadows = SoftShadows::new(&bench.gpu, &scene, s, bench.args.tile)?;
+        let shadows = SoftShadows::new(bench.gpu()?, &scene, s, bench.args.tile)?;
         Ok(Setup {
             scene,
             shadows,
@@ -67,7 +67,7 @@ impl Setup {
 
     /// GPU: the shadow kernel's time per frame (and the G-buffer pass's), after warm-up.
     pub fn gpu(&mut self, bench: &Bench, mode: ShadowMode, su: u32, sv: u32) -> Result<GpuRun> {
-        self.shadows.configure(&bench.gpu, mode, su, sv)?;
+        self.shadows.configure(bench.gpu()?, mode, su, sv)?;
         for _ in 0..self.sizing.warmup {
             self.shadows.render(&self.scene.camera)?;
         }

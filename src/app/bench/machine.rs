@@ -1,11 +1,11 @@
 //! The machine a benchmark ran on: GL implementation, CPU, operating system, time.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use gpgpu_rt::gl::GlInfo;
 
 /// What `report.md` states about the machine.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Machine {
     pub gl_vendor: String,
     pub gl_renderer: String,
@@ -32,6 +32,19 @@ impl Machine {
             } else {
                 format!("{} ({})", info.egl_device, info.egl_device_name)
             },
+            ..Machine::host()
+        }
+    }
+
+    /// This host without a GL implementation (`--list`, `bench merge`): CPU, OS, date.
+    pub fn host() -> Machine {
+        let none = || "none (nothing measured)".to_string();
+        Machine {
+            gl_vendor: none(),
+            gl_renderer: none(),
+            gl_version: none(),
+            glsl_version: none(),
+            egl_device: none(),
             cpu: cpu_model().unwrap_or_else(|| std::env::consts::ARCH.to_string()),
             logical_cpus: std::thread::available_parallelism()
                 .map(|n| n.get())

@@ -30,6 +30,10 @@
 //! - [`adapter`]: the only module that uses the library's renderers (the GL context, the ray
 //!   tracers and the soft-shadow renderer); the rest speaks the bench's own terms.
 //!
+//! - [`shard`]: the units of work (a configuration, or a whole protocol: [`Units`]) that
+//!   `--list` prints, `--shard K/N` measures a part of and `bench merge` replays from the shards'
+//!   records; [`Bench`]'s [`shard::Mode`] says which, so a protocol's `run` is the same in all.
+//!
 //! No module here imports one that imports it; only this file imports the protocols.
 //!
 //! # Adding a protocol (e.g. a new table of Klee 2016)
@@ -42,7 +46,10 @@
 //!    beside ours, with its [`plots::Figure`]s: [`Section::of_sweep`]); see [`thesis_5_3`] for
 //!    a complete example. Work that is not a list of rendered frames (a CPU implementation, a
 //!    build-time measurement) goes through [`adapter`] and [`klee_measure`] or helpers like them.
-//! 3. Add a variant with `#[value(name = "...")]` to [`ProtocolId`] and its line in
+//! 3. Say what its units are: `Units::Configs` when everything it measures goes through
+//!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
+//!    measurements depend on each other.
+//! 4. Add a variant with `#[value(name = "...")]` to [`ProtocolId`] and its line in
 //!    [`protocol_of`]; mention it in the README's benchmark section.
 
 pub mod adapter;
@@ -60,6 +67,7 @@ pub mod published;
 pub mod published_wagner;
 pub mod report;
 pub mod runner;
+pub mod shard;
 pub mod stats;
 pub mod sweep;
 pub mod thesis_5_1;
@@ -71,10 +79,12 @@ pub mod wagner_report;
 use std::time::Instant;
 
 use anyhow::{bail, Result};
+use clap::Parser as _;
 
-pub use args::{BenchArgs, ProtocolId};
-pub use protocol::{Protocol, Section};
-pub use runner::Bench;
+pub use args::{BenchArgs, BenchCommand, MergeArgs, ProtocolId};
+pub use protocol::{Protocol, Section, Units};
+pub use runner::{Bench, NotMeasuredHere};
+use shard::{Mode, Shard};
 
 /// The registry: the protocol each command-line value runs.
 pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
@@ -92,25 +102,48 @@ pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
     }
 }
 
-/// Run the protocols of `args` and write the report. Fails (after writing everything) when a
-/// configuration or protocol failed.
+/// Run the protocols of `args` and write the report (or list their units, or measure one
+/// shard of them, or merge shards). Fails (after writing everything) when a configuration or
+/// protocol failed.
 pub fn run(args: BenchArgs) -> Result<()> {
-    let mut ids = args.protocols.clone();
+    if let Some(BenchCommand::Merge(m)) = &args.command {
+        return merge(m);
+    }
+    let mode = match (args.split.list, args.split.shard) {
+        (true, _) => Mode::List,
+        (false, shard) => Mode::Measure(shard),
+    };
+    let start = Instant::now();
+    let mut bench = Bench::new(args, mode)?;
+    match bench.mode {
+        Mode::List => list(&mut bench),
+        Mode::Measure(Some(shard)) => measure_shard(&mut bench, shard, start),
+        _ => report(&mut bench, start),
+    }
+}
+
+/// The protocols of the command line, each once, in a fixed order (the units' order).
+fn protocols(bench: &Bench) -> Vec<&'static Protocol> {
+    let mut ids = bench.args.protocols.clone();
     ids.sort();
     ids.dedup();
-    let start = Instant::now();
-    let mut bench = Bench::new(args)?;
+    ids.into_iter().map(protocol_of).collect()
+}
+
+/// Measure (or replay) every protocol and write `report.md`.
+fn report(bench: &mut Bench, start: Instant) -> Result<()> {
     eprintln!(
         "bench on {} ({}), writing to {}",
         bench.machine.gl_renderer,
         bench.machine.gl_version,
         bench.out.display()
     );
-    let sections: Vec<Section> = ids
+    let sections: Vec<Section> = protocols(bench)
         .into_iter()
-        .map(|id| run_protocol(protocol_of(id), &mut bench))
+        .map(|p| run_protocol(p, bench))
         .collect();
-    let path = report::write(&bench, &sections, start.elapsed().as_secs_f64())?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let path = report::write(bench, &sections, wall_s)?;
     eprintln!("wrote {}", path.display());
     let failed: usize = sections.iter().map(|s| s.failures).sum();
     if failed > 0 {
@@ -119,11 +152,143 @@ pub fn run(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Run one protocol; a protocol that fails as a whole gets a section that says why.
+/// `--list`: every unit, one per line (index, id, what it is).
+fn list(bench: &mut Bench) -> Result<()> {
+    for p in protocols(bench) {
+        match p.units {
+            Units::Whole => {
+                let (i, id) = bench.next_unit(p.name.to_string());
+                println!("{}", shard::list_line(i, &id, p.title));
+            }
+            Units::Configs => match (p.run)(p, bench) {
+                Err(e) if e.is::<NotMeasuredHere>() => {}
+                Err(e) => {
+                    return Err(e.context(format!("{}: cannot list its configurations", p.name)))
+                }
+                Ok(_) => bail!("{}: measured while listing", p.name),
+            },
+        }
+    }
+    Ok(())
+}
+
+/// `--shard K/N`: measure the units the shard takes, write their rows and `shard.json`.
+fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> {
+    eprintln!(
+        "bench shard {shard} on {}, writing to {}",
+        bench.machine.gl_renderer,
+        bench.out.display()
+    );
+    let mut failed = 0;
+    for p in protocols(bench) {
+        let section = run_protocol(p, bench);
+        failed += section.failures;
+    }
+    let measured = bench
+        .measured
+        .values()
+        .filter(|m| m.error.is_some())
+        .count();
+    let manifest = shard::Manifest {
+        format: shard::FORMAT,
+        shard,
+        argv: shard::recorded_argv(&std::env::args().collect::<Vec<_>>()),
+        units: bench.units(),
+        machine: bench.machine.clone(),
+        wall_s: start.elapsed().as_secs_f64(),
+        configs: std::mem::take(&mut bench.measured),
+        sections: std::mem::take(&mut bench.sections),
+    };
+    let path = shard::write_manifest(bench, &manifest)?;
+    let done = manifest.configs.len() + manifest.sections.len();
+    eprintln!(
+        "shard {shard}: {done} of {} units measured; wrote {} (merge all {} shards with `gpgpu-rt bench merge DIR… --out DIR`)",
+        manifest.units,
+        path.display(),
+        shard.n
+    );
+    if failed + measured > 0 {
+        bail!(
+            "{} unit(s) of shard {shard} failed; see {}",
+            failed + measured,
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// `bench merge`: check the shards, replay the run on their records, write its report.
+fn merge(m: &MergeArgs) -> Result<()> {
+    let start = Instant::now();
+    for d in &m.dirs {
+        if d.exists() && m.out.exists() && same_folder(d, &m.out) {
+            bail!(
+                "--out {} is one of the shards' folders; merge into a new folder",
+                m.out.display()
+            );
+        }
+    }
+    let shards = shard::read_shards(&m.dirs)?;
+    let recorded = shard::recorded(&shards)?;
+    let first = &shards[0].0;
+    let mut args = args::Standalone::try_parse_from(&first.argv)
+        .map_err(|e| anyhow::anyhow!("the shards' command line `{}`: {e}", first.argv.join(" ")))?
+        .args;
+    args.out = m.out.clone();
+    let mut bench = Bench::replay(args, recorded, first.machine.clone())?;
+    bench.command = Some(format!("gpgpu-rt {}", first.argv.join(" ")));
+    bench.contributors = shards
+        .iter()
+        .map(|(s, _)| (s.shard, s.machine.clone()))
+        .collect();
+    bench.contributors.sort_by_key(|(s, _)| s.k);
+    let wall: f64 = shards.iter().map(|(s, _)| s.wall_s).sum();
+    report(&mut bench, start - std::time::Duration::from_secs_f64(wall))
+}
+
+/// Do `a` and `b` name the same folder?
+fn same_folder(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Run one protocol; a protocol that fails as a whole gets a section that says why. A whole
+/// protocol is one unit of work: a shard runs it or not, a merge takes its recorded section.
 fn run_protocol(p: &Protocol, bench: &mut Bench) -> Section {
+    if p.units == Units::Whole {
+        let (i, id) = bench.next_unit(p.name.to_string());
+        match &bench.mode {
+            Mode::Measure(Some(s)) if !s.takes(i) => return Section::new(p, String::new(), vec![]),
+            Mode::Replay(r) => return replayed_section(p, r, &id, &bench.out),
+            _ => {}
+        }
+    }
     eprintln!("{}: {}", p.name, p.title);
-    (p.run)(p, bench).unwrap_or_else(|e| {
+    let section = (p.run)(p, bench).unwrap_or_else(|e| {
+        if e.is::<NotMeasuredHere>() {
+            return Section::new(p, String::new(), vec![]);
+        }
         eprintln!("{}: failed: {e:#}", p.name);
         Section::failed(p, &e)
-    })
+    });
+    if p.units == Units::Whole && matches!(bench.mode, Mode::Measure(Some(_))) {
+        bench.sections.insert(p.name.to_string(), section.clone());
+    }
+    section
+}
+
+/// A whole protocol's section as a shard recorded it, its files copied into `out`.
+fn replayed_section(p: &Protocol, r: &shard::Recorded, id: &str, out: &std::path::Path) -> Section {
+    let copy = || -> Result<Section> {
+        let Some((section, dir)) = r.sections.get(id) else {
+            bail!("{id} was run by none of the shards");
+        };
+        for f in &section.files {
+            shard::copy_file(dir, f, out)?;
+        }
+        Ok(section.clone())
+    };
+    copy().unwrap_or_else(|e| Section::failed(p, &e))
 }

@@ -9,6 +9,7 @@ use super::csv_files;
 use super::outcome::Outcome;
 use super::plots::Figure;
 use super::runner::Bench;
+pub use super::shard::Units;
 
 /// A benchmark protocol: what it measures, and how.
 pub struct Protocol {
@@ -18,10 +19,12 @@ pub struct Protocol {
     pub title: &'static str,
     /// Configure, measure (CSVs and plots into `bench.out`) and report: the section.
     pub run: fn(&Protocol, &mut Bench) -> Result<Section>,
+    /// Its units of work for `--list`, `--shard` and `bench merge`.
+    pub units: Units,
 }
 
 /// A protocol's part of the report.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct Section {
     pub protocol: String,
     pub title: String,

@@ -14,6 +14,7 @@ use super::machine::Machine;
 use super::protocol::Section;
 use super::published;
 use super::runner::Bench;
+use super::shard::Shard;
 
 const MULLER: &str = "Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL 4.5 compute \
                       shaders and a per-frame uniform grid*), ch. 5";
@@ -29,8 +30,11 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
     let (muller, klee, wagner) = (ran("thesis-"), ran("klee-"), ran("wagner-"));
     let sources = [(muller, MULLER), (klee, KLEE), (wagner, WAGNER)];
     let cited: Vec<&str> = sources.iter().filter(|s| s.0).map(|s| s.1).collect();
-    let mut s = heading(&cited, &bench.machine, wall_s);
+    let command = bench.command.clone();
+    let command = command.unwrap_or_else(|| std::env::args().collect::<Vec<_>>().join(" "));
+    let mut s = heading(&cited, &command, &bench.machine, wall_s);
     s.push_str(&machine(&bench.machine, muller));
+    s.push_str(&shards(&bench.contributors));
     if muller {
         s.push_str(&muller_settings(&bench.args));
     }
@@ -44,7 +48,7 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
 
 /// The title, what the report compares (the works `cited`), the command, the date and the wall
 /// time.
-fn heading(cited: &[&str], m: &Machine, wall_s: f64) -> String {
+fn heading(cited: &[&str], command: &str, m: &Machine, wall_s: f64) -> String {
     // "Müller 2015, ch. 5": the citation up to its title
     let sources: Vec<String> = cited
         .iter()
@@ -64,14 +68,42 @@ fn heading(cited: &[&str], m: &Machine, wall_s: f64) -> String {
          the scene files, which the theses do not fully state.\n",
         cited.join(" and ")
     );
-    let args: Vec<String> = std::env::args().collect();
     let _ = writeln!(
         s,
-        "Command: `{}`  \nDate: {}  \nTotal wall time: {:.1} s\n",
-        args.join(" "),
-        m.date,
-        wall_s
+        "Command: `{command}`  \nDate: {}  \nTotal wall time: {wall_s:.1} s\n",
+        m.date
     );
+    s
+}
+
+/// A merged run (`bench merge`): the shards and the machine each ran on. The machine above is
+/// the first shard's; the total wall time is the sum of the shards'.
+fn shards(contributors: &[(Shard, Machine)]) -> String {
+    if contributors.is_empty() {
+        return String::new();
+    }
+    let rows: Vec<Vec<String>> = contributors
+        .iter()
+        .map(|(s, m)| {
+            let cpu = format!("{} ({} logical CPUs)", m.cpu, m.logical_cpus);
+            vec![
+                s.to_string(),
+                m.gl_renderer.clone(),
+                m.gl_version.clone(),
+                cpu,
+                m.date.clone(),
+            ]
+        })
+        .collect();
+    let mut s = format!(
+        "\nMerged from {} shards (`bench … --shard K/N`, `bench merge`); the table above is the first \
+         shard's machine, the wall time the sum of the shards':\n\n",
+        contributors.len()
+    );
+    s.push_str(&table(
+        &["shard", "GL renderer", "GL version", "CPU", "date"],
+        &rows,
+    ));
     s
 }
 

@@ -3,7 +3,7 @@
 //! (not counted), render one frame per angle of the rotation, and write the per-frame and
 //! per-configuration CSVs.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -18,40 +18,115 @@ use super::config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
 use super::csv_files;
 use super::machine::Machine;
 use super::outcome::{FrameRecord, Outcome};
+use super::protocol::Section;
+use super::shard::{self, Measured, Mode, Shard};
 use gpgpu_rt::scene::{Camera, Scene};
 
-/// A benchmark session: the GPU, the options, the output folder and the scenes.
+/// A benchmark session: the GPU, the options, the output folder and the scenes; what it does
+/// with each unit of work (measure, list, replay: [`Mode`]) and what it measured.
 pub struct Bench {
     pub args: BenchArgs,
-    pub gpu: Gpu,
+    /// `None` where nothing is measured (`--list`, `bench merge`).
+    gpu: Option<Gpu>,
     pub machine: Machine,
     pub scenes_dir: PathBuf,
     pub out: PathBuf,
     scenes: HashMap<(String, Overrides), Scene>,
     progress: bool,
+    pub mode: Mode,
+    /// The units met so far (the next one's index) and the ids given out.
+    units: usize,
+    ids: HashMap<String, u32>,
+    /// What this run measured, for a shard's manifest: configurations and whole protocols.
+    pub measured: BTreeMap<String, Measured>,
+    pub sections: BTreeMap<String, Section>,
+    /// `bench merge`: the command line of the run and the machine of every shard.
+    pub command: Option<String>,
+    pub contributors: Vec<(Shard, Machine)>,
 }
 
+/// The error a protocol's measuring returns where this run measures nothing of it: `--list`
+/// (the units were printed) or a shard that took none of them (their rows are in the CSVs).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct NotMeasuredHere(pub &'static str);
+
 impl Bench {
-    pub fn new(args: BenchArgs) -> Result<Bench> {
+    /// A session that measures (`mode` `Measure`) or lists: the GPU is opened only to measure.
+    pub fn new(args: BenchArgs, mode: Mode) -> Result<Bench> {
         args.validate()?;
-        let scenes_dir = find_scenes_dir(args.scenes.as_deref())?;
         let out = args.out.clone();
-        // before the GPU is opened: a folder, or one that can be made, that takes new files
-        gpgpu_rt::output::check_folder("--out", &out)?;
-        std::fs::create_dir_all(&out)
-            .with_context(|| format!("cannot create the output folder {}", out.display()))?;
-        let gpu = Gpu::open(args.device, args.glsl_dir.clone())?;
-        let machine = Machine::describe(gpu.info());
+        let measuring = matches!(mode, Mode::Measure(_));
+        if measuring {
+            // before the GPU is opened: a folder, or one that can be made, that takes new files
+            gpgpu_rt::output::check_folder("--out", &out)?;
+            std::fs::create_dir_all(&out)
+                .with_context(|| format!("cannot create the output folder {}", out.display()))?;
+        }
+        let gpu = match measuring {
+            true => Some(Gpu::open(args.device, args.glsl_dir.clone())?),
+            false => None,
+        };
+        let machine = match &gpu {
+            Some(g) => Machine::describe(g.info()),
+            None => Machine::host(),
+        };
+        Bench::with(args, gpu, machine, mode)
+    }
+
+    /// `bench merge`: a session that replays `recorded` into `out`, on `machine` (the first
+    /// shard's).
+    pub fn replay(args: BenchArgs, recorded: shard::Recorded, machine: Machine) -> Result<Bench> {
+        args.validate()?;
+        gpgpu_rt::output::check_folder("--out", &args.out)?;
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("cannot create the output folder {}", args.out.display()))?;
+        Bench::with(args, None, machine, Mode::Replay(Box::new(recorded)))
+    }
+
+    fn with(args: BenchArgs, gpu: Option<Gpu>, machine: Machine, mode: Mode) -> Result<Bench> {
+        let scenes_dir = find_scenes_dir(args.scenes.as_deref())?;
         let progress = !args.quiet && std::io::stderr().is_terminal();
         Ok(Bench {
+            out: args.out.clone(),
             args,
             gpu,
             machine,
             scenes_dir,
-            out,
             scenes: HashMap::new(),
             progress,
+            mode,
+            units: 0,
+            ids: HashMap::new(),
+            measured: BTreeMap::new(),
+            sections: BTreeMap::new(),
+            command: None,
+            contributors: Vec::new(),
         })
+    }
+
+    /// The GPU; an error where this session measures nothing.
+    pub fn gpu(&self) -> Result<&Gpu> {
+        self.gpu
+            .as_ref()
+            .context("this bench session measures nothing (--list, bench merge): no GPU")
+    }
+
+    /// The next unit of work: its index and its id, `base` made unique within the run.
+    pub fn next_unit(&mut self, base: String) -> (usize, String) {
+        let seen = self.ids.entry(base.clone()).or_insert(0);
+        *seen += 1;
+        let id = match *seen {
+            1 => base,
+            k => format!("{base}#{k}"),
+        };
+        self.units += 1;
+        (self.units - 1, id)
+    }
+
+    /// The units met so far.
+    pub fn units(&self) -> usize {
+        self.units
     }
 
     pub fn scale(&self) -> Scale {
@@ -157,6 +232,10 @@ impl Bench {
     /// `<out>/<protocol>.csv` and `<out>/<protocol>_summary.csv`, the first frame of each
     /// configuration to `<out>/frames/<protocol>/`. A configuration that fails is recorded with
     /// its error and the others go on; a missing scene fails the whole protocol at once.
+    ///
+    /// Each configuration is a unit of work ([`shard`]): `--list` prints them and a shard
+    /// measures those it takes — both then end the protocol with [`NotMeasuredHere`], as a
+    /// report of part of the configurations would mislead — and `bench merge` replays them.
     pub fn measure(&mut self, protocol: &str, configs: &[Config]) -> Result<Vec<Outcome>> {
         for c in configs {
             self.scene_with(&c.scene, c.overrides)?;
@@ -164,22 +243,63 @@ impl Bench {
                 bail!("{protocol}: configuration {} has no angles", c.label());
             }
         }
+        let units: Vec<(usize, String)> = (configs.iter())
+            .map(|c| self.next_unit(config_id(protocol, c)))
+            .collect();
+        if let Mode::List = self.mode {
+            for ((i, id), c) in units.iter().zip(configs) {
+                println!("{}", shard::list_line(*i, id, &c.label()));
+            }
+            return Err(NotMeasuredHere("listed").into());
+        }
+        let outcomes = match &self.mode {
+            Mode::Replay(r) => replayed(r, protocol, configs, &units, &self.out)?,
+            Mode::Measure(shard) => {
+                let shard = *shard;
+                let taken = |i: usize| shard.is_none_or(|s| s.takes(i));
+                let mine: Vec<bool> = units.iter().map(|(i, _)| taken(*i)).collect();
+                self.measure_configs(protocol, configs, &mine, &units)?
+            }
+            Mode::List => unreachable!("returned above"),
+        };
+        csv_files::write(&self.out, protocol, &outcomes, self.args.rotate)?;
+        if let Mode::Measure(Some(_)) = self.mode {
+            return Err(NotMeasuredHere("a shard reports nothing: bench merge does").into());
+        }
+        Ok(outcomes)
+    }
+
+    /// Measure the configurations marked in `mine`; a shard records each in [`Bench::measured`].
+    fn measure_configs(
+        &mut self,
+        protocol: &str,
+        configs: &[Config],
+        mine: &[bool],
+        units: &[(usize, String)],
+    ) -> Result<Vec<Outcome>> {
         let frames_dir = self.out.join("frames").join(protocol);
         std::fs::create_dir_all(&frames_dir)
             .with_context(|| format!("cannot create {}", frames_dir.display()))?;
-        let pb = self.progress_bar(configs.iter().map(Config::frames).sum(), protocol);
-        let mut outcomes = Vec::with_capacity(configs.len());
-        for (c, png) in configs.iter().zip(first_frame_pngs(protocol, configs)) {
+        let todo = configs.iter().zip(mine).filter(|(_, &m)| m);
+        let pb = self.progress_bar(todo.map(|(c, _)| c.frames()).sum(), protocol);
+        let mut outcomes = Vec::new();
+        let pngs = first_frame_pngs(protocol, configs);
+        for (((c, png), &m), (_, id)) in configs.iter().zip(pngs).zip(mine).zip(units) {
+            if !m {
+                continue;
+            }
             pb.set_message(c.label());
             let before = pb.position();
             let outcome = self.run_config(c, png, &pb);
             pb.set_position(before + c.frames());
             let line = outcome.summary_line();
             pb.suspend(|| eprintln!("{protocol}: {line}"));
+            if let Mode::Measure(Some(_)) = self.mode {
+                self.measured.insert(id.clone(), Measured::of(&outcome));
+            }
             outcomes.push(outcome);
         }
         pb.finish_and_clear();
-        csv_files::write(&self.out, protocol, &outcomes, self.args.rotate)?;
         Ok(outcomes)
     }
 
@@ -210,7 +330,7 @@ impl Bench {
         out: &mut Outcome,
     ) -> Result<()> {
         let start = Instant::now();
-        let mut tracer = RayTracer::new(&self.gpu, scene, c, &self.args)?;
+        let mut tracer = RayTracer::new(self.gpu()?, scene, c, &self.args)?;
         out.setup_ms = start.elapsed().as_secs_f64() * 1e3;
         let turntable = Turntable::new(scene, self.args.rotate);
         for _ in 0..c.warmup {
@@ -233,6 +353,41 @@ impl Bench {
         }
         Ok(())
     }
+}
+
+/// A configuration's unit id: `<protocol>/<scene>_<tracer>_<W>x<H>_refl<D>`, e.g.
+/// `thesis-5.3/bunny_grid-exact-24_64x64_refl0` (made unique by [`Bench::next_unit`]).
+pub fn config_id(protocol: &str, c: &Config) -> String {
+    let angles = c.angles.len();
+    format!(
+        "{protocol}/{}_{}x{}_refl{}_{angles}f",
+        c.slug(),
+        c.width,
+        c.height,
+        c.refl_depth
+    )
+}
+
+/// The outcomes of `configs` as the shards recorded them, their first frames copied into
+/// `out`; an error names a configuration no shard measured.
+fn replayed(
+    r: &shard::Recorded,
+    protocol: &str,
+    configs: &[Config],
+    units: &[(usize, String)],
+    out: &Path,
+) -> Result<Vec<Outcome>> {
+    let mut outcomes = Vec::with_capacity(configs.len());
+    for (c, (_, id)) in configs.iter().zip(units) {
+        let Some((m, dir)) = r.configs.get(id) else {
+            bail!("{protocol}: configuration {id} was measured by none of the shards");
+        };
+        if let Some(png) = &m.image {
+            shard::copy_file(dir, png, out)?;
+        }
+        outcomes.push(m.outcome(c));
+    }
+    Ok(outcomes)
 }
 
 /// Where the first measured frame of each configuration goes, relative to the output folder:

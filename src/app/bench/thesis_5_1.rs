@@ -9,7 +9,7 @@ use super::config::{Config, Sizing, TracerSpec};
 use super::format::{int, percent, ratio, table};
 use super::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
 use super::plots::{self, Chart, Figure, Series, Style};
-use super::protocol::{Protocol, Section};
+use super::protocol::{Protocol, Section, Units};
 use super::published::{self, TEAPOT_TRIANGLES};
 use super::runner::Bench;
 
@@ -17,6 +17,7 @@ pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.1",
     title: "influence of the number of triangles, base tracer (Müller 2015, ch. 5.1, Fig. 19, 20)",
     run,
+    units: Units::Configs,
 };
 
 /// Quick: 8 angles (every 45°), 1 warm-up frame. Full: 360 angles (every degree), 5 warm-up.

@@ -9,7 +9,7 @@ use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
 use super::format::{int, num};
 use super::outcome::Outcome;
 use super::plots::Figure;
-use super::protocol::{Protocol, Section};
+use super::protocol::{Protocol, Section, Units};
 use super::published;
 use super::runner::Bench;
 use super::sweep::{self, resolution_chart};
@@ -18,6 +18,7 @@ pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.2",
     title: "influence of the grid resolution (Müller 2015, ch. 5.2, Fig. 21, 22)",
     run,
+    units: Units::Configs,
 };
 
 pub const SCENE: &str = "teapot6.toml";

@@ -11,7 +11,7 @@ use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
 use super::format::{int, num, ratio, table};
 use super::outcome::Outcome;
 use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
-use super::protocol::{Protocol, Section};
+use super::protocol::{Protocol, Section, Units};
 use super::published::{self as p, Published};
 use super::runner::Bench;
 use super::sweep::{self, resolution_chart};
@@ -20,6 +20,7 @@ pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.3",
     title: "base tracer vs uniform grid: bunny and dragon (Müller 2015, ch. 5.3, Fig. 23, 24)",
     run,
+    units: Units::Configs,
 };
 
 pub const BUNNY: &str = "bunny.toml";

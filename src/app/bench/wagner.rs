@@ -17,7 +17,7 @@ use anyhow::Result;
 use super::args::Scale;
 use super::config::{BvhVariant, Config, Sizing, TracerSpec};
 use super::outcome::Outcome;
-use super::protocol::{Protocol, Section};
+use super::protocol::{Protocol, Section, Units};
 use super::published_wagner as pw;
 use super::runner::Bench;
 use super::wagner_report::{self as report, Ratios};
@@ -45,6 +45,7 @@ pub const WAGNER_A1: Protocol = Protocol {
     title:
         "FPS by triangle count and image size, subdivided square (Wagner 2018, Table A.1, Fig. 5.1)",
     run: run_a1,
+    units: Units::Configs,
 };
 
 pub const WAGNER_A2: Protocol = Protocol {
@@ -52,6 +53,7 @@ pub const WAGNER_A2: Protocol = Protocol {
     title: "FPS by image size, sphere and cow; BVH build of the dragon (Wagner 2018, Table A.2, \
             Table 5.1, Fig. 5.4)",
     run: run_a2,
+    units: Units::Configs,
 };
 
 /// What a run of a Wagner protocol measures.
