@@ -42,6 +42,15 @@ pub enum ProtocolId {
     /// Wagner 2018, Table A.2 / Table 5.1 / Fig. 5.4: sphere and cow × 5 resolutions.
     #[value(name = "wagner-a2")]
     WagnerA2,
+    /// Seed 004, Table 1: ray casting (eye rays), streaming grid g and pc vs the compute grid.
+    #[value(name = "purcell-table1")]
+    PurcellTable1,
+    /// Seed 004, Table 2: shadow casting (eye and shadow rays), g and pc vs the compute grid.
+    #[value(name = "purcell-table2")]
+    PurcellTable2,
+    /// Seed 004, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs compute grid.
+    #[value(name = "purcell-table3")]
+    PurcellTable3,
 }
 
 /// `--scale`.

@@ -185,7 +185,14 @@ impl Bench {
 
     /// Measure `c`, its first frame written to `png` (relative to the output folder).
     fn run_config(&self, c: &Config, png: PathBuf, pb: &ProgressBar) -> Outcome {
-        let scene = &self.scenes[&(c.scene.clone(), c.overrides)];
+        let loaded = &self.scenes[&(c.scene.clone(), c.overrides)];
+        let unlit;
+        let scene = if c.shadows {
+            loaded
+        } else {
+            unlit = without_lights(loaded);
+            &unlit
+        };
         let mut outcome = Outcome {
             config: c.clone(),
             triangles: scene.triangle_count(),
@@ -235,6 +242,15 @@ impl Bench {
     }
 }
 
+/// `scene` with its point lights removed: eye (and reflection) rays only, no shadow rays
+/// (seed 004's Table 1, "ray casting (eye rays only)").
+fn without_lights(scene: &Scene) -> Scene {
+    Scene {
+        lights: Vec::new(),
+        ..scene.clone()
+    }
+}
+
 /// Where the first measured frame of each configuration goes, relative to the output folder:
 /// `frames/<protocol>/<scene>_<tracer>.png`, with `_<W>x<H>` where configurations differ only
 /// in their image size.
@@ -256,6 +272,8 @@ struct Turntable<'a> {
     center: Vec3,
     models: Vec<Mat4>,
     rotate: Rotation,
+    /// Whether the objects were moved from where the scene put them.
+    turned: std::cell::Cell<bool>,
 }
 
 impl<'a> Turntable<'a> {
@@ -265,6 +283,7 @@ impl<'a> Turntable<'a> {
             center: rotation_center(scene),
             models: scene.objects.iter().map(|o| o.model).collect(),
             rotate,
+            turned: false.into(),
         }
     }
 
@@ -272,7 +291,11 @@ impl<'a> Turntable<'a> {
     /// camera to render with.
     fn turn(&self, tracer: &mut RayTracer, angle: f64) -> Result<Camera> {
         Ok(match self.rotate {
+            // at 0° before any turn the objects stay where they are: a static tracer (seed
+            // 004's stream, which refuses moving objects) renders fixed configurations
+            Rotation::Objects if angle == 0.0 && !self.turned.get() => self.scene.camera,
             Rotation::Objects => {
+                self.turned.set(true);
                 let r = Mat4::from_translation(self.center)
                     * Mat4::from_rotation_y((angle as f32).to_radians())
                     * Mat4::from_translation(-self.center);
