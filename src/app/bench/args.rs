@@ -147,7 +147,8 @@ pub struct GridArgs {
 #[derive(clap::Args, Debug, Clone)]
 pub struct WagnerArgs {
     /// Image sizes of the Wagner 2018 protocols, comma-separated, e.g. 320x240,640x480
-    /// (default: the protocol's for the scale; 320x240 is always measured, the reference).
+    /// (default: the protocol's for the scale; 320x240 is always measured, the reference); of
+    /// purcell-table1…3 too, which render square images W×W.
     #[arg(long, value_delimiter = ',', value_name = "WxH,...", value_parser = parse_size)]
     pub sizes: Option<Vec<(u32, u32)>>,
     /// Subdivision levels of the square for wagner-a1, comma-separated: level L has 2·4^L

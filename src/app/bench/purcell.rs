@@ -70,6 +70,9 @@ pub struct Plan {
     /// Image sides (square images), ascending.
     pub sides: Vec<u32>,
     pub frames: Sizing,
+    /// Table 1 adds the Stanford bunny at 512² (stream vs compute grid, issue 12 §5) unless the
+    /// command line chose the sizes.
+    pub bunny_512: bool,
 }
 
 impl Plan {
@@ -83,6 +86,7 @@ impl Plan {
             table,
             sides,
             frames: bench.sizing(QUICK, FULL),
+            bunny_512: table == 1 && !bench.sizes_given(),
         }
     }
 
@@ -120,8 +124,8 @@ impl Plan {
         v
     }
 
-    /// Every scene of the table and the sparse room, every tracer, every side; Table 1 adds
-    /// the Stanford bunny at 512² if the sides do not have it.
+    /// Every scene of the table and the sparse room, every tracer, every side; and the
+    /// Stanford bunny at 512² where [`Plan::bunny_512`] says so.
     pub fn configs(&self) -> Vec<Config> {
         let scenes = pp::SCENES.iter().chain(std::iter::once(&SPARSE));
         let mut v = Vec::new();
@@ -132,7 +136,7 @@ impl Plan {
                 }
             }
         }
-        if self.table == 1 && !self.sides.contains(&BUNNY_SIDE) {
+        if self.bunny_512 && !self.sides.contains(&BUNNY_SIDE) {
             for tracer in Plan::tracers(&pp::STANFORD_BUNNY) {
                 v.push(self.config(&pp::STANFORD_BUNNY, tracer, BUNNY_SIDE));
             }
@@ -154,7 +158,10 @@ fn run(p: &Protocol, bench: &mut Bench, table: u32) -> Result<Section> {
     let outcomes = bench.measure(p.name, &plan.configs())?;
     let markdown = report::markdown(&plan, &outcomes);
     let figures = report::figures(p.name, &plan, &outcomes);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
+    let file = report::write_csv(&bench.out, p.name, &plan, &outcomes)?;
+    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    s.files.push(file);
+    Ok(s)
 }
 
 #[cfg(test)]
@@ -182,12 +189,26 @@ mod tests {
             table: 3,
             sides: vec![256, 512, 768],
             frames: FULL,
+            bunny_512: false,
         };
         let configs = plan.configs();
         // 3 scenes × 3 tracers + the Stanford bunny × 2 + the sparse room × 3, at 3 sides
         assert_eq!(configs.len(), (9 + 2 + 3) * 3);
         assert!(configs.iter().all(|c| c.refl_depth == 2 && c.shadows));
-        let t1 = Plan { table: 1, ..plan };
-        assert!(t1.configs().iter().all(|c| c.refl_depth == 0 && !c.shadows));
+        let t1 = Plan {
+            table: 1,
+            sides: vec![64, 128, 192],
+            bunny_512: true,
+            ..plan
+        };
+        let configs = t1.configs();
+        assert!(configs.iter().all(|c| c.refl_depth == 0 && !c.shadows));
+        // the Stanford bunny at 512², stream g and the compute grid at 128³
+        let bunny: Vec<String> = configs
+            .iter()
+            .filter(|c| c.width == BUNNY_SIDE)
+            .map(|c| c.label())
+            .collect();
+        assert_eq!(bunny, ["bunny, stream g 128", "bunny, grid exact 128³"]);
     }
 }

@@ -3,8 +3,12 @@
 //! same frames, the work counts, and the paper's findings beside what we measured.
 
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
 
 use super::config::TracerSpec;
+use super::csv_files::write_rows;
 use super::format::{int, num, ratio, table};
 use super::outcome::Outcome;
 use super::plots::{Chart, Figure, Series, Style};
@@ -21,6 +25,15 @@ pub enum Column {
 }
 
 impl Column {
+    /// The CSV's name: the paper's g and pc for the stream tracer.
+    pub fn name(self) -> &'static str {
+        match self {
+            Column::StreamG => "g",
+            Column::StreamPc => "pc",
+            Column::GridG => "grid-g",
+            Column::GridPc => "grid-pc",
+        }
+    }
     fn of(t: &TracerSpec) -> Option<Column> {
         match *t {
             TracerSpec::Stream {
@@ -96,6 +109,53 @@ fn scenes_and_sides(outcomes: &[Outcome]) -> Vec<(PaperScene, Vec<u32>)> {
         (!sides.is_empty()).then(|| (*s, sides))
     })
     .collect()
+}
+
+/// `<protocol>_paper.csv`: per measured configuration its column (g, pc, grid-g, grid-pc),
+/// the paper's side it stands for, the published milliseconds there (empty where the paper has
+/// none) and our best GPU milliseconds.
+pub fn write_csv(out: &Path, protocol: &str, plan: &Plan, outcomes: &[Outcome]) -> Result<PathBuf> {
+    let file = PathBuf::from(format!("{protocol}_paper.csv"));
+    let header: Vec<String> = [
+        "table",
+        "scene",
+        "triangles",
+        "width",
+        "column",
+        "grid",
+        "paper_width",
+        "paper_ms",
+        "best_gpu_ms",
+    ]
+    .map(String::from)
+    .to_vec();
+    let cell = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
+    let rows: Vec<Vec<String>> = outcomes
+        .iter()
+        .filter_map(|o| {
+            let c = &o.config;
+            let col = Column::of(&c.tracer)?;
+            let side = paper_side(plan, c.width);
+            let pc = col == Column::StreamPc;
+            let paper = match col {
+                Column::StreamG | Column::StreamPc => pp::ms(plan.table, &c.scene, side?, pc),
+                _ => None,
+            };
+            Some(vec![
+                plan.table.to_string(),
+                c.scene_name().to_string(),
+                o.triangles.to_string(),
+                c.width.to_string(),
+                col.name().to_string(),
+                c.tracer.grid_label().unwrap_or_default(),
+                side.map(|s| s.to_string()).unwrap_or_default(),
+                cell(paper),
+                cell(best_ms(o)),
+            ])
+        })
+        .collect();
+    write_rows(&out.join(&file), &header, &rows)?;
+    Ok(file)
 }
 
 /// The report section's markdown.

@@ -104,6 +104,12 @@ impl Bench {
         }
     }
 
+    /// Whether the command line chose the image sizes (`--sizes`, `--width`, `--height`).
+    pub fn sizes_given(&self) -> bool {
+        let a = &self.args;
+        a.wagner.sizes.is_some() || a.width.is_some() || a.height.is_some()
+    }
+
     /// The square's subdivision levels to measure: `--levels` or the protocol's for the scale.
     pub fn levels(&self, quick: &[u32], full: &[u32]) -> Vec<u32> {
         match (&self.args.wagner.levels, self.args.scale) {
