@@ -185,10 +185,10 @@ mod tests {
         }
         // the conclusion: the 1764-triangle bunny renders faster than Knight and Torus knot
         for n in 1..=3 {
-            for i in 0..3 {
-                let b = ms(n, "bunny_low.toml", SIZES[i], false).unwrap();
-                assert!(b < ms(n, "knight.toml", SIZES[i], false).unwrap());
-                assert!(b < ms(n, "torus_knot.toml", SIZES[i], false).unwrap());
+            for side in SIZES {
+                let b = ms(n, "bunny_low.toml", side, false).unwrap();
+                assert!(b < ms(n, "knight.toml", side, false).unwrap());
+                assert!(b < ms(n, "torus_knot.toml", side, false).unwrap());
             }
         }
         let counts: Vec<usize> = SCENES.iter().map(|s| s.triangles).collect();

@@ -106,7 +106,7 @@ fn scenes_and_sides(outcomes: &[Outcome]) -> Vec<(PaperScene, Vec<u32>)> {
             .collect();
         sides.sort();
         sides.dedup();
-        (!sides.is_empty()).then(|| (*s, sides))
+        (!sides.is_empty()).then_some((*s, sides))
     })
     .collect()
 }
