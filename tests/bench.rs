@@ -591,3 +591,185 @@ fn wagner_a1_and_a2_tiny_rows_published_values_and_ratios() {
         .join("frames/wagner-a1/square-level-2_bvh-sah_320x240.png")
         .is_file());
 }
+
+/// The published milliseconds of `purcell-table<n>`'s paper CSV row of `scene` in `column`.
+fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> String {
+    let row = rows
+        .iter()
+        .find(|r| r["scene"] == scene && r["column"] == column);
+    row.unwrap_or_else(|| panic!("no row {scene} {column}"))["paper_ms"].clone()
+}
+
+/// Seed 004's Tables 1–3 at 16×16 (one frame each): every scene with the paper's grid in the
+/// stream tracer's g and pc columns (the Stanford bunny g only) and the compute grid; eye rays
+/// only in Table 1 (no lights, no shadow tests), shadows in 2 and 3, two reflection bounces in 3;
+/// the published milliseconds beside ours; the best GPU time the frames' sum.
+#[test]
+fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bp");
+    let o = bench(&[
+        "purcell-table1",
+        "purcell-table2",
+        "purcell-table3",
+        "--sizes",
+        "16x16",
+        "--angles",
+        "1",
+        "--warmup",
+        "0",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let triangles: HashMap<&str, u64> = [
+        ("knight", 636),
+        ("torus_knot", 1024),
+        ("bunny_low", 1764),
+        ("bunny", 69451),
+        ("sparse_room", 1776),
+    ]
+    .into();
+    let grids: HashMap<&str, &str> = [
+        ("knight", "14x16x14"),
+        ("torus_knot", "16"),
+        ("bunny_low", "20"),
+        ("bunny", "128"),
+        ("sparse_room", "32"),
+    ]
+    .into();
+    // the published values of Tables 1–3 at 256² (16² stands for the smallest side), g and pc
+    let published = [
+        [
+            ("knight", "45", "47"),
+            ("torus_knot", "55", "55"),
+            ("bunny_low", "37", "37"),
+        ],
+        [
+            ("knight", "96", "91"),
+            ("torus_knot", "169", "164"),
+            ("bunny_low", "75", "75"),
+        ],
+        [
+            ("knight", "168", "164"),
+            ("torus_knot", "306", "300"),
+            ("bunny_low", "129", "130"),
+        ],
+    ];
+    let stanford = ["142", "235", "482"];
+    for n in 1..=3u32 {
+        let p = format!("purcell-table{n}");
+        let frames = read_csv(&out.join(format!("{p}.csv")));
+        // 3 scenes × (g, pc, grid) + the Stanford bunny × (g, grid) + the sparse room × 3, and
+        // in Table 2 the 4 scenes' g with naive shadow rays
+        let configs = if n == 2 { 18 } else { 14 };
+        assert_eq!(frames.len(), configs, "{p}");
+        for r in &frames {
+            let scene = r["scene"].as_str();
+            assert_eq!(u(r, "triangles"), triangles[scene], "{p} {scene}");
+            assert_eq!(u(r, "lights"), (n > 1) as u64, "{p}: lights");
+            assert_eq!(u(r, "refl_depth"), if n == 3 { 2 } else { 0 }, "{p}");
+            assert_eq!((u(r, "width"), u(r, "height")), (16, 16));
+            let stream = r["tracer"] == "stream";
+            assert!(
+                stream || (r["tracer"] == "grid" && r["variant"] == "exact"),
+                "{r:?}"
+            );
+            if stream {
+                assert_eq!(r["grid_resolution"], grids[scene], "{p} {scene}");
+                assert!(["g", "pc", "g-naive"].contains(&r["variant"].as_str()));
+                assert_eq!(
+                    r["fact_naive_shadows"],
+                    (r["variant"] == "g-naive").to_string()
+                );
+                assert_eq!(
+                    r["fact_proximity_clouds"],
+                    (r["variant"] == "pc").to_string()
+                );
+            }
+            if n == 1 {
+                let shadow = r["tests_shadow"].as_str();
+                assert!(["", "0"].contains(&shadow), "{p}: eye rays only, {shadow}");
+            }
+        }
+        assert_eq!(
+            rows_with(&frames, "variant", "pc").len(),
+            4,
+            "no pc for bunny"
+        );
+        let naive = rows_with(&frames, "variant", "g-naive");
+        assert_eq!(
+            naive.len(),
+            if n == 2 { 4 } else { 0 },
+            "{p}: naive shadows"
+        );
+        for r in naive {
+            // the same shadows, found the naive way: at least as many tests
+            let g = frames
+                .iter()
+                .find(|g| g["scene"] == r["scene"] && g["variant"] == "g")
+                .unwrap();
+            assert!(u(r, "tests_shadow") >= u(g, "tests_shadow"), "{r:?}");
+            assert_eq!(u(r, "tests_closest"), u(g, "tests_closest"), "{r:?}");
+        }
+        let summary = read_csv(&out.join(format!("{p}_summary.csv")));
+        check_summary_against_frames(&frames, &summary);
+        let paper = read_csv(&out.join(format!("{p}_paper.csv")));
+        assert_eq!(paper.len(), configs);
+        for (scene, g, pc) in published[n as usize - 1] {
+            assert_eq!(
+                paper_ms(&paper, scene, "g"),
+                format!("{g}.000000"),
+                "{p} {scene}"
+            );
+            assert_eq!(
+                paper_ms(&paper, scene, "pc"),
+                format!("{pc}.000000"),
+                "{p} {scene}"
+            );
+            assert_eq!(
+                paper_ms(&paper, scene, "grid-g"),
+                "",
+                "the paper has no compute grid"
+            );
+        }
+        let bunny = paper_ms(&paper, "bunny", "g");
+        assert_eq!(bunny, format!("{}.000000", stanford[n as usize - 1]));
+        assert_eq!(paper_ms(&paper, "sparse_room", "g"), "", "not in the paper");
+        for r in &paper {
+            assert_eq!(u(r, "paper_width"), 256);
+            // one frame: the best GPU time is that frame's
+            let s: Vec<_> = summary
+                .iter()
+                .filter(|s| {
+                    s["scene"] == r["scene"]
+                        && s["grid_resolution"] == r["grid"]
+                        && (s["variant"] == r["column"]
+                            || (s["variant"] == "exact" && r["column"] == "grid-g"))
+                })
+                .collect();
+            assert_eq!(s.len(), 1, "{r:?}");
+            let (best, min) = (f(r, "best_gpu_ms"), f(s[0], "gpu_ms_min"));
+            assert!((best - min).abs() <= 1e-4 * min, "{r:?}: {best} vs {min}");
+        }
+        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(
+            report.contains(&format!("Seed 004, Table {n}:")),
+            "{report}"
+        );
+        assert!(out.join(format!("{p}.png")).is_file());
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    check_report_links(&out, &report);
+    assert!(report.contains("almost always worse than not using proximity clouds"));
+    // Table 2's shadow-ray saving, for every dense scene
+    let shadows = report
+        .lines()
+        .find(|l| l.contains("time saved per frame (1 − g / g-naive)"))
+        .expect("Table 2's shadow-ray finding");
+    for scene in ["Knight", "Torus knot", "Bunny", "Stanford Bunny"] {
+        assert!(shadows.contains(&format!("{scene} ")), "{scene}: {shadows}");
+    }
+    assert!(!shadows.contains('–'), "every saving measured: {shadows}");
+}

@@ -58,14 +58,38 @@ pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
 /// The tracer kind and grid options of configuration `c`, with the command line's list
 /// lengths.
 fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)> {
+    let d = GridOptions::default();
+    match c.tracer {
+        TracerSpec::Stream {
+            axes,
+            proximity_clouds,
+            naive_shadows,
+        } => {
+            let grid = GridOptions {
+                axes: Some(axes),
+                proximity_clouds,
+                stream_naive_shadows: naive_shadows,
+                ..d
+            };
+            return Ok((TracerKind::Stream, grid));
+        }
+        TracerSpec::GridPc { resolution } => {
+            let grid = GridOptions {
+                resolution: Some(resolution),
+                proximity_clouds: true,
+                ..d
+            };
+            return Ok((TracerKind::Grid, grid));
+        }
+        _ => {}
+    }
     let Some((variant, resolution)) = c.tracer.grid() else {
         let kind = match c.tracer {
             TracerSpec::Bvh { .. } => TracerKind::Bvh,
             _ => TracerKind::Base,
         };
-        return Ok((kind, GridOptions::default()));
+        return Ok((kind, d));
     };
-    let d = GridOptions::default();
     let grid = GridOptions {
         variant,
         resolution: Some(resolution),

@@ -43,6 +43,15 @@ pub enum ProtocolId {
     /// Wagner 2018, Table A.2 / Table 5.1 / Fig. 5.4: sphere and cow × 5 resolutions.
     #[value(name = "wagner-a2")]
     WagnerA2,
+    /// Seed 004, Table 1: ray casting (eye rays), streaming grid g and pc vs the compute grid.
+    #[value(name = "purcell-table1")]
+    PurcellTable1,
+    /// Seed 004, Table 2: shadow casting (eye and shadow rays), g and pc vs the compute grid.
+    #[value(name = "purcell-table2")]
+    PurcellTable2,
+    /// Seed 004, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs compute grid.
+    #[value(name = "purcell-table3")]
+    PurcellTable3,
 }
 
 /// `--scale`.
@@ -186,7 +195,8 @@ pub struct GridArgs {
 #[derive(clap::Args, Debug, Clone)]
 pub struct WagnerArgs {
     /// Image sizes of the Wagner 2018 protocols, comma-separated, e.g. 320x240,640x480
-    /// (default: the protocol's for the scale; 320x240 is always measured, the reference).
+    /// (default: the protocol's for the scale; 320x240 is always measured, the reference); of
+    /// purcell-table1…3 too, which render square images W×W.
     #[arg(long, value_delimiter = ',', value_name = "WxH,...", value_parser = parse_size)]
     pub sizes: Option<Vec<(u32, u32)>>,
     /// Subdivision levels of the square for wagner-a1, comma-separated: level L has 2·4^L

@@ -62,6 +62,18 @@ pub enum TracerSpec {
     },
     /// A BVH tracer (`--tracer bvh`) of one variant.
     Bvh { variant: BvhVariant },
+    /// Seed 004's streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
+    /// proximity clouds: the paper's columns pc and g.
+    /// With `naive_shadows`, the naive shadow rays the paper's optimisation is measured
+    /// against (`--stream-naive-shadows`).
+    Stream {
+        axes: [u32; 3],
+        proximity_clouds: bool,
+        naive_shadows: bool,
+    },
+    /// The compute exact grid (`--tracer grid`) of N³ voxels with proximity clouds
+    /// (`--tracer grid --proximity-clouds`, issue 12 §3).
+    GridPc { resolution: u32 },
 }
 
 impl TracerSpec {
@@ -70,6 +82,8 @@ impl TracerSpec {
             TracerSpec::Base => "base",
             TracerSpec::Grid { .. } => "grid",
             TracerSpec::Bvh { .. } => "bvh",
+            TracerSpec::Stream { .. } => "stream",
+            TracerSpec::GridPc { .. } => "grid",
         }
     }
     /// The grid's variant and resolution; `None` for the other tracers.
@@ -89,6 +103,21 @@ impl TracerSpec {
     pub fn resolution(&self) -> Option<u32> {
         self.grid().map(|g| g.1)
     }
+    /// The grid's cells per axis, of any grid tracer: "24", "14x16x14"; `None` without a grid.
+    pub fn grid_label(&self) -> Option<String> {
+        match *self {
+            TracerSpec::Grid { resolution, .. } | TracerSpec::GridPc { resolution } => {
+                Some(resolution.to_string())
+            }
+            TracerSpec::Stream {
+                axes: [x, y, z], ..
+            } if x == y && y == z => Some(x.to_string()),
+            TracerSpec::Stream {
+                axes: [x, y, z], ..
+            } => Some(format!("{x}x{y}x{z}")),
+            _ => None,
+        }
+    }
     /// The BVH's variant; `None` for the other tracers.
     pub fn bvh_variant(&self) -> Option<BvhVariant> {
         match *self {
@@ -102,9 +131,20 @@ impl TracerSpec {
             TracerSpec::Base => None,
             TracerSpec::Grid { variant, .. } => Some(variant_name(variant)),
             TracerSpec::Bvh { variant } => Some(variant.name()),
+            TracerSpec::Stream {
+                proximity_clouds,
+                naive_shadows,
+                ..
+            } => Some(match (proximity_clouds, naive_shadows) {
+                (false, false) => "g",
+                (true, false) => "pc",
+                (false, true) => "g-naive",
+                (true, true) => "pc-naive",
+            }),
+            TracerSpec::GridPc { .. } => Some("exact-pc"),
         }
     }
-    /// "base", "grid thesis 24³", "bvh sah".
+    /// "base", "grid thesis 24³", "bvh sah", "stream pc 14x16x14".
     pub fn label(&self) -> String {
         match *self {
             TracerSpec::Base => "base".into(),
@@ -113,6 +153,12 @@ impl TracerSpec {
                 resolution,
             } => format!("grid {} {resolution}³", variant_name(variant)),
             TracerSpec::Bvh { variant } => format!("bvh {}", variant.name()),
+            TracerSpec::Stream { .. } | TracerSpec::GridPc { .. } => format!(
+                "{} {} {}",
+                self.name(),
+                self.variant_label().unwrap_or_default(),
+                self.grid_label().unwrap_or_default()
+            ),
         }
     }
     /// A file-name friendly form: "base", "grid-thesis-24", "bvh-sah".
@@ -144,6 +190,9 @@ pub struct Config {
     pub angles: Vec<f64>,
     /// Frames rendered first at the first angle and not counted.
     pub warmup: u32,
+    /// Shadow rays towards the scene's lights; `false`: the lights removed, eye rays (and
+    /// reflection rays) only, lit by the ambient term (seed 004's Table 1, ray casting).
+    pub shadows: bool,
 }
 
 impl Config {
@@ -158,6 +207,7 @@ impl Config {
             height: s.height,
             angles: rotation_angles(s.angles),
             warmup: s.warmup,
+            shadows: true,
         }
     }
     /// `tracer` on `scene` at `width`×`height`, `frames` frames after `warmup`, camera and

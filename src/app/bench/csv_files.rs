@@ -61,7 +61,7 @@ fn common_columns(protocol: &str, o: &Outcome, rotate: Rotation) -> Vec<String> 
     let c = &o.config;
     let variant = c.tracer.variant_label().unwrap_or("");
     let level = c.overrides.level.map(|l| l.to_string());
-    let resolution = c.tracer.resolution().map(|r| r.to_string());
+    let resolution = c.tracer.grid_label();
     let rotation = match rotate {
         Rotation::Objects => "objects",
         Rotation::Camera => "camera",

@@ -64,7 +64,10 @@ pub mod outcome;
 pub mod plots;
 pub mod protocol;
 pub mod published;
+pub mod published_purcell;
 pub mod published_wagner;
+pub mod purcell;
+pub mod purcell_report;
 pub mod report;
 pub mod runner;
 pub mod shard;
@@ -99,6 +102,9 @@ pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
         ProtocolId::KleeFig13 => &klee::KLEE_FIG13,
         ProtocolId::WagnerA1 => &wagner::WAGNER_A1,
         ProtocolId::WagnerA2 => &wagner::WAGNER_A2,
+        ProtocolId::PurcellTable1 => &purcell::PURCELL_TABLE1,
+        ProtocolId::PurcellTable2 => &purcell::PURCELL_TABLE2,
+        ProtocolId::PurcellTable3 => &purcell::PURCELL_TABLE3,
     }
 }
 

@@ -179,6 +179,12 @@ impl Bench {
         }
     }
 
+    /// Whether the command line chose the image sizes (`--sizes`, `--width`, `--height`).
+    pub fn sizes_given(&self) -> bool {
+        let a = &self.args;
+        a.wagner.sizes.is_some() || a.width.is_some() || a.height.is_some()
+    }
+
     /// The square's subdivision levels to measure: `--levels` or the protocol's for the scale.
     pub fn levels(&self, quick: &[u32], full: &[u32]) -> Vec<u32> {
         match (&self.args.wagner.levels, self.args.scale) {
@@ -305,7 +311,14 @@ impl Bench {
 
     /// Measure `c`, its first frame written to `png` (relative to the output folder).
     fn run_config(&self, c: &Config, png: PathBuf, pb: &ProgressBar) -> Outcome {
-        let scene = &self.scenes[&(c.scene.clone(), c.overrides)];
+        let loaded = &self.scenes[&(c.scene.clone(), c.overrides)];
+        let unlit;
+        let scene = if c.shadows {
+            loaded
+        } else {
+            unlit = without_lights(loaded);
+            &unlit
+        };
         let mut outcome = Outcome {
             config: c.clone(),
             triangles: scene.triangle_count(),
@@ -359,8 +372,9 @@ impl Bench {
 /// `thesis-5.3/bunny_grid-exact-24_64x64_refl0` (made unique by [`Bench::next_unit`]).
 pub fn config_id(protocol: &str, c: &Config) -> String {
     let angles = c.angles.len();
+    let lights = if c.shadows { "" } else { "_nolights" };
     format!(
-        "{protocol}/{}_{}x{}_refl{}_{angles}f",
+        "{protocol}/{}_{}x{}_refl{}{lights}_{angles}f",
         c.slug(),
         c.width,
         c.height,
@@ -390,6 +404,15 @@ fn replayed(
     Ok(outcomes)
 }
 
+/// `scene` with its point lights removed: eye (and reflection) rays only, no shadow rays
+/// (seed 004's Table 1, "ray casting (eye rays only)").
+fn without_lights(scene: &Scene) -> Scene {
+    Scene {
+        lights: Vec::new(),
+        ..scene.clone()
+    }
+}
+
 /// Where the first measured frame of each configuration goes, relative to the output folder:
 /// `frames/<protocol>/<scene>_<tracer>.png`, with `_<W>x<H>` where configurations differ only
 /// in their image size.
@@ -411,6 +434,8 @@ struct Turntable<'a> {
     center: Vec3,
     models: Vec<Mat4>,
     rotate: Rotation,
+    /// Whether the objects were moved from where the scene put them.
+    turned: std::cell::Cell<bool>,
 }
 
 impl<'a> Turntable<'a> {
@@ -420,6 +445,7 @@ impl<'a> Turntable<'a> {
             center: rotation_center(scene),
             models: scene.objects.iter().map(|o| o.model).collect(),
             rotate,
+            turned: false.into(),
         }
     }
 
@@ -427,7 +453,11 @@ impl<'a> Turntable<'a> {
     /// camera to render with.
     fn turn(&self, tracer: &mut RayTracer, angle: f64) -> Result<Camera> {
         Ok(match self.rotate {
+            // at 0° before any turn the objects stay where they are: a static tracer (seed
+            // 004's stream, which refuses moving objects) renders fixed configurations
+            Rotation::Objects if angle == 0.0 && !self.turned.get() => self.scene.camera,
             Rotation::Objects => {
+                self.turned.set(true);
                 let r = Mat4::from_translation(self.center)
                     * Mat4::from_rotation_y((angle as f32).to_radians())
                     * Mat4::from_translation(-self.center);

@@ -494,6 +494,7 @@ impl StreamRenderer {
             ("grid_references", json!(g.refs.len())),
             ("grid_build_ms", json!(self.grid_ms)),
             ("proximity_clouds", json!(self.options.proximity_clouds)),
+            ("naive_shadows", json!(self.options.naive_shadows)),
             ("steps_per_call", json!(self.options.steps_per_call)),
         ] {
             stats.facts.insert(k.into(), v);
