@@ -76,6 +76,10 @@ pub struct Walk {
     t_max: Vec3,
     t_delta: Vec3,
     t_end: f32,
+    /// the ray in grid space (origin, direction, 1/direction), for a proximity-cloud jump
+    rog: Vec3,
+    rdg: Vec3,
+    inv: Vec3,
 }
 
 impl Walk {
@@ -105,12 +109,20 @@ impl Walk {
             t_max,
             t_delta,
             t_end,
+            rog,
+            rdg,
+            inv,
         })
     }
 
     /// voxelExit: the parameter at which the ray leaves the current voxel.
     pub fn exit(&self) -> f32 {
         self.t_max.min_element()
+    }
+
+    /// The parameter at which the walk ends (grid exit or ray end).
+    pub fn t_end(&self) -> f32 {
+        self.t_end
     }
 
     /// stepWalk: into the next voxel; false when the walk has ended.
@@ -129,6 +141,74 @@ impl Walk {
         self.voxel[d] += self.step[d];
         self.t_max[d] += self.t_delta[d];
         space.voxel_id(self.voxel).is_some()
+    }
+}
+
+impl Walk {
+    /// planeT: the parameter of the face that voxel column `k` of axis `a` is left through
+    /// (the one beyond it in the direction of travel), as beginWalk computes tMax; +∞ for an
+    /// axis the ray does not move along.
+    fn plane_t(&self, space: &GridSpace, a: usize, k: i32) -> f32 {
+        if self.step[a] == 0 {
+            return f32::INFINITY;
+        }
+        let up = (self.step[a] > 0) as i32;
+        let face = (k + up) as f32 * space.vx_edge() - 1.0;
+        (face - self.rog[a]) * self.inv[a]
+    }
+
+    /// jumpWalk (`glsl/exact_grid/dda.glsl`), seed 004's proximity-cloud jump in the exact
+    /// grid: the current voxel is empty and its distance `dist` ≥ 2, so the cube of voxels
+    /// within Chebyshev radius dist − 1 around it is empty; leave it where the ray does. The
+    /// exit axis' voxel is the first beyond the cube's face, the others the exit point's
+    /// (within the cube) as the plane parameters place it; tMax is recomputed for the landing
+    /// voxel. False when the cube is left beyond the walk's end or the grid. The same
+    /// algorithm as `StreamGrid::jump` in grid space (voxel faces at k·vx_edge − 1).
+    pub fn jump(&mut self, space: &GridSpace, dist: u32) -> bool {
+        let rad = IVec3::splat(dist as i32 - 1);
+        let lo = (self.voxel - rad).max(IVec3::ZERO);
+        let hi = (self.voxel + rad).min(IVec3::splat(space.n as i32 - 1));
+        let far = IVec3::select(self.step.cmpgt(IVec3::ZERO), hi, lo);
+        let t_box = Vec3::new(
+            self.plane_t(space, 0, far.x),
+            self.plane_t(space, 1, far.y),
+            self.plane_t(space, 2, far.z),
+        );
+        let exit = t_box.min_element();
+        if exit > self.t_end {
+            return false;
+        }
+        let a = if t_box.x == exit {
+            0
+        } else if t_box.y == exit {
+            1
+        } else {
+            2
+        };
+        let p = self.rog + exit * self.rdg;
+        let mut v = space.get_voxel(p).clamp(lo, hi);
+        for b in (0..3).filter(|&b| b != a && self.step[b] != 0) {
+            // the exit point's voxel as the plane parameters place it (floor() may round
+            // across a face the point lies on)
+            let s = self.step[b];
+            if self.plane_t(space, b, v[b] - s) > exit {
+                v[b] -= s;
+            } else if self.plane_t(space, b, v[b]) < exit {
+                v[b] += s;
+            }
+            v[b] = v[b].clamp(lo[b], hi[b]);
+        }
+        v[a] = far[a] + self.step[a];
+        if space.voxel_id(v).is_none() {
+            return false;
+        }
+        self.voxel = v;
+        self.t_max = Vec3::new(
+            self.plane_t(space, 0, v.x),
+            self.plane_t(space, 1, v.y),
+            self.plane_t(space, 2, v.z),
+        );
+        true
     }
 }
 

@@ -12,6 +12,7 @@
 use glam::{IVec3, UVec3, Vec3};
 
 use super::grid::tri_box_overlap;
+pub use super::proximity::{cells_between, chebyshev_distances};
 use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
 
 /// Ray state of the traversal (Fig. 2, `tMax`'s w channel): still walking.
@@ -175,54 +176,6 @@ impl StreamGrid {
     pub fn paper_bytes(&self) -> u64 {
         96 * self.triangles.len() as u64 + 16 * self.bx.cell_count() as u64
     }
-}
-
-/// The 26 neighbour offsets (dz, dy, dx) before a cell in x-fastest scan order.
-fn causal_neighbours() -> Vec<IVec3> {
-    let mut v = Vec::new();
-    for dz in -1..=1 {
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let o = IVec3::new(dx, dy, dz);
-                if (dz, dy, dx) < (0, 0, 0) {
-                    v.push(o);
-                }
-            }
-        }
-    }
-    v
-}
-
-/// Proximity clouds (Cohen and Sheffer 1994) in the Chebyshev (L∞) metric: for every cell the
-/// distance, in cells, to the nearest cell with `filled` set — by the two-pass chamfer
-/// transform with unit weights over the 26-neighbourhood (Rosenfeld and Pfaltz), which is
-/// exact for L∞. An empty grid gets the largest side everywhere.
-pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
-    let d = dims.as_ivec3();
-    let far = dims.max_element();
-    let mut dist: Vec<u32> = filled.iter().map(|&f| if f { 0 } else { far }).collect();
-    let idx = |c: IVec3| ((c.z * d.y + c.y) * d.x + c.x) as usize;
-    let inside = |c: IVec3| c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
-    let back = causal_neighbours();
-    let cells: Vec<IVec3> = (0..d.z)
-        .flat_map(|z| (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z))))
-        .collect();
-    let mut relax = |c: IVec3, offsets: &mut dyn Iterator<Item = IVec3>| {
-        let mut best = dist[idx(c)];
-        for o in offsets {
-            if inside(c + o) {
-                best = best.min(dist[idx(c + o)] + 1);
-            }
-        }
-        dist[idx(c)] = best;
-    };
-    for &c in &cells {
-        relax(c, &mut back.iter().copied());
-    }
-    for &c in cells.iter().rev() {
-        relax(c, &mut back.iter().map(|o| -*o));
-    }
-    dist.into_iter().map(|v| v.min(far)).collect()
 }
 
 /// What a walk counted: triangle tests, cells entered, proximity-cloud jumps, and the empty
@@ -412,12 +365,6 @@ impl StreamGrid {
     }
 }
 
-/// The cells a 3D-DDA enters strictly between cells `a` and `b` of its walk: each of its
-/// steps moves one cell along one axis, so it takes |b − a|₁ steps from `a` to `b`.
-pub fn cells_between(a: IVec3, b: IVec3) -> u64 {
-    ((b - a).abs().element_sum() as u64).saturating_sub(1)
-}
-
 /// The grid as a [`CpuAccelerator`] (closest hits and shadow feelers, without proximity
 /// clouds — they change the counts, not the hits).
 impl CpuAccelerator for StreamGrid {
@@ -441,35 +388,5 @@ impl CpuAccelerator for StreamGrid {
         };
         let (h, n) = self.trace(&r, Some(f.offset), false);
         (h.is_some(), n.tests)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The distance field against its definition, on a small grid with a few filled cells.
-    #[test]
-    fn chebyshev_transform_equals_brute_force() {
-        let dims = UVec3::new(7, 5, 6);
-        let n = (dims.x * dims.y * dims.z) as usize;
-        let mut filled = vec![false; n];
-        for i in [3usize, 77, 150, 151, 209] {
-            filled[i] = true;
-        }
-        let d = dims.as_ivec3();
-        let pos = |i: usize| {
-            let i = i as i32;
-            IVec3::new(i % d.x, (i / d.x) % d.y, i / (d.x * d.y))
-        };
-        let got = chebyshev_distances(dims, &filled);
-        for (i, g) in got.iter().enumerate() {
-            let want = (0..n)
-                .filter(|&j| filled[j])
-                .map(|j| (pos(i) - pos(j)).abs().max_element() as u32)
-                .min()
-                .unwrap();
-            assert_eq!(*g, want, "cell {:?}", pos(i));
-        }
     }
 }
