@@ -6,6 +6,8 @@
 
 use glam::{IVec3, Mat4, Vec3};
 
+use super::proximity::cloud_jump;
+
 /// The scene-to-grid mapping of `glsl/common/grid.glsl`: grid = (p − centre) · scale, which
 /// puts the scene's current bounds onto [-1, 1)³ with one scale (so ray parameters are the
 /// same in scene and grid space).
@@ -162,46 +164,21 @@ impl Walk {
     /// within Chebyshev radius dist − 1 around it is empty; leave it where the ray does. The
     /// exit axis' voxel is the first beyond the cube's face, the others the exit point's
     /// (within the cube) as the plane parameters place it; tMax is recomputed for the landing
-    /// voxel. False when the cube is left beyond the walk's end or the grid. The same
-    /// algorithm as `StreamGrid::jump` in grid space (voxel faces at k·vx_edge − 1).
+    /// voxel. False when the cube is left beyond the walk's end or the grid. The landing is
+    /// `proximity::cloud_jump`, shared with `StreamGrid::jump` (here in grid space: voxel
+    /// faces at k·vx_edge − 1).
     pub fn jump(&mut self, space: &GridSpace, dist: u32) -> bool {
-        let rad = IVec3::splat(dist as i32 - 1);
-        let lo = (self.voxel - rad).max(IVec3::ZERO);
-        let hi = (self.voxel + rad).min(IVec3::splat(space.n as i32 - 1));
-        let far = IVec3::select(self.step.cmpgt(IVec3::ZERO), hi, lo);
-        let t_box = Vec3::new(
-            self.plane_t(space, 0, far.x),
-            self.plane_t(space, 1, far.y),
-            self.plane_t(space, 2, far.z),
+        let dims = IVec3::splat(space.n as i32);
+        let landed = cloud_jump(
+            self.voxel,
+            dist,
+            dims,
+            self.step,
+            self.t_end,
+            |a, k| self.plane_t(space, a, k),
+            |t| space.get_voxel(self.rog + t * self.rdg),
         );
-        let exit = t_box.min_element();
-        if exit > self.t_end {
-            return false;
-        }
-        let a = if t_box.x == exit {
-            0
-        } else if t_box.y == exit {
-            1
-        } else {
-            2
-        };
-        let p = self.rog + exit * self.rdg;
-        let mut v = space.get_voxel(p).clamp(lo, hi);
-        for b in (0..3).filter(|&b| b != a && self.step[b] != 0) {
-            // the exit point's voxel as the plane parameters place it (floor() may round
-            // across a face the point lies on)
-            let s = self.step[b];
-            if self.plane_t(space, b, v[b] - s) > exit {
-                v[b] -= s;
-            } else if self.plane_t(space, b, v[b]) < exit {
-                v[b] += s;
-            }
-            v[b] = v[b].clamp(lo[b], hi[b]);
-        }
-        v[a] = far[a] + self.step[a];
-        if space.voxel_id(v).is_none() {
-            return false;
-        }
+        let Some(v) = landed else { return false };
         self.voxel = v;
         self.t_max = Vec3::new(
             self.plane_t(space, 0, v.x),

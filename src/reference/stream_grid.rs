@@ -12,6 +12,7 @@
 use glam::{IVec3, UVec3, Vec3};
 
 use super::grid::tri_box_overlap;
+use super::proximity::cloud_jump;
 pub use super::proximity::{cells_between, chebyshev_distances};
 use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
 
@@ -243,43 +244,25 @@ impl StreamGrid {
     /// jumpCloud: leave the cube of cells within Chebyshev distance `dist − 1` of the current
     /// cell (all empty) where the ray leaves it; false when that is beyond the grid or the
     /// ray's limit. The exit axis' cell is the first beyond the cube's face; the others are
-    /// the exit point's (within the cube's range), placed by the DDA's plane parameters.
+    /// the exit point's (within the cube's range), placed by the DDA's plane parameters
+    /// (`proximity::cloud_jump`, shared with the exact grid's `grid::Walk::jump`).
     fn jump(&self, r: &StreamRay, w: &mut Walk, dist: u32) -> bool {
-        let rad = IVec3::splat(dist as i32 - 1);
-        let lo = (w.cell - rad).max(IVec3::ZERO);
-        let hi = (w.cell + rad).min(self.bx.dims.as_ivec3() - 1);
-        let far = IVec3::select(r.d.cmpgt(Vec3::ZERO), hi, lo);
-        let t_box = self.bx.t_max(r.o, r.d, far);
-        let exit = t_box.min_element();
-        if exit > r.limit {
-            return false;
-        }
-        let a = if t_box.x == exit {
-            0
-        } else if t_box.y == exit {
-            1
-        } else {
-            2
-        };
-        let p = ((r.o + exit * r.d - self.bx.min) / self.bx.cell)
-            .floor()
-            .as_ivec3();
-        let mut cell = p.clamp(lo, hi);
-        for b in (0..3).filter(|&b| b != a && r.d[b] != 0.0) {
-            // the exit point's cell as the DDA's plane parameters place it (floor() may round
-            // across a plane the point lies on)
-            let s = if r.d[b] > 0.0 { 1 } else { -1 };
-            if self.bx.plane_t(r.o, r.d, b, cell[b] - s) > exit {
-                cell[b] -= s;
-            } else if self.bx.plane_t(r.o, r.d, b, cell[b]) < exit {
-                cell[b] += s;
-            }
-            cell[b] = cell[b].clamp(lo[b], hi[b]);
-        }
-        cell[a] = far[a] + if r.d[a] > 0.0 { 1 } else { -1 };
-        if self.bx.index(cell).is_none() {
-            return false;
-        }
+        let sign = |x: f32| (x > 0.0) as i32 - (x < 0.0) as i32;
+        let step = IVec3::new(sign(r.d.x), sign(r.d.y), sign(r.d.z));
+        let landed = cloud_jump(
+            w.cell,
+            dist,
+            self.bx.dims.as_ivec3(),
+            step,
+            r.limit,
+            |a, k| self.bx.plane_t(r.o, r.d, a, k),
+            |t| {
+                ((r.o + t * r.d - self.bx.min) / self.bx.cell)
+                    .floor()
+                    .as_ivec3()
+            },
+        );
+        let Some(cell) = landed else { return false };
         *w = Walk {
             cell,
             t_max: self.bx.t_max(r.o, r.d, cell),
