@@ -661,9 +661,9 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
     for n in 1..=3u32 {
         let p = format!("purcell-table{n}");
         let frames = read_csv(&out.join(format!("{p}.csv")));
-        // 3 scenes × (g, pc, grid) + the Stanford bunny × (g, grid) + the sparse room × 3, and
-        // in Table 2 the 4 scenes' g with naive shadow rays
-        let configs = if n == 2 { 18 } else { 14 };
+        // 3 scenes × (g, pc, grid g, grid pc) + the Stanford bunny × (g, grid g) + the sparse
+        // room × 4, and in Table 2 the 4 scenes' g with naive shadow rays
+        let configs = if n == 2 { 22 } else { 18 };
         assert_eq!(frames.len(), configs, "{p}");
         for r in &frames {
             let scene = r["scene"].as_str();
@@ -673,7 +673,9 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
             assert_eq!((u(r, "width"), u(r, "height")), (16, 16));
             let stream = r["tracer"] == "stream";
             assert!(
-                stream || (r["tracer"] == "grid" && r["variant"] == "exact"),
+                stream
+                    || (r["tracer"] == "grid"
+                        && ["exact", "exact-pc"].contains(&r["variant"].as_str())),
                 "{r:?}"
             );
             if stream {
@@ -746,7 +748,8 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
                     s["scene"] == r["scene"]
                         && s["grid_resolution"] == r["grid"]
                         && (s["variant"] == r["column"]
-                            || (s["variant"] == "exact" && r["column"] == "grid-g"))
+                            || (s["variant"] == "exact" && r["column"] == "grid-g")
+                            || (s["variant"] == "exact-pc" && r["column"] == "grid-pc"))
                 })
                 .collect();
             assert_eq!(s.len(), 1, "{r:?}");

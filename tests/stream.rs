@@ -491,8 +491,14 @@ fn the_command_line_reports_and_refuses() {
     for (args, says) in [
         (&["--tracer", "stream", "--grid", "14x16"][..], "GXxGYxGZ"),
         (
-            &["--tracer", "grid", "--proximity-clouds"],
-            "--tracer stream only",
+            &[
+                "--tracer",
+                "grid",
+                "--grid-variant",
+                "thesis",
+                "--proximity-clouds",
+            ],
+            "--grid-variant exact only",
         ),
         (
             &["--tracer", "base", "--stream-steps", "8"],

@@ -4,7 +4,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
-#define COUNTER_SLOTS_PER_KERNEL 4
+#define COUNTER_SLOTS_PER_KERNEL 6
 #include "scene.glsl"
 #include "images.glsl"
 #include "intersect.glsl"
@@ -14,6 +14,8 @@ uint tests = 0u;         // ray–triangle tests of this invocation
 uint truncated = 0u;     // 1 if a loop of this invocation ended early (see loopLimit)
 uint voxelsVisited = 0u; // voxels whose triangle lists this invocation walked
 uint nodesVisited = 0u;  // BVH nodes this invocation visited
+uint cloudJumps = 0u;    // proximity-cloud jumps (exact grid, exact_grid/dda.glsl)
+uint cellsSkipped = 0u;  // voxels those jumps passed over
 
 // The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl.
 void trace(ivec2 storePos);
@@ -29,8 +31,14 @@ void traceAndCount(int testsSlot)
     countAdd(1, truncated);
     countAdd(2, voxelsVisited);
     countAdd(3, nodesVisited);
+    countAdd(4, cloudJumps);
+    countAdd(5, cellsSkipped);
     countersEnd(0, testsSlot);
     countersEnd(1, COUNTER_TRUNCATED_RAYS);
     countersEnd(2, COUNTER_VOXELS_VISITED);
     countersEnd(3, COUNTER_NODES_VISITED);
+#ifdef COUNTER_CLOUD_JUMPS
+    countersEnd(4, COUNTER_CLOUD_JUMPS);
+    countersEnd(5, COUNTER_EMPTY_CELLS_SKIPPED);
+#endif
 }

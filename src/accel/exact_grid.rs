@@ -2,7 +2,9 @@
 //! frame: triangle/box overlap registration, compact lists built by a count pass, a prefix sum
 //! and a fill pass, and a 3D-DDA inside the intersection kernels that ends only at a hit inside
 //! the current voxel (`glsl/exact_grid/`). Its image equals the base tracer's. CPU twin:
-//! `reference::exact_grid`.
+//! `reference::exact_grid`. With `--proximity-clouds` a fifth pass (`proximity.comp`) writes
+//! every voxel's Chebyshev distance to the nearest non-empty voxel after the lists, and the
+//! DDA jumps out of empty voxels by it (seed 004's proximity clouds, `dda.glsl`).
 
 use std::any::Any;
 use std::sync::Arc;
@@ -30,18 +32,24 @@ pub const ENTRY: Entry = Entry {
     gpu: ExactGrid::create,
     cpu: |scene, options| -> Result<Box<dyn CpuAccelerator>> {
         let n = resolution(scene, options, MAX_RESOLUTION)?;
-        Ok(Box::new(reference::exact_grid::ExactGrid::new(
+        let g = reference::exact_grid::ExactGrid::new(
             scene.world_triangles(),
             n,
             GridMapping::of_scene(scene),
-        )))
+        );
+        Ok(Box::new(if options.proximity_clouds {
+            g.with_proximity()
+        } else {
+            g
+        }))
     },
 };
 
 /// The compact lists: voxelCount (references per voxel), voxelStart (their prefix sum),
 /// voxelFill (the fill pass's cursor), blockSums and gridTotal (the prefix sum's),
 /// voxelTrisFilled (the references as filled) and voxelTris (ordered by id; both grown to the
-/// count of every build).
+/// count of every build), voxelDist and voxelDistTmp (the proximity clouds and the middle pass'
+/// output; 4 bytes when the clouds are off).
 struct Lists {
     voxel_count: Ssbo,
     voxel_start: Ssbo,
@@ -50,10 +58,12 @@ struct Lists {
     grid_total: Ssbo,
     voxel_tris_filled: Ssbo,
     voxel_tris: Ssbo,
+    voxel_dist: Ssbo,
+    voxel_dist_tmp: Ssbo,
 }
 
 impl Lists {
-    fn all(&self) -> [(&Ssbo, u32); 7] {
+    fn all(&self) -> [(&Ssbo, u32); 9] {
         [
             (&self.voxel_count, ssbo::VOXEL_COUNT),
             (&self.voxel_start, ssbo::VOXEL_START),
@@ -62,6 +72,9 @@ impl Lists {
             (&self.grid_total, ssbo::GRID_TOTAL),
             (&self.voxel_tris_filled, ssbo::VOXEL_TRIS_FILLED),
             (&self.voxel_tris, ssbo::VOXEL_TRIS),
+            (&self.voxel_dist, ssbo::VOXEL_DIST),
+            // bound by the proximity passes only
+            (&self.voxel_dist_tmp, ssbo::DIST_OUT),
         ]
     }
 
@@ -82,6 +95,8 @@ pub struct ExactGrid {
     order: Kernel,
     intersect1: Kernel,
     intersect2: Kernel,
+    /// `--proximity-clouds`: the distance pass
+    proximity: Option<Kernel>,
     lists: Lists,
     max_ssbo: i64,
     /// triangle references of the last build
@@ -95,6 +110,7 @@ impl ExactGrid {
         let defs = [frame.define()];
         let max_ssbo = b.info.max_ssbo_block_size;
         let ssbo = |name, bytes| Ssbo::new(b.gl, name, bytes, None, max_ssbo);
+        let dist_bytes = if o.proximity_clouds { 4 * n3 } else { 4 };
         let lists = Lists {
             voxel_count: ssbo("voxelCount", 4 * n3)?,
             voxel_start: ssbo("voxelStart", 4 * n3)?,
@@ -104,7 +120,13 @@ impl ExactGrid {
             // grown to the number of references on the first build
             voxel_tris_filled: ssbo("voxelTrisFilled", 4 * scene.triangle_count())?,
             voxel_tris: ssbo("voxelTris", 4 * scene.triangle_count())?,
+            voxel_dist: ssbo("voxelDist", dist_bytes)?,
+            voxel_dist_tmp: ssbo("voxelDistTmp", dist_bytes)?,
         };
+        let proximity = o
+            .proximity_clouds
+            .then(|| b.kernel("exact_grid/proximity.comp", &defs, "grid_proximity"))
+            .transpose()?;
         Ok(Box::new(ExactGrid {
             gl: b.gl.clone(),
             triangles: scene.triangle_count(),
@@ -114,6 +136,7 @@ impl ExactGrid {
             order: b.kernel("exact_grid/order.comp", &[], "grid_order")?,
             intersect1: b.kernel("exact_grid/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("exact_grid/intersect2.comp", &defs, "intersect2")?,
+            proximity,
             lists,
             max_ssbo,
             refs: 0,
@@ -142,6 +165,38 @@ impl ExactGrid {
         k.set_i32("referenceCount", total as i32);
         k.set_i32("voxelTotal", self.frame.voxels() as i32);
         k.dispatch_1d(f.timers, total.div_ceil(128).max(1));
+    }
+
+    /// The proximity clouds (`glsl/exact_grid/proximity.comp`): the x pass from the counts into
+    /// voxelDist, y into voxelDistTmp, z back into voxelDist.
+    fn proximity(&self, f: &mut FrameContext) {
+        let Some(k) = &self.proximity else { return };
+        let (gl, l) = (f.gl, &self.lists);
+        let groups = (self.frame.voxels() as u32).div_ceil(128);
+        k.use_program();
+        self.frame.set_uniforms(k);
+        let passes = [
+            (&l.voxel_dist_tmp, &l.voxel_dist),
+            (&l.voxel_dist, &l.voxel_dist_tmp),
+            (&l.voxel_dist_tmp, &l.voxel_dist),
+        ];
+        for (axis, (input, output)) in passes.into_iter().enumerate() {
+            input.bind(gl, ssbo::DIST_IN);
+            output.bind(gl, ssbo::DIST_OUT);
+            k.set_i32("axis", axis as i32);
+            k.set_i32("fromCounts", (axis == 0) as i32);
+            k.dispatch_1d(f.timers, groups);
+        }
+    }
+
+    /// The proximity-cloud distances of the last build (`--proximity-clouds`), for tests.
+    pub fn read_distances(&self, gl: &Gl) -> Option<Vec<u32>> {
+        let n3 = self.frame.voxels();
+        let d = self
+            .proximity
+            .as_ref()
+            .map(|_| self.lists.voxel_dist.read_u32(gl));
+        d.map(|d| d[..n3].to_vec())
     }
 
     /// Make room for `total` references (half again as many, so a moving scene rarely
@@ -201,6 +256,7 @@ impl Accelerator for ExactGrid {
         self.frame.set_uniforms(&self.fill);
         self.fill.dispatch_1d(f.timers, tri_groups);
         self.order(f, total as u32);
+        self.proximity(f);
         Ok(())
     }
 
@@ -208,6 +264,8 @@ impl Accelerator for ExactGrid {
         self.lists.bind(f.gl);
         self.intersect1.use_program();
         self.frame.set_uniforms(&self.intersect1);
+        let clouds = self.proximity.is_some() as i32;
+        self.intersect1.set_i32("proximityClouds", clouds);
         &self.intersect1
     }
 
@@ -215,6 +273,8 @@ impl Accelerator for ExactGrid {
         self.lists.bind(f.gl);
         self.intersect2.use_program();
         self.frame.set_uniforms(&self.intersect2);
+        let clouds = self.proximity.is_some() as i32;
+        self.intersect2.set_i32("proximityClouds", clouds);
         &self.intersect2
     }
 
@@ -225,6 +285,7 @@ impl Accelerator for ExactGrid {
             "grid_scan",
             "grid_fill",
             "grid_order",
+            "grid_proximity",
         ]
         .iter()
         .filter_map(|k| stats.gpu_ms.get(*k))
@@ -236,6 +297,12 @@ impl Accelerator for ExactGrid {
         f.insert("grid_build_ms".into(), json!(build));
         f.insert("grid_variant".into(), json!("exact"));
         f.insert("grid_triangle_refs".into(), json!(self.refs));
+        f.insert("proximity_clouds".into(), json!(self.proximity.is_some()));
+        if self.proximity.is_some() {
+            // the distance pass alone (also in grid_build_ms)
+            let ms = stats.gpu_ms.get("grid_proximity").copied().unwrap_or(0.0);
+            f.insert("proximity_ms".into(), json!(ms));
+        }
         // the exact grid loses nothing
         stats.events.insert("dropped_triangle_refs".into(), 0);
         stats.events.insert("ray_list_overflows".into(), 0);

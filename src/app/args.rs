@@ -64,8 +64,9 @@ pub struct GridArgs {
     /// also takes GXxGYxGZ cells, e.g. 14x16x14.
     #[arg(long, default_value = "auto", value_name = "N|GXxGYxGZ|auto")]
     pub grid: GridResolution,
-    /// --tracer stream: skip empty cells by their proximity-cloud distance (Chebyshev
-    /// distance, in cells, to the nearest non-empty cell).
+    /// --tracer stream and --tracer grid --grid-variant exact: skip empty cells by their
+    /// proximity-cloud distance (Chebyshev distance, in cells, to the nearest non-empty cell;
+    /// the exact grid computes it on the GPU after every per-frame build).
     #[arg(long)]
     pub proximity_clouds: bool,
     /// --tracer stream: steps (one triangle test or one move to the next cell) per call of

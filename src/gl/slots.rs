@@ -47,6 +47,11 @@ slot_table! {
         VOXEL_TRIS = 15,
         /// the lists as the fill pass leaves them, before the order pass
         VOXEL_TRIS_FILLED = 16,
+        /// proximity-cloud distances per voxel (--proximity-clouds), and the two buffers one
+        /// pass of glsl/exact_grid/proximity.comp reads and writes
+        VOXEL_DIST = 17,
+        DIST_IN = 18,
+        DIST_OUT = 19,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,

@@ -18,7 +18,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use glam::Mat4;
 
-use crate::accel::{BvhVariant, TracerKind};
+use crate::accel::{BvhVariant, GridVariant, TracerKind};
 use crate::frame::{Frame, FrameStats};
 use crate::gl::{Gl, GlInfo, ShaderSource};
 use crate::scene::{Camera, Scene};
@@ -89,10 +89,16 @@ pub fn ray_tracer(
     if options.grid.stream_naive_shadows {
         anyhow::bail!("--stream-naive-shadows applies to --tracer stream only");
     }
-    if options.grid.axes.is_some() || options.grid.proximity_clouds {
+    if options.grid.axes.is_some() {
         anyhow::bail!(
-            "--grid GXxGYxGZ and --proximity-clouds apply to --tracer stream only (the compute \
-             grids are cubic and do not skip empty cells yet)"
+            "--grid GXxGYxGZ applies to --tracer stream only (the compute grids are cubic)"
+        );
+    }
+    let exact = options.tracer == TracerKind::Grid && options.grid.variant == GridVariant::Exact;
+    if options.grid.proximity_clouds && !exact {
+        anyhow::bail!(
+            "--proximity-clouds applies to --tracer stream and to --tracer grid with \
+             --grid-variant exact only (the thesis grid's per-ray voxel lists cannot skip cells)"
         );
     }
     let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;

@@ -1,12 +1,36 @@
 //! CPU twin of the exact grid (`accel::exact_grid`, `glsl/exact_grid/`): triangles registered
 //! in every voxel their triangle/box overlap test accepts, rays walked with a 3D-DDA that ends
 //! only at a hit inside the current voxel (`glsl/exact_grid/intersect1.comp`), shadow feelers
-//! walked to the first occluder (`intersect2.comp`).
+//! walked to the first occluder (`intersect2.comp`); with proximity clouds
+//! (`--proximity-clouds`, `glsl/exact_grid/proximity.comp`) an empty voxel at distance ≥ 2 is
+//! left by a jump (`Walk::jump`), as the kernels' stepWalk does.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 use glam::Vec3;
 
 use super::grid::{GridMapping, GridSpace, Walk};
+use super::proximity::{cells_between, chebyshev_distances};
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
+
+/// The walks' counts, summed over every ray traced (shared with whoever reads them, as the
+/// GPU's counters are): voxels entered (`voxels_visited`), proximity-cloud jumps
+/// (`cloud_jumps`) and the voxels they passed over (`empty_cells_skipped`).
+#[derive(Debug, Default)]
+pub struct WalkTally {
+    pub visited: AtomicU64,
+    pub jumps: AtomicU64,
+    pub skipped: AtomicU64,
+}
+
+impl WalkTally {
+    /// (visited, jumps, skipped) so far.
+    pub fn get(&self) -> (u64, u64, u64) {
+        let l = |a: &AtomicU64| a.load(Ordering::Relaxed);
+        (l(&self.visited), l(&self.jumps), l(&self.skipped))
+    }
+}
 
 pub struct ExactGrid {
     triangles: Vec<[Vec3; 3]>,
@@ -14,6 +38,9 @@ pub struct ExactGrid {
     pub mapping: GridMapping,
     /// The triangle ids of every voxel, ascending.
     pub lists: Vec<Vec<u32>>,
+    /// Proximity-cloud distances per voxel, when the walks jump (`with_proximity`).
+    pub proximity: Option<Vec<u32>>,
+    pub tally: Arc<WalkTally>,
 }
 
 impl ExactGrid {
@@ -31,7 +58,42 @@ impl ExactGrid {
             space,
             mapping,
             lists,
+            proximity: None,
+            tally: Arc::default(),
         }
+    }
+
+    /// The distances of the voxels to the nearest non-empty one (`proximity.comp`'s result).
+    pub fn distances(&self) -> Vec<u32> {
+        let filled: Vec<bool> = self.lists.iter().map(|l| !l.is_empty()).collect();
+        let n = self.space.n;
+        chebyshev_distances(glam::UVec3::splat(n), &filled)
+    }
+
+    /// Walk with proximity-cloud jumps.
+    pub fn with_proximity(mut self) -> ExactGrid {
+        self.proximity = Some(self.distances());
+        self
+    }
+
+    /// stepWalk with its jump: out of an empty voxel at distance ≥ 2 by a jump, else one
+    /// step; false when the walk has ended.
+    fn advance(&self, w: &mut Walk, id: usize) -> bool {
+        let dist = self.proximity.as_ref().map_or(0, |p| p[id]);
+        if w.exit() > w.t_end() {
+            return false;
+        }
+        if self.lists[id].is_empty() && dist >= 2 {
+            self.tally.jumps.fetch_add(1, Ordering::Relaxed);
+            let from = w.voxel;
+            let landed = w.jump(&self.space, dist);
+            if landed {
+                let skipped = cells_between(from, w.voxel);
+                self.tally.skipped.fetch_add(skipped, Ordering::Relaxed);
+            }
+            return landed;
+        }
+        w.step(&self.space)
     }
 
     /// Call `visit` with the triangle list of every voxel the ray passes up to `t_end`, in
@@ -43,7 +105,8 @@ impl ExactGrid {
         };
         loop {
             let id = self.space.voxel_id(w.voxel).expect("the walk stays inside");
-            if visit(&self.lists[id], w.exit()) || !w.step(&self.space) {
+            self.tally.visited.fetch_add(1, Ordering::Relaxed);
+            if visit(&self.lists[id], w.exit()) || !self.advance(&mut w, id) {
                 return;
             }
         }

@@ -6,6 +6,8 @@
 
 use glam::{IVec3, Mat4, Vec3};
 
+use super::proximity::cloud_jump;
+
 /// The scene-to-grid mapping of `glsl/common/grid.glsl`: grid = (p − centre) · scale, which
 /// puts the scene's current bounds onto [-1, 1)³ with one scale (so ray parameters are the
 /// same in scene and grid space).
@@ -76,6 +78,10 @@ pub struct Walk {
     t_max: Vec3,
     t_delta: Vec3,
     t_end: f32,
+    /// the ray in grid space (origin, direction, 1/direction), for a proximity-cloud jump
+    rog: Vec3,
+    rdg: Vec3,
+    inv: Vec3,
 }
 
 impl Walk {
@@ -105,12 +111,20 @@ impl Walk {
             t_max,
             t_delta,
             t_end,
+            rog,
+            rdg,
+            inv,
         })
     }
 
     /// voxelExit: the parameter at which the ray leaves the current voxel.
     pub fn exit(&self) -> f32 {
         self.t_max.min_element()
+    }
+
+    /// The parameter at which the walk ends (grid exit or ray end).
+    pub fn t_end(&self) -> f32 {
+        self.t_end
     }
 
     /// stepWalk: into the next voxel; false when the walk has ended.
@@ -129,6 +143,49 @@ impl Walk {
         self.voxel[d] += self.step[d];
         self.t_max[d] += self.t_delta[d];
         space.voxel_id(self.voxel).is_some()
+    }
+}
+
+impl Walk {
+    /// planeT: the parameter of the face that voxel column `k` of axis `a` is left through
+    /// (the one beyond it in the direction of travel), as beginWalk computes tMax; +∞ for an
+    /// axis the ray does not move along.
+    fn plane_t(&self, space: &GridSpace, a: usize, k: i32) -> f32 {
+        if self.step[a] == 0 {
+            return f32::INFINITY;
+        }
+        let up = (self.step[a] > 0) as i32;
+        let face = (k + up) as f32 * space.vx_edge() - 1.0;
+        (face - self.rog[a]) * self.inv[a]
+    }
+
+    /// jumpWalk (`glsl/exact_grid/dda.glsl`), seed 004's proximity-cloud jump in the exact
+    /// grid: the current voxel is empty and its distance `dist` ≥ 2, so the cube of voxels
+    /// within Chebyshev radius dist − 1 around it is empty; leave it where the ray does. The
+    /// exit axis' voxel is the first beyond the cube's face, the others the exit point's
+    /// (within the cube) as the plane parameters place it; tMax is recomputed for the landing
+    /// voxel. False when the cube is left beyond the walk's end or the grid. The landing is
+    /// `proximity::cloud_jump`, shared with `StreamGrid::jump` (here in grid space: voxel
+    /// faces at k·vx_edge − 1).
+    pub fn jump(&mut self, space: &GridSpace, dist: u32) -> bool {
+        let dims = IVec3::splat(space.n as i32);
+        let landed = cloud_jump(
+            self.voxel,
+            dist,
+            dims,
+            self.step,
+            self.t_end,
+            |a, k| self.plane_t(space, a, k),
+            |t| space.get_voxel(self.rog + t * self.rdg),
+        );
+        let Some(v) = landed else { return false };
+        self.voxel = v;
+        self.t_max = Vec3::new(
+            self.plane_t(space, 0, v.x),
+            self.plane_t(space, 1, v.y),
+            self.plane_t(space, 2, v.z),
+        );
+        true
     }
 }
 

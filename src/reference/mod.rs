@@ -10,6 +10,7 @@ pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
 pub mod ntree;
+pub mod proximity;
 pub mod stream_grid;
 pub mod stream_shading;
 pub mod thesis_grid;

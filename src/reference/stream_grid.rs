@@ -12,6 +12,8 @@
 use glam::{IVec3, UVec3, Vec3};
 
 use super::grid::tri_box_overlap;
+use super::proximity::cloud_jump;
+pub use super::proximity::{cells_between, chebyshev_distances};
 use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
 
 /// Ray state of the traversal (Fig. 2, `tMax`'s w channel): still walking.
@@ -177,54 +179,6 @@ impl StreamGrid {
     }
 }
 
-/// The 26 neighbour offsets (dz, dy, dx) before a cell in x-fastest scan order.
-fn causal_neighbours() -> Vec<IVec3> {
-    let mut v = Vec::new();
-    for dz in -1..=1 {
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let o = IVec3::new(dx, dy, dz);
-                if (dz, dy, dx) < (0, 0, 0) {
-                    v.push(o);
-                }
-            }
-        }
-    }
-    v
-}
-
-/// Proximity clouds (Cohen and Sheffer 1994) in the Chebyshev (L∞) metric: for every cell the
-/// distance, in cells, to the nearest cell with `filled` set — by the two-pass chamfer
-/// transform with unit weights over the 26-neighbourhood (Rosenfeld and Pfaltz), which is
-/// exact for L∞. An empty grid gets the largest side everywhere.
-pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
-    let d = dims.as_ivec3();
-    let far = dims.max_element();
-    let mut dist: Vec<u32> = filled.iter().map(|&f| if f { 0 } else { far }).collect();
-    let idx = |c: IVec3| ((c.z * d.y + c.y) * d.x + c.x) as usize;
-    let inside = |c: IVec3| c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
-    let back = causal_neighbours();
-    let cells: Vec<IVec3> = (0..d.z)
-        .flat_map(|z| (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z))))
-        .collect();
-    let mut relax = |c: IVec3, offsets: &mut dyn Iterator<Item = IVec3>| {
-        let mut best = dist[idx(c)];
-        for o in offsets {
-            if inside(c + o) {
-                best = best.min(dist[idx(c + o)] + 1);
-            }
-        }
-        dist[idx(c)] = best;
-    };
-    for &c in &cells {
-        relax(c, &mut back.iter().copied());
-    }
-    for &c in cells.iter().rev() {
-        relax(c, &mut back.iter().map(|o| -*o));
-    }
-    dist.into_iter().map(|v| v.min(far)).collect()
-}
-
 /// What a walk counted: triangle tests, cells entered, proximity-cloud jumps, and the empty
 /// cells the jumps skipped (those the 3D-DDA would have entered between the cell a jump leaves
 /// and the one it lands in).
@@ -302,43 +256,25 @@ impl StreamGrid {
     /// jumpCloud: leave the cube of cells within Chebyshev distance `dist − 1` of the current
     /// cell (all empty) where the ray leaves it; false when that is beyond the grid or the
     /// ray's limit. The exit axis' cell is the first beyond the cube's face; the others are
-    /// the exit point's (within the cube's range), placed by the DDA's plane parameters.
+    /// the exit point's (within the cube's range), placed by the DDA's plane parameters
+    /// (`proximity::cloud_jump`, shared with the exact grid's `grid::Walk::jump`).
     fn jump(&self, r: &StreamRay, w: &mut Walk, dist: u32) -> bool {
-        let rad = IVec3::splat(dist as i32 - 1);
-        let lo = (w.cell - rad).max(IVec3::ZERO);
-        let hi = (w.cell + rad).min(self.bx.dims.as_ivec3() - 1);
-        let far = IVec3::select(r.d.cmpgt(Vec3::ZERO), hi, lo);
-        let t_box = self.bx.t_max(r.o, r.d, far);
-        let exit = t_box.min_element();
-        if exit > r.limit {
-            return false;
-        }
-        let a = if t_box.x == exit {
-            0
-        } else if t_box.y == exit {
-            1
-        } else {
-            2
-        };
-        let p = ((r.o + exit * r.d - self.bx.min) / self.bx.cell)
-            .floor()
-            .as_ivec3();
-        let mut cell = p.clamp(lo, hi);
-        for b in (0..3).filter(|&b| b != a && r.d[b] != 0.0) {
-            // the exit point's cell as the DDA's plane parameters place it (floor() may round
-            // across a plane the point lies on)
-            let s = if r.d[b] > 0.0 { 1 } else { -1 };
-            if self.bx.plane_t(r.o, r.d, b, cell[b] - s) > exit {
-                cell[b] -= s;
-            } else if self.bx.plane_t(r.o, r.d, b, cell[b]) < exit {
-                cell[b] += s;
-            }
-            cell[b] = cell[b].clamp(lo[b], hi[b]);
-        }
-        cell[a] = far[a] + if r.d[a] > 0.0 { 1 } else { -1 };
-        if self.bx.index(cell).is_none() {
-            return false;
-        }
+        let sign = |x: f32| (x > 0.0) as i32 - (x < 0.0) as i32;
+        let step = IVec3::new(sign(r.d.x), sign(r.d.y), sign(r.d.z));
+        let landed = cloud_jump(
+            w.cell,
+            dist,
+            self.bx.dims.as_ivec3(),
+            step,
+            r.limit,
+            |a, k| self.bx.plane_t(r.o, r.d, a, k),
+            |t| {
+                ((r.o + t * r.d - self.bx.min) / self.bx.cell)
+                    .floor()
+                    .as_ivec3()
+            },
+        );
+        let Some(cell) = landed else { return false };
         *w = Walk {
             cell,
             t_max: self.bx.t_max(r.o, r.d, cell),
@@ -454,12 +390,6 @@ impl StreamGrid {
     }
 }
 
-/// The cells a 3D-DDA enters strictly between cells `a` and `b` of its walk: each of its
-/// steps moves one cell along one axis, so it takes |b − a|₁ steps from `a` to `b`.
-pub fn cells_between(a: IVec3, b: IVec3) -> u64 {
-    ((b - a).abs().element_sum() as u64).saturating_sub(1)
-}
-
 /// The grid as a [`CpuAccelerator`] (closest hits and shadow feelers, without proximity
 /// clouds — they change the counts, not the hits).
 impl CpuAccelerator for StreamGrid {
@@ -483,35 +413,5 @@ impl CpuAccelerator for StreamGrid {
         };
         let (h, n) = self.trace(&r, Rule::AnyHit(f.offset), false);
         (h.is_some(), n.tests)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The distance field against its definition, on a small grid with a few filled cells.
-    #[test]
-    fn chebyshev_transform_equals_brute_force() {
-        let dims = UVec3::new(7, 5, 6);
-        let n = (dims.x * dims.y * dims.z) as usize;
-        let mut filled = vec![false; n];
-        for i in [3usize, 77, 150, 151, 209] {
-            filled[i] = true;
-        }
-        let d = dims.as_ivec3();
-        let pos = |i: usize| {
-            let i = i as i32;
-            IVec3::new(i % d.x, (i / d.x) % d.y, i / (d.x * d.y))
-        };
-        let got = chebyshev_distances(dims, &filled);
-        for (i, g) in got.iter().enumerate() {
-            let want = (0..n)
-                .filter(|&j| filled[j])
-                .map(|j| (pos(i) - pos(j)).abs().max_element() as u32)
-                .min()
-                .unwrap();
-            assert_eq!(*g, want, "cell {:?}", pos(i));
-        }
     }
 }

@@ -19,11 +19,6 @@ use super::published_purcell::{self as pp, PaperScene};
 use super::purcell_report as report;
 use super::runner::Bench;
 
-/// Whether the compute grid is also measured with proximity clouds (`--tracer grid
-/// --proximity-clouds`, issue 12 §3: being added on another branch). Until the pipeline takes
-/// it the configuration would fail, so it is off; turning it on adds the column.
-pub const COMPUTE_GRID_PC: bool = false;
-
 /// The sparse scene (not in the paper): a small detailed object in a large empty room.
 pub const SPARSE: PaperScene = PaperScene {
     file: "sparse_room.toml",
@@ -106,7 +101,8 @@ impl Plan {
     }
 
     /// The tracers of `scene`: stream g, stream pc (where the paper has pc), the compute exact
-    /// grid g (cubic, the paper's largest axis), and its pc column when [`COMPUTE_GRID_PC`].
+    /// grid g (cubic, the paper's largest axis), and its pc column (`--tracer grid
+    /// --proximity-clouds`) where the paper has pc.
     pub fn tracers(scene: &PaperScene) -> Vec<TracerSpec> {
         let stream = |pc| TracerSpec::Stream {
             axes: scene.grid,
@@ -122,7 +118,7 @@ impl Plan {
             variant: GridVariant::Exact,
             resolution,
         });
-        if COMPUTE_GRID_PC && scene.pc {
+        if scene.pc {
             v.push(TracerSpec::GridPc { resolution });
         }
         v
@@ -191,11 +187,21 @@ mod tests {
         };
         assert_eq!(
             stream(&pp::KNIGHT),
-            ["stream g 14x16x14", "stream pc 14x16x14", "grid exact 16³"]
+            [
+                "stream g 14x16x14",
+                "stream pc 14x16x14",
+                "grid exact 16³",
+                "grid exact-pc 16"
+            ]
         );
         assert_eq!(
             stream(&pp::TORUS_KNOT),
-            ["stream g 16", "stream pc 16", "grid exact 16³"]
+            [
+                "stream g 16",
+                "stream pc 16",
+                "grid exact 16³",
+                "grid exact-pc 16"
+            ]
         );
         assert_eq!(
             stream(&pp::STANFORD_BUNNY),
@@ -208,8 +214,8 @@ mod tests {
             bunny_512: false,
         };
         let configs = plan.configs();
-        // 3 scenes × 3 tracers + the Stanford bunny × 2 + the sparse room × 3, at 3 sides
-        assert_eq!(configs.len(), (9 + 2 + 3) * 3);
+        // 3 scenes × 4 tracers + the Stanford bunny × 2 + the sparse room × 4, at 3 sides
+        assert_eq!(configs.len(), (12 + 2 + 4) * 3);
         assert!(configs.iter().all(|c| c.refl_depth == 2 && c.shadows));
         let t1 = Plan {
             table: 1,

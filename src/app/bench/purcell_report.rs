@@ -425,10 +425,12 @@ fn sparse_line(plan: &Plan, outcomes: &[Outcome]) -> String {
         .iter()
         .map(|&side| {
             let at = |c| ours(outcomes, SPARSE.file, side, c);
-            let (g, pc, gg) = (at(Column::StreamG), at(Column::StreamPc), at(Column::GridG));
+            let (g, pc) = (at(Column::StreamG), at(Column::StreamPc));
+            let (gg, gpc) = (at(Column::GridG), at(Column::GridPc));
             format!(
-                "{side}²: stream pc/g {}, stream g / grid g {}",
+                "{side}²: stream pc/g {}, grid pc/g {}, stream g / grid g {}",
                 ratio(div(pc, g)),
+                ratio(div(gpc, gg)),
                 ratio(div(g, gg))
             )
         })

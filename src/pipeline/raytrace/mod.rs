@@ -85,6 +85,9 @@ pub const COUNTERS: &[&str] = &[
     "dropped_triangle_refs",
     "ray_list_overflows",
     "nodes_visited",
+    // the exact grid's proximity clouds (reported with --proximity-clouds only)
+    "cloud_jumps",
+    "empty_cells_skipped",
 ];
 
 /// The counters that count ray–triangle tests (the rest count events).
@@ -319,6 +322,11 @@ impl RayTracer {
                 stats.truncated_rays = v;
             } else {
                 stats.events.insert(name.to_string(), v);
+            }
+        }
+        if !self.options.grid.proximity_clouds {
+            for k in ["cloud_jumps", "empty_cells_skipped"] {
+                stats.events.remove(k);
             }
         }
         self.accel.stats(&mut stats);
