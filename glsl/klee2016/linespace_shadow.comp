@@ -11,6 +11,11 @@
 //                              thesis' approximation, Table 2 "Linespace-Abfrage").
 //   SHADOW_MODE 2 (linespace-dda): every ray alone with a hierarchical 3D-DDA [AW87] and the
 //                              same line-space termination (Table 3).
+//   SHADOW_MODE 3 (variant1):  Table 2's "Variante 1" as defined: mode 0 without our
+//                              near-origin rule (NEAR_ORIGIN_RULE 0).
+//   SHADOW_MODE 4 (variant2):  Table 2's "Variante 2" as defined: mode 1 without it — the
+//                              deepest level is never visited, no triangle is tested.
+// NEAR_ORIGIN_RULE and BIT_IS_HIT come from the host (ShadowMode::near_origin_rule, bit_is_hit).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
 // it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it.
@@ -455,11 +460,12 @@ int traverse()
                     // opposite — a hit means the children are traversed, an empty shaft is
                     // skipped (Empty-Space-Skipping). We follow the prose: descend only when
                     // isIntersection is true
-                    bool inside = nearOrigin(childStart);
+                    // ours: a node near the origin is descended; the variants ask it too
+                    bool inside = NEAR_ORIGIN_RULE == 1 && nearOrigin(childStart);
                     bool descend;
                     if (inside) {
                         descend = true;
-                    } else if (SHADOW_MODE == 1 && depth == LAST_LS_DEPTH) {
+                    } else if (BIT_IS_HIT == 1 && depth == LAST_LS_DEPTH) {
                         isIntersection(node, childStart, depth + 1, true);
                         descend = false;
                     } else {

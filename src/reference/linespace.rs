@@ -35,6 +35,9 @@ pub struct ShadowCounts {
     pub nodes_visited: u64,
     /// Pixels whose light corners do not all lie on one side of an axis (no packet): lit.
     pub packet_failures: u64,
+    /// Line-space lookups per stack depth (0: the root's children, as the thesis counts
+    /// "Tiefe null"): the cascade shows as lookups at more than one depth.
+    pub lookups_by_depth: [u64; 3],
 }
 
 impl std::ops::AddAssign for ShadowCounts {
@@ -43,6 +46,9 @@ impl std::ops::AddAssign for ShadowCounts {
         self.linespace_lookups += o.linespace_lookups;
         self.nodes_visited += o.nodes_visited;
         self.packet_failures += o.packet_failures;
+        for (a, b) in self.lookups_by_depth.iter_mut().zip(o.lookups_by_depth) {
+            *a += b;
+        }
     }
 }
 
@@ -493,6 +499,7 @@ impl<'a> LinespaceShadows<'a> {
                 continue;
             };
             counts.linespace_lookups += 1;
+            counts.lookups_by_depth[level - 1] += 1;
             if get_entry(self.tree.n, self.packed, node[1], hit) {
                 found = true;
                 if deactivate {
@@ -595,10 +602,11 @@ impl<'a> LinespaceShadows<'a> {
                     if node[0] & CHILDREN_BIT == 0 {
                         self.leaf_tests(s, node, child_start, level_of_node, counts);
                     } else {
-                        let inside = near_origin(child_start, nf);
+                        // ours: a node near the origin is descended; the variants ask it too
+                        let inside = mode.near_origin_rule() && near_origin(child_start, nf);
                         let descend = if inside {
                             true
-                        } else if mode == ShadowMode::Linespace && d as i32 == last_ls_depth {
+                        } else if mode.bit_is_hit() && d as i32 == last_ls_depth {
                             self.is_intersection(s, node, child_start, level_of_node, true, counts);
                             false
                         } else {
@@ -704,6 +712,7 @@ impl<'a> LinespaceShadows<'a> {
                 true
             } else if let Some(hit) = node_intersection(self.tree.n, child_start, dir, te) {
                 counts.linespace_lookups += 1;
+                counts.lookups_by_depth[d] += 1;
                 if get_entry(self.tree.n, self.packed, node[1], hit) {
                     if d as i32 == last_ls_depth {
                         return true;
