@@ -12,6 +12,8 @@
 //! * [`ShadowMode::Exact`]: the packet traversal of `Linespace` with the line spaces used only
 //!   to skip empty shafts, down to the leaves, where the rays are tested against the leaves'
 //!   triangles (Table 2's "Schnitttests mit Dreiecken"); the reference.
+//! * [`ShadowMode::Variant1`], [`ShadowMode::Variant2`]: Table 2's "Variante 1" and "Variante
+//!   2" as the thesis defines them: `Exact` and `Linespace` without the near-origin rule below.
 //!
 //! Where the thesis is silent we do this (and the kernel the same): the node that contains the
 //! rays' common origin has no entry side, so no line-space entry; it is always descended, and
