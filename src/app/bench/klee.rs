@@ -100,7 +100,7 @@ fn bunny_on_cpu(
     levels: u32,
     min_cpu_frames: u32,
     runs: &[(&str, ShadowMode, u32)],
-) -> Result<(Vec<(Row, Vec<f32>)>, (usize, usize))> {
+) -> Result<(Vec<(Row, Vec<f32>)>, Memory)> {
     let mut st = Setup::new(bench, BUNNY, s, levels)?;
     st.min_cpu_frames = min_cpu_frames;
     let frame = st.gpu(bench, ShadowMode::Linespace, 2, 2)?.last;
@@ -112,6 +112,9 @@ fn bunny_on_cpu(
     };
     Ok((runs.iter().map(row).collect(), st.memory()))
 }
+
+/// Bytes of an N-tree's node pool and of its line spaces.
+type Memory = (usize, usize);
 
 /// The reading's letter for `levels` (see [`READINGS`]).
 fn reading(levels: u32) -> &'static str {
@@ -251,7 +254,8 @@ fn table2_gap(savings: &[(&str, f64, f64)]) -> String {
             share(var_b - ours_a),
         );
     }
-    text += "\nAt the quick size these CPU times are milliseconds: the split of the gap moves by tens \
+    text +=
+        "\nAt the quick size these CPU times are milliseconds: the split of the gap moves by tens \
              of points between runs on a shared machine; the triangle tests, lookups and errors do \
              not.\n";
     text + "\n`variant1` is `exact` without our near-origin rule: the line space of the node holding \
