@@ -100,7 +100,7 @@ fn bunny_on_cpu(
     levels: u32,
     min_cpu_frames: u32,
     runs: &[(&str, ShadowMode, u32)],
-) -> Result<(Vec<(Row, Vec<f32>)>, Memory)> {
+) -> Result<(Vec<Measured1>, Memory)> {
     let mut st = Setup::new(bench, BUNNY, s, levels)?;
     st.min_cpu_frames = min_cpu_frames;
     let frame = st.gpu(bench, ShadowMode::Linespace, 2, 2)?.last;
@@ -115,6 +115,8 @@ fn bunny_on_cpu(
 
 /// Bytes of an N-tree's node pool and of its line spaces.
 type Memory = (usize, usize);
+/// A row and the shadow values of its pixels.
+type Measured1 = (Row, Vec<f32>);
 
 /// The reading's letter for `levels` (see [`READINGS`]).
 fn reading(levels: u32) -> &'static str {
