@@ -75,12 +75,14 @@ fn every_kernel_compiles_without_warnings() {
         .expect("the streaming tracer");
     r.render(&scene.camera).expect("frame");
 
-    // the soft shadows: G-buffer, the three shadow modes, the quad
+    // the soft shadows: G-buffer, the five shadow modes, the quad
     let area = common::load("bunny_area.toml");
     for mode in [
         ShadowMode::Exact,
         ShadowMode::Linespace,
         ShadowMode::LinespaceDda,
+        ShadowMode::Variant1,
+        ShadowMode::Variant2,
     ] {
         let opts = SoftShadowOptions {
             mode,

@@ -11,6 +11,11 @@
 //                              thesis' approximation, Table 2 "Linespace-Abfrage").
 //   SHADOW_MODE 2 (linespace-dda): every ray alone with a hierarchical 3D-DDA [AW87] and the
 //                              same line-space termination (Table 3).
+//   SHADOW_MODE 3 (variant1):  Table 2's "Variante 1" as defined: mode 0 without our
+//                              near-origin rule (NEAR_ORIGIN_RULE 0).
+//   SHADOW_MODE 4 (variant2):  Table 2's "Variante 2" as defined: mode 1 without it — the
+//                              deepest level is never visited, no triangle is tested.
+// NEAR_ORIGIN_RULE and BIT_IS_HIT come from the host (ShadowMode::near_origin_rule, bit_is_hit).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
 // it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it.
@@ -86,6 +91,12 @@ bool loopStep()
     if (loopIterations > LOOP_BUDGET) { truncated = 1u; return false; }
     return true;
 }
+// The loop guard (see loopLimit), written once at the head of every loop, after the loop's own
+// condition: `while (cond && WITHIN_BUDGET)` counts one iteration each time the body runs, as
+// a check at the top of the body would. Past the budget every loop ends at its next test, the
+// invocation unwinds and the pixel is counted in truncated (and rendered again in batches), so
+// the algorithm's loops below read as printed.
+#define WITHIN_BUDGET loopStep()
 
 struct Stack
 {
@@ -161,7 +172,10 @@ float tEnd(int level)
 }
 
 // the two axes of a side's cells
-ivec2 faceAxes(int axis) { return axis == 0 ? ivec2(1, 2) : (axis == 1 ? ivec2(0, 2) : ivec2(0, 1)); }
+ivec2 faceAxes(int axis)
+{
+    return axis == 0 ? ivec2(1, 2) : (axis == 1 ? ivec2(0, 2) : ivec2(0, 1));
+}
 
 // one slab of Kay–Kajiya: false when the ray runs parallel outside it
 bool slab(int a, vec3 startPoint, vec3 direction, inout float tnear, inout float tfar,
@@ -209,7 +223,8 @@ bool isNodeIntersection(vec3 startPoint, vec3 direction, float t_end,
 #define NEAR_MARGIN 1.0
 bool nearOrigin(vec3 childStart)
 {
-    return all(greaterThanEqual(childStart, vec3(-NEAR_MARGIN))) && all(lessThanEqual(childStart, vec3(float(N) + NEAR_MARGIN)));
+    return all(greaterThanEqual(childStart, vec3(-NEAR_MARGIN)))
+        && all(lessThanEqual(childStart, vec3(float(N) + NEAR_MARGIN)));
 }
 
 // Algorithm 4 and Listing 3: getEntry — the bit of the shaft between two boundary cells.
@@ -267,8 +282,7 @@ bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 {
     bool found_intersection = false;
     float te = tEnd(level);
-    for (int r = rayBegin; r < rayEnd; r += 4) {
-        if (!loopStep()) return false;
+    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r += 4) {
         bool f0 = lineSpaceRay(r, node, childStart, te, deactivate);
         if (f0 && !deactivate) return true;
         bool f1 = lineSpaceRay(r + 1, node, childStart, te, deactivate);
@@ -286,7 +300,9 @@ bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 bool occludes(uint t, vec3 ro, vec3 rd)
 {
     triangleTests++;
-    vec3 v0 = triVertex[3u * t].xyz, v1 = triVertex[3u * t + 1u].xyz, v2 = triVertex[3u * t + 2u].xyz;
+    vec3 v0 = triVertex[3u * t].xyz;
+    vec3 v1 = triVertex[3u * t + 1u].xyz;
+    vec3 v2 = triVertex[3u * t + 2u].xyz;
     vec3 edge1 = v1 - v0;
     vec3 edge2 = v2 - v0;
     vec3 pvec = cross(rd, edge2);
@@ -310,8 +326,7 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     vec3 rd = samplePoint(r) - originWorld;
     uint off = node.r >> 2;
     uint count = node.g;
-    for (uint i = 0u; i < count; i += 4u) {
-        if (!loopStep()) return;
+    for (uint i = 0u; i < count && WITHIN_BUDGET; i += 4u) {
         if (occludes(leafTriangles[off + i], originWorld, rd)
             || (i + 1u < count && occludes(leafTriangles[off + i + 1u], originWorld, rd))
             || (i + 2u < count && occludes(leafTriangles[off + i + 2u], originWorld, rd))
@@ -328,8 +343,7 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
 void leafTests(uvec2 node, vec3 childStart, int level)
 {
     float te = tEnd(level);
-    for (int r = rayBegin; r < rayEnd; r += 4) {
-        if (!loopStep()) return;
+    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r += 4) {
         leafRay(r, node, childStart, te);
         leafRay(r + 1, node, childStart, te);
         leafRay(r + 2, node, childStart, te);
@@ -409,12 +423,11 @@ int traverse()
     float fN = float(N);
     if (!initLevel(0, uvec2(GEOMETRY_BIT | CHILDREN_BIT, 0u))) return active_rays;
     int depth = 0;
-    while (depth >= 0) {
-        if (!loopStep()) return active_rays;
+    while (depth >= 0 && WITHIN_BUDGET) {
         bool next_depth = false;
-        int slice = stack[depth].current_slice;
-        for (;;) {
-            if (!loopStep()) return active_rays;
+        // for all slices of the node, from current_slice on (the loop ends at last_slice or
+        // when a child is to be traversed: next_depth)
+        for (int slice = stack[depth].current_slice; WITHIN_BUDGET; slice += dir) {
             if (!stack[depth].traverse_chilids) {
                 sliceUV(depth, slice);
                 int cu0 = max(int(floor(stack[depth].u_min)), 0);
@@ -423,8 +436,7 @@ int traverse()
                 int cv1 = min(int(floor(stack[depth].v_max)), N - 1);
                 stack[depth].nodelist_index = 0;
                 for (int cu = cu0; cu <= cu1; cu++) {
-                    for (int cv = cv0; cv <= cv1; cv++) {
-                        if (!loopStep()) return active_rays;
+                    for (int cv = cv0; cv <= cv1 && WITHIN_BUDGET; cv++) {
                         ivec3 c;
                         c[k] = slice; c[u] = cu; c[v] = cv;
                         uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
@@ -439,12 +451,13 @@ int traverse()
                     }
                 }
             }
-            while (stack[depth].nodelist_index > 0) {
-                if (!loopStep()) return active_rays;
+            while (stack[depth].nodelist_index > 0 && WITHIN_BUDGET) {
                 int i = --stack[depth].nodelist_index;
                 uvec2 node = stack[depth].nodelist[i];
                 ivec3 uvk_offset;
-                uvk_offset[k] = slice; uvk_offset[u] = stack[depth].offset[i].x; uvk_offset[v] = stack[depth].offset[i].y;
+                uvk_offset[k] = slice;
+                uvk_offset[u] = stack[depth].offset[i].x;
+                uvk_offset[v] = stack[depth].offset[i].y;
                 // ray_start[depth + 1] = n × (ray_start[depth] − uvk_offset)
                 vec3 childStart = (shaft.ray_start[depth] - vec3(uvk_offset)) * fN;
                 if ((node.r & CHILDREN_BIT) == 0u) {
@@ -455,11 +468,12 @@ int traverse()
                     // opposite — a hit means the children are traversed, an empty shaft is
                     // skipped (Empty-Space-Skipping). We follow the prose: descend only when
                     // isIntersection is true
-                    bool inside = nearOrigin(childStart);
+                    // ours: a node near the origin is descended; the variants ask it too
+                    bool inside = NEAR_ORIGIN_RULE == 1 && nearOrigin(childStart);
                     bool descend;
                     if (inside) {
                         descend = true;
-                    } else if (SHADOW_MODE == 1 && depth == LAST_LS_DEPTH) {
+                    } else if (BIT_IS_HIT == 1 && depth == LAST_LS_DEPTH) {
                         isIntersection(node, childStart, depth + 1, true);
                         descend = false;
                     } else {
@@ -480,7 +494,6 @@ int traverse()
             if (next_depth) break;
             stack[depth].traverse_chilids = false;
             if (slice == stack[depth].last_slice) break;
-            slice += dir;
         }
         // the thesis adds 2 and subtracts 1 at the end of the while loop
         depth += next_depth ? 1 : -1;
@@ -529,15 +542,16 @@ bool ddaBlocked(int r)
 {
     float fN = float(N);
     vec3 direction = shaft.ray_direction[r];
-    ivec3 stp = ivec3(direction.x > 0.0 ? 1 : -1, direction.y > 0.0 ? 1 : -1, direction.z > 0.0 ? 1 : -1);
+    ivec3 stp = ivec3(direction.x > 0.0 ? 1 : -1, direction.y > 0.0 ? 1 : -1,
+                      direction.z > 0.0 ? 1 : -1);
     vec3 t_delta = 1.0 / abs(direction);
     if (!ddaInit(0, 0u, shaft.origin, 1.0, direction)) return false;
     vec3 rd = samplePoint(r) - originWorld;
     int depth = 0;
-    while (depth >= 0) {
-        if (!loopStep()) return false;
+    while (depth >= 0 && WITHIN_BUDGET) {
         ivec3 cell = dstack[depth].cell;
-        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(N))) || dstack[depth].t > dstack[depth].t_end) {
+        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, ivec3(N)))
+            || dstack[depth].t > dstack[depth].t_end) {
             depth--;
             continue;
         }
@@ -552,8 +566,7 @@ bool ddaBlocked(int r)
         float te = tEnd(depth + 1);
         if ((node.r & CHILDREN_BIT) == 0u) {
             uint off = node.r >> 2;
-            for (uint i = 0u; i < node.g; i++) {
-                if (!loopStep()) return false;
+            for (uint i = 0u; i < node.g && WITHIN_BUDGET; i++) {
                 if (occludes(leafTriangles[off + i], originWorld, rd)) return true;
             }
             continue;
@@ -563,7 +576,8 @@ bool ddaBlocked(int r)
         if (!inside) {
             int sf, ef;
             ivec2 sd, ed;
-            if (isNodeIntersection(childStart, direction, te, sf, sd, ef, ed) && getEntry(node, sf, sd, ef, ed)) {
+            if (isNodeIntersection(childStart, direction, te, sf, sd, ef, ed)
+                && getEntry(node, sf, sd, ef, ed)) {
                 if (depth == LAST_LS_DEPTH) return true;
                 descend = true;
             }
@@ -584,8 +598,7 @@ int litRays(vec3 pos, vec3 normal)
     vec3 centre = lightCorner + 0.5 * (lightEdgeU + lightEdgeV);
     if (SHADOW_MODE == 2) {
         int lit = 0;
-        for (int r = rayBegin; r < rayEnd; r++) {
-            if (!loopStep()) break;
+        for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
             if (shaft.active_rays[r] && !ddaBlocked(r)) lit++;
         }
         return lit;
@@ -658,14 +671,15 @@ void main()
             imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 1.0));
         }
     }
-    countAdd(0, triangleTests);
-    countAdd(1, linespaceLookups);
-    countAdd(2, nodesVisited);
-    countAdd(3, truncated);
-    countAdd(4, packetFailures);
-    countersEnd(0, COUNTER_TRIANGLE_TESTS);
-    countersEnd(1, COUNTER_LINESPACE_LOOKUPS);
-    countersEnd(2, COUNTER_NODES_VISITED);
-    countersEnd(3, COUNTER_TRUNCATED);
-    countersEnd(4, COUNTER_PACKET_FAILURES);
+    // the kernel's counters, named by the host (shadow_pass::COUNTERS): local slot = global slot
+    countAdd(COUNTER_TRIANGLE_TESTS, triangleTests);
+    countAdd(COUNTER_LINESPACE_LOOKUPS, linespaceLookups);
+    countAdd(COUNTER_NODES_VISITED, nodesVisited);
+    countAdd(COUNTER_TRUNCATED, truncated);
+    countAdd(COUNTER_PACKET_FAILURES, packetFailures);
+    countersEnd(COUNTER_TRIANGLE_TESTS, COUNTER_TRIANGLE_TESTS);
+    countersEnd(COUNTER_LINESPACE_LOOKUPS, COUNTER_LINESPACE_LOOKUPS);
+    countersEnd(COUNTER_NODES_VISITED, COUNTER_NODES_VISITED);
+    countersEnd(COUNTER_TRUNCATED, COUNTER_TRUNCATED);
+    countersEnd(COUNTER_PACKET_FAILURES, COUNTER_PACKET_FAILURES);
 }

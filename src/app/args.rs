@@ -123,7 +123,9 @@ pub struct SoftShadowArgs {
     /// Soft shadows from the scene's `[[area_light]]` with the Cascaded Line Space (Klee 2016):
     /// G-buffer, shadow compute pass, screen-filling quad. `exact`: triangle tests (the
     /// reference); `linespace`: packet traversal, the line-space bit decides a hit;
-    /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination.
+    /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination; `variant1`,
+    /// `variant2`: Table 2's "Variante 1/2" as defined (exact / linespace without our
+    /// near-origin rule).
     /// [default: the scene's render.shadows, else the point-light ray tracer]
     #[arg(long, value_enum)]
     pub shadows: Option<ShadowMode>,
@@ -134,8 +136,13 @@ pub struct SoftShadowArgs {
     /// Cells per axis of every N-tree node (N; 10 in the thesis).
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub ntree_n: u32,
-    /// Levels of the N-tree including the root (3 in the thesis; 3 or 4).
-    #[arg(long, default_value_t = 3, value_name = "D")]
+    /// Levels of the N-tree counting the root: 3 (reading A of the thesis' "maximale Tiefe von
+    /// 3": root, nodes of 1/N, leaves of 1/N²; only one level of line spaces is asked, no
+    /// cascade) or 4 (reading B: "Tiefe null ist die Tiefe der Kinder des Wurzelknotens", so
+    /// depths 0, 1, 2 below the root; leaves of 1/N³, a cascade of two line-space levels).
+    /// The number counts levels with the root, not the thesis' depth index (README, "where we
+    /// differ").
+    #[arg(long, default_value_t = 3, value_name = "LEVELS")]
     pub ntree_depth: u32,
     /// How the shadow value s lights a pixel: `lit` (ours: diffuse · (ambient + light · s ·
     /// N·L)) or `fig7` (Klee 2016's Fig. 7: s · diffuse).

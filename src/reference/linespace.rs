@@ -12,6 +12,8 @@
 //! * [`ShadowMode::Exact`]: the packet traversal of `Linespace` with the line spaces used only
 //!   to skip empty shafts, down to the leaves, where the rays are tested against the leaves'
 //!   triangles (Table 2's "Schnitttests mit Dreiecken"); the reference.
+//! * [`ShadowMode::Variant1`], [`ShadowMode::Variant2`]: Table 2's "Variante 1" and "Variante
+//!   2" as the thesis defines them: `Exact` and `Linespace` without the near-origin rule below.
 //!
 //! Where the thesis is silent we do this (and the kernel the same): the node that contains the
 //! rays' common origin has no entry side, so no line-space entry; it is always descended, and
@@ -35,6 +37,9 @@ pub struct ShadowCounts {
     pub nodes_visited: u64,
     /// Pixels whose light corners do not all lie on one side of an axis (no packet): lit.
     pub packet_failures: u64,
+    /// Line-space lookups per stack depth (0: the root's children, as the thesis counts
+    /// "Tiefe null"): the cascade shows as lookups at more than one depth.
+    pub lookups_by_depth: [u64; 3],
 }
 
 impl std::ops::AddAssign for ShadowCounts {
@@ -43,6 +48,9 @@ impl std::ops::AddAssign for ShadowCounts {
         self.linespace_lookups += o.linespace_lookups;
         self.nodes_visited += o.nodes_visited;
         self.packet_failures += o.packet_failures;
+        for (a, b) in self.lookups_by_depth.iter_mut().zip(o.lookups_by_depth) {
+            *a += b;
+        }
     }
 }
 
@@ -493,6 +501,7 @@ impl<'a> LinespaceShadows<'a> {
                 continue;
             };
             counts.linespace_lookups += 1;
+            counts.lookups_by_depth[level - 1] += 1;
             if get_entry(self.tree.n, self.packed, node[1], hit) {
                 found = true;
                 if deactivate {
@@ -595,10 +604,11 @@ impl<'a> LinespaceShadows<'a> {
                     if node[0] & CHILDREN_BIT == 0 {
                         self.leaf_tests(s, node, child_start, level_of_node, counts);
                     } else {
-                        let inside = near_origin(child_start, nf);
+                        // ours: a node near the origin is descended; the variants ask it too
+                        let inside = mode.near_origin_rule() && near_origin(child_start, nf);
                         let descend = if inside {
                             true
-                        } else if mode == ShadowMode::Linespace && d as i32 == last_ls_depth {
+                        } else if mode.bit_is_hit() && d as i32 == last_ls_depth {
                             self.is_intersection(s, node, child_start, level_of_node, true, counts);
                             false
                         } else {
@@ -704,6 +714,7 @@ impl<'a> LinespaceShadows<'a> {
                 true
             } else if let Some(hit) = node_intersection(self.tree.n, child_start, dir, te) {
                 counts.linespace_lookups += 1;
+                counts.lookups_by_depth[d] += 1;
                 if get_entry(self.tree.n, self.packed, node[1], hit) {
                     if d as i32 == last_ls_depth {
                         return true;

@@ -3,8 +3,13 @@
 //!
 //! * **N-tree**: an octree with N cells per axis (N = 10 in the thesis). Levels: the root (level
 //!   0), its N³ children (level 1), ..., the leaves at level `depth − 1`, which store triangles.
-//!   `depth = 3` (the thesis' "maximale Tiefe 3") therefore gives a root, inner nodes of
-//!   size 1/N and leaves of size 1/N² of the scene cube.
+//!   `depth = 3` (reading A of the thesis' "maximale Tiefe von 3") therefore gives a root,
+//!   inner nodes of size 1/N and leaves of size 1/N² of the scene cube; only the line spaces
+//!   of level 1 are ever asked (the traversal starts at the root's children), so there is no
+//!   cascade. Reading B takes the thesis' own numbering, "Tiefe null ist die Tiefe der Kinder
+//!   des Wurzelknotens" (ch. 4.3.1): depths 0, 1, 2 below the root, i.e. `depth = 4` here,
+//!   leaves of 1/N³ and line spaces asked at levels 1 and 2 (the cascade). `depth` counts
+//!   levels with the root (`--ntree-depth`), so old inputs keep their meaning.
 //! * **Node pool** (Fig. 8–9): groups of N³ nodes, group 0 the children of the root. A node is
 //!   two u32 (red, green): red bit 0 = geometry, bit 1 = children, bits 2.. = the group of
 //!   its children; green = the index of its line space in the line-space pool. A leaf (geometry,
@@ -443,7 +448,11 @@ impl NTree {
             bail!("--ntree-n {n}: must lie in 2..=16");
         }
         if !(3..=4).contains(&depth) {
-            bail!("--ntree-depth {depth}: must be 3 or 4 (the line spaces sit on the levels above the leaves)");
+            bail!(
+                "--ntree-depth {depth}: must be 3 or 4 levels counting the root (3: leaves at \
+                 1/N², reading A of the thesis' depth 3; 4: leaves at 1/N³, reading B, three \
+                 levels below the root; the line spaces sit on the levels above the leaves)"
+            );
         }
         if triangles.is_empty() {
             bail!("the scene has no triangles to build an N-tree over");

@@ -16,6 +16,16 @@ pub enum ShadowMode {
     Linespace,
     /// Every ray alone with a 3D-DDA through the N-tree, same line-space termination (Table 3).
     LinespaceDda,
+    /// Table 2's "Variante 1" as the thesis defines it: `exact` without our near-origin rule —
+    /// every node with children, the one holding the rays' origin included, is descended only
+    /// when Algorithm 2 finds a set bit; one more level is traversed and the leaves' triangles
+    /// are tested ("Traversierung einer weiteren Ebene, sowie der Verwendung von Schnitttests").
+    Variant1,
+    /// Table 2's "Variante 2" as the thesis defines it: `linespace` without our near-origin
+    /// rule — at the last depth with line spaces a set bit is a hit for every node, the one
+    /// holding the origin included; the deepest level is never visited, no triangle is tested
+    /// ("die tiefste Ebene des N-tree [muss] nicht traversiert werden").
+    Variant2,
 }
 
 impl ShadowMode {
@@ -25,6 +35,8 @@ impl ShadowMode {
             ShadowMode::Exact => 0,
             ShadowMode::Linespace => 1,
             ShadowMode::LinespaceDda => 2,
+            ShadowMode::Variant1 => 3,
+            ShadowMode::Variant2 => 4,
         }
     }
     pub fn name(self) -> &'static str {
@@ -32,7 +44,19 @@ impl ShadowMode {
             ShadowMode::Exact => "exact",
             ShadowMode::Linespace => "linespace",
             ShadowMode::LinespaceDda => "linespace-dda",
+            ShadowMode::Variant1 => "variant1",
+            ShadowMode::Variant2 => "variant2",
         }
+    }
+    /// Does the mode descend (and test exactly) the nodes near the rays' origin instead of
+    /// asking their line space? Ours (`exact`, `linespace`, `linespace-dda`); the thesis'
+    /// variants do not.
+    pub fn near_origin_rule(self) -> bool {
+        !matches!(self, ShadowMode::Variant1 | ShadowMode::Variant2)
+    }
+    /// Does a set line-space bit at the last depth with line spaces count as a hit?
+    pub fn bit_is_hit(self) -> bool {
+        matches!(self, ShadowMode::Linespace | ShadowMode::Variant2)
     }
 }
 

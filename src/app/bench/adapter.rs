@@ -151,20 +151,21 @@ pub struct ShadowFrame {
     pub gbuffer_normal: Vec<[f32; 4]>,
 }
 
-/// Klee 2016's soft-shadow renderer for one scene: the N-tree (N = 10, depth 3, as the thesis)
-/// and its line spaces built once; mode and light samples switchable.
+/// Klee 2016's soft-shadow renderer for one scene: the N-tree (N = 10, `levels` levels counting
+/// the root: 3 or 4, the two readings of the thesis' "maximale Tiefe von 3") and its line spaces
+/// built once; mode and light samples switchable.
 pub struct SoftShadows(SoftShadowRenderer);
 
 impl SoftShadows {
     /// Build the N-tree of `scene` and the renderer for the image size of `s`, 2×2 samples,
-    /// dispatches of at most `tile`×`tile` pixels.
-    pub fn new(gpu: &Gpu, scene: &Scene, s: Sizing, tile: u32) -> Result<Self> {
+    /// dispatches of at most `tile`×`tile` pixels, an N-tree of `levels` levels (root included).
+    pub fn new(gpu: &Gpu, scene: &Scene, s: Sizing, tile: u32, levels: u32) -> Result<Self> {
         let options = SoftShadowOptions {
             mode: ShadowMode::Linespace,
             samples_u: 2,
             samples_v: 2,
             ntree_n: 10,
-            ntree_depth: 3,
+            ntree_depth: levels,
             shading: Default::default(),
             width: s.width,
             height: s.height,
@@ -195,5 +196,10 @@ impl SoftShadows {
     /// The CPU implementation over the same N-tree and light.
     pub fn cpu(&self) -> LinespaceShadows<'_> {
         self.0.cpu()
+    }
+
+    /// Bytes of the N-tree's node pool and of its line spaces.
+    pub fn memory(&self) -> (usize, usize) {
+        (self.0.ntree_bytes(), self.0.linespace_bytes())
     }
 }

@@ -1,5 +1,6 @@
 //! Klee 2016, ch. 5: the evaluation of soft shadows with the Cascaded Line Space, replicated.
-//! N-tree N = 10, depth 3 as the thesis; the bunny (`bunny_area.toml`) and the dragon
+//! N-tree N = 10, 3 levels counting the root (reading A of the thesis' depth 3; table 2, 3 and
+//! Fig. 12 also at 4 levels, reading B); the bunny (`bunny_area.toml`) and the dragon
 //! (`dragon_area.toml`: 202520 triangles — the thesis' 871k dragon is not available). Shadow
 //! times exclude the primary rays, as the thesis measures them; every time is the mean over
 //! the frames (the thesis: ten). "CPU" is our CPU implementation (`src/reference/linespace.rs`,
@@ -7,7 +8,9 @@
 //! timer-query time. The measuring is in [`super::klee_measure`].
 //!
 //! - `klee-table1`: primary rays, GPU rasterisation (the G-buffer pass) vs CPU ray casting.
-//! - `klee-table2`: CPU, bunny, 4 rays: triangle tests (`exact`) vs line-space lookups.
+//! - `klee-table2`: CPU, bunny, 4 rays: triangle tests (`exact`, `variant1`) vs line-space
+//!   lookups (`linespace`, `variant2`), at both readings of the N-tree depth, and how much of
+//!   the gap to the published saving each explains.
 //! - `klee-table3`: CPU, bunny, CGT (`linespace`) vs DDA (`linespace-dda`), 4/9/16/100 rays.
 //! - `klee-fig12`: bunny, 2×2 … 10×10 rays, CPU vs GPU (FPS and seconds).
 //! - `klee-fig13`: GPU, bunny vs dragon, 2×2 … 10×10 rays.
@@ -16,7 +19,7 @@ use anyhow::Result;
 
 use super::config::Sizing;
 use super::format::{int, num, percent, ratio, table};
-use super::klee_measure::{section, Meas, Row, Setup};
+use super::klee_measure::{section, Row, Setup, READINGS};
 use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
 use super::protocol::{Protocol, Section, Units};
 use super::runner::Bench;
@@ -87,20 +90,43 @@ fn klee(
     section(p, bench, s, &m.markdown, &m.rows, &m.figures)
 }
 
-/// The bunny's shadows on the CPU, a row per (variant, mode, rays per pixel), for the pixels
-/// of its G-buffer from the GPU (2×2 samples).
+/// The bunny's shadows on the CPU with an N-tree of `levels` levels: a row per (variant, mode,
+/// rays per pixel) and its shadow values, for the pixels of its G-buffer from the GPU (2×2
+/// samples), at least `min_cpu_frames` frames each; and the bytes of the node pool and of the
+/// line spaces.
 fn bunny_on_cpu(
     bench: &mut Bench,
     s: Sizing,
+    levels: u32,
+    min_cpu_frames: u32,
     runs: &[(&str, ShadowMode, u32)],
-) -> Result<Vec<Row>> {
-    let mut st = Setup::new(bench, BUNNY, s)?;
+) -> Result<(Vec<Measured1>, Memory)> {
+    let mut st = Setup::new(bench, BUNNY, s, levels)?;
+    st.min_cpu_frames = min_cpu_frames;
     let frame = st.gpu(bench, ShadowMode::Linespace, 2, 2)?.last;
     let row = |&(variant, mode, rays): &(&str, ShadowMode, u32)| {
         let k = (rays as f64).sqrt() as u32;
-        Row::new("bunny", variant, "CPU", rays, st.cpu(&frame, mode, k, k))
+        let (m, values) = st.cpu_values(&frame, mode, k, k);
+        let row = Row::new("bunny", variant, "CPU", rays, m).levels(levels);
+        (row, values)
     };
-    Ok(runs.iter().map(row).collect())
+    Ok((runs.iter().map(row).collect(), st.memory()))
+}
+
+/// Bytes of an N-tree's node pool and of its line spaces.
+type Memory = (usize, usize);
+/// A row and the shadow values of its pixels.
+type Measured1 = (Row, Vec<f32>);
+
+/// The reading's letter for `levels` (see [`READINGS`]).
+fn reading(levels: u32) -> &'static str {
+    READINGS.iter().find(|r| r.1 == levels).map_or("?", |r| r.0)
+}
+
+/// Mean |a − b| over the pixels.
+fn mean_error(a: &[f32], b: &[f32]) -> f64 {
+    let sum: f64 = a.iter().zip(b).map(|(x, y)| (x - y).abs() as f64).sum();
+    sum / a.len().max(1) as f64
 }
 
 pub const KLEE_TABLE1: Protocol = Protocol {
@@ -114,7 +140,7 @@ pub const KLEE_TABLE1: Protocol = Protocol {
 fn table1(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let mut rows = Vec::new();
     for (scene, label) in SCENES {
-        let mut st = Setup::new(bench, scene, s)?;
+        let mut st = Setup::new(bench, scene, s, 3)?;
         let gpu = st.gpu(bench, ShadowMode::Linespace, 2, 2)?.gbuffer;
         rows.push(Row::new(label, "primary", "GPU", 1, gpu));
         rows.push(Row::new(label, "primary", "CPU", 1, st.cpu_primary()));
@@ -140,42 +166,120 @@ pub const KLEE_TABLE2: Protocol = Protocol {
     units: Units::Whole,
 };
 
-/// Table 2: the bunny's 2×2 shadows on the CPU, with triangle tests and with line-space lookups.
+/// Table 2: frames timed on the CPU per mode (the fastest counts: milliseconds at the quick
+/// size on a shared machine).
+const TABLE2_FRAMES: u32 = 5;
+
+/// Table 2's modes: ours and the thesis' two variants, with the published time each compares to.
+const TABLE2_MODES: [(&str, ShadowMode, f64); 4] = [
+    ("exact", ShadowMode::Exact, TABLE2[0].1),
+    ("variant1", ShadowMode::Variant1, TABLE2[0].1),
+    ("linespace", ShadowMode::Linespace, TABLE2[1].1),
+    ("variant2", ShadowMode::Variant2, TABLE2[1].1),
+];
+
+/// Table 2: the bunny's 2×2 shadows on the CPU, with triangle tests and with line-space lookups,
+/// ours and the thesis' variants, at both readings of the N-tree depth.
 fn table2(bench: &mut Bench, s: Sizing) -> Result<Measured> {
-    let modes = [
-        ("exact", ShadowMode::Exact, 4),
-        ("linespace", ShadowMode::Linespace, 4),
-    ];
-    let rows = bunny_on_cpu(bench, s, &modes)?;
-    let (exact, ls) = (&rows[0].m, &rows[1].m);
-    let line = |what: &str, published: f64, m: &Meas| {
-        let [tests, lookups] = [m.triangle_tests, m.linespace_lookups].map(|v| int(v as f64));
-        vec![what.into(), num(published), num(m.mean_s), tests, lookups]
-    };
-    let saving = |part: f64, whole: f64| format!("{:.1} %", 100.0 * (1.0 - part / whole));
-    let lines = [
-        line("CPU triangle tests (`exact`)", TABLE2[0].1, exact),
-        line("CPU line-space lookups (`linespace`)", TABLE2[1].1, ls),
-        vec![
-            "saving".into(),
-            saving(TABLE2[1].1, TABLE2[0].1),
-            saving(ls.mean_s, exact.mean_s),
+    let runs = TABLE2_MODES.map(|(name, mode, _)| (name, mode, 4));
+    let (mut rows, mut lines, mut savings) = (Vec::new(), Vec::new(), Vec::new());
+    for (letter, levels) in READINGS {
+        let (measured, (tree_b, ls_b)) = bunny_on_cpu(bench, s, levels, TABLE2_FRAMES, &runs)?;
+        let exact = &measured[0].1;
+        for ((row, values), (_, _, published)) in measured.iter().zip(TABLE2_MODES) {
+            let m = &row.m;
+            let depths = m.lookups_by_depth.map(|v| int(v as f64)).join(" / ");
+            lines.push(vec![
+                format!("{} ({letter})", row.variant),
+                num(published),
+                num(m.min_s),
+                int(m.triangle_tests as f64),
+                depths,
+                format!("{:.4}", mean_error(values, exact)),
+            ]);
+        }
+        let t = |i: usize| measured[i].0.m.min_s;
+        savings.push((letter, 1.0 - t(2) / t(0), 1.0 - t(3) / t(1)));
+        lines.push(vec![
+            format!("memory ({letter}): node pool + line spaces"),
+            String::new(),
+            format!(
+                "{:.1} MB + {:.1} MB",
+                tree_b as f64 / 1e6,
+                ls_b as f64 / 1e6
+            ),
             String::new(),
             String::new(),
-        ],
-    ];
+            String::new(),
+        ]);
+        rows.extend(measured.into_iter().map(|(r, _)| r));
+    }
     let header = [
-        "variant",
+        "variant (reading)",
         "published (s)",
-        "ours (s)",
+        "ours (s, fastest frame)",
         "triangle tests",
-        "line-space lookups",
+        "lookups at depth 0 / 1 / 2",
+        "mean |s − exact|",
     ];
-    let markdown = table(&header, &lines)
-        + "\nOur `exact` uses the line spaces to skip empty shafts on the way down (the thesis' \
-           variant 1 had no such help, hence its 92.6 % saving); our `linespace` tests the triangles \
-           of the leaves near the ray origin exactly (see the README), hence its triangle tests.\n";
+    let markdown = table(&header, &lines) + &table2_gap(&savings);
     Ok(Measured::table(rows, markdown))
+}
+
+/// What Table 2's savings say: ours vs the variants, reading A vs B, against the published
+/// 92.6 %. `savings`: (reading, linespace vs exact, variant2 vs variant1).
+fn table2_gap(savings: &[(&str, f64, f64)]) -> String {
+    let published = 1.0 - TABLE2[1].1 / TABLE2[0].1;
+    let mut text = format!(
+        "\nPublished saving of the line-space lookups over the triangle tests: {}.\n\n",
+        pct(published)
+    );
+    for (letter, ours, variants) in savings {
+        text += &format!(
+            "- reading {letter}: `linespace` vs `exact` saves {}, `variant2` vs `variant1` {}.\n",
+            pct(*ours),
+            pct(*variants)
+        );
+    }
+    if let [(_, ours_a, var_a), (_, ours_b, var_b)] = savings {
+        let gap = published - ours_a;
+        let share = |x: f64| pct(x / gap);
+        text += &format!(
+            "\nOf the gap between ours at reading A and the published saving ({} points), the depth \
+             reading (A → B, `linespace` vs `exact`) closes {} points ({} of it), the variants \
+             as defined (at A) {} points ({}), both together (`variant2` vs `variant1` at B) {} \
+             points ({}).\n",
+            pp(gap),
+            pp(ours_b - ours_a),
+            share(ours_b - ours_a),
+            pp(var_a - ours_a),
+            share(var_a - ours_a),
+            pp(var_b - ours_a),
+            share(var_b - ours_a),
+        );
+    }
+    text +=
+        "\nAt the quick size these CPU times are milliseconds: the split of the gap moves by tens \
+             of points between runs on a shared machine; the triangle tests, lookups and errors do \
+             not.\n";
+    text + "\n`variant1` is `exact` without our near-origin rule: the line space of the node holding \
+            the origin is asked too (its shaft reaches back behind the origin, so it is conservative \
+            and the image equals `exact`). `variant2` is `linespace` without it: the deepest level \
+            is never visited, no triangle is tested — and the shaft of the origin's own node holds \
+            the surface the rays start on, so surfaces shadow themselves (see its error). Depth 0 \
+            is the root's children (\"Tiefe null ist die Tiefe der Kinder des Wurzelknotens\"); \
+            reading A (3 levels counting the root) asks line spaces at depth 0 only, reading B (4 \
+            levels) at depths 0 and 1: the cascade.\n"
+}
+
+/// Percentage points.
+fn pp(x: f64) -> String {
+    format!("{:.1}", 100.0 * x)
+}
+
+/// A percentage with one decimal.
+fn pct(x: f64) -> String {
+    format!("{:.1} %", 100.0 * x)
 }
 
 pub const KLEE_TABLE3: Protocol = Protocol {
@@ -185,7 +289,8 @@ pub const KLEE_TABLE3: Protocol = Protocol {
     units: Units::Whole,
 };
 
-/// Table 3: the bunny's shadows on the CPU, coherent grid traversal vs 3D-DDA, 4 to 100 rays.
+/// Table 3: the bunny's shadows on the CPU, coherent grid traversal vs 3D-DDA, 4 to 100 rays,
+/// at both readings of the N-tree depth.
 fn table3(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let modes: Vec<(&str, ShadowMode, u32)> = TABLE3
         .iter()
@@ -196,33 +301,59 @@ fn table3(bench: &mut Bench, s: Sizing) -> Result<Measured> {
             ]
         })
         .collect();
-    let rows = bunny_on_cpu(bench, s, &modes)?;
-    let lines: Vec<Vec<String>> = TABLE3
-        .iter()
-        .zip(rows.chunks(2))
-        .map(|(&(rays, p_cgt, p_dda), pair)| {
-            let (cgt, dda) = (pair[0].m.mean_s, pair[1].m.mean_s);
-            vec![
-                rays.to_string(),
-                num(p_cgt),
-                num(p_dda),
-                ratio(Some(p_cgt / p_dda)),
-                num(cgt),
-                num(dda),
-                ratio(Some(cgt / dda)),
-            ]
-        })
-        .collect();
+    let (mut rows, mut lines) = (Vec::new(), Vec::new());
+    for (_, levels) in READINGS {
+        let (measured, memory) = bunny_on_cpu(bench, s, levels, 1, &modes)?;
+        let measured: Vec<Row> = measured.into_iter().map(|(r, _)| r).collect();
+        lines.extend(table3_lines(&measured, memory));
+        rows.extend(measured);
+    }
     let header = [
-        "rays",
+        "rays (reading)",
         "published CGT (s)",
         "published DDA (s)",
         "CGT/DDA",
         "ours CGT (s)",
         "ours DDA (s)",
         "CGT/DDA",
+        "CGT lookups at depth 0 / 1 / 2",
     ];
-    Ok(Measured::table(rows, table(&header, &lines)))
+    let markdown = table(&header, &lines)
+        + "\nReading A: 3 levels counting the root, line spaces asked at depth 0 only; B: 4 levels, \
+           the cascade (depths 0 and 1). See klee-table2 for the readings.\n";
+    Ok(Measured::table(rows, markdown))
+}
+
+/// Table 3's lines of one reading (rows: cgt, dda per ray count) and its memory line.
+fn table3_lines(rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>> {
+    let letter = reading(rows[0].levels);
+    let mut lines: Vec<Vec<String>> = TABLE3
+        .iter()
+        .zip(rows.chunks(2))
+        .map(|(&(rays, p_cgt, p_dda), pair)| {
+            let (cgt, dda) = (pair[0].m.mean_s, pair[1].m.mean_s);
+            let depths = pair[0].m.lookups_by_depth.map(|v| int(v as f64));
+            vec![
+                format!("{rays} ({letter})"),
+                num(p_cgt),
+                num(p_dda),
+                ratio(Some(p_cgt / p_dda)),
+                num(cgt),
+                num(dda),
+                ratio(Some(cgt / dda)),
+                depths.join(" / "),
+            ]
+        })
+        .collect();
+    let mut memory = vec![String::new(); 8];
+    memory[0] = format!("memory ({letter})");
+    memory[4] = format!(
+        "{:.1} MB + {:.1} MB",
+        tree_b as f64 / 1e6,
+        ls_b as f64 / 1e6
+    );
+    lines.push(memory);
+    lines
 }
 
 pub const KLEE_FIG12: Protocol = Protocol {
@@ -232,51 +363,78 @@ pub const KLEE_FIG12: Protocol = Protocol {
     units: Units::Whole,
 };
 
-/// Fig. 12: the bunny's shadows with 2×2 … 10×10 rays on the GPU and on the CPU.
+/// Fig. 12: the bunny's shadows with 2×2 … 10×10 rays on the GPU and on the CPU, at both
+/// readings of the N-tree depth.
 fn fig12(bench: &mut Bench, s: Sizing) -> Result<Measured> {
-    let mut st = Setup::new(bench, BUNNY, s)?;
     let mut rows = Vec::new();
-    for k in SAMPLES {
-        let gpu = st.gpu(bench, ShadowMode::Linespace, k, k)?;
-        let cpu = st.cpu(&gpu.last, ShadowMode::Linespace, k, k);
-        rows.push(Row::new("bunny", "linespace", "GPU", k * k, gpu.shadow));
-        rows.push(Row::new("bunny", "linespace", "CPU", k * k, cpu));
+    let mut lines = Vec::new();
+    for (letter, levels) in READINGS {
+        let mut st = Setup::new(bench, BUNNY, s, levels)?;
+        let first = rows.len();
+        for k in SAMPLES {
+            let gpu = st.gpu(bench, ShadowMode::Linespace, k, k)?;
+            let cpu = st.cpu(&gpu.last, ShadowMode::Linespace, k, k);
+            rows.push(Row::new("bunny", "linespace", "GPU", k * k, gpu.shadow).levels(levels));
+            rows.push(Row::new("bunny", "linespace", "CPU", k * k, cpu).levels(levels));
+        }
+        lines.extend(fig12_lines(letter, &rows[first..], st.memory()));
     }
-    let lines: Vec<Vec<String>> = rows
+    let header = [
+        "rays (reading)",
+        "CPU (s)",
+        "GPU (s)",
+        "CPU FPS",
+        "GPU FPS",
+        "GPU saving",
+        "CPU lookups at depth 0 / 1 / 2",
+    ];
+    let markdown = format!(
+        "Published: the GPU takes {:.0} % less time than the CPU at every sample count, never below \
+         1 FPS; the CPU needs several seconds beyond 36 rays. Reading A: 3 levels counting the \
+         root; B: 4 levels, the cascade (see klee-table2); the figure shows A.\n\n{}",
+        100.0 * FIG12_GPU_SAVING,
+        table(&header, &lines)
+    );
+    let a: Vec<Row> = rows.iter().filter(|r| r.levels == 3).cloned().collect();
+    let figures = vec![fig12_figure(&a)];
+    Ok(Measured {
+        rows,
+        markdown,
+        figures,
+    })
+}
+
+/// Fig. 12's lines of one reading (rows: GPU, CPU per sample count) and its memory line.
+fn fig12_lines(letter: &str, rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>> {
+    let mut lines: Vec<Vec<String>> = rows
         .chunks(2)
         .zip(SAMPLES)
         .map(|(pair, k)| {
             let (g, c) = (pair[0].m.mean_s, pair[1].m.mean_s);
+            let depths = pair[1].m.lookups_by_depth.map(|v| int(v as f64));
             let cells = [
                 num(c),
                 num(g),
                 num(1.0 / c),
                 num(1.0 / g),
                 percent(1.0 - g / c),
+                depths.join(" / "),
             ];
-            [format!("{k}×{k}")].into_iter().chain(cells).collect()
+            [format!("{k}×{k} ({letter})")]
+                .into_iter()
+                .chain(cells)
+                .collect()
         })
         .collect();
-    let header = [
-        "rays",
-        "CPU (s)",
-        "GPU (s)",
-        "CPU FPS",
-        "GPU FPS",
-        "GPU saving",
-    ];
-    let markdown = format!(
-        "Published: the GPU takes {:.0} % less time than the CPU at every sample count, never below \
-         1 FPS; the CPU needs several seconds beyond 36 rays.\n\n{}",
-        100.0 * FIG12_GPU_SAVING,
-        table(&header, &lines)
+    let mut memory = vec![String::new(); 7];
+    memory[0] = format!("memory ({letter})");
+    memory[1] = format!(
+        "{:.1} MB + {:.1} MB",
+        tree_b as f64 / 1e6,
+        ls_b as f64 / 1e6
     );
-    let figures = vec![fig12_figure(&rows)];
-    Ok(Measured {
-        rows,
-        markdown,
-        figures,
-    })
+    lines.push(memory);
+    lines
 }
 
 /// (rays, f(seconds)) of the rows measured on `device`.
@@ -323,7 +481,7 @@ fn fig13(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let mut rows = Vec::new();
     let mut series = Vec::new();
     for (i, (scene, label)) in SCENES.into_iter().enumerate() {
-        let mut st = Setup::new(bench, scene, s)?;
+        let mut st = Setup::new(bench, scene, s, 3)?;
         for k in SAMPLES {
             let gpu = st.gpu(bench, ShadowMode::Linespace, k, k)?.shadow;
             rows.push(Row::new(label, "linespace", "GPU", k * k, gpu));

@@ -26,6 +26,8 @@ pub struct Meas {
     pub frames: u32,
     pub triangle_tests: u64,
     pub linespace_lookups: u64,
+    /// CPU only: the line-space lookups per stack depth (0: the root's children).
+    pub lookups_by_depth: [u64; 3],
 }
 
 fn meas(times: &[f64], tests: u64, lookups: u64) -> Meas {
@@ -37,8 +39,15 @@ fn meas(times: &[f64], tests: u64, lookups: u64) -> Meas {
         frames: times.len() as u32,
         triangle_tests: tests,
         linespace_lookups: lookups,
+        lookups_by_depth: [0; 3],
     }
 }
+
+/// The two readings of the thesis' N-tree depth, as levels counting the root (`--ntree-depth`):
+/// A = 3 (root, 1/10, leaves at 1/100: the line spaces of one level are asked, no cascade),
+/// B = 4 ("Tiefe null ist die Tiefe der Kinder des Wurzelknotens", "maximale Tiefe von 3":
+/// three levels below the root, leaves at 1/1000, a cascade of two line-space levels).
+pub const READINGS: [(&str, u32); 2] = [("A", 3), ("B", 4)];
 
 /// The shadow pass on the GPU: its time per frame, the G-buffer pass's, and the last frame.
 pub struct GpuRun {
@@ -52,17 +61,26 @@ pub struct Setup {
     pub scene: Scene,
     shadows: SoftShadows,
     sizing: Sizing,
+    /// At least this many frames timed on the CPU (Table 2's runs take milliseconds at the
+    /// quick size: one frame is mostly noise on a shared machine).
+    pub min_cpu_frames: u32,
 }
 
 impl Setup {
-    pub fn new(bench: &mut Bench, scene: &str, s: Sizing) -> Result<Setup> {
+    pub fn new(bench: &mut Bench, scene: &str, s: Sizing, levels: u32) -> Result<Setup> {
         let scene = bench.scene(scene)?.clone();
-        let shadows = SoftShadows::new(bench.gpu()?, &scene, s, bench.args.tile)?;
+        let shadows = SoftShadows::new(bench.gpu()?, &scene, s, bench.args.tile, levels)?;
         Ok(Setup {
             scene,
             shadows,
             sizing: s,
+            min_cpu_frames: 1,
         })
+    }
+
+    /// Bytes of the N-tree's node pool and of its line spaces.
+    pub fn memory(&self) -> (usize, usize) {
+        self.shadows.memory()
     }
 
     /// GPU: the shadow kernel's time per frame (and the G-buffer pass's), after warm-up.
@@ -93,38 +111,52 @@ impl Setup {
         })
     }
 
-    /// Frames timed on the CPU: 3 where the GPU has more than 2, else 1.
+    /// Frames timed on the CPU: 3 where the GPU has more than 2, else 1; at least
+    /// `min_cpu_frames`.
     fn cpu_frames(&self) -> u32 {
-        if self.sizing.angles > 2 {
-            3
-        } else {
-            1
-        }
+        let frames = if self.sizing.angles > 2 { 3 } else { 1 };
+        frames.max(self.min_cpu_frames)
     }
 
     /// CPU: the shadow values of every pixel of `f`'s G-buffer, one thread.
     pub fn cpu(&self, f: &ShadowFrame, mode: ShadowMode, su: u32, sv: u32) -> Meas {
+        self.cpu_values(f, mode, su, sv).0
+    }
+
+    /// [`Setup::cpu`] and the shadow values of the pixels that hit geometry.
+    pub fn cpu_values(
+        &self,
+        f: &ShadowFrame,
+        mode: ShadowMode,
+        su: u32,
+        sv: u32,
+    ) -> (Meas, Vec<f32>) {
         let mut cpu = self.shadows.cpu();
         cpu.samples_u = su;
         cpu.samples_v = sv;
         let mut times = Vec::new();
         let mut counts = Default::default();
+        let mut values = Vec::new();
         for _ in 0..self.cpu_frames() {
             counts = ShadowCounts::default();
+            values.clear();
             let t = Instant::now();
             for (p, n) in f.gbuffer_position.iter().zip(&f.gbuffer_normal) {
                 if p[3] > 0.0 {
-                    let (_, c) = cpu.shadow(
+                    let (v, c) = cpu.shadow(
                         mode,
                         Vec3::new(p[0], p[1], p[2]),
                         Vec3::new(n[0], n[1], n[2]).normalize(),
                     );
                     counts += c;
+                    values.push(v);
                 }
             }
             times.push(t.elapsed().as_secs_f64());
         }
-        meas(&times, counts.triangle_tests, counts.linespace_lookups)
+        let mut m = meas(&times, counts.triangle_tests, counts.linespace_lookups);
+        m.lookups_by_depth = counts.lookups_by_depth;
+        (m, values)
     }
 
     /// CPU: the primary rays ray cast through the N-tree, one thread.
@@ -150,12 +182,15 @@ impl Setup {
 }
 
 /// One CSV row.
+#[derive(Clone)]
 pub struct Row {
     pub scene: String,
     pub variant: String,
     pub device: String,
     pub rays: u32,
     pub m: Meas,
+    /// N-tree levels counting the root (3: reading A, 4: reading B).
+    pub levels: u32,
 }
 
 impl Row {
@@ -166,7 +201,14 @@ impl Row {
             device: device.into(),
             rays,
             m,
+            levels: 3,
         }
+    }
+
+    /// The row measured with an N-tree of `levels` levels (root included).
+    pub fn levels(mut self, levels: u32) -> Row {
+        self.levels = levels;
+        self
     }
 }
 
@@ -177,6 +219,7 @@ fn write_csv(bench: &Bench, name: &str, rows: &[Row], s: Sizing) -> Result<PathB
         "scene",
         "variant",
         "device",
+        "ntree_levels",
         "width",
         "height",
         "rays",
@@ -187,15 +230,20 @@ fn write_csv(bench: &Bench, name: &str, rows: &[Row], s: Sizing) -> Result<PathB
         "fps",
         "triangle_tests",
         "linespace_lookups",
+        "lookups_depth0",
+        "lookups_depth1",
+        "lookups_depth2",
     ];
     let lines: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
             let mut line = vec![r.scene.clone(), r.variant.clone(), r.device.clone()];
+            line.push(r.levels.to_string());
             line.extend([s.width, s.height, r.rays, r.m.frames].map(|v| v.to_string()));
             line.extend([r.m.mean_s, r.m.min_s, r.m.max_s].map(|v| format!("{v:.6}")));
             line.push(format!("{:.4}", 1.0 / r.m.mean_s));
             line.extend([r.m.triangle_tests, r.m.linespace_lookups].map(|v| v.to_string()));
+            line.extend(r.m.lookups_by_depth.map(|v| v.to_string()));
             line
         })
         .collect();
@@ -216,7 +264,8 @@ pub fn section(
 ) -> Result<Section> {
     let csv = write_csv(bench, p.name, rows, s)?;
     let opening = format!(
-        "{} pixels, N-tree N = 10, depth 3, mean over {} frames (after {} warm-up); GPU: {}; CPU: one \
+        "{} pixels, N-tree N = 10, 3 levels counting the root (reading A) unless a row says \
+         B (4 levels), mean over {} frames (after {} warm-up); GPU: {}; CPU: one \
          thread of this machine. Published: NVIDIA GTX 760 / Xeon E3-1230 v3, 512×512. Compare ratios, \
          not seconds.\n\n",
         s.size(),

@@ -45,7 +45,9 @@ pub fn shadow_kernel(
         .set("SAMPLES_U", su)
         .set("SAMPLES_V", sv)
         .set("NUM_RAYS", su * sv)
-        .set("SHADOW_MODE", mode.kernel_mode());
+        .set("SHADOW_MODE", mode.kernel_mode())
+        .set("NEAR_ORIGIN_RULE", mode.near_origin_rule() as u32)
+        .set("BIT_IS_HIT", mode.bit_is_hit() as u32);
     for (i, c) in COUNTERS.iter().enumerate() {
         defines = defines.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -53,6 +55,8 @@ pub fn shadow_kernel(
         ShadowMode::Exact => "shadow_exact",
         ShadowMode::Linespace => "shadow_linespace",
         ShadowMode::LinespaceDda => "shadow_linespace_dda",
+        ShadowMode::Variant1 => "shadow_variant1",
+        ShadowMode::Variant2 => "shadow_variant2",
     };
     Kernel::compute(
         gl,
