@@ -180,6 +180,10 @@ pub struct GridOptions {
     /// The streaming tracer: the most traverse calls per traversal (rays still walking then
     /// are counted in `truncated_rays` and the frame refused).
     pub stream_max_calls: u32,
+    /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
+    /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
+    /// split only where the GL implementation ends long loops.
+    pub triangles_per_dispatch: Option<u32>,
 }
 
 impl Default for GridOptions {
@@ -193,6 +197,7 @@ impl Default for GridOptions {
             proximity_clouds: false,
             stream_steps: 64,
             stream_max_calls: 10_000,
+            triangles_per_dispatch: None,
         }
     }
 }

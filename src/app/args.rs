@@ -105,6 +105,7 @@ impl GridArgs {
             proximity_clouds: self.proximity_clouds,
             stream_steps: self.stream_steps,
             stream_max_calls: self.stream_max_calls,
+            triangles_per_dispatch: None,
         }
     }
 }
