@@ -15,7 +15,8 @@ uint truncated = 0u;     // 1 if a loop of this invocation ended early (see loop
 uint voxelsVisited = 0u; // voxels whose triangle lists this invocation walked
 uint nodesVisited = 0u;  // BVH nodes this invocation visited
 
-// The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl.
+// The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl (the
+// base tracer's intersect1: brute_force/intersect1.comp itself).
 void trace(ivec2 storePos);
 
 // main() of every intersection kernel: trace this invocation's pixel, then add its work counts

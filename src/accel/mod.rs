@@ -12,8 +12,9 @@
 //! (intersect1) and whether a shadow feeler is blocked (intersect2) — and may rebuild itself
 //! every frame from the freshly transformed scene. In the GLSL, its intersect1 kernel defines
 //! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
-//! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). [`REGISTRY`] lists
-//! every accelerator once.
+//! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). The base tracer's
+//! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
+//! `glsl/common/intersect1_hit.glsl`. [`REGISTRY`] lists every accelerator once.
 
 pub mod brute_force;
 pub mod bvh;
