@@ -299,3 +299,95 @@ fn counts_past_two_to_the_32_carry_into_the_high_word() {
         assert_eq!(got, start + 16 * 64 * per as u64, "from {start:#x}");
     }
 }
+
+/// Primary rays (from the AOVs) whose closest hit lies in an earlier dispatch than a farther
+/// hit, and those whose closest hit lies in a later one, for dispatches of `per` triangles.
+fn hits_across_dispatches(scene: &Scene, frame: &gpgpu_rt::frame::Frame, per: usize) -> [usize; 2] {
+    let tris = scene.world_triangles();
+    let a = frame.aovs.as_ref().unwrap();
+    let mut found = [0usize; 2];
+    for (o, d) in a.ray_origin.iter().zip(&a.ray_direction) {
+        let (o, d) = (Vec3::from(*o), Vec3::from(*d));
+        let hits: Vec<(f32, usize)> = tris
+            .iter()
+            .enumerate()
+            .filter_map(|(i, t)| {
+                gpgpu_rt::reference::intersect_triangle(o, d, t[0], t[1], t[2]).map(|h| (h.0, i))
+            })
+            .collect();
+        let Some(&(t0, id0)) = hits.iter().min_by(|x, y| x.0.total_cmp(&y.0)) else {
+            continue;
+        };
+        let later = |&&(t, i): &&(f32, usize)| t > t0 && i / per > id0 / per;
+        let earlier = |&&(t, i): &&(f32, usize)| t > t0 && i / per < id0 / per;
+        found[0] += hits.iter().any(|h| later(&h)) as usize;
+        found[1] += hits.iter().any(|h| earlier(&h)) as usize;
+    }
+    found
+}
+
+/// The base tracer with the triangles split over several dispatches (what llvmpipe's loop
+/// limit needs, here 1000 triangles per dispatch) renders the same frame as one dispatch and
+/// the CPU reference: the closest hit so far is carried from dispatch to dispatch (intersect1),
+/// a shadow flag set by one dispatch ends the feeler (intersect2). Caught the planted bugs
+/// "the last dispatch dropped" and "t compared without the carried t_min".
+#[test]
+fn split_dispatches_render_the_frame_of_one_dispatch() {
+    let ctx = context();
+    let scene = load("teapot1.toml");
+    let per = 1000;
+    let split_opts = |per: Option<u32>| {
+        let mut o = options(64, 48, 2);
+        o.grid.triangles_per_dispatch = per;
+        o
+    };
+    let split = render_gpu(&ctx, &scene, split_opts(Some(per)));
+    let whole = render_gpu(&ctx, &scene, split_opts(Some(u32::MAX)));
+    // both cases the carry must handle occur: the closest hit before a farther one in a later
+    // dispatch, and the closest hit after a farther one in an earlier dispatch
+    let [later, earlier] = hits_across_dispatches(&scene, &split, per as usize);
+    assert!(later > 100 && earlier > 100, "{later} / {earlier} rays");
+    assert_eq!(split.color, whole.color);
+    assert_eq!(split.stats.triangle_tests, whole.stats.triangle_tests);
+    let (s, w) = (split.aovs.as_ref().unwrap(), whole.aovs.as_ref().unwrap());
+    assert_eq!(s.triangle_id, w.triangle_id);
+    assert_eq!(s.hit_t, w.hit_t);
+    assert_eq!(s.shadow, w.shadow);
+    let cpu = render_cpu(&scene, &split_opts(Some(per)));
+    assert_close(&split, &cpu, "teapot1 in dispatches of 1000 triangles");
+    assert_eq!(
+        split.stats.triangle_tests["intersect1"],
+        cpu.intersect1_tests
+    );
+    assert_eq!(
+        split.stats.triangle_tests["intersect2"],
+        cpu.intersect2_tests
+    );
+}
+
+/// The listings' loops, one triangle per iteration, in one dispatch over the 69451-triangle
+/// bunny: where the implementation ends long loops (llvmpipe, 65535 iterations) the cut is
+/// counted and the frame refused, not silently wrong. Elsewhere the frame is the split one's.
+#[test]
+fn a_loop_the_implementation_cuts_short_is_refused() {
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let mut opts = options(8, 8, 0);
+    opts.grid.triangles_per_dispatch = Some(u32::MAX);
+    let one = ray_tracer(&ctx, &scene, opts.clone()).render(&scene.camera);
+    if ctx.info.renderer.contains("llvmpipe") {
+        let Err(err) = one else {
+            panic!("llvmpipe cuts the loop short: the frame must be refused")
+        };
+        let err = format!("{err:#}");
+        assert!(err.contains("stopped early"), "{err}");
+    } else {
+        opts.grid.triangles_per_dispatch = None;
+        let split = render_gpu(&ctx, &scene, opts);
+        assert_eq!(one.expect("one dispatch").color, split.color);
+    }
+    // the default: split where needed, every triangle tested once per pixel
+    let gpu = render_gpu(&ctx, &scene, options(8, 8, 0));
+    assert_eq!(gpu.stats.triangle_tests["intersect1"], 64 * 69451);
+    assert_eq!(gpu.stats.truncated_rays, 0);
+}

@@ -1,20 +1,13 @@
-// The part of the intersect1 kernel all tracer designs share — Müller 2015, ch. 4.1.2,
-// Listings 13 and 14 — around the closest-hit search of the design (Listing 12 for the base
-// tracer, Listing 22 for the thesis grid, a 3D-DDA for the exact grid), which the including
-// kernel defines before including this file:
+// The intersect1 kernel of the tracer designs with an acceleration structure (thesis grid,
+// exact grid, BVH) — Müller 2015, ch. 4.1.2 — around the closest-hit search of the design
+// (Listing 22 for the thesis grid, a 3D-DDA for the exact grid, a BVH walk), which the
+// including kernel defines before including this file:
 //     void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
 //                     inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
-// It adds its work to the globals below (declared in common/intersect_head.glsl).
-//
-// At the closest hit the vertex normal is interpolated with (u, v) (Listing 13), the colour
-// is taken from the texture through the sampler or interpolated from the vertex colours, and
-// on a reflecting triangle the rayState is raised, the colour weighted and the direction
-// reflected (Listing 14). A miss writes the background colour and ends the ray.
-
-uniform vec4 backgroundColor;
-// 1 in the first pass (primary rays): the first hit is also stored for the AOVs.
-uniform int storePrimaryHit;
-layout(binding = SAMPLER_TEXTURES) uniform sampler2DArray textures;
+// It adds its work to the globals of common/intersect_head.glsl. The evaluation of the hit
+// (Listings 13 and 14) is in common/intersect1_hit.glsl; the base tracer's kernel
+// (brute_force/intersect1.comp, Listing 12) calls it directly.
+#include "intersect1_hit.glsl"
 
 void trace(ivec2 storePos)
 {
@@ -22,11 +15,7 @@ void trace(ivec2 storePos)
     vec4 dirTri = imageLoad(rayDirTexture, storePos);
     float rayState = originState.w;
     if (rayState <= 0.0) {
-        // inactive ray: an empty colour buffer, nothing for shading to add. Ours: weight -1
-        // marks it; the thesis' shading skips an empty colour buffer (ch. 4.1.3, "sofern
-        // dieser nicht leer ist") without saying how it is marked, and a weight of 0 is a
-        // real one (a perfect mirror)
-        imageStore(colorBufferTexture, storePos, vec4(0.0, 0.0, 0.0, -1.0));
+        emptyColorBuffer(storePos);
         return;
     }
     vec3 ro = originState.xyz;
@@ -37,53 +26,7 @@ void trace(ivec2 storePos)
     int triID = -1;
     float hit_u = 0.0, hit_v = 0.0;
     closestHit(storePos, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
-
-    if (storePrimaryHit != 0)
-        imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
-
-    if (triID < 0) {
-        // no hit: the background colour with full weight; the ray leaves the scene
-        imageStore(colorBufferTexture, storePos, vec4(backgroundColor.rgb, 1.0));
-        imageStore(normalTexture, storePos, vec4(0.0));
-        imageStore(rayOriginTexture, storePos, vec4(ro, 0.0));
-        return;
-    }
-
-    // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
-    vec3 direction = rd;
-    float w = 1.0 - hit_u - hit_v;
-    vec3 interpolated_normal = normalize(w * normals[3 * triID].xyz
-                                         + hit_u * normals[3 * triID + 1].xyz
-                                         + hit_v * normals[3 * triID + 2].xyz);
-    // ours: the normal faces the incoming ray (two-sided surfaces)
-    if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
-
-    vec4 mat = material[triMaterial[triID]];
-    vec3 color;
-    if (mat.w >= 0.0) {
-        // textured triangle: interpolated texture coordinates, sampled through the sampler
-        vec2 uv = w * texcoords[3 * triID] + hit_u * texcoords[3 * triID + 1]
-                + hit_v * texcoords[3 * triID + 2];
-        color = textureLod(textures, vec3(uv, mat.w), 0.0).rgb;
-    } else {
-        color = w * colors[3 * triID].rgb + hit_u * colors[3 * triID + 1].rgb
-              + hit_v * colors[3 * triID + 2].rgb;
-    }
-
-    // Listing 14: reflection on the hit triangle?
-    float refl = mat.x;
-    if (refl > 0.0) {
-        rayState += 1.0;
-        direction = reflect(direction, interpolated_normal);
-    }
-    // weight of the hit colour; the reflection gets the rest
-    float weight = 1.0 - refl;
-
-    vec3 hitPoint = ro + t_min * rd;
-    imageStore(rayOriginTexture, storePos, vec4(hitPoint, rayState));
-    imageStore(rayDirTexture, storePos, vec4(direction, float(triID)));
-    imageStore(normalTexture, storePos, vec4(interpolated_normal, 0.0));
-    imageStore(colorBufferTexture, storePos, vec4(color, weight));
+    evaluateHit(storePos, ro, rd, rayState, t_min, triID, hit_u, hit_v);
 }
 
 void main()

@@ -16,6 +16,18 @@
 
 uniform int lightSource;
 
+// Is this light's shadow flag already set at storePos? (For a kernel that splits its search
+// over several dispatches: brute_force/intersect2.comp.)
+bool shadowFlagSet(ivec2 storePos)
+{
+#if SHADOW_BITS
+    return (imageLoad(shadowTexture, storePos)[lightSource >> 5]
+            & (1u << uint(lightSource & 31))) != 0u;
+#else
+    return imageLoad(shadowTexture, storePos)[lightSource] > 0.5;
+#endif
+}
+
 void trace(ivec2 storePos)
 {
     vec4 originState = imageLoad(rayOriginTexture, storePos);

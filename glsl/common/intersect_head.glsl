@@ -17,7 +17,8 @@ uint nodesVisited = 0u;  // BVH nodes this invocation visited
 uint cloudJumps = 0u;    // proximity-cloud jumps (exact grid, exact_grid/dda.glsl)
 uint cellsSkipped = 0u;  // voxels those jumps passed over
 
-// The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl.
+// The pixel's work: defined by common/intersect1_main.glsl or common/intersect2_main.glsl (the
+// base tracer's intersect1: brute_force/intersect1.comp itself).
 void trace(ivec2 storePos);
 
 // main() of every intersection kernel: trace this invocation's pixel, then add its work counts

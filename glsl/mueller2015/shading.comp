@@ -30,7 +30,7 @@ void main()
     ivec2 storePos = pixelPosition();
     if (!insideImage(storePos)) return;
     vec4 pColor = imageLoad(colorBufferTexture, storePos);
-    // empty colour buffer (weight -1, ours: see common/intersect1_main.glsl): the ray was
+    // empty colour buffer (weight -1, ours: see common/intersect1_hit.glsl): the ray was
     // inactive in this pass
     if (pColor.w < 0.0) return;
     vec4 originState = imageLoad(rayOriginTexture, storePos);

@@ -12,8 +12,9 @@
 //! (intersect1) and whether a shadow feeler is blocked (intersect2) — and may rebuild itself
 //! every frame from the freshly transformed scene. In the GLSL, its intersect1 kernel defines
 //! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
-//! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). [`REGISTRY`] lists
-//! every accelerator once.
+//! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). The base tracer's
+//! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
+//! `glsl/common/intersect1_hit.glsl`. [`REGISTRY`] lists every accelerator once.
 
 pub mod brute_force;
 pub mod bvh;
@@ -183,6 +184,10 @@ pub struct GridOptions {
     /// The streaming tracer: shadow rays as the naive closest-hit search the paper's shadow
     /// optimisation improves on (`--stream-naive-shadows`).
     pub stream_naive_shadows: bool,
+    /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
+    /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
+    /// split only where the GL implementation ends long loops.
+    pub triangles_per_dispatch: Option<u32>,
 }
 
 impl Default for GridOptions {
@@ -197,6 +202,7 @@ impl Default for GridOptions {
             stream_steps: 64,
             stream_max_calls: 10_000,
             stream_naive_shadows: false,
+            triangles_per_dispatch: None,
         }
     }
 }

@@ -113,6 +113,7 @@ impl GridArgs {
             stream_steps: self.stream_steps,
             stream_max_calls: self.stream_max_calls,
             stream_naive_shadows: self.stream_naive_shadows,
+            triangles_per_dispatch: None,
         }
     }
 }
