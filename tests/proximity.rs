@@ -7,6 +7,7 @@
 mod common;
 
 use common::*;
+use glam::UVec3;
 use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
@@ -15,6 +16,7 @@ use gpgpu_rt::pipeline::raytrace::RenderOptions;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::exact_grid::ExactGrid as Twin;
 use gpgpu_rt::reference::grid::GridMapping;
+use gpgpu_rt::reference::proximity::{chebyshev_distances, EXACT_GRID_CLOUD_CAP};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
@@ -78,7 +80,8 @@ fn twin(scene: &Scene, n: u32, clouds: bool) -> Twin {
 
 /// The distance pass on the GPU equals the CPU transform of the same lists, voxel by voxel,
 /// on every adversarial scene, at resolutions odd and even, small and large (N = 1: a single
-/// non-empty voxel; the corners scene's N = 16 has distances up to 7), and on a real scene.
+/// non-empty voxel; the corners scene's N = 16 has distances up to 7, N = 24 beyond
+/// [`EXACT_GRID_CLOUD_CAP`], which the pass caps), and on a real scene.
 #[test]
 fn gpu_distances_equal_the_cpu_transform() {
     let ctx = context();
@@ -86,7 +89,7 @@ fn gpu_distances_equal_the_cpu_transform() {
     let mut all = scenes(dir.path());
     all.push(("cow", load("cow.toml")));
     for (name, scene) in &all {
-        for n in [1, 2, 5, 8, 13, 16] {
+        for n in [1, 2, 5, 8, 13, 16, 24] {
             let mut t = ray_tracer(&ctx, scene, grid_options(8, 8, n, true));
             t.render(&scene.camera).unwrap();
             let g = t
@@ -106,6 +109,16 @@ fn gpu_distances_equal_the_cpu_transform() {
             );
             if *name == "corners" && n == 16 {
                 assert!(want.iter().any(|&d| d >= 6), "{name}: no far voxel");
+            }
+            if *name == "corners" && n == 24 {
+                // the corners are farther apart than the cap: the pass caps them, as the twin
+                let filled: Vec<bool> = want.iter().map(|&d| d == 0).collect();
+                let uncapped = chebyshev_distances(UVec3::splat(n), &filled);
+                assert!(
+                    uncapped.iter().any(|&d| d > EXACT_GRID_CLOUD_CAP),
+                    "{name}: cap unused"
+                );
+                assert_eq!(want.iter().max(), Some(&EXACT_GRID_CLOUD_CAP));
             }
         }
     }

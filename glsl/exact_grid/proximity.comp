@@ -9,8 +9,10 @@
 // rebuilt per frame on the GPU, so the L∞ transform runs here in its separable form, three
 // 1D passes along x, y and z, each d'(i) = min_j max(|i - j|, d(j)) over the voxel's line
 // (exact for L∞: the max of the per-axis distances is minimised axis by axis). Distances are
-// bounded by voxel_amount, the value of every voxel of an empty grid (as the CPU's `far`).
-// Pass 0 reads the counts (distance 0 where a voxel has references, voxel_amount else).
+// capped at cloudCap (reference::proximity::EXACT_GRID_CLOUD_CAP, at most voxel_amount): a
+// voxel scans outward only while |i - j| < its distance so far, so the cap bounds the pass;
+// min(d, cap) is still safe and the passes give it exactly.
+// Pass 0 reads the counts (distance 0 where a voxel has references, cloudCap else).
 layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;
 
 #include "../common/grid.glsl"
@@ -21,10 +23,11 @@ layout(std430, binding = SSBO_DIST_OUT) writeonly buffer DistOut { uint distOut[
 
 uniform int axis;       // 0, 1, 2: the pass' axis
 uniform int fromCounts; // 1 (the x pass): the input is voxelCount
+uniform int cloudCap;   // the largest distance
 
 uint inputAt(int id)
 {
-    if (fromCounts != 0) return voxelCount[id] > 0u ? 0u : uint(voxel_amount);
+    if (fromCounts != 0) return voxelCount[id] > 0u ? 0u : uint(cloudCap);
     return distIn[id];
 }
 

@@ -19,6 +19,7 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
+use crate::reference::proximity::EXACT_GRID_CLOUD_CAP;
 use crate::reference::{self, grid::GridMapping, CpuAccelerator};
 use crate::scene::Scene;
 
@@ -185,6 +186,7 @@ impl ExactGrid {
             output.bind(gl, ssbo::DIST_OUT);
             k.set_i32("axis", axis as i32);
             k.set_i32("fromCounts", (axis == 0) as i32);
+            k.set_i32("cloudCap", EXACT_GRID_CLOUD_CAP.min(self.frame.n) as i32);
             k.dispatch_1d(f.timers, groups);
         }
     }

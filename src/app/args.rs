@@ -8,7 +8,7 @@ use gpgpu_rt::limits;
 use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions};
 use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Debug, Clone)]
 pub struct GpuArgs {
     /// EGL device index (default: the first that gives an OpenGL 4.5 core context).
     #[arg(long)]

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::grid::{GridMapping, GridSpace, Walk};
-use super::proximity::{cells_between, chebyshev_distances};
+use super::proximity::{cells_between, chebyshev_distances, EXACT_GRID_CLOUD_CAP};
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 /// The walks' counts, summed over every ray traced (shared with whoever reads them, as the
@@ -63,11 +63,13 @@ impl ExactGrid {
         }
     }
 
-    /// The distances of the voxels to the nearest non-empty one (`proximity.comp`'s result).
+    /// The distances of the voxels to the nearest non-empty one, at most
+    /// [`EXACT_GRID_CLOUD_CAP`] (`proximity.comp`'s result).
     pub fn distances(&self) -> Vec<u32> {
         let filled: Vec<bool> = self.lists.iter().map(|l| !l.is_empty()).collect();
         let n = self.space.n;
-        chebyshev_distances(glam::UVec3::splat(n), &filled)
+        let d = chebyshev_distances(glam::UVec3::splat(n), &filled);
+        d.into_iter().map(|d| d.min(EXACT_GRID_CLOUD_CAP)).collect()
     }
 
     /// Walk with proximity-cloud jumps.

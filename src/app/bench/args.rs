@@ -109,6 +109,8 @@ pub struct BenchArgs {
     pub grid: GridArgs,
     #[command(flatten)]
     pub wagner: WagnerArgs,
+    #[command(flatten)]
+    pub klee: KleeArgs,
     /// How the scene turns: its objects (default) or the camera around them.
     #[arg(long, value_enum, default_value = "objects")]
     pub rotate: Rotation,
@@ -119,12 +121,8 @@ pub struct BenchArgs {
     /// Folder with the scene files (default: ./scenes, else the source tree's).
     #[arg(long, value_name = "DIR")]
     pub scenes: Option<PathBuf>,
-    /// EGL device index (default: the first that gives an OpenGL 4.5 core context).
-    #[arg(long)]
-    pub device: Option<usize>,
-    /// Load the GLSL kernels from this directory instead of the copies built into the binary.
-    #[arg(long, value_name = "DIR")]
-    pub glsl_dir: Option<PathBuf>,
+    #[command(flatten)]
+    pub gpu: crate::args::GpuArgs,
     /// No progress bar (it shows only on a terminal anyway).
     #[arg(long)]
     pub quiet: bool,
@@ -191,6 +189,16 @@ pub struct GridArgs {
     pub ray_array_length: Option<u32>,
 }
 
+/// The options of the Klee 2016 protocols.
+#[derive(clap::Args, Debug, Clone)]
+pub struct KleeArgs {
+    /// The readings of the thesis' N-tree depth to measure in klee-table2, klee-table3 and
+    /// klee-fig12, as levels counting the root, comma-separated: 3 (reading A), 4 (reading B,
+    /// the cascade; its bunny tree takes minutes to build on one core). Default: both.
+    #[arg(long, value_delimiter = ',', value_name = "3,4")]
+    pub ntree_levels: Option<Vec<u32>>,
+}
+
 /// The options of the Wagner 2018 protocols.
 #[derive(clap::Args, Debug, Clone)]
 pub struct WagnerArgs {
@@ -253,6 +261,13 @@ impl BenchArgs {
                 bail!(
                     "--levels takes subdivision levels 1 to {MAX_LEVEL} of the square (2·4^L triangles), \
                      e.g. --levels 1,3,5"
+                );
+            }
+        }
+        if let Some(l) = &self.klee.ntree_levels {
+            if l.is_empty() || l.iter().any(|l| !(3..=4).contains(l)) {
+                bail!(
+                    "--ntree-levels takes 3 (reading A) and/or 4 (reading B), e.g. --ntree-levels 3"
                 );
             }
         }

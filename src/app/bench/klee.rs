@@ -118,6 +118,13 @@ type Memory = (usize, usize);
 /// A row and the shadow values of its pixels.
 type Measured1 = (Row, Vec<f32>);
 
+/// The readings of the N-tree depth to measure: `--ntree-levels`, or both [`READINGS`].
+fn readings(bench: &Bench) -> Vec<(&'static str, u32)> {
+    let chosen = bench.args.klee.ntree_levels.as_ref();
+    let wanted = |r: &(&str, u32)| chosen.is_none_or(|c| c.contains(&r.1));
+    READINGS.into_iter().filter(wanted).collect()
+}
+
 /// The reading's letter for `levels` (see [`READINGS`]).
 fn reading(levels: u32) -> &'static str {
     READINGS.iter().find(|r| r.1 == levels).map_or("?", |r| r.0)
@@ -183,7 +190,7 @@ const TABLE2_MODES: [(&str, ShadowMode, f64); 4] = [
 fn table2(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let runs = TABLE2_MODES.map(|(name, mode, _)| (name, mode, 4));
     let (mut rows, mut lines, mut savings) = (Vec::new(), Vec::new(), Vec::new());
-    for (letter, levels) in READINGS {
+    for (letter, levels) in readings(bench) {
         let (measured, (tree_b, ls_b)) = bunny_on_cpu(bench, s, levels, TABLE2_FRAMES, &runs)?;
         let exact = &measured[0].1;
         for ((row, values), (_, _, published)) in measured.iter().zip(TABLE2_MODES) {
@@ -302,7 +309,7 @@ fn table3(bench: &mut Bench, s: Sizing) -> Result<Measured> {
         })
         .collect();
     let (mut rows, mut lines) = (Vec::new(), Vec::new());
-    for (_, levels) in READINGS {
+    for (_, levels) in readings(bench) {
         let (measured, memory) = bunny_on_cpu(bench, s, levels, 1, &modes)?;
         let measured: Vec<Row> = measured.into_iter().map(|(r, _)| r).collect();
         lines.extend(table3_lines(&measured, memory));
@@ -368,7 +375,7 @@ pub const KLEE_FIG12: Protocol = Protocol {
 fn fig12(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let mut rows = Vec::new();
     let mut lines = Vec::new();
-    for (letter, levels) in READINGS {
+    for (letter, levels) in readings(bench) {
         let mut st = Setup::new(bench, BUNNY, s, levels)?;
         let first = rows.len();
         for k in SAMPLES {

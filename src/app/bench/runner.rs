@@ -64,7 +64,7 @@ impl Bench {
                 .with_context(|| format!("cannot create the output folder {}", out.display()))?;
         }
         let gpu = match measuring {
-            true => Some(Gpu::open(args.device, args.glsl_dir.clone())?),
+            true => Some(Gpu::open(args.gpu.device, args.gpu.glsl_dir.clone())?),
             false => None,
         };
         let machine = match &gpu {
