@@ -276,22 +276,15 @@ bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
 }
 
 // Algorithm 2: isIntersection. deactivate: at the last depth with line spaces a set bit is a
-// hit and deactivates the ray; elsewhere the first set bit returns true (descend). Four rays
-// per loop iteration (see loopLimit).
+// hit and deactivates the ray; elsewhere the first set bit returns true (descend).
 bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 {
     bool found_intersection = false;
     float te = tEnd(level);
-    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r += 4) {
-        bool f0 = lineSpaceRay(r, node, childStart, te, deactivate);
-        if (f0 && !deactivate) return true;
-        bool f1 = lineSpaceRay(r + 1, node, childStart, te, deactivate);
-        if (f1 && !deactivate) return true;
-        bool f2 = lineSpaceRay(r + 2, node, childStart, te, deactivate);
-        if (f2 && !deactivate) return true;
-        bool f3 = lineSpaceRay(r + 3, node, childStart, te, deactivate);
-        if (f3 && !deactivate) return true;
-        found_intersection = found_intersection || f0 || f1 || f2 || f3;
+    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
+        bool found = lineSpaceRay(r, node, childStart, te, deactivate);
+        if (found && !deactivate) return true;
+        found_intersection = found_intersection || found;
     }
     return found_intersection;
 }
@@ -316,7 +309,7 @@ bool occludes(uint t, vec3 ro, vec3 rd)
     return uu >= 0.0 && vv >= 0.0 && uu + vv <= 1.0 && tt > 0.0 && tt < 1.0;
 }
 
-// the exact triangle tests of a leaf for ray r, four triangles per loop iteration
+// the exact triangle tests of a leaf for ray r
 void leafRay(int r, uvec2 node, vec3 childStart, float te)
 {
     if (r >= rayEnd || !shaft.active_rays[r]) return;
@@ -326,11 +319,8 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     vec3 rd = samplePoint(r) - originWorld;
     uint off = node.r >> 2;
     uint count = node.g;
-    for (uint i = 0u; i < count && WITHIN_BUDGET; i += 4u) {
-        if (occludes(leafTriangles[off + i], originWorld, rd)
-            || (i + 1u < count && occludes(leafTriangles[off + i + 1u], originWorld, rd))
-            || (i + 2u < count && occludes(leafTriangles[off + i + 2u], originWorld, rd))
-            || (i + 3u < count && occludes(leafTriangles[off + i + 3u], originWorld, rd))) {
+    for (uint i = 0u; i < count && WITHIN_BUDGET; i++) {
+        if (occludes(leafTriangles[off + i], originWorld, rd)) {
             shaft.active_rays[r] = false;
             active_rays--;
             return;
@@ -338,17 +328,11 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     }
 }
 
-// the exact triangle tests of a leaf for every active ray crossing it, four rays per loop
-// iteration (see loopLimit)
+// the exact triangle tests of a leaf for every active ray crossing it
 void leafTests(uvec2 node, vec3 childStart, int level)
 {
     float te = tEnd(level);
-    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r += 4) {
-        leafRay(r, node, childStart, te);
-        leafRay(r + 1, node, childStart, te);
-        leafRay(r + 2, node, childStart, te);
-        leafRay(r + 3, node, childStart, te);
-    }
+    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) leafRay(r, node, childStart, te);
 }
 
 // the slices [first, last] the packet crosses in a node at stack depth d
