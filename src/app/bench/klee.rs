@@ -207,18 +207,8 @@ fn table2(bench: &mut Bench, s: Sizing) -> Result<Measured> {
         }
         let t = |i: usize| measured[i].0.m.min_s;
         savings.push((letter, 1.0 - t(2) / t(0), 1.0 - t(3) / t(1)));
-        lines.push(vec![
-            format!("memory ({letter}): node pool + line spaces"),
-            String::new(),
-            format!(
-                "{:.1} MB + {:.1} MB",
-                tree_b as f64 / 1e6,
-                ls_b as f64 / 1e6
-            ),
-            String::new(),
-            String::new(),
-            String::new(),
-        ]);
+        let label = format!("memory ({letter}): node pool + line spaces");
+        lines.push(memory_line(label, (tree_b, ls_b), 6, 2));
         rows.extend(measured.into_iter().map(|(r, _)| r));
     }
     let header = [
@@ -352,15 +342,31 @@ fn table3_lines(rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>
             ]
         })
         .collect();
-    let mut memory = vec![String::new(); 8];
-    memory[0] = format!("memory ({letter})");
-    memory[4] = format!(
+    lines.push(memory_line(
+        format!("memory ({letter})"),
+        (tree_b, ls_b),
+        8,
+        4,
+    ));
+    lines
+}
+
+/// A table line of `width` cells: `label`, and in cell `at` the bytes of the N-tree's node pool
+/// and line spaces ("1.6 MB + 3.2 MB").
+fn memory_line(
+    label: String,
+    (tree_b, ls_b): (usize, usize),
+    width: usize,
+    at: usize,
+) -> Vec<String> {
+    let mut line = vec![String::new(); width];
+    line[0] = label;
+    line[at] = format!(
         "{:.1} MB + {:.1} MB",
         tree_b as f64 / 1e6,
         ls_b as f64 / 1e6
     );
-    lines.push(memory);
-    lines
+    line
 }
 
 pub const KLEE_FIG12: Protocol = Protocol {
@@ -433,14 +439,12 @@ fn fig12_lines(letter: &str, rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Ve
                 .collect()
         })
         .collect();
-    let mut memory = vec![String::new(); 7];
-    memory[0] = format!("memory ({letter})");
-    memory[1] = format!(
-        "{:.1} MB + {:.1} MB",
-        tree_b as f64 / 1e6,
-        ls_b as f64 / 1e6
-    );
-    lines.push(memory);
+    lines.push(memory_line(
+        format!("memory ({letter})"),
+        (tree_b, ls_b),
+        7,
+        1,
+    ));
     lines
 }
 
