@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use gpgpu_rt::frame::{Aovs, FrameStats};
-use gpgpu_rt::gl::ShaderSource;
+use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::linespace::ShadowCounts;
@@ -238,15 +238,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
     let scene = common::load("bunny_area.toml");
     let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = SoftShadowRenderer::with_tree(
-        ctx.gl.clone(),
-        &ctx.info,
-        &scene,
-        &shaders,
-        opts(ShadowMode::Exact, 3, 64),
-        tree,
-    )
-    .unwrap();
+    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 64), tree);
     // the 3D texture holds exactly the packed layout
     assert_eq!(r.read_linespace_texture(), r.scene.packed.texels);
     let mut shadows = Vec::new();
@@ -407,18 +399,32 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
 /// Hit pixels (indices into the frame) whose GPU shadow value differs from the CPU
 /// implementation's for the same G-buffer point.
 fn cpu_mismatches(r: &SoftShadowRenderer, f: &SoftFrame, mode: ShadowMode, hit: &[usize]) -> usize {
-    let cpu = r.cpu();
-    hit.iter()
-        .filter(|&&i| {
-            let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
-            let (s, _) = cpu.shadow(
-                mode,
-                Vec3::new(p[0], p[1], p[2]),
-                Vec3::new(n[0], n[1], n[2]).normalize(),
-            );
-            (s - f.shadow[i]).abs() > 1e-6
-        })
+    differing(f, hit, &cpu_frame(r, f, mode, hit).0)
+}
+
+/// How many of the `hit` pixels' GPU shadow values differ from `cpu` (in `hit`'s order).
+fn differing(f: &SoftFrame, hit: &[usize], cpu: &[f32]) -> usize {
+    let off = hit.iter().zip(cpu);
+    off.filter(|(&i, s)| (f.shadow[i] - **s).abs() > 1e-6)
         .count()
+}
+
+/// The pixels whose G-buffer holds geometry.
+fn hit_pixels(f: &SoftFrame) -> Vec<usize> {
+    (0..f.shadow.len())
+        .filter(|&i| f.gbuffer_position[i][3] > 0.0)
+        .collect()
+}
+
+/// A soft-shadow renderer on `scene` with the N-tree `tree`, built once for several modes.
+fn tree_renderer(
+    ctx: &GlContext,
+    scene: &Scene,
+    shaders: &ShaderSource,
+    o: SoftShadowOptions,
+    tree: NTree,
+) -> SoftShadowRenderer {
+    SoftShadowRenderer::with_tree(ctx.gl.clone(), &ctx.info, scene, shaders, o, tree).unwrap()
 }
 
 /// A floor under a 1×1 area light at y = 2, a small occluder at y = 1 between them, and a
@@ -457,15 +463,7 @@ fn occluders_beyond_the_area_light_shadow_nothing() {
     let ctx = common::context();
     let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = SoftShadowRenderer::with_tree(
-        ctx.gl.clone(),
-        &ctx.info,
-        &scene,
-        &shaders,
-        opts(ShadowMode::Exact, 3, 48),
-        tree,
-    )
-    .unwrap();
+    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 48), tree);
     for mode in [
         ShadowMode::Exact,
         ShadowMode::Linespace,
@@ -473,9 +471,7 @@ fn occluders_beyond_the_area_light_shadow_nothing() {
     ] {
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
-        let hit: Vec<usize> = (0..f.shadow.len())
-            .filter(|&i| f.gbuffer_position[i][3] > 0.0)
-            .collect();
+        let hit: Vec<usize> = hit_pixels(&f);
         let off = cpu_mismatches(&r, &f, mode, &hit);
         assert_eq!(off, 0, "{mode:?}: GPU vs CPU");
         if mode != ShadowMode::Exact {
@@ -733,15 +729,7 @@ fn table2_variants_as_defined_gpu_equals_twin() {
     let scene = common::load("bunny_area.toml");
     let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = SoftShadowRenderer::with_tree(
-        ctx.gl.clone(),
-        &ctx.info,
-        &scene,
-        &shaders,
-        opts(ShadowMode::Exact, 3, 64),
-        tree,
-    )
-    .unwrap();
+    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 64), tree);
     let mut frames = Vec::new();
     for mode in [
         ShadowMode::Exact,
@@ -750,19 +738,10 @@ fn table2_variants_as_defined_gpu_equals_twin() {
     ] {
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
-        let hit: Vec<usize> = (0..f.shadow.len())
-            .filter(|&i| f.gbuffer_position[i][3] > 0.0)
-            .collect();
+        let hit: Vec<usize> = hit_pixels(&f);
         let (cpu, counts) = cpu_frame(&r, &f, mode, &hit);
-        let off = hit
-            .iter()
-            .zip(&cpu)
-            .filter(|(&i, s)| (f.shadow[i] - **s).abs() > 1e-6);
-        assert_eq!(
-            off.count(),
-            0,
-            "{mode:?}: pixels differ between GPU and twin"
-        );
+        let off = differing(&f, &hit, &cpu);
+        assert_eq!(off, 0, "{mode:?}: pixels differ between GPU and twin");
         assert_eq!(
             f.stats.total_triangle_tests(),
             counts.triangle_tests,
@@ -817,15 +796,13 @@ fn four_levels_query_the_cascade_gpu_equals_twin() {
     let shaders = ShaderSource::default();
     for levels in [3, 4] {
         let tree = NTree::build(&scene.world_triangles(), 5, levels).unwrap();
-        let mut r = SoftShadowRenderer::with_tree(
-            ctx.gl.clone(),
-            &ctx.info,
+        let mut r = tree_renderer(
+            &ctx,
             &scene,
             &shaders,
             opts(ShadowMode::Linespace, 2, 32),
             tree,
-        )
-        .unwrap();
+        );
         for mode in [
             ShadowMode::Linespace,
             ShadowMode::Exact,
@@ -833,15 +810,10 @@ fn four_levels_query_the_cascade_gpu_equals_twin() {
         ] {
             r.reconfigure(&shaders, mode, 2, 2).unwrap();
             let f = render(&mut r, &scene.camera).unwrap();
-            let hit: Vec<usize> = (0..f.shadow.len())
-                .filter(|&i| f.gbuffer_position[i][3] > 0.0)
-                .collect();
+            let hit: Vec<usize> = hit_pixels(&f);
             let (cpu, counts) = cpu_frame(&r, &f, mode, &hit);
-            let off = hit
-                .iter()
-                .zip(&cpu)
-                .filter(|(&i, s)| (f.shadow[i] - **s).abs() > 1e-6);
-            assert_eq!(off.count(), 0, "{levels} levels, {mode:?}: GPU vs twin");
+            let off = differing(&f, &hit, &cpu);
+            assert_eq!(off, 0, "{levels} levels, {mode:?}: GPU vs twin");
             assert_eq!(
                 f.stats.events["linespace_lookups"], counts.linespace_lookups,
                 "{levels} levels, {mode:?}: line-space lookups GPU vs twin"

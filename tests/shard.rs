@@ -6,6 +6,8 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::{Command, Output};
 
+mod common;
+
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 
 /// Three base-tracer configurations (thesis-5.1) and one whole protocol (klee-table2 at the
@@ -26,12 +28,7 @@ const RUN: [&str; 12] = [
 ];
 
 fn bench(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .arg("bench")
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run gpgpu-rt")
+    common::run(&[&["bench"], args].concat())
 }
 
 fn run_into(out: &Path, extra: &[&str]) -> Output {

@@ -176,6 +176,7 @@ impl ExactGrid {
         let groups = (self.frame.voxels() as u32).div_ceil(128);
         k.use_program();
         self.frame.set_uniforms(k);
+        k.set_i32("cloudCap", EXACT_GRID_CLOUD_CAP.min(self.frame.n) as i32);
         let passes = [
             (&l.voxel_dist_tmp, &l.voxel_dist),
             (&l.voxel_dist, &l.voxel_dist_tmp),
@@ -186,7 +187,6 @@ impl ExactGrid {
             output.bind(gl, ssbo::DIST_OUT);
             k.set_i32("axis", axis as i32);
             k.set_i32("fromCounts", (axis == 0) as i32);
-            k.set_i32("cloudCap", EXACT_GRID_CLOUD_CAP.min(self.frame.n) as i32);
             k.dispatch_1d(f.timers, groups);
         }
     }

@@ -124,7 +124,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     match bench.mode {
         Mode::List => list(&mut bench),
         Mode::Measure(Some(shard)) => measure_shard(&mut bench, shard, start),
-        _ => report(&mut bench, start),
+        _ => report(&mut bench, start, 0.0),
     }
 }
 
@@ -136,8 +136,9 @@ fn protocols(bench: &Bench) -> Vec<&'static Protocol> {
     ids.into_iter().map(protocol_of).collect()
 }
 
-/// Measure (or replay) every protocol and write `report.md`.
-fn report(bench: &mut Bench, start: Instant) -> Result<()> {
+/// Measure (or replay) every protocol and write `report.md`; its wall time is this run's plus
+/// `earlier_s` (a merge: the shards').
+fn report(bench: &mut Bench, start: Instant, earlier_s: f64) -> Result<()> {
     eprintln!(
         "bench on {} ({}), writing to {}",
         bench.machine.gl_renderer,
@@ -148,7 +149,7 @@ fn report(bench: &mut Bench, start: Instant) -> Result<()> {
         .into_iter()
         .map(|p| run_protocol(p, bench))
         .collect();
-    let wall_s = start.elapsed().as_secs_f64();
+    let wall_s = earlier_s + start.elapsed().as_secs_f64();
     let path = report::write(bench, &sections, wall_s)?;
     eprintln!("wrote {}", path.display());
     let failed: usize = sections.iter().map(|s| s.failures).sum();
@@ -190,7 +191,7 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         let section = run_protocol(p, bench);
         failed += section.failures;
     }
-    let measured = bench
+    let failed_configs = bench
         .measured
         .values()
         .filter(|m| m.error.is_some())
@@ -213,10 +214,10 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         path.display(),
         shard.n
     );
-    if failed + measured > 0 {
+    let failed = failed + failed_configs;
+    if failed > 0 {
         bail!(
-            "{} unit(s) of shard {shard} failed; see {}",
-            failed + measured,
+            "{failed} unit(s) of shard {shard} failed; see {}",
             path.display()
         );
     }
@@ -249,7 +250,7 @@ fn merge(m: &MergeArgs) -> Result<()> {
         .collect();
     bench.contributors.sort_by_key(|(s, _)| s.k);
     let wall: f64 = shards.iter().map(|(s, _)| s.wall_s).sum();
-    report(&mut bench, start - std::time::Duration::from_secs_f64(wall))
+    report(&mut bench, start, wall)
 }
 
 /// Do `a` and `b` name the same folder?
