@@ -9,6 +9,8 @@
 // llvmpipe, see loopLimit in common/intersect.glsl; src/accel/brute_force.rs). The closest hit
 // so far goes from one dispatch to the next in the colour buffer (which only the last one
 // writes otherwise); the dispatch that ends with the last triangle evaluates it.
+// the first of the dispatches counts the ray (raysTraced, common/intersect_head.glsl)
+#define COUNTS_RAY (firstTriangle == 0)
 #include "../common/intersect_head.glsl"
 #include "../common/intersect1_hit.glsl"
 
@@ -26,6 +28,7 @@ void trace(ivec2 storePos)
         emptyColorBuffer(storePos);
         return;
     }
+    raysTraced = uint(COUNTS_RAY);
     vec3 ro = originState.xyz;
     vec3 rd = dirTri.xyz;
     int lastTriID = int(dirTri.w);

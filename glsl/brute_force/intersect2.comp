@@ -6,6 +6,8 @@
 // (firstTriangle <= i < endTriangle) where the GL implementation ends long loops (loopLimit in
 // common/intersect.glsl). The shadow flag carries the result from one dispatch to the next: it
 // is only ever set, so a feeler whose flag a dispatch before set is done.
+// the first of the dispatches counts the feeler (raysTraced, common/intersect_head.glsl)
+#define COUNTS_RAY (firstTriangle == 0)
 #include "../common/intersect_head.glsl"
 
 // this dispatch's triangles (ours): firstTriangle <= i < endTriangle; one dispatch: 0 and

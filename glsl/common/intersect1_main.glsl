@@ -18,6 +18,7 @@ void trace(ivec2 storePos)
         emptyColorBuffer(storePos);
         return;
     }
+    raysTraced = uint(COUNTS_RAY);
     vec3 ro = originState.xyz;
     vec3 rd = dirTri.xyz;
     int lastTriID = int(dirTri.w);

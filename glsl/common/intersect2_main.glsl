@@ -42,7 +42,10 @@ void trace(ivec2 storePos)
 
     // light in the back half-space of the hit point: shadow without a test
     bool shadow = dot(n, rd) <= 0.0;
-    if (!shadow) shadow = occluded(storePos, ro, rd, lightDistance, lastTriID);
+    if (!shadow) {
+        raysTraced = uint(COUNTS_RAY); // ours: the feelers traced, per ray kind
+        shadow = occluded(storePos, ro, rd, lightDistance, lastTriID);
+    }
 
     // set the shadow flag if needed
     if (shadow) {

@@ -249,6 +249,9 @@ pub fn stats_doc(ctx: &GlContext, scene: &Scene, r: &dyn Renderer, f: &Frame) ->
         "gpu_ms_total": s.total_gpu_ms(),
         "wall_ms": s.wall_ms,
     });
+    if !s.ray_kinds.is_empty() {
+        doc["ray_kinds"] = json!(s.ray_kinds);
+    }
     for (k, v) in r.settings() {
         doc[k] = v;
     }

@@ -26,6 +26,8 @@ pub struct GlInfo {
     pub egl_device: usize,
     pub egl_device_name: String,
     pub max_ssbo_block_size: i64,
+    /// GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT: where a bound range of a buffer may start.
+    pub ssbo_offset_alignment: i32,
     pub max_texture_size: i32,
     pub max_3d_texture_size: i32,
     pub max_compute_work_group_count: [i32; 3],
@@ -171,6 +173,7 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
             egl_device: device,
             egl_device_name: device_name.to_string(),
             max_ssbo_block_size: gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE),
+            ssbo_offset_alignment: int(glow::SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT),
             max_texture_size: int(glow::MAX_TEXTURE_SIZE),
             max_3d_texture_size: int(glow::MAX_3D_TEXTURE_SIZE),
             max_compute_work_group_count: [

@@ -71,6 +71,21 @@ impl Ssbo {
         unsafe { gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, binding, Some(self.buffer)) };
     }
 
+    /// Bind `bytes` bytes from `offset` (a multiple of `GlInfo::ssbo_offset_alignment`).
+    pub fn bind_range(&self, gl: &Gl, binding: u32, offset: usize, bytes: usize) {
+        debug_assert!(offset + bytes <= self.bytes);
+        // SAFETY: binding a range inside an existing buffer.
+        unsafe {
+            gl.bind_buffer_range(
+                glow::SHADER_STORAGE_BUFFER,
+                binding,
+                Some(self.buffer),
+                offset as i32,
+                bytes as i32,
+            )
+        };
+    }
+
     /// `glClearBufferData` with a 32-bit value.
     pub fn clear_u32(&self, gl: &Gl, value: u32) {
         // SAFETY: binding an existing buffer.
@@ -389,12 +404,18 @@ pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> 
 /// GPU time per kernel from GL timer queries: a `GL_TIMESTAMP` query (`glQueryCounter`)
 /// before and after every dispatch, differences summed per kernel name when the frame is
 /// resolved. (Timestamps rather than `GL_TIME_ELAPSED`, whose compute-dispatch results Mesa's
-/// llvmpipe does not fill in; both are GL timer queries.)
+/// llvmpipe does not fill in; both are GL timer queries.) Dispatches timed while a ray kind is
+/// set ([`GpuTimers::set_ray_kind`]) are also summed per ray kind.
 #[derive(Default)]
 pub struct GpuTimers {
     free: Vec<glow::Query>,
-    pending: Vec<(&'static str, glow::Query, glow::Query)>,
+    pending: Vec<Pending>,
+    ray_kind: Option<&'static str>,
+    ray_kind_ms: BTreeMap<String, f64>,
 }
+
+/// A timed dispatch: kernel name, ray kind, the queries before and after.
+type Pending = (&'static str, Option<&'static str>, glow::Query, glow::Query);
 
 impl GpuTimers {
     fn query(&mut self, gl: &Gl) -> glow::Query {
@@ -405,6 +426,12 @@ impl GpuTimers {
         }
     }
 
+    /// The kind of rays the dispatches timed from now on trace ("primary", "shadow", ...), or
+    /// `None`: work that is not one kind's (builds, eye-ray generation, shading).
+    pub fn set_ray_kind(&mut self, kind: Option<&'static str>) {
+        self.ray_kind = kind;
+    }
+
     /// Time the GL commands `f` issues under `name`.
     pub fn time<R>(&mut self, gl: &Gl, name: &'static str, f: impl FnOnce() -> R) -> R {
         let (a, b) = (self.query(gl), self.query(gl));
@@ -412,22 +439,33 @@ impl GpuTimers {
         unsafe { gl.query_counter(a, glow::TIMESTAMP) };
         let r = f();
         unsafe { gl.query_counter(b, glow::TIMESTAMP) };
-        self.pending.push((name, a, b));
+        self.pending.push((name, self.ray_kind, a, b));
         r
     }
 
-    /// Wait for all queries and return milliseconds per kernel name.
+    /// Wait for all queries and return milliseconds per kernel name; the milliseconds per ray
+    /// kind wait in [`GpuTimers::take_ray_kind_ms`].
     pub fn resolve(&mut self, gl: &Gl) -> BTreeMap<String, f64> {
         let mut out = BTreeMap::new();
-        for (name, a, b) in std::mem::take(&mut self.pending) {
+        self.ray_kind_ms.clear();
+        for (name, kind, a, b) in std::mem::take(&mut self.pending) {
             let ns = gl
                 .query_result_u64(b)
                 .saturating_sub(gl.query_result_u64(a));
-            *out.entry(name.to_string()).or_insert(0.0) += ns as f64 / 1e6;
+            let ms = ns as f64 / 1e6;
+            *out.entry(name.to_string()).or_insert(0.0) += ms;
+            if let Some(k) = kind {
+                *self.ray_kind_ms.entry(k.to_string()).or_insert(0.0) += ms;
+            }
             self.free.push(a);
             self.free.push(b);
         }
         out
+    }
+
+    /// Milliseconds per ray kind of the frame [`GpuTimers::resolve`] resolved last.
+    pub fn take_ray_kind_ms(&mut self) -> BTreeMap<String, f64> {
+        std::mem::take(&mut self.ray_kind_ms)
     }
 
     pub fn delete(&mut self, gl: &Gl) {
@@ -435,7 +473,7 @@ impl GpuTimers {
         for q in self
             .free
             .drain(..)
-            .chain(pending.into_iter().flat_map(|p| [p.1, p.2]))
+            .chain(pending.into_iter().flat_map(|p| [p.2, p.3]))
         {
             // SAFETY: deleting our own queries.
             unsafe { gl.delete_query(q) };

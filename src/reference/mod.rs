@@ -114,6 +114,10 @@ pub struct ReferenceFrame {
     pub aovs: Aovs,
     pub intersect1_tests: u64,
     pub intersect2_tests: u64,
+    /// Rays traced per kind, in [`crate::frame::RAY_KINDS`] order: primary rays, feelers
+    /// towards the first light and the others (those with N·L > 0: the kernel traces no other),
+    /// reflection rays.
+    pub rays: [u64; 4],
 }
 
 /// Algorithm 1 (Möller–Trumbore without a determinant epsilon), as `glsl/common/intersect.glsl`.
@@ -201,21 +205,23 @@ impl Reference {
         top.lerp(bottom, fy)
     }
 
-    /// The shadow feeler of Listing 15: (in shadow, tests).
-    fn shadowed(&self, p: Vec3, n: Vec3, last: usize, light: Vec3) -> (bool, u64) {
+    /// The shadow feeler of Listing 15: (in shadow, tests, whether it was traced — not when
+    /// the light is behind the surface).
+    fn shadowed(&self, p: Vec3, n: Vec3, last: usize, light: Vec3) -> (bool, u64, bool) {
         let to_light = light - p;
         let dist = to_light.length();
         let rd = to_light / dist;
         if n.dot(rd) <= 0.0 {
-            return (true, 0);
+            return (true, 0, false);
         }
-        self.accel.occluded(&Feeler {
+        let (shadow, tests) = self.accel.occluded(&Feeler {
             ro: p,
             rd,
             light_distance: dist,
             offset: self.shadow_offset,
             last: last as i32,
-        })
+        });
+        (shadow, tests, true)
     }
 
     /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.
@@ -238,6 +244,7 @@ impl Reference {
             }
             let (hit, tests) = self.accel.closest_hit(ro, rd, last);
             out.tests1 += tests;
+            out.rays[if pass == 0 { 0 } else { 3 }] += 1;
             let (temp, weight_in) = match hit {
                 None => {
                     ray_state = 0.0;
@@ -274,9 +281,12 @@ impl Reference {
                     let view = (camera_pos - p).normalize();
                     let mut temp = self.ambient * color;
                     let mut unblocked = 0;
-                    for &(lp, lc) in &self.lights {
-                        let (shadow, tests) = self.shadowed(p, n, id, lp);
+                    for (light, &(lp, lc)) in self.lights.iter().enumerate() {
+                        let (shadow, tests, traced) = self.shadowed(p, n, id, lp);
                         out.tests2 += tests;
+                        if traced {
+                            out.rays[if light == 0 { 1 } else { 2 }] += 1;
+                        }
                         if shadow {
                             continue;
                         }
@@ -338,6 +348,7 @@ impl Reference {
             },
             intersect1_tests: 0,
             intersect2_tests: 0,
+            rays: [0; 4],
         };
         for (p, (o, d)) in pixels {
             frame.color.push(p.color);
@@ -349,6 +360,9 @@ impl Reference {
             frame.aovs.shadow.as_mut().unwrap().push(p.lit);
             frame.intersect1_tests += p.tests1;
             frame.intersect2_tests += p.tests2;
+            for (all, r) in frame.rays.iter_mut().zip(p.rays) {
+                *all += r;
+            }
         }
         frame
     }
@@ -364,6 +378,8 @@ struct PixelResult {
     lit: f32,
     tests1: u64,
     tests2: u64,
+    /// rays traced per kind (see `ReferenceFrame::rays`)
+    rays: [u64; 4],
 }
 
 #[cfg(test)]

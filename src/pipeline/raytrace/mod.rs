@@ -6,6 +6,7 @@
 
 pub mod gpu_scene;
 pub mod images;
+pub mod ray_kinds;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,13 +18,13 @@ use serde_json::json;
 
 use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
+use self::ray_kinds::{Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
     self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
-use crate::gl::resources::{GpuTimers, Ssbo};
-use crate::gl::slots::ssbo;
+use crate::gl::resources::GpuTimers;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::scene::{Camera, CameraRays, Scene};
 
@@ -88,6 +89,8 @@ pub const COUNTERS: &[&str] = &[
     // the exact grid's proximity clouds (reported with --proximity-clouds only)
     "cloud_jumps",
     "empty_cells_skipped",
+    // rays traced by intersect1 and feelers traced by intersect2 (ours: per ray kind)
+    "rays",
 ];
 
 /// The counters that count ray–triangle tests (the rest count events).
@@ -130,7 +133,7 @@ pub struct RayTracer {
     images: RayImages,
     aov_images: Option<AovImages>,
     kernels: Kernels,
-    counters: Ssbo,
+    counters: CounterBanks,
     timers: GpuTimers,
     options: RenderOptions,
     pixels: PixelGrid,
@@ -214,13 +217,7 @@ impl RayTracer {
             height: h,
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
-        let counters = Ssbo::new(
-            &gl,
-            "counters",
-            8 * COUNTERS.len(),
-            None,
-            info.max_ssbo_block_size,
-        )?;
+        let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
             images: RayImages::new(&gl, w, h, options.shadow_flags)?,
             aov_images: options
@@ -286,6 +283,7 @@ impl RayTracer {
             pixels: self.pixels,
             models: &self.models,
         };
+        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         let k = self.accel.closest_hit(&mut f, pass);
         k.set_vec4("backgroundColor", self.lighting.background, 1.0);
         k.set_i32("storePrimaryHit", (pass == 0) as i32);
@@ -295,10 +293,12 @@ impl RayTracer {
         // would inherit the flags of the pass before it)
         self.images.shadow.clear(&self.gl);
         for light in 0..self.lighting.lights {
+            self.counters.bind(f.gl, f.timers, Bank::any_hit(light));
             let k = self.accel.any_hit(&mut f, light);
             k.set_i32("lightSource", light as i32);
             k.dispatch_pixels(f.timers, f.pixels);
         }
+        self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
         let k = &self.kernels.shading;
         k.use_program();
         k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
@@ -309,13 +309,16 @@ impl RayTracer {
 
     /// The counters and timers of the frame, with the accelerator's facts.
     fn frame_stats(&mut self) -> FrameStats {
-        let raw = self.counters.read_u32(&self.gl);
+        let banks = self.counters.read(&self.gl);
+        let gpu_ms = self.timers.resolve(&self.gl);
+        let kind_ms = self.timers.take_ray_kind_ms();
         let mut stats = FrameStats {
-            gpu_ms: self.timers.resolve(&self.gl),
+            gpu_ms,
+            ray_kinds: ray_kinds::ray_kind_stats(&banks, COUNTERS, kind_ms),
             ..Default::default()
         };
         for (i, name) in COUNTERS.iter().enumerate() {
-            let v = super::counter_value(&raw, i);
+            let v = banks.iter().map(|b| b[i]).sum();
             if TRIANGLE_TEST_COUNTERS.contains(name) {
                 stats.triangle_tests.insert(name.to_string(), v);
             } else if *name == "truncated_rays" {
@@ -350,8 +353,7 @@ impl Renderer for RayTracer {
         // the scene data is transformed into the SSBOs at the start of every frame
         self.scene.transform(&gl, &mut self.timers, &self.models);
         self.scene.bind(&gl);
-        self.counters.bind(&gl, ssbo::COUNTERS);
-        self.counters.clear_u32(&gl, 0);
+        self.counters.clear(&gl, &mut self.timers);
         self.accel.build(&mut FrameContext {
             gl: &self.gl,
             timers: &mut self.timers,

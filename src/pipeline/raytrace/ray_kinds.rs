@@ -1,0 +1,152 @@
+//! The kinds of rays the ray tracer counts and times apart (ours; issue 15's `accel-compare`):
+//! primary rays (pass 0's intersect1), shadow feelers towards the first light and towards the
+//! others (intersect2, every pass), and reflection rays (intersect1 of passes 1…REFL_DEPTH).
+//!
+//! The counter buffer holds one bank of [`super::COUNTERS`] per kind and one for the rest of
+//! the frame (the accelerator's build, eye rays, shading). Before each dispatch the host binds
+//! the kind's bank to `SSBO_COUNTERS` (`glBindBufferRange`), so the kernels — which know
+//! nothing of kinds — add to it; the frame's totals are the sums over the banks. The GPU timers
+//! are told the kind the same way ([`GpuTimers::set_ray_kind`]).
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+
+use crate::frame::{RayKindStats, RAY_KINDS};
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::slots::ssbo;
+use crate::gl::{Gl, GlInfo};
+
+/// A bank of the counter buffer: the work of one kind of rays, or of none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bank {
+    /// Work that is not one kind of rays': the build, eye-ray generation, shading.
+    Frame,
+    Primary,
+    /// Shadow feelers towards light 0.
+    ShadowFirstLight,
+    /// Shadow feelers towards lights 1…n−1.
+    ShadowOtherLights,
+    Reflection,
+}
+
+/// The banks in buffer order.
+pub const BANKS: [Bank; 5] = [
+    Bank::Frame,
+    Bank::Primary,
+    Bank::ShadowFirstLight,
+    Bank::ShadowOtherLights,
+    Bank::Reflection,
+];
+
+impl Bank {
+    /// The kind's name in `FrameStats::ray_kinds`; `None` for [`Bank::Frame`].
+    pub fn ray_kind(self) -> Option<&'static str> {
+        match self {
+            Bank::Frame => None,
+            Bank::Primary => Some(RAY_KINDS[0]),
+            Bank::ShadowFirstLight => Some(RAY_KINDS[1]),
+            Bank::ShadowOtherLights => Some(RAY_KINDS[2]),
+            Bank::Reflection => Some(RAY_KINDS[3]),
+        }
+    }
+
+    /// The bank of the closest-hit search of `pass`.
+    pub fn closest_hit(pass: u32) -> Bank {
+        match pass {
+            0 => Bank::Primary,
+            _ => Bank::Reflection,
+        }
+    }
+
+    /// The bank of the feelers towards `light`.
+    pub fn any_hit(light: usize) -> Bank {
+        match light {
+            0 => Bank::ShadowFirstLight,
+            _ => Bank::ShadowOtherLights,
+        }
+    }
+}
+
+/// The counter buffer, a bank per [`Bank`].
+pub struct CounterBanks {
+    ssbo: Ssbo,
+    /// Counters per bank.
+    slots: usize,
+    /// Bytes from one bank to the next: the counters' 8 bytes each, rounded up to the GL's
+    /// offset alignment.
+    stride: usize,
+}
+
+impl CounterBanks {
+    pub fn new(gl: &Gl, info: &GlInfo, slots: usize) -> Result<CounterBanks> {
+        let align = info.ssbo_offset_alignment.max(1) as usize;
+        let stride = (8 * slots).div_ceil(align) * align;
+        let bytes = stride * BANKS.len();
+        let ssbo = Ssbo::new(gl, "counters", bytes, None, info.max_ssbo_block_size)?;
+        Ok(CounterBanks {
+            ssbo,
+            slots,
+            stride,
+        })
+    }
+
+    /// Zero every bank and bind [`Bank::Frame`].
+    pub fn clear(&self, gl: &Gl, timers: &mut GpuTimers) {
+        self.ssbo.clear_u32(gl, 0);
+        self.bind(gl, timers, Bank::Frame);
+    }
+
+    /// The kernels dispatched from now on count into `bank` and are timed under its kind.
+    pub fn bind(&self, gl: &Gl, timers: &mut GpuTimers, bank: Bank) {
+        let i = BANKS.iter().position(|b| *b == bank).expect("a bank");
+        let bytes = 8 * self.slots;
+        self.ssbo
+            .bind_range(gl, ssbo::COUNTERS, i * self.stride, bytes);
+        timers.set_ray_kind(bank.ray_kind());
+    }
+
+    /// Every bank's counts (64-bit, see `glsl/common/counters.glsl`), in [`BANKS`] order.
+    pub fn read(&self, gl: &Gl) -> Vec<Vec<u64>> {
+        let raw = self.ssbo.read_u32(gl);
+        let words = self.stride / 4;
+        (0..BANKS.len())
+            .map(|b| {
+                let bank = &raw[b * words..];
+                (0..self.slots)
+                    .map(|i| super::super::counter_value(bank, i))
+                    .collect()
+            })
+            .collect()
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        self.ssbo.delete(gl);
+    }
+}
+
+/// The statistics per ray kind: each kind bank's counts under `names`, with the kind's GPU
+/// milliseconds; kinds that traced no ray and took no time are left out.
+pub fn ray_kind_stats(
+    banks: &[Vec<u64>],
+    names: &[&str],
+    mut ms: BTreeMap<String, f64>,
+) -> BTreeMap<String, RayKindStats> {
+    let mut out = BTreeMap::new();
+    for (bank, counts) in BANKS.iter().zip(banks) {
+        let Some(kind) = bank.ray_kind() else {
+            continue;
+        };
+        let gpu_ms = ms.remove(kind).unwrap_or(0.0);
+        let counts: BTreeMap<String, u64> = names
+            .iter()
+            .zip(counts)
+            .filter(|(_, &v)| v > 0)
+            .map(|(n, &v)| (n.to_string(), v))
+            .collect();
+        if gpu_ms > 0.0 || !counts.is_empty() {
+            out.insert(kind.to_string(), RayKindStats { gpu_ms, counts });
+        }
+    }
+    out
+}
