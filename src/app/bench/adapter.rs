@@ -21,7 +21,7 @@ use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::reference::linespace::LinespaceShadows;
 use gpgpu_rt::scene::{Camera, Scene, ShadowMode};
 
-pub use gpgpu_rt::frame::FrameStats;
+pub use gpgpu_rt::frame::{Frame, FrameStats};
 
 /// The GL context and where the kernels come from.
 pub struct Gpu {
@@ -116,7 +116,8 @@ impl RayTracer {
             refl_depth: c.refl_depth,
             tile: args.tile,
             shadow_flags: ShadowFlags::Rgba,
-            aovs: false,
+            // first hits kept where the configuration is judged against the CPU reference
+            aovs: c.judge,
             grid,
             bvh_variant: c.tracer.bvh_variant().unwrap_or_default(),
         };
@@ -128,6 +129,14 @@ impl RayTracer {
     /// Place object `object` (index in the scene's objects) for the next frames.
     pub fn set_model(&mut self, object: usize, model: Mat4) -> Result<()> {
         self.0.set_model(object, model)
+    }
+
+    /// Render a frame seen from `camera` and read it back (with the first hits where the
+    /// configuration is judged), its colour written to `png`.
+    pub fn render_frame(&mut self, camera: &Camera, png: &Path) -> Result<Frame> {
+        let frame = self.0.render(camera)?;
+        gpgpu_rt::output::write_image(png, &frame)?;
+        Ok(frame)
     }
 
     /// Render a frame seen from `camera`, write its colour to `png` if given, and return its

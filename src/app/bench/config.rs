@@ -193,6 +193,9 @@ pub struct Config {
     /// Shadow rays towards the scene's lights; `false`: the lights removed, eye rays (and
     /// reflection rays) only, lit by the ambient term (seed 004's Table 1, ray casting).
     pub shadows: bool,
+    /// Compare the first frame's first hits with the CPU reference's (`accel-compare`): the
+    /// facts `first_hit_agreement` and `first_hit_judge` of that frame.
+    pub judge: bool,
 }
 
 impl Config {
@@ -208,6 +211,7 @@ impl Config {
             angles: rotation_angles(s.angles),
             warmup: s.warmup,
             shadows: true,
+            judge: false,
         }
     }
     /// `tracer` on `scene` at `width`×`height`, `frames` frames after `warmup`, camera and

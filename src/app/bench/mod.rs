@@ -57,6 +57,7 @@ pub mod args;
 pub mod config;
 pub mod csv_files;
 pub mod format;
+pub mod judge;
 pub mod klee;
 pub mod klee_measure;
 pub mod machine;

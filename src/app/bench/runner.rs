@@ -3,19 +3,22 @@
 //! (not counted), render one frame per angle of the rotation, and write the per-frame and
 //! per-configuration CSVs.
 
+use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::adapter::{Gpu, RayTracer, BVH_VARIANTS};
+use super::adapter::{Frame, FrameStats, Gpu, RayTracer, BVH_VARIANTS};
 use super::args::{BenchArgs, Rotation, Scale};
 use super::config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
 use super::csv_files;
+use super::judge::Judge;
 use super::machine::Machine;
 use super::outcome::{FrameRecord, Outcome};
 use super::protocol::Section;
@@ -32,6 +35,8 @@ pub struct Bench {
     pub scenes_dir: PathBuf,
     pub out: PathBuf,
     scenes: HashMap<(String, Overrides), Scene>,
+    /// The CPU reference's first hits per scene and image size ([`Config::judge`]).
+    judges: RefCell<HashMap<JudgeKey, Rc<Judge>>>,
     progress: bool,
     pub mode: Mode,
     /// The units met so far (the next one's index) and the ids given out.
@@ -94,6 +99,7 @@ impl Bench {
             machine,
             scenes_dir,
             scenes: HashMap::new(),
+            judges: RefCell::default(),
             progress,
             mode,
             units: 0,
@@ -312,12 +318,15 @@ impl Bench {
     /// Measure `c`, its first frame written to `png` (relative to the output folder).
     fn run_config(&self, c: &Config, png: PathBuf, pb: &ProgressBar) -> Outcome {
         let loaded = &self.scenes[&(c.scene.clone(), c.overrides)];
-        let unlit;
-        let scene = if c.shadows {
-            loaded
+        let relit;
+        let scene = if !c.shadows {
+            relit = without_lights(loaded);
+            &relit
+        } else if loaded.lights.is_empty() && !loaded.area_lights.is_empty() {
+            relit = area_centres_lit(loaded);
+            &relit
         } else {
-            unlit = without_lights(loaded);
-            &unlit
+            loaded
         };
         let mut outcome = Outcome {
             config: c.clone(),
@@ -355,9 +364,14 @@ impl Bench {
             let camera = turntable.turn(&mut tracer, angle)?;
             let image = (i == 0).then(|| first_png.clone());
             let png = image.as_ref().map(|rel| self.out.join(rel));
-            let stats = tracer
-                .render(&camera, png.as_deref())
-                .with_context(|| format!("frame at {angle}°"))?;
+            let at = || format!("frame at {angle}°");
+            let stats = match (&png, c.judge) {
+                (Some(png), true) => {
+                    let frame = tracer.render_frame(&camera, png).with_context(at)?;
+                    self.judged(c, scene, frame)?
+                }
+                _ => tracer.render(&camera, png.as_deref()).with_context(at)?,
+            };
             if image.is_some() {
                 out.image = image;
             }
@@ -365,6 +379,35 @@ impl Bench {
             pb.inc(1);
         }
         Ok(())
+    }
+}
+
+/// A scene (with its overrides) at an image size.
+type JudgeKey = (String, Overrides, u32, u32);
+
+impl Bench {
+    /// `frame`'s statistics with its first hits judged against the CPU reference's
+    /// (computed once per scene and size): the facts `first_hit_agreement` (a share) and
+    /// `first_hit_judge`.
+    fn judged(&self, c: &Config, scene: &Scene, frame: Frame) -> Result<FrameStats> {
+        let key = (c.scene.clone(), c.overrides, c.width, c.height);
+        let known = self.judges.borrow().get(&key).cloned();
+        let judge = match known {
+            Some(j) => j,
+            None => {
+                let j = Rc::new(Judge::of(scene, c.width, c.height)?);
+                self.judges.borrow_mut().insert(key, j.clone());
+                j
+            }
+        };
+        let mut stats = frame.stats.clone();
+        if let Some(a) = judge.agreement(&frame) {
+            stats.facts.insert("first_hit_agreement".into(), a.into());
+            stats
+                .facts
+                .insert("first_hit_judge".into(), judge.name.into());
+        }
+        Ok(stats)
     }
 }
 
@@ -402,6 +445,19 @@ fn replayed(
         outcomes.push(m.outcome(c));
     }
     Ok(outcomes)
+}
+
+/// `scene` (whose only lights are area lights, for Klee 2016's pipeline) lit by a point light at
+/// the centre of each area light: the area scenes' geometry in the point-light ray tracer.
+fn area_centres_lit(scene: &Scene) -> Scene {
+    let lights = scene.area_lights.iter().map(|a| gpgpu_rt::scene::Light {
+        position: a.center(),
+        color: a.color,
+    });
+    Scene {
+        lights: lights.collect(),
+        ..scene.clone()
+    }
 }
 
 /// `scene` with its point lights removed: eye (and reflection) rays only, no shadow rays
