@@ -134,3 +134,55 @@ fn one_light_and_no_reflection_leave_their_kinds_out() {
     assert_eq!(kinds, ["primary", "shadow_first_light"]);
     assert_eq!(count(&f, "primary", "rays"), (SIZE * SIZE) as u64);
 }
+
+/// The rays of `f`'s frame: `rays` among its events.
+fn rays(f: &Frame) -> u64 {
+    f.stats.events["rays"]
+}
+
+#[test]
+fn the_own_pipelines_count_the_rays_they_trace() {
+    let ctx = context();
+    let scene = load("teapot1.toml");
+    assert_eq!(scene.lights.len(), 1);
+    // the stream traces the same rays as Müller's pipeline: eye, feelers, reflection
+    let mut opts = options(SIZE, SIZE, 1);
+    opts.tracer = TracerKind::Bvh;
+    let mueller = render_gpu(&ctx, &scene, opts.clone());
+    let reflection = count(&mueller, "reflection", "rays");
+    assert!(reflection > 0, "the teapot reflects");
+    opts.tracer = TracerKind::Stream;
+    let stream = gpgpu_rt::pipeline::ray_tracer(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &gpgpu_rt::gl::ShaderSource::default(),
+        opts.clone(),
+    )
+    .expect("stream")
+    .render(&scene.camera)
+    .expect("frame");
+    assert_eq!(rays(&stream), rays(&mueller), "stream rays");
+    // Wagner's kernel: the eye rays and the first light's feelers, no reflection
+    opts.tracer = TracerKind::Bvh;
+    opts.bvh_variant = gpgpu_rt::accel::BvhVariant::Wagner;
+    opts.refl_depth = 0;
+    let wagner = gpgpu_rt::pipeline::ray_tracer(
+        ctx.gl.clone(),
+        &ctx.info,
+        &scene,
+        &gpgpu_rt::gl::ShaderSource::default(),
+        opts.clone(),
+    )
+    .expect("wagner")
+    .render(&scene.camera)
+    .expect("frame");
+    opts.bvh_variant = Default::default();
+    let eye_and_feelers = render_gpu(&ctx, &scene, opts);
+    assert_eq!(rays(&wagner), rays(&eye_and_feelers), "Wagner's rays");
+    assert_eq!(
+        rays(&eye_and_feelers),
+        count(&eye_and_feelers, "primary", "rays")
+            + count(&eye_and_feelers, "shadow_first_light", "rays")
+    );
+}

@@ -11,6 +11,7 @@
 //               times reflectivity; none elsewhere
 #include "grid.glsl"
 #include "rays.glsl"
+#include "counters.glsl"
 
 uniform int generate;
 uniform vec3 camImgPosition;
@@ -28,6 +29,7 @@ void primaryRay(vec2 px)
     vec3 across = (px.x + 0.5) * camWidth + (imageSize2.y - px.y - 0.5) * camHeight;
     outOrigin = vec4(camImgPosition + across, -1.0);
     outDirection = vec4(normalize(camImgOffset + across), 1.0);
+    countAdd(COUNTER_RAYS, 1u); // ours: rays generated, for rays per second (accel-compare)
 }
 
 void secondaryRay(ivec2 px)
@@ -47,6 +49,7 @@ void secondaryRay(ivec2 px)
     } else if (s.reflectivity > 0.0) {
         outDirection = vec4(reflect(d.xyz, s.normal), d.w * s.reflectivity);
     }
+    if (outDirection.w > 0.0) countAdd(COUNTER_RAYS, 1u);
 }
 
 void main()

@@ -33,7 +33,7 @@
 //   the host refuses the frame.
 layout(local_size_x = 16, local_size_y = 16) in;
 
-#define COUNTER_SLOTS_PER_KERNEL 4
+#define COUNTER_SLOTS_PER_KERNEL 5
 #include "../common/counters.glsl"
 
 // Fig. 4.3, texture 1: two texels per node, the box's centre (xyz) and half extent (xyz)
@@ -84,6 +84,7 @@ uint primaryTests = 0u;
 uint shadowTests = 0u;
 uint nodesVisited = 0u;
 uint truncated = 0u;
+uint raysTraced = 0u; // ours: the primary ray and the shadow ray if traced (accel-compare)
 
 // Listing 4.1; x, y: pixel, y = 0 the top row
 Ray createRay(Camera camera, int x, int y, int width, int height)
@@ -256,6 +257,7 @@ vec3 shade(ivec2 storePos, Ray ray, int id, float t, float u, float v)
     float lambert = dot(n, dir);
     bool lit = false;
     if (lambert > 0.0) {
+        raysTraced++; // ours: the shadow ray is traced
         float st, su, sv;
         lit = traverse(Ray(p, dir), true, SHADOW_OFFSET, lightDistance, id, st, su, sv) < 0;
     }
@@ -270,6 +272,7 @@ void raytrace(ivec2 storePos)
     int width = imageSize2.x, height = imageSize2.y;
     // GL's row 0 is the bottom row; createRay counts rows from the top
     Ray ray = createRay(camera, storePos.x, height - 1 - storePos.y, width, height);
+    raysTraced++; // ours: the primary ray
     float t, u, v;
     int id = traverse(ray, false, 0.0, 1.0 / 0.0, -1, t, u, v);
     vec3 color = backgroundColor;
@@ -290,8 +293,10 @@ void main()
     countAdd(1, shadowTests);
     countAdd(2, nodesVisited);
     countAdd(3, truncated);
+    countAdd(4, raysTraced);
     countersEnd(0, COUNTER_PRIMARY_TESTS);
     countersEnd(1, COUNTER_SHADOW_TESTS);
     countersEnd(2, COUNTER_NODES_VISITED);
     countersEnd(3, COUNTER_TRUNCATED_RAYS);
+    countersEnd(4, COUNTER_RAYS);
 }

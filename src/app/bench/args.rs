@@ -52,6 +52,9 @@ pub enum ProtocolId {
     /// Seed 004, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs compute grid.
     #[value(name = "purcell-table3")]
     PurcellTable3,
+    /// Issue 15: every accelerator on every scene and kind of ray (and the stadium).
+    #[value(name = "accel-compare")]
+    AccelCompare,
 }
 
 /// `--scale`.

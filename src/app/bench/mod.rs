@@ -52,6 +52,8 @@
 //! 4. Add a variant with `#[value(name = "...")]` to [`ProtocolId`] and its line in
 //!    [`protocol_of`]; mention it in the README's benchmark section.
 
+pub mod accel_compare;
+pub mod accel_compare_report;
 pub mod adapter;
 pub mod args;
 pub mod config;
@@ -106,6 +108,7 @@ pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
         ProtocolId::PurcellTable1 => &purcell::PURCELL_TABLE1,
         ProtocolId::PurcellTable2 => &purcell::PURCELL_TABLE2,
         ProtocolId::PurcellTable3 => &purcell::PURCELL_TABLE3,
+        ProtocolId::AccelCompare => &accel_compare::ACCEL_COMPARE,
     }
 }
 
@@ -166,7 +169,7 @@ fn list(bench: &mut Bench) -> Result<()> {
         match p.units {
             Units::Whole => {
                 let (i, id) = bench.next_unit(p.name.to_string());
-                println!("{}", shard::list_line(i, &id, p.title));
+                shard::print_list_line(i, &id, p.title);
             }
             Units::Configs => match (p.run)(p, bench) {
                 Err(e) if e.is::<NotMeasuredHere>() => {}

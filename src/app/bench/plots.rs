@@ -74,6 +74,10 @@ pub struct Chart {
     pub x_range: Option<(f64, f64)>,
     /// A logarithmic y axis (for series that differ by orders of magnitude).
     pub log_y: bool,
+    /// A logarithmic x axis: drawn as log10 x, labelled with x.
+    pub log_x: bool,
+    /// The x values are exponents of 10 (what `log_x` becomes when drawn).
+    x_exponent: bool,
 }
 
 impl Chart {
@@ -97,6 +101,14 @@ impl Chart {
     pub fn log_y(self) -> Chart {
         Chart {
             log_y: true,
+            ..self
+        }
+    }
+
+    /// The same panel with a logarithmic x axis.
+    pub fn log_x(self) -> Chart {
+        Chart {
+            log_x: true,
             ..self
         }
     }
@@ -168,6 +180,9 @@ fn color(i: usize) -> RGBColor {
 /// Axis numbers: 1.2G, 350M, 12k, 2.5.
 pub fn si(v: f64) -> String {
     let a = v.abs();
+    if a > 0.0 && a < 0.01 {
+        return format!("{v:.0e}");
+    }
     let (d, s) = if a >= 1e9 {
         (1e9, "G")
     } else if a >= 1e6 {
@@ -215,6 +230,9 @@ fn range(values: impl Iterator<Item = f64>, from_zero: bool) -> (f64, f64) {
 }
 
 fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Result<()> {
+    if chart.log_x {
+        return draw_panel(area, &log10_x(chart));
+    }
     let points = || chart.series.iter().flat_map(|s| s.points.iter());
     let (x0, x1) = chart.x_range.unwrap_or_else(|| {
         let (lo, hi) = range(points().map(|p| p.0), false);
@@ -233,6 +251,28 @@ fn draw_panel(area: &DrawingArea<BitMapBackend<'_>, Shift>, chart: &Chart) -> Re
     } else {
         let (y0, y1) = range(points().map(|p| p.1), true);
         draw_on(area, chart, x0..x1, y0..y1)
+    }
+}
+
+/// `chart` with its x values replaced by their log10 (points at x ≤ 0 dropped), to be drawn on
+/// a linear axis labelled with 10^x: what `log_x` asks for.
+fn log10_x(chart: &Chart) -> Chart {
+    let series = chart.series.iter().map(|s| Series {
+        points: s
+            .points
+            .iter()
+            .filter(|p| p.0 > 0.0)
+            .map(|&(x, y)| (x.log10(), y))
+            .collect(),
+        ..s.clone()
+    });
+    Chart {
+        series: series.collect(),
+        x_range: chart.x_range.map(|(lo, hi)| (lo.log10(), hi.log10())),
+        x_label: format!("{} (log scale)", chart.x_label),
+        log_x: false,
+        x_exponent: true,
+        ..chart.clone()
     }
 }
 
@@ -263,7 +303,10 @@ where
         })
         .axis_desc_style((FONT, 14))
         .label_style((FONT, 12))
-        .x_label_formatter(&|v| si(*v))
+        .x_label_formatter(&|v| match chart.x_exponent {
+            true => si(10f64.powf(*v)),
+            false => si(*v),
+        })
         .y_label_formatter(&|v| si(*v))
         .light_line_style(if chart.log_y {
             WHITE
@@ -416,6 +459,7 @@ mod tests {
         assert_eq!(si(350_000_000.0), "350M");
         assert_eq!(si(12_000.0), "12k");
         assert_eq!(si(360.0), "360");
+        assert_eq!(si(0.001), "1e-3");
     }
 
     #[test]
@@ -438,7 +482,7 @@ mod tests {
                 Series::new("published", vec![(180.0, 2.5)], Style::Crosses, BLACK_INDEX),
             ],
             x_range: Some((0.0, 360.0)),
-            log_y: false,
+            ..Chart::default()
         };
         let log = Chart {
             log_y: true,

@@ -260,7 +260,7 @@ impl Bench {
             .collect();
         if let Mode::List = self.mode {
             for ((i, id), c) in units.iter().zip(configs) {
-                println!("{}", shard::list_line(*i, id, &c.label()));
+                shard::print_list_line(*i, id, &c.label());
             }
             return Err(NotMeasuredHere("listed").into());
         }

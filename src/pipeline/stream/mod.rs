@@ -48,6 +48,8 @@ pub const COUNTERS: &[&str] = &[
     "voxels_visited",
     "cloud_jumps",
     "empty_cells_skipped",
+    // rays generated (primary, shadow, reflection; ours: rays per second in accel-compare)
+    "rays",
 ];
 
 /// Options of the streaming tracer.
@@ -474,6 +476,7 @@ impl StreamRenderer {
         stats.events.insert("voxels_visited".into(), count(2));
         stats.events.insert("cloud_jumps".into(), count(3));
         stats.events.insert("empty_cells_skipped".into(), count(4));
+        stats.events.insert("rays".into(), count(5));
         stats.events.insert("kernel_calls".into(), self.calls.total);
         stats
             .events

@@ -45,6 +45,8 @@ pub const COUNTERS: &[&str] = &[
     "shadow_tests",
     "nodes_visited",
     "truncated_rays",
+    // the primary rays and the shadow rays traced (ours: rays per second in accel-compare)
+    "rays",
 ];
 
 /// Options of Wagner 2018's renderer.
@@ -309,6 +311,7 @@ impl WagnerRenderer {
         stats.triangle_tests.insert("primary".into(), count(0));
         stats.triangle_tests.insert("shadow".into(), count(1));
         stats.events.insert("nodes_visited".into(), count(2));
+        stats.events.insert("rays".into(), count(4));
         let (s, b) = (&self.builds.stats, &self.builds);
         let (bvh_bytes, triangle_bytes) = self.textures.bytes();
         for (k, v) in [

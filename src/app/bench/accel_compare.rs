@@ -1,0 +1,348 @@
+//! `accel-compare` (issue 15): every acceleration structure under the same conditions — the
+//! comparison seed 004 wishes for ("a full scale comparison of different ray shooting
+//! acceleration schemes as had been done for software implementations": Havran et al. 2000,
+//! "Statistical Comparison of Ray-Shooting Efficiency Schemes") and none of the four sources
+//! could make.
+//!
+//! - Accelerators in Müller 2015's pipeline (four compute kernels, the same eye rays, feelers
+//!   and shading): brute force (`base`), the uniform grid as the thesis builds it and exact,
+//!   the exact grid with proximity clouds, our SAH BVH. In their own pipelines, marked so:
+//!   Wagner 2018's BVH megakernel and seed 004's streaming grid (fragment passes, with and
+//!   without proximity clouds).
+//! - Scenes: every shipped scene of every source, the area scenes' geometry lit by a point
+//!   light at the area light's centre, and the teapot in a stadium (`stadium.toml`).
+//! - Per configuration (camera and objects fixed): build ms, memory bytes, and per kind of ray
+//!   (primary, feelers to the first light, to all lights, reflection; Müller's pipeline counts
+//!   and times them apart, `pipeline::raytrace::ray_kinds`) Mrays/s, triangle tests and
+//!   voxels/nodes visited per ray; the frame's Mrays/s (all rays over all of the frame's GPU
+//!   time, the one figure every pipeline has); agreement of the first hits with the CPU
+//!   reference ([`super::judge`]).
+//!
+//! The tables, figures and analysis are in [`super::accel_compare_report`].
+
+use anyhow::Result;
+
+use super::accel_compare_report as report;
+use super::args::Scale;
+use super::config::{BvhVariant, Config, GridVariant, Sizing, TracerSpec};
+use super::outcome::Outcome;
+use super::protocol::{Protocol, Section, Units};
+use super::runner::Bench;
+use gpgpu_rt::accel::auto_resolution;
+use gpgpu_rt::frame::{FrameStats, RAY_KINDS};
+use gpgpu_rt::reference::stream_grid::auto_dims;
+
+pub const ACCEL_COMPARE: Protocol = Protocol {
+    name: "accel-compare",
+    title: "every acceleration structure on the same pipeline, scenes and rays (issue 15)",
+    run,
+    units: Units::Configs,
+};
+
+/// Quick: 32², 2 frames after 1 (every configuration in a few seconds on llvmpipe). Full:
+/// 512², 5 frames after 2.
+pub const QUICK: Sizing = Sizing {
+    width: 32,
+    height: 32,
+    angles: 2,
+    warmup: 1,
+};
+pub const FULL: Sizing = Sizing::full(5, 2);
+
+/// Every shipped scene of every source (the area scenes for their geometry), and the stadium.
+pub const SCENES: [&str; 15] = [
+    "square.toml",
+    "sphere.toml",
+    "knight.toml",
+    "torus_knot.toml",
+    "bunny_low.toml",
+    "sparse_room.toml",
+    "cow.toml",
+    "stadium.toml",
+    "teapot1.toml",
+    "teapot3.toml",
+    "teapot6.toml",
+    "bunny.toml",
+    "bunny_area.toml",
+    "dragon.toml",
+    "dragon_area.toml",
+];
+
+/// The stadium: where the uniform grid is expected to break.
+pub const STADIUM: &str = "stadium.toml";
+
+/// At `--scale quick` the base tracer runs only up to this many triangles (above, its frame
+/// takes tens of seconds on llvmpipe; the CPU reference still judges the first hits).
+pub const QUICK_BASE_MAX_TRIANGLES: usize = 30_000;
+/// At `--scale quick` Wagner's faithful build (recursive, as the thesis') only up to this many
+/// triangles (above it takes minutes, as the thesis says of 100k).
+pub const QUICK_WAGNER_MAX_TRIANGLES: usize = 50_000;
+
+/// An accelerator of the comparison: its name in the tables and figures, its pipeline, and
+/// the tracer for a scene of `triangles` triangles.
+#[derive(Debug)]
+pub struct Accelerator {
+    pub name: &'static str,
+    pub pipeline: Pipeline,
+    tracer: fn(usize) -> TracerSpec,
+}
+
+/// Which pipeline an accelerator runs in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pipeline {
+    /// Müller 2015's four compute kernels: every kind of ray counted and timed apart.
+    Mueller,
+    /// Wagner 2018's megakernel: one dispatch for every ray of the frame.
+    Wagner,
+    /// Seed 004's fragment passes.
+    Stream,
+}
+
+impl Pipeline {
+    pub fn label(self) -> &'static str {
+        match self {
+            Pipeline::Mueller => "Müller 2015 (4 kernels)",
+            Pipeline::Wagner => "own: Wagner 2018 megakernel",
+            Pipeline::Stream => "own: seed 004 fragment passes",
+        }
+    }
+}
+
+fn grid(variant: GridVariant) -> impl Fn(usize) -> TracerSpec {
+    move |t| TracerSpec::Grid {
+        variant,
+        resolution: auto_resolution(t),
+    }
+}
+
+fn stream(proximity_clouds: bool) -> impl Fn(usize) -> TracerSpec {
+    move |t| TracerSpec::Stream {
+        axes: auto_dims(t).to_array(),
+        proximity_clouds,
+        naive_shadows: false,
+    }
+}
+
+/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's 3·∛T
+/// per axis).
+pub const ACCELERATORS: [Accelerator; 8] = [
+    Accelerator {
+        name: "base",
+        pipeline: Pipeline::Mueller,
+        tracer: |_| TracerSpec::Base,
+    },
+    Accelerator {
+        name: "grid thesis",
+        pipeline: Pipeline::Mueller,
+        tracer: |t| grid(GridVariant::Thesis)(t),
+    },
+    Accelerator {
+        name: "grid exact",
+        pipeline: Pipeline::Mueller,
+        tracer: |t| grid(GridVariant::Exact)(t),
+    },
+    Accelerator {
+        name: "grid exact+pc",
+        pipeline: Pipeline::Mueller,
+        tracer: |t| TracerSpec::GridPc {
+            resolution: auto_resolution(t),
+        },
+    },
+    Accelerator {
+        name: "bvh sah",
+        pipeline: Pipeline::Mueller,
+        tracer: |_| TracerSpec::Bvh {
+            variant: BvhVariant::Sah,
+        },
+    },
+    Accelerator {
+        name: "bvh wagner",
+        pipeline: Pipeline::Wagner,
+        tracer: |_| TracerSpec::Bvh {
+            variant: BvhVariant::Wagner,
+        },
+    },
+    Accelerator {
+        name: "stream g",
+        pipeline: Pipeline::Stream,
+        tracer: |t| stream(false)(t),
+    },
+    Accelerator {
+        name: "stream pc",
+        pipeline: Pipeline::Stream,
+        tracer: |t| stream(true)(t),
+    },
+];
+
+/// The accelerator a configuration's tracer belongs to.
+pub fn accelerator_of(spec: &TracerSpec) -> &'static Accelerator {
+    let i = match *spec {
+        TracerSpec::Base => 0,
+        TracerSpec::Grid { variant, .. } => 1 + (variant == GridVariant::Exact) as usize,
+        TracerSpec::GridPc { .. } => 3,
+        TracerSpec::Bvh { variant } => 4 + (variant == BvhVariant::Wagner) as usize,
+        TracerSpec::Stream {
+            proximity_clouds, ..
+        } => 6 + proximity_clouds as usize,
+    };
+    &ACCELERATORS[i]
+}
+
+/// Whether `a` runs on a scene of `triangles` triangles at `scale`.
+fn runs(a: &Accelerator, triangles: usize, scale: Scale) -> bool {
+    scale == Scale::Full
+        || match a.name {
+            "base" => triangles <= QUICK_BASE_MAX_TRIANGLES,
+            "bvh wagner" => triangles <= QUICK_WAGNER_MAX_TRIANGLES,
+            _ => true,
+        }
+}
+
+/// Every scene with every accelerator that runs on it, camera and objects fixed, at the scene's
+/// reflection depth, first hits judged.
+fn configs(bench: &mut Bench) -> Result<Vec<Config>> {
+    let s = bench.sizing(QUICK, FULL);
+    let scale = bench.scale();
+    let mut v = Vec::new();
+    for scene in SCENES {
+        let loaded = bench.scene(scene)?;
+        let (t, refl) = (loaded.triangle_count(), loaded.settings.refl_depth);
+        for a in ACCELERATORS.iter().filter(|a| runs(a, t, scale)) {
+            let mut c = Config::fixed(scene, (a.tracer)(t), (s.width, s.height), s);
+            c.refl_depth = refl;
+            c.judge = true;
+            v.push(c);
+        }
+    }
+    Ok(v)
+}
+
+fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
+    let configs = configs(bench)?;
+    let outcomes = bench.measure(p.name, &configs)?;
+    let rows = rows(&outcomes);
+    let file = report::write_csv(&bench.out, p.name, &rows)?;
+    let markdown = report::markdown(&rows, bench.sizing(QUICK, FULL), bench.scale());
+    let figures = report::figures(&rows);
+    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    s.files.push(file);
+    Ok(s)
+}
+
+/// The work of one kind of rays (or of the whole frame) per frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Work {
+    pub rays: f64,
+    /// Mean GPU milliseconds over the measured frames.
+    pub gpu_ms: f64,
+    pub tests: f64,
+    /// Voxels (grids) or BVH nodes visited.
+    pub visits: f64,
+}
+
+impl Work {
+    pub fn mrays_per_s(&self) -> Option<f64> {
+        (self.gpu_ms > 0.0 && self.rays > 0.0).then(|| self.rays / self.gpu_ms / 1e3)
+    }
+    pub fn tests_per_ray(&self) -> Option<f64> {
+        (self.rays > 0.0).then(|| self.tests / self.rays)
+    }
+    pub fn visits_per_ray(&self) -> Option<f64> {
+        (self.rays > 0.0 && self.visits > 0.0).then(|| self.visits / self.rays)
+    }
+    fn add(&mut self, o: &Work) {
+        self.rays += o.rays;
+        self.gpu_ms += o.gpu_ms;
+        self.tests += o.tests;
+        self.visits += o.visits;
+    }
+}
+
+/// One configuration's measurements.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub scene: String,
+    pub triangles: usize,
+    pub lights: usize,
+    pub accelerator: &'static Accelerator,
+    /// "grid exact 24³", "stream pc 58": the tracer with its resolution.
+    pub tracer: String,
+    pub build_ms: Option<f64>,
+    pub bytes: Option<f64>,
+    /// Per kind of ray, [`RAY_KINDS`] order (Müller's pipeline; zero work elsewhere).
+    pub kinds: [Work; 4],
+    /// Every ray of the frame over all of the frame's GPU time (builds included).
+    pub frame: Work,
+    /// Share of the pixels whose first hit agrees with the judge's, and the judge.
+    pub agreement: Option<(f64, String)>,
+    /// Triangle references and voxel ids the thesis grid's fixed lists could not hold.
+    pub lost: u64,
+    pub error: Option<String>,
+}
+
+impl Row {
+    /// The feelers towards every light: the first light's and the others'.
+    pub fn shadow_all(&self) -> Work {
+        let mut w = self.kinds[1];
+        w.add(&self.kinds[2]);
+        w
+    }
+}
+
+/// The rows of the outcomes.
+pub fn rows(outcomes: &[Outcome]) -> Vec<Row> {
+    outcomes.iter().map(row).collect()
+}
+
+fn row(o: &Outcome) -> Row {
+    let frames: Vec<&FrameStats> = o.frames.iter().map(|f| &f.stats).collect();
+    let n = frames.len().max(1) as f64;
+    let mean = |f: &dyn Fn(&FrameStats) -> f64| frames.iter().map(|s| f(s)).sum::<f64>() / n;
+    let last = frames.last();
+    let kinds = RAY_KINDS.map(|k| {
+        let count = |name: &str| {
+            last.and_then(|s| s.ray_kinds.get(k))
+                .map_or(0, |w| w.count(name))
+        };
+        Work {
+            rays: count("rays") as f64,
+            gpu_ms: mean(&|s| s.ray_kinds.get(k).map_or(0.0, |w| w.gpu_ms)),
+            tests: (count("intersect1") + count("intersect2")) as f64,
+            visits: (count("voxels_visited") + count("nodes_visited")) as f64,
+        }
+    });
+    let visits = |s: &FrameStats| {
+        let e = |k: &str| s.events.get(k).copied().unwrap_or(0);
+        (e("voxels_visited") + e("nodes_visited")) as f64
+    };
+    // every pipeline counts the rays it traces: Müller's per kind, the others per frame
+    let frame = Work {
+        rays: last.map_or(0, |s| s.events.get("rays").copied().unwrap_or(0)) as f64,
+        gpu_ms: mean(&|s| s.total_gpu_ms()),
+        tests: last.map_or(0, |s| s.total_triangle_tests()) as f64,
+        visits: last.map_or(0.0, |s| visits(s)),
+    };
+    let build = ["grid_build_ms", "bvh_build_ms", "proximity_ms"].map(|f| o.fact(f));
+    let agreement = o.fact("first_hit_agreement").map(|a| {
+        let judge = o.frames[0].stats.facts.get("first_hit_judge");
+        let judge = judge.and_then(|j| j.as_str()).unwrap_or("?");
+        (a, judge.to_string())
+    });
+    Row {
+        scene: o.config.scene_name().to_string(),
+        triangles: o.triangles,
+        lights: o.lights,
+        accelerator: accelerator_of(&o.config.tracer),
+        tracer: o.config.tracer.label(),
+        build_ms: build.iter().flatten().copied().reduce(|a, b| a + b),
+        bytes: o.fact("grid_bytes").or(o.fact("bvh_bytes")),
+        kinds,
+        frame,
+        agreement,
+        lost: last.map_or(0, |s| {
+            let e = |k: &str| s.events.get(k).copied().unwrap_or(0);
+            e("dropped_triangle_refs") + e("ray_list_overflows")
+        }),
+        error: o.error.clone(),
+    }
+}

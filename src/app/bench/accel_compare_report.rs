@@ -1,0 +1,514 @@
+//! The report of `accel-compare` ([`super::accel_compare`]): its CSV, tables, figures and the
+//! analysis in the sources' terms.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+
+use super::accel_compare::{Pipeline, Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
+use super::accel_compare::{QUICK_WAGNER_MAX_TRIANGLES, STADIUM};
+use super::args::Scale;
+use super::config::Sizing;
+use super::csv_files::write_rows;
+use super::format::{int, num, ratio, table};
+use super::plots::{Chart, Figure, Series, Style};
+
+/// The row's work of one kind of ray.
+type KindOf = fn(&Row) -> Work;
+
+/// The kinds of the tables: (column title, the row's work of that kind).
+const KINDS: [(&str, KindOf); 5] = [
+    ("primary", |r| r.kinds[0]),
+    ("shadow, 1st light", |r| r.kinds[1]),
+    ("shadow, all lights", |r| r.shadow_all()),
+    ("reflection", |r| r.kinds[3]),
+    ("frame", |r| r.frame),
+];
+
+/// `<out>/<protocol>_kinds.csv`: a line per configuration and kind of ray.
+pub fn write_csv(out: &Path, protocol: &str, rows: &[Row]) -> Result<PathBuf> {
+    let file = PathBuf::from(format!("{protocol}_kinds.csv"));
+    let header = [
+        "scene",
+        "triangles",
+        "lights",
+        "accelerator",
+        "pipeline",
+        "tracer",
+        "kind",
+        "rays",
+        "gpu_ms",
+        "mrays_per_s",
+        "tests_per_ray",
+        "visits_per_ray",
+        "build_ms",
+        "bytes",
+        "first_hit_agreement",
+        "judge",
+    ]
+    .map(String::from);
+    let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
+    let mut lines = Vec::new();
+    for r in rows.iter().filter(|r| r.error.is_none()) {
+        for (kind, work) in KINDS {
+            let w = work(r);
+            let (agreement, judge) = match &r.agreement {
+                Some((a, j)) => (format!("{a}"), j.clone()),
+                None => (String::new(), String::new()),
+            };
+            lines.push(vec![
+                r.scene.clone(),
+                r.triangles.to_string(),
+                r.lights.to_string(),
+                r.accelerator.name.into(),
+                r.accelerator.pipeline.label().into(),
+                r.tracer.clone(),
+                kind.into(),
+                format!("{}", w.rays),
+                format!("{}", w.gpu_ms),
+                opt(w.mrays_per_s()),
+                opt(w.tests_per_ray()),
+                opt(w.visits_per_ray()),
+                opt(r.build_ms),
+                opt(r.bytes),
+                agreement,
+                judge,
+            ]);
+        }
+    }
+    write_rows(&out.join(&file), &header, &lines)?;
+    Ok(file)
+}
+
+/// The scenes in the order measured, with their triangle counts.
+fn scenes(rows: &[Row]) -> Vec<(String, usize)> {
+    let mut v: Vec<(String, usize)> = Vec::new();
+    for r in rows {
+        if !v.iter().any(|(s, _)| *s == r.scene) {
+            v.push((r.scene.clone(), r.triangles));
+        }
+    }
+    v
+}
+
+/// The row of `scene` and `accelerator`, if it was measured without error.
+fn find<'a>(rows: &'a [Row], scene: &str, accelerator: &str) -> Option<&'a Row> {
+    rows.iter()
+        .find(|r| r.scene == scene && r.accelerator.name == accelerator && r.error.is_none())
+}
+
+fn opt_num(v: Option<f64>) -> String {
+    v.map_or("–".into(), num)
+}
+
+pub fn markdown(rows: &[Row], s: Sizing, scale: Scale) -> String {
+    let mut md = intro(s, scale);
+    md += "\n### Frame throughput (Mrays/s: all rays of the frame over all of its GPU time)\n\n";
+    md += &throughput_matrix(rows);
+    md += "\n### Each kind of ray apart (Müller 2015's pipeline)\n\n";
+    md += &kinds_table(rows);
+    md += "\n### Build, memory, work per ray, agreement\n\n";
+    md += &configs_table(rows);
+    md += "\n### Analysis\n\n";
+    md += &analysis(rows);
+    md
+}
+
+fn intro(s: Sizing, scale: Scale) -> String {
+    let skipped = match scale {
+        Scale::Quick => format!(
+            " At this scale the base tracer runs on scenes of at most {} triangles and Wagner's \
+             faithful (recursive) build on at most {} (the CPU reference judges every scene).",
+            int(QUICK_BASE_MAX_TRIANGLES as f64),
+            int(QUICK_WAGNER_MAX_TRIANGLES as f64)
+        ),
+        Scale::Full => String::new(),
+    };
+    format!(
+        "{}, camera and objects fixed, {} frames after {} warm-up, each scene at its own \
+         reflection depth. Grids at `--grid auto` (N = ∛(T/5)), the stream's at the paper's \
+         3·∛T per axis. Mrays/s = rays / GPU ms of the kind's dispatches (GL timer queries); \
+         the own pipelines (Wagner's megakernel traces every ray in one dispatch, the stream in \
+         fragment passes) have only the frame's figure. Every pipeline counts the rays it \
+         traces; shadow rays are the feelers actually traced (N·L > 0). Wagner's kernel lights \
+         with the scene's first light only and traces no reflection (as the thesis), so it \
+         traces fewer rays of a scene than the others. Agreement: \
+         pixels whose first hit is the judge's triangle, or a hit at the same distance (a shared \
+         edge).{skipped}\n",
+        s.size(),
+        s.angles,
+        s.warmup
+    )
+}
+
+/// Scenes × accelerators: the frame's Mrays/s, the fastest in bold.
+fn throughput_matrix(rows: &[Row]) -> String {
+    let mut header = vec!["scene", "triangles"];
+    header.extend(ACCELERATORS.iter().map(|a| a.name));
+    let lines: Vec<Vec<String>> = scenes(rows)
+        .iter()
+        .map(|(scene, t)| {
+            let values: Vec<Option<f64>> = ACCELERATORS
+                .iter()
+                .map(|a| find(rows, scene, a.name).and_then(|r| r.frame.mrays_per_s()))
+                .collect();
+            let best = values.iter().flatten().cloned().fold(0.0, f64::max);
+            let cell = |v: &Option<f64>| match v {
+                Some(v) if *v == best => format!("**{}**", num(*v)),
+                v => opt_num(*v),
+            };
+            [scene.clone(), int(*t as f64)]
+                .into_iter()
+                .chain(values.iter().map(cell))
+                .collect()
+        })
+        .collect();
+    table(&header, &lines)
+}
+
+/// A line per scene and accelerator of Müller's pipeline: Mrays/s, tests and visits per ray of
+/// each kind.
+fn kinds_table(rows: &[Row]) -> String {
+    let header = [
+        "scene",
+        "accelerator",
+        "primary Mrays/s",
+        "shadow 1st light",
+        "shadow all lights",
+        "reflection",
+        "tests/ray primary",
+        "tests/ray shadow",
+        "visits/ray primary",
+        "visits/ray shadow",
+    ];
+    let mut lines = Vec::new();
+    for r in rows
+        .iter()
+        .filter(|r| r.accelerator.pipeline == Pipeline::Mueller)
+    {
+        if r.error.is_some() {
+            continue;
+        }
+        let shadow = r.shadow_all();
+        let mut line = vec![r.scene.clone(), r.tracer.clone()];
+        line.extend(KINDS[..4].iter().map(|(_, w)| opt_num(w(r).mrays_per_s())));
+        line.push(opt_num(r.kinds[0].tests_per_ray()));
+        line.push(opt_num(shadow.tests_per_ray()));
+        line.push(opt_num(r.kinds[0].visits_per_ray()));
+        line.push(opt_num(shadow.visits_per_ray()));
+        lines.push(line);
+    }
+    table(&header, &lines)
+}
+
+/// A line per configuration: pipeline, build, memory, work per ray of the frame, agreement.
+fn configs_table(rows: &[Row]) -> String {
+    let header = [
+        "scene",
+        "tracer",
+        "pipeline",
+        "build ms",
+        "memory MB",
+        "frame Mrays/s",
+        "tests/ray",
+        "visits/ray",
+        "first hits agree %",
+        "judge",
+    ];
+    let lines: Vec<Vec<String>> = rows
+        .iter()
+        .filter(|r| r.error.is_none())
+        .map(|r| {
+            let (agree, judge) = match &r.agreement {
+                Some((a, j)) => (format!("{:.2}", 100.0 * a), j.clone()),
+                None => ("–".into(), "–".into()),
+            };
+            vec![
+                r.scene.clone(),
+                r.tracer.clone(),
+                r.accelerator.pipeline.label().into(),
+                opt_num(r.build_ms),
+                opt_num(r.bytes.map(|b| b / 1e6)),
+                opt_num(r.frame.mrays_per_s()),
+                opt_num(r.frame.tests_per_ray()),
+                opt_num(r.frame.visits_per_ray()),
+                agree,
+                judge,
+            ]
+        })
+        .collect();
+    table(&header, &lines)
+}
+
+/// The least-squares slope of log y over log x: 0 where y does not grow with x, 1 where it
+/// grows in proportion.
+pub fn log_log_slope(points: &[(f64, f64)]) -> Option<f64> {
+    let p: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .map(|(x, y)| (x.ln(), y.ln()))
+        .collect();
+    if p.len() < 3 {
+        return None;
+    }
+    let n = p.len() as f64;
+    let (mx, my) = (
+        p.iter().map(|q| q.0).sum::<f64>() / n,
+        p.iter().map(|q| q.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = p.iter().map(|q| (q.0 - mx).powi(2)).sum();
+    let sxy: f64 = p.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// The geometric mean of `values`.
+fn geo_mean(values: &[f64]) -> Option<f64> {
+    let v: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0).collect();
+    (!v.is_empty()).then(|| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp())
+}
+
+fn median(values: &mut [f64]) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    (!values.is_empty()).then(|| values[values.len() / 2])
+}
+
+/// (triangles, primary tests per ray) of an accelerator over the scenes but the stadium.
+fn tests_per_primary_ray(rows: &[Row], accelerator: &str) -> Vec<(f64, f64)> {
+    let r = rows.iter().filter(|r| {
+        r.accelerator.name == accelerator && r.error.is_none() && r.scene != stem(STADIUM)
+    });
+    let work = |r: &Row| match r.accelerator.pipeline {
+        Pipeline::Mueller => r.kinds[0].tests_per_ray(),
+        _ => r.frame.tests_per_ray(),
+    };
+    r.filter_map(|r| Some((r.triangles as f64, work(r)?)))
+        .collect()
+}
+
+fn stem(scene: &str) -> &str {
+    scene.strip_suffix(".toml").unwrap_or(scene)
+}
+
+/// The findings: who wins where, whether tests per ray stay constant, where the grid breaks,
+/// and each accelerator against the SAH BVH (the peer table's yardstick against Embree).
+fn analysis(rows: &[Row]) -> String {
+    wins(rows) + &constancy(rows) + &stadium(rows) + &agreement(rows) + &versus_bvh(rows)
+}
+
+/// The configurations whose first hits differ from the judge's, with what their lists lost.
+fn agreement(rows: &[Row]) -> String {
+    let off: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.agreement.as_ref().is_some_and(|(a, _)| *a < 0.999))
+        .collect();
+    let judged = rows.iter().filter(|r| r.agreement.is_some()).count();
+    if off.is_empty() {
+        return format!(
+            "- **First hits**: all {judged} configurations agree with the CPU reference on at \
+             least 99.9 % of the pixels.\n"
+        );
+    }
+    let list: Vec<String> = off
+        .iter()
+        .map(|r| {
+            let a = r.agreement.as_ref().map_or(0.0, |a| a.0);
+            let lost = int(r.lost as f64);
+            format!(
+                "{} `{}` {:.1} % ({lost} lost)",
+                r.scene,
+                r.tracer,
+                100.0 * a
+            )
+        })
+        .collect();
+    let why = if off.iter().all(|r| r.lost > 0) {
+        "Each lost triangle references or voxel ids that the thesis grid's fixed lists \
+         (Listing 17: 512 triangles per voxel, 3·N voxels per ray) could not hold."
+    } else {
+        "Those without lost references differ for another reason: compare their frames."
+    };
+    format!(
+        "- **First hits**: of {judged} configurations, these agree with the CPU reference on \
+         less than 99.9 % of the pixels: {}. {why}\n",
+        list.join("; ")
+    )
+}
+
+/// The fastest accelerator of each scene (frame Mrays/s).
+fn wins(rows: &[Row]) -> String {
+    let mut wins: BTreeMap<&str, Vec<String>> = BTreeMap::new();
+    for (scene, _) in scenes(rows) {
+        let best = rows
+            .iter()
+            .filter(|r| r.scene == scene && r.error.is_none())
+            .filter_map(|r| Some((r.accelerator.name, r.frame.mrays_per_s()?)))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((name, _)) = best {
+            wins.entry(name).or_default().push(scene);
+        }
+    }
+    let mut s = String::from("- **Where each structure wins** (highest frame Mrays/s): ");
+    let parts: Vec<String> = wins
+        .iter()
+        .map(|(a, scenes)| format!("`{a}` on {} ({})", scenes.len(), scenes.join(", ")))
+        .collect();
+    s += &parts.join("; ");
+    s + ".\n"
+}
+
+/// Szirmay-Kalos et al. 2002: with a grid of ~T cells the expected tests per ray are O(1).
+fn constancy(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "- **Do the tests per ray stay constant?** Szirmay-Kalos et al. (2002) expect O(1) \
+         tests and steps per ray for a uniform grid with cells in proportion to the triangles. \
+         The log–log slope of primary-ray triangle tests per ray over the triangle count \
+         (0: constant, 1: in proportion; every scene but the stadium): ",
+    );
+    let parts: Vec<String> = ACCELERATORS
+        .iter()
+        .filter_map(|a| {
+            let p = tests_per_primary_ray(rows, a.name);
+            let slope = log_log_slope(&p)?;
+            let ys: Vec<f64> = p.iter().map(|q| q.1).collect();
+            let lo = ys.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = ys.iter().cloned().fold(0.0, f64::max);
+            Some(format!(
+                "`{}` {slope:.2} ({} … {} tests)",
+                a.name,
+                num(lo),
+                num(hi)
+            ))
+        })
+        .collect();
+    s += &parts.join(", ");
+    s + ".\n"
+}
+
+/// The stadium against the other scenes, for the grids and the BVH.
+fn stadium(rows: &[Row]) -> String {
+    let scene = stem(STADIUM);
+    let mut s = String::from(
+        "- **The teapot in a stadium** (the whole teapot falls into a few of the grid's cells): \
+         primary tests per ray there vs the median over the other scenes, and the frame \
+         throughput relative to `bvh sah` there vs the median elsewhere: ",
+    );
+    let bvh = |scene: &str| find(rows, scene, "bvh sah").and_then(|r| r.frame.mrays_per_s());
+    let parts: Vec<String> = ACCELERATORS
+        .iter()
+        .filter(|a| a.name != "bvh sah")
+        .filter_map(|a| {
+            let here = find(rows, scene, a.name)?;
+            let tests = match a.pipeline {
+                Pipeline::Mueller => here.kinds[0].tests_per_ray(),
+                _ => here.frame.tests_per_ray(),
+            }?;
+            let mut others: Vec<f64> = tests_per_primary_ray(rows, a.name)
+                .iter()
+                .map(|p| p.1)
+                .collect();
+            let rel = |r: &Row| Some(r.frame.mrays_per_s()? / bvh(&r.scene)?);
+            let mut rel_others: Vec<f64> = rows
+                .iter()
+                .filter(|r| r.accelerator.name == a.name && r.scene != scene)
+                .filter(|r| r.error.is_none())
+                .filter_map(rel)
+                .collect();
+            Some(format!(
+                "`{}` {} tests (elsewhere {}), {} of `bvh sah` (elsewhere {})",
+                a.name,
+                num(tests),
+                opt_num(median(&mut others)),
+                ratio(rel(here)),
+                ratio(median(&mut rel_others)),
+            ))
+        })
+        .collect();
+    s += &parts.join("; ");
+    s + ".\n"
+}
+
+/// Each accelerator's frame throughput relative to the SAH BVH, over the scenes both ran.
+fn versus_bvh(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "- **Against the SAH BVH, and so against Embree**: the geometric mean over the scenes of \
+         each accelerator's frame Mrays/s divided by `bvh sah`'s on the same scene: ",
+    );
+    let parts: Vec<String> = ACCELERATORS
+        .iter()
+        .map(|a| {
+            let ratios: Vec<f64> = rows
+                .iter()
+                .filter(|r| r.accelerator.name == a.name && r.error.is_none())
+                .filter_map(|r| {
+                    let b = find(rows, &r.scene, "bvh sah")?.frame.mrays_per_s()?;
+                    Some(r.frame.mrays_per_s()? / b)
+                })
+                .collect();
+            format!("`{}` {}", a.name, ratio(geo_mean(&ratios)))
+        })
+        .collect();
+    s += &parts.join(", ");
+    s + ". How far `bvh sah` is from Intel Embree on the very same rays is the peer table of the \
+         BVH issue (`python3 tools/embree_peer.py`, docs/results/embree_peer.md, its own run); \
+         multiply to place the others.\n"
+}
+
+/// Points (triangles, y) of an accelerator, sorted by the triangle count.
+fn series_points(rows: &[Row], name: &str, y: impl Fn(&Row) -> Option<f64>) -> Vec<(f64, f64)> {
+    let mut p: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.accelerator.name == name && r.error.is_none())
+        .filter_map(|r| Some((r.triangles as f64, y(r)?)))
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    p
+}
+
+/// A log–log chart of `y` over the triangle count, a series per accelerator with data.
+fn chart(rows: &[Row], title: &str, y_label: &str, y: fn(&Row) -> Option<f64>) -> Chart {
+    let series = ACCELERATORS
+        .iter()
+        .enumerate()
+        .map(|(i, a)| Series::new(a.name, series_points(rows, a.name, y), Style::LinePoints, i))
+        .filter(|s| !s.points.is_empty())
+        .collect();
+    Chart::new(title, "triangles", y_label, series)
+        .log_x()
+        .log_y()
+}
+
+pub fn figures(rows: &[Row]) -> Vec<Figure> {
+    let throughput = chart(rows, "Frame throughput", "Mrays/s", |r| {
+        r.frame.mrays_per_s()
+    });
+    let tests = chart(rows, "Triangle tests per ray", "tests per ray", |r| {
+        r.frame.tests_per_ray()
+    });
+    let build = chart(rows, "Build", "build ms", |r| r.build_ms);
+    vec![Figure::new(
+        "accel-compare.png",
+        "Mrays/s, tests per ray and build time over the triangle count (log–log)",
+        (560, 420),
+        vec![throughput, tests, build],
+    )]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_log_slope_reads_growth() {
+        let line = |k: f64| -> Vec<(f64, f64)> {
+            [10.0, 100.0, 1e3, 1e4]
+                .map(|x: f64| (x, 3.0 * x.powf(k)))
+                .to_vec()
+        };
+        assert!((log_log_slope(&line(1.0)).unwrap() - 1.0).abs() < 1e-9);
+        assert!(log_log_slope(&line(0.0)).unwrap().abs() < 1e-9);
+        assert!((log_log_slope(&line(0.5)).unwrap() - 0.5).abs() < 1e-9);
+        assert_eq!(log_log_slope(&line(1.0)[..2]), None, "too few points");
+        assert_eq!(geo_mean(&[2.0, 8.0]), Some(4.0));
+    }
+}
