@@ -135,6 +135,18 @@ fn one_light_and_no_reflection_leave_their_kinds_out() {
     assert_eq!(count(&f, "primary", "rays"), (SIZE * SIZE) as u64);
 }
 
+/// A frame of the pipeline `opts` choose (Müller's, Wagner's megakernel or the stream).
+fn pipeline_frame(
+    ctx: &gpgpu_rt::gl::GlContext,
+    scene: &gpgpu_rt::scene::Scene,
+    opts: RenderOptions,
+) -> Frame {
+    let shaders = gpgpu_rt::gl::ShaderSource::default();
+    let mut r = gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, &shaders, opts)
+        .expect("a pipeline");
+    r.render(&scene.camera).expect("frame")
+}
+
 /// The rays of `f`'s frame: `rays` among its events.
 fn rays(f: &Frame) -> u64 {
     f.stats.events["rays"]
@@ -152,31 +164,13 @@ fn the_own_pipelines_count_the_rays_they_trace() {
     let reflection = count(&mueller, "reflection", "rays");
     assert!(reflection > 0, "the teapot reflects");
     opts.tracer = TracerKind::Stream;
-    let stream = gpgpu_rt::pipeline::ray_tracer(
-        ctx.gl.clone(),
-        &ctx.info,
-        &scene,
-        &gpgpu_rt::gl::ShaderSource::default(),
-        opts.clone(),
-    )
-    .expect("stream")
-    .render(&scene.camera)
-    .expect("frame");
+    let stream = pipeline_frame(&ctx, &scene, opts.clone());
     assert_eq!(rays(&stream), rays(&mueller), "stream rays");
     // Wagner's kernel: the eye rays and the first light's feelers, no reflection
     opts.tracer = TracerKind::Bvh;
     opts.bvh_variant = gpgpu_rt::accel::BvhVariant::Wagner;
     opts.refl_depth = 0;
-    let wagner = gpgpu_rt::pipeline::ray_tracer(
-        ctx.gl.clone(),
-        &ctx.info,
-        &scene,
-        &gpgpu_rt::gl::ShaderSource::default(),
-        opts.clone(),
-    )
-    .expect("wagner")
-    .render(&scene.camera)
-    .expect("frame");
+    let wagner = pipeline_frame(&ctx, &scene, opts.clone());
     opts.bvh_variant = Default::default();
     let eye_and_feelers = render_gpu(&ctx, &scene, opts);
     assert_eq!(rays(&wagner), rays(&eye_and_feelers), "Wagner's rays");
