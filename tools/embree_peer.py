@@ -28,6 +28,8 @@ JSON beside it; exits 1 if a scene's first hits (ties included) agree on less th
 
     python3 tools/embree_peer.py                       # every scene in scenes/
     python3 tools/embree_peer.py scenes/bunny.toml scenes/dragon.toml --repeats 9
+    python3 tools/embree_peer.py scenes/cow.toml --tracer grid-exact --out /tmp/grid_peer.md
+                                                       # any accelerator of `bench accel-compare`
 """
 
 import argparse
@@ -196,8 +198,8 @@ def measure(scene, a, work):
     # the soft-shadow pipeline: its first hits only (one frame, one light sample)
     # Wagner's megakernel has no reflection passes to turn off
     no_reflection = ["--refl-depth", "0"] if a.bvh_variant == "sah" else []
-    pipeline_args = (["--tracer", "bvh", "--bvh-variant", a.bvh_variant, *no_reflection,
-                      "--frames", a.frames] if ray_tracer else ["--light-samples", "1x1"])
+    pipeline_args = ([*tracer_args(a), *no_reflection, "--frames", a.frames] if ray_tracer
+                     else ["--light-samples", "1x1"])
     cmd = ["render", scene, *pipeline_args, "--width", a.size,
            "--height", a.size, "--aov-dir", d, "--stats", stats_file, "-o", d / "image.png"]
     gpgpu_rt(a.bin, *cmd)
@@ -212,7 +214,7 @@ def measure(scene, a, work):
          "variant": a.bvh_variant if ray_tracer else None,
          "embree_build_ms": emb.build_ms, "embree_upload_ms": emb.upload_ms,
          "embree_build_cores": emb.build_cores,
-         "bvh_build_ms": stats.get("bvh_build_ms"), "gl_renderer": stats["renderer"],
+         "bvh_build_ms": stats.get("bvh_build_ms", stats.get("grid_build_ms")), "gl_renderer": stats["renderer"],
          "primary": primary(emb, aov, tris, a.repeats)}
     if ray_tracer:
         # the megakernel times primary rays and feelers together: agreement only
@@ -224,6 +226,23 @@ def measure(scene, a, work):
             if timed:
                 r["feelers"]["ours_ms"] = stats["gpu_ms"]["intersect2"]
     return r
+
+
+def tracer_args(a):
+    """The render options of the tracer measured: --tracer bvh (either variant), or another
+    accelerator of Müller 2015's pipeline (base, the grids at --grid auto) on the same rays."""
+    if a.tracer == "bvh":
+        return ["--tracer", "bvh", "--bvh-variant", a.bvh_variant]
+    if a.tracer == "base":
+        return ["--tracer", "base"]
+    variant, _, pc = a.tracer.partition("+")
+    return ["--tracer", "grid", "--grid", "auto", "--grid-variant", variant.split("-")[1],
+            *(["--proximity-clouds"] if pc else [])]
+
+
+def tracer_label(a):
+    """`--tracer bvh --bvh-variant sah`, `--tracer grid-exact+pc`: the title's name."""
+    return f"--tracer bvh --bvh-variant {a.bvh_variant}" if a.tracer == "bvh" else f"--tracer {a.tracer}"
 
 
 def soft_shadow_scene(scene):
@@ -256,7 +275,7 @@ def report(results, a, command, load):
     cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text()
                 .splitlines() if line.startswith("model name")), platform.processor())
     lines = [
-        f"# Embree as the peer of `--tracer bvh --bvh-variant {a.bvh_variant}`: the same rays on "
+        f"# Embree as the peer of `{tracer_label(a)}`: the same rays on "
         "the same machine", "",
         *([f"**{a.note}**", ""] if a.note else []),
         f"- command: `{command}`",
@@ -270,7 +289,7 @@ def report(results, a, command, load):
         f"{a.frames} frames (W·H / gpu_ms.intersect1; feelers / gpu_ms.intersect2). "
         "Agreement: same triangle id / with ties (ids differ, t within 1e-5 relative)", "",
         "## Primary rays (closest hit)", "",
-        f"| scene | size | triangles | Embree build ms | our bvh_build_ms | Embree Mrays/s "
+        f"| scene | size | triangles | Embree build ms | our build ms (BVH or grid) | Embree Mrays/s "
         f"(1 thread) | Embree Mrays/s ({th} threads) | ours Mrays/s | ours/Embree | "
         "first-hit agreement % (ids / with ties) |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
@@ -324,6 +343,10 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--robust", action="store_true", help="Embree's robust mode (slower)")
     ap.add_argument("--min-agreement", type=float, default=99.9)
+    ap.add_argument("--tracer", choices=["bvh", "base", "grid-thesis", "grid-exact",
+                                         "grid-exact+pc"], default="bvh",
+                    help="the accelerator measured (Müller 2015's pipeline; grids at --grid auto): "
+                         "places every accelerator of `bench accel-compare` against Embree")
     ap.add_argument("--bvh-variant", choices=["sah", "wagner"], default="sah",
                     help="wagner: Wagner 2018's megakernel (agreement only: it times primary "
                     "rays and feelers as one kernel)")

@@ -451,9 +451,10 @@ fn versus_bvh(rows: &[Row]) -> String {
         })
         .collect();
     s += &parts.join(", ");
-    s + ". How far `bvh sah` is from Intel Embree on the very same rays is the peer table of the \
-         BVH issue (`python3 tools/embree_peer.py`, docs/results/embree_peer.md, its own run); \
-         multiply to place the others.\n"
+    s + ". How far each accelerator of Müller's pipeline is from Intel Embree on the very same \
+         rays, in one run, is the peer table: `python3 tools/embree_peer.py --tracer bvh` (the \
+         BVH issue's, docs/results/embree_peer.md), `--tracer grid-exact`, `grid-exact+pc`, \
+         `grid-thesis` or `base` (docs/results/embree_peer_accel.md).\n"
 }
 
 /// Points (triangles, y) of an accelerator, sorted by the triangle count.
