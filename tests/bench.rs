@@ -882,3 +882,52 @@ fn accel_compare_tiny_every_scene_and_accelerator_kinds_agreement_and_the_stadiu
     assert!(out.join("accel-compare.png").is_file());
     check_report_links(&out, &report);
 }
+
+/// The cells of the markdown table line of `report` that starts with `| first |`.
+fn report_line<'a>(report: &'a str, first: &str) -> Vec<&'a str> {
+    let line = report
+        .lines()
+        .find(|l| l.starts_with(&format!("| {first} |")))
+        .unwrap_or_else(|| panic!("no line {first}"));
+    line.trim_matches('|').split('|').map(str::trim).collect()
+}
+
+#[test]
+fn klee_tables_2_3_and_fig12_tiny_report_the_same_error_against_exact() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("klee");
+    let o = bench(&[
+        "klee-table2",
+        "klee-table3",
+        "klee-fig12",
+        "--ntree-levels",
+        "3",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let table3 =
+        &report[report.find("## klee-table3").unwrap()..report.find("## klee-fig12").unwrap()];
+    let fig12 = &report[report.find("## klee-fig12").unwrap()..];
+    // Table 2's `linespace` at 4 rays is Table 3's CGT at 4 rays and Fig. 12's 2×2: the same
+    // G-buffer, rays and modes, each against its own `exact`
+    let table2 = report_line(&report, "linespace (A)")[5].to_string();
+    let error: f64 = table2.parse().unwrap();
+    assert!(error > 0.0 && error < 0.2, "{table2}");
+    for (rays, k) in [(4, 2), (9, 3), (16, 4), (100, 10)] {
+        let t3 = report_line(table3, &format!("{rays} (A)"));
+        let f12 = report_line(fig12, &format!("{k}×{k} (A)"));
+        // CGT and DDA ask the same line spaces: the same shadows
+        assert_eq!(t3[8], t3[9], "{rays} rays: CGT and DDA errors");
+        assert_eq!(f12[7], t3[8], "{rays} rays: Fig. 12 and Table 3");
+        if rays == 4 {
+            assert_eq!(t3[8], table2, "Table 2 and Table 3 at 4 rays");
+        }
+    }
+}

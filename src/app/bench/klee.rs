@@ -11,8 +11,10 @@
 //! - `klee-table2`: CPU, bunny, 4 rays: triangle tests (`exact`, `variant1`) vs line-space
 //!   lookups (`linespace`, `variant2`), at both readings of the N-tree depth, and how much of
 //!   the gap to the published saving each explains.
-//! - `klee-table3`: CPU, bunny, CGT (`linespace`) vs DDA (`linespace-dda`), 4/9/16/100 rays.
-//! - `klee-fig12`: bunny, 2×2 … 10×10 rays, CPU vs GPU (FPS and seconds).
+//! - `klee-table3`: CPU, bunny, CGT (`linespace`) vs DDA (`linespace-dda`), 4/9/16/100 rays, and
+//!   the error of each against `exact`, at both readings.
+//! - `klee-fig12`: bunny, 2×2 … 10×10 rays, CPU vs GPU (FPS and seconds), and the error
+//!   against `exact`, at both readings.
 //! - `klee-fig13`: GPU, bunny vs dragon, 2×2 … 10×10 rays.
 
 use anyhow::Result;
@@ -286,24 +288,25 @@ pub const KLEE_TABLE3: Protocol = Protocol {
     units: Units::Whole,
 };
 
+/// Table 3's modes per ray count: the two traversals, and `exact` for their error.
+const TABLE3_MODES: [(&str, ShadowMode); 3] = [
+    ("cgt", ShadowMode::Linespace),
+    ("dda", ShadowMode::LinespaceDda),
+    ("exact", ShadowMode::Exact),
+];
+
 /// Table 3: the bunny's shadows on the CPU, coherent grid traversal vs 3D-DDA, 4 to 100 rays,
-/// at both readings of the N-tree depth.
+/// at both readings of the N-tree depth, each with its error against `exact`.
 fn table3(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let modes: Vec<(&str, ShadowMode, u32)> = TABLE3
         .iter()
-        .flat_map(|t| {
-            [
-                ("cgt", ShadowMode::Linespace, t.0),
-                ("dda", ShadowMode::LinespaceDda, t.0),
-            ]
-        })
+        .flat_map(|t| TABLE3_MODES.map(|(name, mode)| (name, mode, t.0)))
         .collect();
     let (mut rows, mut lines) = (Vec::new(), Vec::new());
     for (_, levels) in readings(bench) {
         let (measured, memory) = bunny_on_cpu(bench, s, levels, 1, &modes)?;
-        let measured: Vec<Row> = measured.into_iter().map(|(r, _)| r).collect();
         lines.extend(table3_lines(&measured, memory));
-        rows.extend(measured);
+        rows.extend(measured.into_iter().map(|(r, _)| r));
     }
     let header = [
         "rays (reading)",
@@ -314,38 +317,47 @@ fn table3(bench: &mut Bench, s: Sizing) -> Result<Measured> {
         "ours DDA (s)",
         "CGT/DDA",
         "CGT lookups at depth 0 / 1 / 2",
+        "mean |CGT − exact|",
+        "mean |DDA − exact|",
     ];
     let markdown = table(&header, &lines)
         + "\nReading A: 3 levels counting the root, line spaces asked at depth 0 only; B: 4 levels, \
-           the cascade (depths 0 and 1). See klee-table2 for the readings.\n";
+           the cascade (depths 0 and 1). See klee-table2 for the readings. The errors: the mean \
+           over the pixels of the difference of the shadow values from `exact`'s (triangle tests, \
+           the same rays), on the CPU.\n";
     Ok(Measured::table(rows, markdown))
 }
 
-/// Table 3's lines of one reading (rows: cgt, dda per ray count) and its memory line.
-fn table3_lines(rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>> {
-    let letter = reading(rows[0].levels);
+/// Table 3's lines of one reading (measured: cgt, dda, exact per ray count) and its memory line.
+fn table3_lines(measured: &[Measured1], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>> {
+    let letter = reading(measured[0].0.levels);
     let mut lines: Vec<Vec<String>> = TABLE3
         .iter()
-        .zip(rows.chunks(2))
-        .map(|(&(rays, p_cgt, p_dda), pair)| {
-            let (cgt, dda) = (pair[0].m.mean_s, pair[1].m.mean_s);
-            let depths = pair[0].m.lookups_by_depth.map(|v| int(v as f64));
+        .zip(measured.chunks(TABLE3_MODES.len()))
+        .map(|(&(rays, p_cgt, p_dda), m)| {
+            let ([cgt, dda, exact], depths) = (
+                [0, 1, 2].map(|i| &m[i]),
+                m[0].0.m.lookups_by_depth.map(|v| int(v as f64)),
+            );
+            let (t_cgt, t_dda) = (cgt.0.m.mean_s, dda.0.m.mean_s);
             vec![
                 format!("{rays} ({letter})"),
                 num(p_cgt),
                 num(p_dda),
                 ratio(Some(p_cgt / p_dda)),
-                num(cgt),
-                num(dda),
-                ratio(Some(cgt / dda)),
+                num(t_cgt),
+                num(t_dda),
+                ratio(Some(t_cgt / t_dda)),
                 depths.join(" / "),
+                format!("{:.4}", mean_error(&cgt.1, &exact.1)),
+                format!("{:.4}", mean_error(&dda.1, &exact.1)),
             ]
         })
         .collect();
     lines.push(memory_line(
         format!("memory ({letter})"),
         (tree_b, ls_b),
-        8,
+        10,
         4,
     ));
     lines
@@ -383,14 +395,16 @@ fn fig12(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     let mut lines = Vec::new();
     for (letter, levels) in readings(bench) {
         let mut st = Setup::new(bench, BUNNY, s, levels)?;
-        let first = rows.len();
+        let (first, mut errors) = (rows.len(), Vec::new());
         for k in SAMPLES {
             let gpu = st.gpu(bench, ShadowMode::Linespace, k, k)?;
-            let cpu = st.cpu(&gpu.last, ShadowMode::Linespace, k, k);
+            let (cpu, values) = st.cpu_values(&gpu.last, ShadowMode::Linespace, k, k);
+            let (_, exact) = st.cpu_values(&gpu.last, ShadowMode::Exact, k, k);
+            errors.push(mean_error(&values, &exact));
             rows.push(Row::new("bunny", "linespace", "GPU", k * k, gpu.shadow).levels(levels));
             rows.push(Row::new("bunny", "linespace", "CPU", k * k, cpu).levels(levels));
         }
-        lines.extend(fig12_lines(letter, &rows[first..], st.memory()));
+        lines.extend(fig12_lines(letter, &rows[first..], &errors, st.memory()));
     }
     let header = [
         "rays (reading)",
@@ -400,11 +414,15 @@ fn fig12(bench: &mut Bench, s: Sizing) -> Result<Measured> {
         "GPU FPS",
         "GPU saving",
         "CPU lookups at depth 0 / 1 / 2",
+        "mean |s − exact|",
     ];
     let markdown = format!(
         "Published: the GPU takes {:.0} % less time than the CPU at every sample count, never below \
          1 FPS; the CPU needs several seconds beyond 36 rays. Reading A: 3 levels counting the \
-         root; B: 4 levels, the cascade (see klee-table2); the figure shows A.\n\n{}",
+         root; B: 4 levels, the cascade (see klee-table2); the figure shows A. The error: the \
+         mean over the pixels of the difference of the CPU's `linespace` shadow values from its \
+         `exact` ones (triangle tests) with the same rays; the GPU's values equal the CPU's \
+         (tests/linespace.rs).\n\n{}",
         100.0 * FIG12_GPU_SAVING,
         table(&header, &lines)
     );
@@ -417,12 +435,19 @@ fn fig12(bench: &mut Bench, s: Sizing) -> Result<Measured> {
     })
 }
 
-/// Fig. 12's lines of one reading (rows: GPU, CPU per sample count) and its memory line.
-fn fig12_lines(letter: &str, rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Vec<Vec<String>> {
+/// Fig. 12's lines of one reading (rows: GPU, CPU per sample count; `errors`: the CPU's against
+/// `exact` per sample count) and its memory line.
+fn fig12_lines(
+    letter: &str,
+    rows: &[Row],
+    errors: &[f64],
+    (tree_b, ls_b): (usize, usize),
+) -> Vec<Vec<String>> {
     let mut lines: Vec<Vec<String>> = rows
         .chunks(2)
         .zip(SAMPLES)
-        .map(|(pair, k)| {
+        .zip(errors)
+        .map(|((pair, k), error)| {
             let (g, c) = (pair[0].m.mean_s, pair[1].m.mean_s);
             let depths = pair[1].m.lookups_by_depth.map(|v| int(v as f64));
             let cells = [
@@ -432,6 +457,7 @@ fn fig12_lines(letter: &str, rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Ve
                 num(1.0 / g),
                 percent(1.0 - g / c),
                 depths.join(" / "),
+                format!("{error:.4}"),
             ];
             [format!("{k}×{k} ({letter})")]
                 .into_iter()
@@ -442,7 +468,7 @@ fn fig12_lines(letter: &str, rows: &[Row], (tree_b, ls_b): (usize, usize)) -> Ve
     lines.push(memory_line(
         format!("memory ({letter})"),
         (tree_b, ls_b),
-        7,
+        8,
         1,
     ));
     lines

@@ -118,12 +118,8 @@ impl Setup {
         frames.max(self.min_cpu_frames)
     }
 
-    /// CPU: the shadow values of every pixel of `f`'s G-buffer, one thread.
-    pub fn cpu(&self, f: &ShadowFrame, mode: ShadowMode, su: u32, sv: u32) -> Meas {
-        self.cpu_values(f, mode, su, sv).0
-    }
-
-    /// [`Setup::cpu`] and the shadow values of the pixels that hit geometry.
+    /// CPU: the shadow values of every pixel of `f`'s G-buffer, one thread: its measurement
+    /// and the values of the pixels that hit geometry.
     pub fn cpu_values(
         &self,
         f: &ShadowFrame,
