@@ -368,7 +368,7 @@ impl Bench {
             let stats = match (&png, c.judge) {
                 (Some(png), true) => {
                     let frame = tracer.render_frame(&camera, png).with_context(at)?;
-                    self.judged(c, scene, frame)?
+                    self.judged(c, scene, frame, angle)?
                 }
                 _ => tracer.render(&camera, png.as_deref()).with_context(at)?,
             };
@@ -380,16 +380,18 @@ impl Bench {
         }
         Ok(())
     }
-}
 
-/// A scene (with its overrides) at an image size.
-type JudgeKey = (String, Overrides, u32, u32);
-
-impl Bench {
     /// `frame`'s statistics with its first hits judged against the CPU reference's
     /// (computed once per scene and size): the facts `first_hit_agreement` (a share) and
     /// `first_hit_judge`.
-    fn judged(&self, c: &Config, scene: &Scene, frame: Frame) -> Result<FrameStats> {
+    fn judged(&self, c: &Config, scene: &Scene, frame: Frame, angle: f64) -> Result<FrameStats> {
+        if angle != 0.0 {
+            // the judge sees the scene as loaded
+            bail!(
+                "{}: first hits are judged at 0° only, not {angle}°",
+                c.label()
+            );
+        }
         let key = (c.scene.clone(), c.overrides, c.width, c.height);
         let known = self.judges.borrow().get(&key).cloned();
         let judge = match known {
@@ -410,6 +412,9 @@ impl Bench {
         Ok(stats)
     }
 }
+
+/// A scene (with its overrides) at an image size.
+type JudgeKey = (String, Overrides, u32, u32);
 
 /// A configuration's unit id: `<protocol>/<scene>_<tracer>_<W>x<H>_refl<D>`, e.g.
 /// `thesis-5.3/bunny_grid-exact-24_64x64_refl0` (made unique by [`Bench::next_unit`]).
