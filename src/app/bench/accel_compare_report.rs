@@ -26,7 +26,8 @@ const KINDS: [(&str, KindOf); 5] = [
     ("frame", |r| r.frame),
 ];
 
-/// `<out>/<protocol>_kinds.csv`: a line per configuration and kind of ray.
+/// `<out>/<protocol>_kinds.csv`: a line per configuration and kind of ray (the own pipelines:
+/// the frame only).
 pub fn write_csv(out: &Path, protocol: &str, rows: &[Row]) -> Result<PathBuf> {
     let file = PathBuf::from(format!("{protocol}_kinds.csv"));
     let header = [
@@ -51,7 +52,9 @@ pub fn write_csv(out: &Path, protocol: &str, rows: &[Row]) -> Result<PathBuf> {
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
     let mut lines = Vec::new();
     for r in rows.iter().filter(|r| r.error.is_none()) {
-        for (kind, work) in KINDS {
+        // the own pipelines have only the frame's figures
+        let own = r.accelerator.pipeline != Pipeline::Mueller;
+        for (kind, work) in KINDS.into_iter().filter(|k| !own || k.0 == "frame") {
             let w = work(r);
             let (agreement, judge) = match &r.agreement {
                 Some((a, j)) => (format!("{a}"), j.clone()),
