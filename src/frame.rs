@@ -24,15 +24,15 @@ pub struct FrameStats {
     /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
     pub wall_ms: f64,
     /// The work of each kind of rays apart ("primary", "shadow_first_light",
-    /// "shadow_other_lights", "reflection"): Müller 2015's pipeline only (see
-    /// `pipeline::raytrace::ray_kinds`); empty for the others.
+    /// "shadow_other_lights", "reflection"): Müller 2015's and seed 004's pipelines (see
+    /// `pipeline::ray_kinds`); empty for the others.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub ray_kinds: BTreeMap<String, RayKindStats>,
 }
 
-/// The kinds of rays Müller 2015's pipeline counts and times apart: pass 0's closest hits, the
-/// shadow feelers towards the first light and towards the others (every pass), the closest
-/// hits of the reflection passes.
+/// The kinds of rays the pipelines count and time apart: the primary rays' closest hits, the
+/// shadow feelers towards the first light and towards the others (every bounce), the closest
+/// hits of the reflection rays.
 pub const RAY_KINDS: [&str; 4] = [
     "primary",
     "shadow_first_light",
@@ -45,8 +45,11 @@ pub const RAY_KINDS: [&str; 4] = [
 pub struct RayKindStats {
     /// GPU time of the kind's dispatches (GL timer queries), in milliseconds.
     pub gpu_ms: f64,
-    /// The kind's non-zero counters: `rays` (rays traced), the kernel's triangle tests
-    /// (`intersect1` or `intersect2`), `voxels_visited`, `nodes_visited`, ...
+    /// Ray–triangle tests of the kind (of whichever kernels count them).
+    pub triangle_tests: u64,
+    /// The kind's non-zero counters by the pipeline's names: `rays` (rays traced), the
+    /// kernels' triangle tests (`intersect1`, `intersect2`; `closest_tests`, `shadow_tests`),
+    /// `voxels_visited`, `nodes_visited`, ...
     pub counts: BTreeMap<String, u64>,
 }
 
@@ -54,10 +57,6 @@ impl RayKindStats {
     /// A counter of the kind, 0 where it stayed zero.
     pub fn count(&self, name: &str) -> u64 {
         self.counts.get(name).copied().unwrap_or(0)
-    }
-    /// Ray–triangle tests of the kind (intersect1's or intersect2's).
-    pub fn triangle_tests(&self) -> u64 {
-        self.count("intersect1") + self.count("intersect2")
     }
 }
 

@@ -1,6 +1,6 @@
-//! The work of each kind of rays apart (issue 15's `accel-compare`): Müller 2015's pipeline
-//! counts primary rays, the feelers towards the first light and towards the others, and the
-//! reflection rays into banks of its counter buffer, and times them apart. Checked for every
+//! The work of each kind of rays apart (issue 15's `accel-compare`): Müller 2015's pipeline (and
+//! seed 004's stream) counts primary rays, the feelers towards the first light and towards the
+//! others, and the reflection rays into banks of its counter buffer, and times them apart. Checked for every
 //! accelerator of the pipeline on the stadium (4 lights, a reflective teapot): the rays of each
 //! kind equal those of the CPU reference with the accelerator's twin, the kinds add up to the
 //! frame's totals, each kind counts only its own kernel's tests, and each has GPU time.
@@ -109,6 +109,13 @@ fn every_kind_of_ray_is_counted_and_timed_apart() {
             kinds_ms <= s.total_gpu_ms() + 1e-6,
             "{label}: kinds' time within the frame's"
         );
+        for (kind, k) in &s.ray_kinds {
+            assert_eq!(
+                k.triangle_tests,
+                k.count("intersect1") + k.count("intersect2"),
+                "{kind}"
+            );
+        }
         if label.starts_with("base") {
             let tests = |kinds: &[&str], name| kinds.iter().map(|k| count(&f, k, name)).sum();
             let i1: u64 = tests(&["primary", "reflection"], "intersect1");
@@ -166,6 +173,25 @@ fn the_own_pipelines_count_the_rays_they_trace() {
     opts.tracer = TracerKind::Stream;
     let stream = pipeline_frame(&ctx, &scene, opts.clone());
     assert_eq!(rays(&stream), rays(&mueller), "stream rays");
+    // and counts them per kind, as Müller's pipeline does
+    for kind in RAY_KINDS {
+        let (s, m) = (count(&stream, kind, "rays"), count(&mueller, kind, "rays"));
+        assert_eq!(s, m, "stream: {kind} rays");
+    }
+    let closest: u64 = ["primary", "reflection"]
+        .map(|k| stream.stats.ray_kinds[k].triangle_tests)
+        .iter()
+        .sum();
+    assert_eq!(
+        closest, stream.stats.triangle_tests["closest"],
+        "stream: closest-hit tests"
+    );
+    assert_eq!(
+        stream.stats.ray_kinds["shadow_first_light"].triangle_tests,
+        stream.stats.triangle_tests["shadow"],
+        "stream: one light's feelers"
+    );
+    assert!(stream.stats.ray_kinds.values().all(|k| k.gpu_ms > 0.0));
     // Wagner's kernel: the eye rays and the first light's feelers, no reflection
     opts.tracer = TracerKind::Bvh;
     opts.bvh_variant = gpgpu_rt::accel::BvhVariant::Wagner;

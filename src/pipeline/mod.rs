@@ -8,6 +8,7 @@
 //! | one kernel per pixel (primary ray, BVH walk, Lambert, hard shadow) | Wagner 2018 | [`wagner2018`] | `glsl/wagner2018/` | its BVH in three textures (`--tracer bvh --bvh-variant wagner`) |
 //! | fragment programs over a viewport-sized quad, traversal looped until an occlusion query counts no fragment | seed 004 | [`stream`] | `glsl/stream/` | its static grid in textures, proximity clouds (`--tracer stream`) |
 
+pub mod ray_kinds;
 pub mod raytrace;
 pub mod softshadow;
 pub mod stream;

@@ -12,8 +12,8 @@
 //! - Scenes: every shipped scene of every source, the area scenes' geometry lit by a point
 //!   light at the area light's centre, and the teapot in a stadium (`stadium.toml`).
 //! - Per configuration (camera and objects fixed): build ms, memory bytes, and per kind of ray
-//!   (primary, feelers to the first light, to all lights, reflection; Müller's pipeline counts
-//!   and times them apart, `pipeline::raytrace::ray_kinds`) Mrays/s, triangle tests and
+//!   (primary, feelers to the first light, to all lights, reflection; Müller's pipeline and the
+//!   stream count and time them apart, `pipeline::ray_kinds`) Mrays/s, triangle tests and
 //!   voxels/nodes visited per ray; the frame's Mrays/s (all rays over all of the frame's GPU
 //!   time, the one figure every pipeline has); agreement of the first hits with the CPU
 //!   reference ([`super::judge`]).
@@ -269,7 +269,8 @@ pub struct Row {
     pub tracer: String,
     pub build_ms: Option<f64>,
     pub bytes: Option<f64>,
-    /// Per kind of ray, [`RAY_KINDS`] order (Müller's pipeline; zero work elsewhere).
+    /// Per kind of ray, [`RAY_KINDS`] order (Müller's pipeline and the stream; zero work in
+    /// Wagner's megakernel).
     pub kinds: [Work; 4],
     /// Every ray of the frame over all of the frame's GPU time (builds included).
     pub frame: Work,
@@ -281,6 +282,11 @@ pub struct Row {
 }
 
 impl Row {
+    /// Whether the pipeline counted the kinds of ray apart (all but Wagner's megakernel).
+    pub fn has_kinds(&self) -> bool {
+        self.kinds[0].rays > 0.0
+    }
+
     /// The feelers towards every light: the first light's and the others'.
     pub fn shadow_all(&self) -> Work {
         let mut w = self.kinds[1];
@@ -307,7 +313,9 @@ fn row(o: &Outcome) -> Row {
         Work {
             rays: count("rays") as f64,
             gpu_ms: mean(&|s| s.ray_kinds.get(k).map_or(0.0, |w| w.gpu_ms)),
-            tests: (count("intersect1") + count("intersect2")) as f64,
+            tests: last
+                .and_then(|s| s.ray_kinds.get(k))
+                .map_or(0, |w| w.triangle_tests) as f64,
             visits: (count("voxels_visited") + count("nodes_visited")) as f64,
         }
     });

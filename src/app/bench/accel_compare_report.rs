@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::accel_compare::{Pipeline, Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
+use super::accel_compare::{Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
 use super::accel_compare::{QUICK_WAGNER_MAX_TRIANGLES, STADIUM};
 use super::args::Scale;
 use super::config::Sizing;
@@ -52,9 +52,9 @@ pub fn write_csv(out: &Path, protocol: &str, rows: &[Row]) -> Result<PathBuf> {
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
     let mut lines = Vec::new();
     for r in rows.iter().filter(|r| r.error.is_none()) {
-        // the own pipelines have only the frame's figures
-        let own = r.accelerator.pipeline != Pipeline::Mueller;
-        for (kind, work) in KINDS.into_iter().filter(|k| !own || k.0 == "frame") {
+        // Wagner's megakernel has only the frame's figures
+        let frame_only = !r.has_kinds();
+        for (kind, work) in KINDS.into_iter().filter(|k| !frame_only || k.0 == "frame") {
             let w = work(r);
             let (agreement, judge) = match &r.agreement {
                 Some((a, j)) => (format!("{a}"), j.clone()),
@@ -109,7 +109,7 @@ pub fn markdown(rows: &[Row], s: Sizing, scale: Scale) -> String {
     let mut md = intro(s, scale);
     md += "\n### Frame throughput (Mrays/s: all rays of the frame over all of its GPU time)\n\n";
     md += &throughput_matrix(rows);
-    md += "\n### Each kind of ray apart (Müller 2015's pipeline)\n\n";
+    md += "\n### Each kind of ray apart (Müller 2015's pipeline and the stream)\n\n";
     md += &kinds_table(rows);
     md += "\n### Build, memory, work per ray, agreement\n\n";
     md += &configs_table(rows);
@@ -132,8 +132,9 @@ fn intro(s: Sizing, scale: Scale) -> String {
         "{}, camera and objects fixed, {} frames after {} warm-up, each scene at its own \
          reflection depth. Grids at `--grid auto` (N = ∛(T/5)), the stream's at the paper's \
          3·∛T per axis. Mrays/s = rays / GPU ms of the kind's dispatches (GL timer queries); \
-         the own pipelines (Wagner's megakernel traces every ray in one dispatch, the stream in \
-         fragment passes) have only the frame's figure. Every pipeline counts the rays it \
+         the stream's fragment passes are counted and timed per kind as Müller's kernels are; \
+         Wagner's megakernel traces every ray in one dispatch, so it has only the frame's figure. \
+         Every pipeline counts the rays it \
          traces; shadow rays are the feelers actually traced (N·L > 0). Wagner's kernel lights \
          with the scene's first light only and traces no reflection (as the thesis), so it \
          traces fewer rays of a scene than the others. Agreement: \
@@ -170,8 +171,8 @@ fn throughput_matrix(rows: &[Row]) -> String {
     table(&header, &lines)
 }
 
-/// A line per scene and accelerator of Müller's pipeline: Mrays/s, tests and visits per ray of
-/// each kind.
+/// A line per scene and accelerator that counts the kinds apart (Müller's pipeline and the
+/// stream): Mrays/s, tests and visits per ray of each kind.
 fn kinds_table(rows: &[Row]) -> String {
     let header = [
         "scene",
@@ -186,10 +187,7 @@ fn kinds_table(rows: &[Row]) -> String {
         "visits/ray shadow",
     ];
     let mut lines = Vec::new();
-    for r in rows
-        .iter()
-        .filter(|r| r.accelerator.pipeline == Pipeline::Mueller)
-    {
+    for r in rows.iter().filter(|r| r.has_kinds()) {
         if r.error.is_some() {
             continue;
         }
@@ -281,9 +279,9 @@ fn tests_per_primary_ray(rows: &[Row], accelerator: &str) -> Vec<(f64, f64)> {
     let r = rows.iter().filter(|r| {
         r.accelerator.name == accelerator && r.error.is_none() && r.scene != stem(STADIUM)
     });
-    let work = |r: &Row| match r.accelerator.pipeline {
-        Pipeline::Mueller => r.kinds[0].tests_per_ray(),
-        _ => r.frame.tests_per_ray(),
+    let work = |r: &Row| match r.has_kinds() {
+        true => r.kinds[0].tests_per_ray(),
+        false => r.frame.tests_per_ray(),
     };
     r.filter_map(|r| Some((r.triangles as f64, work(r)?)))
         .collect()
@@ -404,9 +402,9 @@ fn stadium(rows: &[Row]) -> String {
         .filter(|a| a.name != "bvh sah")
         .filter_map(|a| {
             let here = find(rows, scene, a.name)?;
-            let tests = match a.pipeline {
-                Pipeline::Mueller => here.kinds[0].tests_per_ray(),
-                _ => here.frame.tests_per_ray(),
+            let tests = match here.has_kinds() {
+                true => here.kinds[0].tests_per_ray(),
+                false => here.frame.tests_per_ray(),
             }?;
             let mut others: Vec<f64> = tests_per_primary_ray(rows, a.name)
                 .iter()

@@ -6,7 +6,6 @@
 
 pub mod gpu_scene;
 pub mod images;
-pub mod ray_kinds;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -18,7 +17,7 @@ use serde_json::json;
 
 use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
-use self::ray_kinds::{Bank, CounterBanks};
+use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
     self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, TracerKind,
@@ -314,7 +313,7 @@ impl RayTracer {
         let kind_ms = self.timers.take_ray_kind_ms();
         let mut stats = FrameStats {
             gpu_ms,
-            ray_kinds: ray_kinds::ray_kind_stats(&banks, COUNTERS, kind_ms),
+            ray_kinds: ray_kinds::ray_kind_stats(&banks, COUNTERS, TRIANGLE_TEST_COUNTERS, kind_ms),
             ..Default::default()
         };
         for (i, name) in COUNTERS.iter().enumerate() {

@@ -32,11 +32,11 @@ use serde_json::json;
 
 use self::grid_textures::GridTextures;
 use self::targets::{AovTargets, Targets};
+use super::ray_kinds::{self, Bank, CounterBanks};
 use super::raytrace::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
-use crate::gl::resources::{GpuTimers, Ssbo};
-use crate::gl::slots::ssbo;
+use crate::gl::resources::GpuTimers;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, ShaderSource};
 use crate::reference::stream_grid::{auto_dims, StreamGrid};
 use crate::scene::{Camera, Scene};
@@ -144,7 +144,7 @@ pub struct StreamRenderer {
     textures: GridTextures,
     targets: Targets,
     kernels: Kernels,
-    counters: Ssbo,
+    counters: CounterBanks,
     timers: GpuTimers,
     query: glow::Query,
     calls: Calls,
@@ -217,7 +217,7 @@ impl StreamRenderer {
         let grid_ms = start.elapsed().as_secs_f64() * 1e3;
         let textures = GridTextures::upload(&gl, &grid, &scene)?;
         let targets = Targets::new(&gl, options.width, options.height, options.aovs)?;
-        let counters = Ssbo::new(&gl, "counters", 8 * COUNTERS.len(), None, i64::MAX)?;
+        let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         // SAFETY: query creation on a current context.
         let query = unsafe { gl.create_query().map_err(|e| anyhow!(e))? };
         let r = StreamRenderer {
@@ -428,46 +428,63 @@ impl StreamRenderer {
     /// One bounce: trace the rays of `cur`, shade, generate the next bounce's rays.
     fn bounce(&mut self, camera: &Camera, bounce: u32) {
         let cur = (bounce % 2) as usize;
+        self.count_as(Bank::closest_hit(bounce));
         self.trace(cur, false);
+        self.count_as(Bank::Frame);
         self.keep_hits();
         if bounce == 0 {
             self.keep_primary();
         }
         self.shade(cur, 0, 0);
         for light in 0..self.scene.lights.len() {
+            self.count_as(Bank::any_hit(light));
             self.generate(camera, 1, cur, 2, light);
             self.trace(2, true);
+            self.count_as(Bank::Frame);
             if bounce == 0 {
                 self.count_unblocked();
             }
             self.shade(cur, 1, light);
         }
         if bounce < self.options.refl_depth {
+            self.count_as(Bank::Reflection);
             self.generate(camera, 2, cur, 1 - cur, 0);
+            self.count_as(Bank::Frame);
         }
     }
 
     /// The whole frame: the primary rays, then every bounce.
     fn frame(&mut self, camera: &Camera) {
         let gl = &self.gl;
-        self.counters.bind(gl, ssbo::COUNTERS);
-        self.counters.clear_u32(gl, 0);
+        self.counters.clear(gl, &mut self.timers);
         self.textures.bind(gl);
         gl.clear_tex_f32(self.targets.color.texture, [0.0, 0.0, 0.0, 1.0]);
         self.calls = Calls::default();
         self.unblocked.iter_mut().for_each(|n| *n = 0);
+        self.count_as(Bank::Primary);
         self.generate(camera, 0, 1, 0, 0);
         for b in 0..=self.options.refl_depth {
             self.bounce(camera, b);
         }
     }
 
+    /// The passes from now on count into `bank` and are timed under its kind of ray
+    /// ([`super::ray_kinds`]): the generation and traversal of the primary, shadow and
+    /// reflection rays apart.
+    fn count_as(&mut self, bank: Bank) {
+        self.counters.bind(&self.gl, &mut self.timers, bank);
+    }
+
     /// The counters, timers and facts of the frame.
     fn frame_stats(&mut self) -> FrameStats {
-        let raw = self.counters.read_u32(&self.gl);
-        let count = |i: usize| raw[2 * i] as u64 | ((raw[2 * i + 1] as u64) << 32);
+        let banks = self.counters.read(&self.gl);
+        let count = |i: usize| banks.iter().map(|b| b[i]).sum::<u64>();
+        let gpu_ms = self.timers.resolve(&self.gl);
+        let tests = ["closest_tests", "shadow_tests"];
+        let kind_ms = self.timers.take_ray_kind_ms();
         let mut stats = FrameStats {
-            gpu_ms: self.timers.resolve(&self.gl),
+            ray_kinds: ray_kinds::ray_kind_stats(&banks, COUNTERS, &tests, kind_ms),
+            gpu_ms,
             truncated_rays: self.calls.unfinished,
             ..Default::default()
         };

@@ -1,12 +1,13 @@
-//! The kinds of rays the ray tracer counts and times apart (ours; issue 15's `accel-compare`):
-//! primary rays (pass 0's intersect1), shadow feelers towards the first light and towards the
-//! others (intersect2, every pass), and reflection rays (intersect1 of passes 1…REFL_DEPTH).
+//! The kinds of rays a pipeline counts and times apart (ours; issue 15's `accel-compare`):
+//! primary rays, shadow feelers towards the first light and towards the others, and reflection
+//! rays — in Müller 2015's pipeline pass 0's intersect1, intersect2 of every pass and the later
+//! passes' intersect1; in seed 004's streaming pipeline the generation and traversal of each.
 //!
-//! The counter buffer holds one bank of [`super::COUNTERS`] per kind and one for the rest of
-//! the frame (the accelerator's build, eye rays, shading). Before each dispatch the host binds
-//! the kind's bank to `SSBO_COUNTERS` (`glBindBufferRange`), so the kernels — which know
-//! nothing of kinds — add to it; the frame's totals are the sums over the banks. The GPU timers
-//! are told the kind the same way ([`GpuTimers::set_ray_kind`]).
+//! The counter buffer holds one bank of the pipeline's counters per kind and one for the rest of
+//! the frame (builds, shading). Before each dispatch or draw the host binds the kind's bank to
+//! `SSBO_COUNTERS` (`glBindBufferRange`), so the kernels — which know nothing of kinds — add to
+//! it; the frame's totals are the sums over the banks. The GPU timers are told the kind the same
+//! way ([`GpuTimers::set_ray_kind`]).
 
 use std::collections::BTreeMap;
 
@@ -20,7 +21,7 @@ use crate::gl::{Gl, GlInfo};
 /// A bank of the counter buffer: the work of one kind of rays, or of none.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Bank {
-    /// Work that is not one kind of rays': the build, eye-ray generation, shading.
+    /// Work that is not one kind of rays': builds, shading (Müller's: eye-ray generation too).
     Frame,
     Primary,
     /// Shadow feelers towards light 0.
@@ -114,7 +115,7 @@ impl CounterBanks {
             .map(|b| {
                 let bank = &raw[b * words..];
                 (0..self.slots)
-                    .map(|i| super::super::counter_value(bank, i))
+                    .map(|i| super::counter_value(bank, i))
                     .collect()
             })
             .collect()
@@ -125,11 +126,13 @@ impl CounterBanks {
     }
 }
 
-/// The statistics per ray kind: each kind bank's counts under `names`, with the kind's GPU
-/// milliseconds; kinds that traced no ray and took no time are left out.
+/// The statistics per ray kind: each kind bank's counts under `names` (those in `tests` count
+/// ray–triangle tests), with the kind's GPU milliseconds; kinds that traced no ray and took no
+/// time are left out.
 pub fn ray_kind_stats(
     banks: &[Vec<u64>],
     names: &[&str],
+    tests: &[&str],
     mut ms: BTreeMap<String, f64>,
 ) -> BTreeMap<String, RayKindStats> {
     let mut out = BTreeMap::new();
@@ -144,8 +147,14 @@ pub fn ray_kind_stats(
             .filter(|(_, &v)| v > 0)
             .map(|(n, &v)| (n.to_string(), v))
             .collect();
+        let triangle_tests = tests.iter().filter_map(|t| counts.get(*t)).sum();
         if gpu_ms > 0.0 || !counts.is_empty() {
-            out.insert(kind.to_string(), RayKindStats { gpu_ms, counts });
+            let k = RayKindStats {
+                gpu_ms,
+                triangle_tests,
+                counts,
+            };
+            out.insert(kind.to_string(), k);
         }
     }
     out
