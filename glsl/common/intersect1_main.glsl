@@ -6,7 +6,9 @@
 //                     inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 // It adds its work to the globals of common/intersect_head.glsl. The evaluation of the hit
 // (Listings 13 and 14) is in common/intersect1_hit.glsl; the base tracer's kernel
-// (brute_force/intersect1.comp, Listing 12) calls it directly.
+// (brute_force/intersect1.comp, Listing 12) calls it directly. With HIT_RECORDS (ours, the
+// SAH BVH) the kernel only stores the closest hit (common/records.glsl) and
+// common/evaluate_hit.comp evaluates it.
 #include "intersect1_hit.glsl"
 
 void trace(ivec2 storePos)
@@ -15,7 +17,9 @@ void trace(ivec2 storePos)
     vec4 dirTri = imageLoad(rayDirTexture, storePos);
     float rayState = originState.w;
     if (rayState <= 0.0) {
+#if !HIT_RECORDS
         emptyColorBuffer(storePos);
+#endif
         return;
     }
     raysTraced = uint(COUNTS_RAY);
@@ -27,7 +31,11 @@ void trace(ivec2 storePos)
     int triID = -1;
     float hit_u = 0.0, hit_v = 0.0;
     closestHit(storePos, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
+#if HIT_RECORDS
+    hitRecord[pixelIndex(storePos)] = vec4(t_min, intBitsToFloat(triID), hit_u, hit_v);
+#else
     evaluateHit(storePos, ro, rd, rayState, t_min, triID, hit_u, hit_v);
+#endif
 }
 
 void main()

@@ -10,6 +10,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "images.glsl"
 #include "intersect.glsl"
 #include "counters.glsl"
+#if HIT_RECORDS || PIXEL_COUNTS
+#include "records.glsl"
+#endif
 
 uint tests = 0u;         // ray–triangle tests of this invocation
 uint truncated = 0u;     // 1 if a loop of this invocation ended early (see loopLimit)
@@ -31,9 +34,18 @@ uint raysTraced = 0u;    // 1 if this invocation traced its pixel's ray (ours: r
 void trace(ivec2 storePos);
 
 // main() of every intersection kernel: trace this invocation's pixel, then add its work counts
-// to the 64-bit counters — its triangle tests to `testsSlot` (COUNTER_INTERSECT1 or 2).
+// to the 64-bit counters — its triangle tests to `testsSlot` (COUNTER_INTERSECT1 or 2) — or,
+// with PIXEL_COUNTS, store them for common/pixel_counts.comp (the other counts stay 0 there:
+// the designs that store per-pixel counts neither walk voxels nor jump clouds).
 void traceAndCount(int testsSlot)
 {
+#if PIXEL_COUNTS
+    ivec2 storePos = pixelPosition();
+    if (insideImage(storePos)) {
+        trace(storePos);
+        pixelCounts[pixelIndex(storePos)] = uvec4(tests, nodesVisited, truncated, raysTraced);
+    }
+#else
     countersBegin();
     ivec2 storePos = pixelPosition();
     if (insideImage(storePos)) trace(storePos);
@@ -52,5 +64,6 @@ void traceAndCount(int testsSlot)
 #ifdef COUNTER_CLOUD_JUMPS
     countersEnd(4, COUNTER_CLOUD_JUMPS);
     countersEnd(5, COUNTER_EMPTY_CELLS_SKIPPED);
+#endif
 #endif
 }

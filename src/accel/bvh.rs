@@ -16,7 +16,7 @@ use serde_json::json;
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
 use crate::frame::FrameStats;
 use crate::gl::resources::{TexelData, TextureBuffers};
-use crate::gl::slots::sampler;
+use crate::gl::slots::image;
 use crate::gl::{Gl, Kernel};
 use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
 use crate::reference::CpuAccelerator;
@@ -35,33 +35,32 @@ pub const ENTRY: Entry = Entry {
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes, miss links, leaf triangles.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     let leaf_triangles = bvh.leaf_triangles();
+    let nodes = bvh.gpu_nodes();
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
         [
             data(
                 "bvhNodes",
-                glow::RGBA32F,
-                16,
-                bytemuck::cast_slice(&bvh.nodes),
-                sampler::BVH_NODES,
-            ),
-            data(
-                "bvhLinks",
-                glow::R32I,
+                glow::R32UI,
                 4,
-                bytemuck::cast_slice(&bvh.links),
-                sampler::BVH_LINKS,
+                bytemuck::cast_slice(&nodes),
+                image::BVH_NODES,
             ),
             data(
                 "bvhLeafTriangles",
-                glow::RGBA32F,
-                16,
+                glow::R32UI,
+                4,
                 bytemuck::cast_slice(&leaf_triangles),
-                sampler::BVH_LEAF_TRIANGLES,
+                image::BVH_LEAF_TRIANGLES,
             ),
         ],
     )
+}
+
+/// The kernels store hit records and per-pixel counts (`Accelerator::records`).
+fn records_defines() -> [(&'static str, String); 2] {
+    [("HIT_RECORDS", "1".into()), ("PIXEL_COUNTS", "1".into())]
 }
 
 pub struct Bvh {
@@ -84,10 +83,11 @@ pub struct Bvh {
 
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        let defs = records_defines();
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
-            intersect1: b.kernel("bvh/intersect1.comp", &[], "intersect1")?,
-            intersect2: b.kernel("bvh/intersect2.comp", &[], "intersect2")?,
+            intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
+            intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             objects: scene
                 .objects
                 .iter()
@@ -135,7 +135,7 @@ impl Bvh {
 
     fn bind(&self, gl: &Gl) {
         if let Some(b) = &self.buffers {
-            b.bind(gl);
+            b.bind_images(gl);
         }
     }
 }
@@ -172,6 +172,10 @@ impl Accelerator for Bvh {
         f.insert("bvh_depth".into(), json!(s.depth));
         f.insert("bvh_bytes".into(), json!(s.bytes));
         f.insert("bvh_sah_cost".into(), json!(s.sah_cost));
+    }
+
+    fn records(&self) -> bool {
+        true
     }
 
     fn as_any(&self) -> &dyn Any {

@@ -49,6 +49,13 @@ pub trait Accelerator {
     fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel;
     /// Add the design's facts (sizes, build time, settings) and events to the statistics.
     fn stats(&self, stats: &mut FrameStats);
+    /// Whether the design's intersect1 stores hit records and its intersection kernels store
+    /// per-pixel counts (`HIT_RECORDS`, `PIXEL_COUNTS`: `glsl/common/records.glsl`), for the
+    /// pipeline to evaluate the hits and add the counts after them
+    /// (`pipeline::raytrace::records`). The thesis' designs evaluate and count in the kernel.
+    fn records(&self) -> bool {
+        false
+    }
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
 }

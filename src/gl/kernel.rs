@@ -134,6 +134,13 @@ impl Kernel {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_3_i32(self.loc(name), v[0], v[1], v[2]) };
     }
+    pub fn set_ivec4(&self, name: &str, v: [i32; 4]) {
+        // SAFETY: a uniform of the program in use.
+        unsafe {
+            self.gl
+                .uniform_4_i32(self.loc(name), v[0], v[1], v[2], v[3])
+        };
+    }
     pub fn set_vec2(&self, name: &str, v: [f32; 2]) {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_2_f32(self.loc(name), v[0], v[1]) };

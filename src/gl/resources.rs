@@ -238,6 +238,8 @@ impl Image2d {
 pub struct TextureBuffer {
     pub buffer: glow::Buffer,
     pub texture: glow::Texture,
+    /// The texel format (`GL_RGBA32F`, ...).
+    pub format: u32,
     /// Texels and bytes of the data.
     pub texels: usize,
     pub bytes: usize,
@@ -280,6 +282,7 @@ impl TextureBuffer {
             Ok(TextureBuffer {
                 buffer,
                 texture,
+                format,
                 texels,
                 bytes: data.len(),
             })
@@ -294,6 +297,24 @@ impl TextureBuffer {
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture));
             gl.active_texture(glow::TEXTURE0);
         }
+    }
+
+    /// Bind to image unit `unit`, read-only (an `imageBuffer` with `layout(format, binding =
+    /// unit) readonly`). llvmpipe generates image loads inline, where it calls a function for
+    /// every `texelFetch` of a format other than 8-bit RGBA (docs/results/bvh_steps.md).
+    pub fn bind_image(&self, gl: &Gl, unit: u32) {
+        // SAFETY: binding our own texture to an image unit.
+        unsafe {
+            gl.bind_image_texture(
+                unit,
+                Some(self.texture),
+                0,
+                false,
+                0,
+                glow::READ_ONLY,
+                self.format,
+            )
+        };
     }
 
     pub fn delete(&self, gl: &Gl) {
@@ -372,6 +393,13 @@ impl TextureBuffers {
     pub fn bind(&self, gl: &Gl) {
         for (t, unit) in &self.0 {
             t.bind(gl, *unit);
+        }
+    }
+
+    /// Bind every one to its unit as a read-only image (the units are image units).
+    pub fn bind_images(&self, gl: &Gl) {
+        for (t, unit) in &self.0 {
+            t.bind_image(gl, *unit);
         }
     }
 

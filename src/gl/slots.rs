@@ -52,6 +52,11 @@ slot_table! {
         VOXEL_DIST = 17,
         DIST_IN = 18,
         DIST_OUT = 19,
+        /// Müller's pipeline, for the designs that keep the closest-hit search apart from the
+        /// hit's evaluation and count per pixel (glsl/common/records.glsl): a hit record and
+        /// the work counts per pixel
+        HIT_RECORDS = 20,
+        PIXEL_COUNTS = 21,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,
@@ -82,6 +87,11 @@ slot_table! {
         WAGNER_HIT = 1,
         WAGNER_RAY = 2,
         WAGNER_NORMAL = 3,
+        /// the SAH BVH's texture buffers, read as image buffers (glsl/bvh/traverse.glsl):
+        /// nodes, miss links, leaf triangles
+        BVH_NODES = 8,
+        BVH_LINKS = 9,
+        BVH_LEAF_TRIANGLES = 10,
     }
 }
 
@@ -92,10 +102,6 @@ slot_table! {
         TEXTURES = 0,
         /// Klee 2016's node pool (a texture buffer)
         NODE_POOL = 1,
-        /// the BVH's texture buffers (glsl/bvh/traverse.glsl): nodes, miss links, leaf triangles
-        BVH_NODES = 1,
-        BVH_LINKS = 2,
-        BVH_LEAF_TRIANGLES = 3,
         /// the texture a screen-filling quad shows
         QUAD_COLOR = 0,
         /// Wagner 2018's BVH in three textures (Fig. 4.3, texture buffers): the boxes (centre,

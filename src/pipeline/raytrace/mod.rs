@@ -6,6 +6,7 @@
 
 pub mod gpu_scene;
 pub mod images;
+pub mod records;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,6 +18,7 @@ use serde_json::json;
 
 use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
+use self::records::Records;
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
@@ -105,7 +107,12 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         .set(
             "SHADOW_OFFSET",
             format!("{:?}", scene.settings.shadow_offset),
-        );
+        )
+        // the image size (common/records.glsl); the designs that use records set these to 1
+        .set("IMAGE_WIDTH", options.width)
+        .set("IMAGE_HEIGHT", options.height)
+        .set("HIT_RECORDS", 0)
+        .set("PIXEL_COUNTS", 0);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -142,6 +149,8 @@ pub struct RayTracer {
     models: Vec<Mat4>,
     entry: &'static Entry,
     accel: Box<dyn Accelerator>,
+    /// The hit records and per-pixel counts, for an accelerator that uses them.
+    records: Option<Records>,
     last: Option<FrameStats>,
 }
 
@@ -216,6 +225,10 @@ impl RayTracer {
             height: h,
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
+        let records = accel
+            .records()
+            .then(|| Records::new(&gl, info, shaders, &defines, (w, h)))
+            .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
             images: RayImages::new(&gl, w, h, options.shadow_flags)?,
@@ -238,6 +251,7 @@ impl RayTracer {
             renderer: info.renderer.clone(),
             entry,
             accel,
+            records,
             last: None,
             gl,
         };
@@ -287,6 +301,9 @@ impl RayTracer {
         k.set_vec4("backgroundColor", self.lighting.background, 1.0);
         k.set_i32("storePrimaryHit", (pass == 0) as i32);
         k.dispatch_pixels(f.timers, f.pixels);
+        if let Some(r) = &self.records {
+            r.after_closest_hit(f.timers, f.pixels, self.lighting.background, pass == 0);
+        }
         // the shadow flags of this pass: cleared before every pass (the thesis, ch. 3.1.3,
         // clears the textures once a frame; intersect2 only sets flags, so a reflection pass
         // would inherit the flags of the pass before it)
@@ -296,6 +313,9 @@ impl RayTracer {
             let k = self.accel.any_hit(&mut f, light);
             k.set_i32("lightSource", light as i32);
             k.dispatch_pixels(f.timers, f.pixels);
+            if let Some(r) = &self.records {
+                r.add_counts(f.timers, "intersect2");
+            }
         }
         self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
         let k = &self.kernels.shading;
@@ -361,6 +381,9 @@ impl Renderer for RayTracer {
         })?;
         self.images.clear(&gl);
         self.images.bind(&gl);
+        if let Some(r) = &self.records {
+            r.bind(&gl);
+        }
         let cam = camera.rays(self.options.width, self.options.height);
         self.eye_rays(&cam);
         if let Some(a) = &self.aov_images {
@@ -442,6 +465,9 @@ impl Drop for RayTracer {
             a.delete(&gl);
         }
         self.counters.delete(&gl);
+        if let Some(r) = &self.records {
+            r.delete(&gl);
+        }
         self.timers.delete(&gl);
     }
 }

@@ -149,6 +149,24 @@ impl Bvh {
         }
     }
 
+    /// The nodes as uploaded: one 64-byte cache line per node, 16 words: lo.xyz, first,
+    /// hi.xyz, meta (the floats as bits), then the node's miss link for each of the 8 octants.
+    pub fn gpu_nodes(&self) -> Vec<u32> {
+        let mut out = Vec::with_capacity(16 * self.nodes.len());
+        for (n, node) in self.nodes.iter().enumerate() {
+            out.extend(node.lo.map(f32::to_bits));
+            out.push(node.first);
+            out.extend(node.hi.map(f32::to_bits));
+            out.push(node.meta as u32);
+            out.extend(
+                self.links[OCTANTS * n..OCTANTS * (n + 1)]
+                    .iter()
+                    .map(|&l| l as u32),
+            );
+        }
+        out
+    }
+
     /// The triangles of the leaves in leaf order, as uploaded.
     pub fn leaf_triangles(&self) -> Vec<LeafTriangle> {
         let sub = |a: Vec3, b: Vec3| (a - b).to_array();

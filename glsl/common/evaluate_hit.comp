@@ -1,0 +1,30 @@
+// The evaluation of the closest hit as a kernel of its own (ours) — Müller 2015, ch. 4.1.2,
+// Listings 13 and 14, which the thesis runs at the end of intersect1 (evaluateHit in
+// common/intersect1_hit.glsl, unchanged). For the designs whose intersect1 stores hit records
+// (HIT_RECORDS, common/records.glsl): one invocation per pixel reads its ray from the
+// ray-state textures and its closest hit (t, triangle id, u, v) from the hit record, and
+// evaluates it exactly as the thesis' intersect1 does; an inactive ray (rayState <= 0) gets an
+// empty colour buffer. The host dispatches it right after intersect1, under the same ray kind.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#define SCENE_QUALIFIER readonly
+#include "scene.glsl"
+#include "images.glsl"
+#include "records.glsl"
+#include "intersect1_hit.glsl"
+
+void main()
+{
+    ivec2 storePos = pixelPosition();
+    if (!insideImage(storePos)) return;
+    vec4 originState = imageLoad(rayOriginTexture, storePos);
+    float rayState = originState.w;
+    if (rayState <= 0.0) {
+        emptyColorBuffer(storePos);
+        return;
+    }
+    vec3 rd = imageLoad(rayDirTexture, storePos).xyz;
+    vec4 hit = hitRecord[pixelIndex(storePos)];
+    evaluateHit(storePos, originState.xyz, rd, rayState, hit.x, floatBitsToInt(hit.y), hit.z,
+                hit.w);
+}

@@ -1,0 +1,27 @@
+// The per-pixel work counts of an intersection dispatch added to the 64-bit counters (ours;
+// common/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
+// counts — (ray–triangle tests, BVH nodes visited, loops cut short, rays traced) — and adds the
+// sums to the counter slots `countSlots` through common/counters.glsl (one global atomic per
+// work group and counter). A pixel's counts are below 2^32 / PIXELS_PER_INVOCATION: a ray
+// tests each triangle and visits each node at most once, and the scene buffers' limit
+// (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, 128 MiB on llvmpipe) keeps both far below 2^28.
+layout(local_size_x = 64) in;
+
+#define COUNTER_SLOTS_PER_KERNEL 4
+#include "counters.glsl"
+#include "records.glsl"
+
+const int PIXELS_PER_INVOCATION = 16;
+// the global counter slot of each component
+uniform ivec4 countSlots;
+
+void main()
+{
+    countersBegin();
+    uvec4 sum = uvec4(0u);
+    int first = int(gl_GlobalInvocationID.x) * PIXELS_PER_INVOCATION;
+    int end = min(first + PIXELS_PER_INVOCATION, IMAGE_WIDTH * IMAGE_HEIGHT);
+    for (int k = first; k < end; k++) sum += pixelCounts[k];
+    for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
+    for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);
+}

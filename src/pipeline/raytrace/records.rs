@@ -1,0 +1,102 @@
+//! Hit records and per-pixel counts (ours, `glsl/common/records.glsl`): for an accelerator
+//! whose intersect1 only stores the closest hit of each pixel and whose intersection kernels
+//! store their work counts per pixel ([`crate::accel::Accelerator::records`], the SAH BVH).
+//! After its intersect1 the pipeline evaluates the hits (`glsl/common/evaluate_hit.comp`:
+//! Listings 13 and 14, which the thesis runs inside intersect1) and after each intersection
+//! dispatch adds the counts to the 64-bit counters (`glsl/common/pixel_counts.comp`), both under
+//! the same counter bank and ray kind. So `gpu_ms.intersect1` is the closest-hit search alone,
+//! as a ray-tracing kernel like Embree's `rtcIntersect1` measures it, and `evaluate_hit`,
+//! `pixel_counts` are timed apart.
+
+use anyhow::Result;
+
+use super::COUNTERS;
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::slots::ssbo;
+use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+
+/// Pixels each invocation of `pixel_counts.comp` sums (`PIXELS_PER_INVOCATION` there) and its
+/// work group size.
+const PIXELS_PER_INVOCATION: u32 = 16;
+const COUNT_GROUP: u32 = 64;
+
+/// The hit-record and count buffers and the two kernels that read them.
+pub struct Records {
+    hits: Ssbo,
+    counts: Ssbo,
+    evaluate_hit: Kernel,
+    pixel_counts: Kernel,
+    pixels: u32,
+}
+
+/// The counter slot of `name` (an entry of [`COUNTERS`]).
+fn slot(name: &str) -> i32 {
+    COUNTERS.iter().position(|c| *c == name).expect("a counter") as i32
+}
+
+impl Records {
+    pub fn new(
+        gl: &std::sync::Arc<Gl>,
+        info: &GlInfo,
+        shaders: &ShaderSource,
+        defines: &Defines,
+        (w, h): (u32, u32),
+    ) -> Result<Records> {
+        let bytes = 16 * (w as usize) * (h as usize);
+        let max = info.max_ssbo_block_size;
+        let compute = |file, timer| Kernel::compute(gl, shaders, file, defines, timer);
+        Ok(Records {
+            hits: Ssbo::new(gl, "hit records", bytes, None, max)?,
+            counts: Ssbo::new(gl, "pixel counts", bytes, None, max)?,
+            evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
+            pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,
+            pixels: w * h,
+        })
+    }
+
+    pub fn bind(&self, gl: &Gl) {
+        self.hits.bind(gl, ssbo::HIT_RECORDS);
+        self.counts.bind(gl, ssbo::PIXEL_COUNTS);
+    }
+
+    /// After intersect1: evaluate the hits (Listings 13, 14), then count.
+    pub fn after_closest_hit(
+        &self,
+        timers: &mut GpuTimers,
+        grid: PixelGrid,
+        background: [f32; 3],
+        first_pass: bool,
+    ) {
+        let k = &self.evaluate_hit;
+        k.use_program();
+        k.set_vec4("backgroundColor", background, 1.0);
+        k.set_i32("storePrimaryHit", first_pass as i32);
+        k.dispatch_pixels(timers, grid);
+        self.add_counts(timers, "intersect1");
+    }
+
+    /// After an intersection dispatch whose triangle tests count under `tests`: add every
+    /// pixel's counts to the bound bank.
+    pub fn add_counts(&self, timers: &mut GpuTimers, tests: &str) {
+        let k = &self.pixel_counts;
+        k.use_program();
+        k.set_ivec4(
+            "countSlots",
+            [
+                slot(tests),
+                slot("nodes_visited"),
+                slot("truncated_rays"),
+                slot("rays"),
+            ],
+        );
+        k.dispatch_1d(
+            timers,
+            self.pixels.div_ceil(PIXELS_PER_INVOCATION * COUNT_GROUP),
+        );
+    }
+
+    pub fn delete(&self, gl: &Gl) {
+        self.hits.delete(gl);
+        self.counts.delete(gl);
+    }
+}
