@@ -94,3 +94,35 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
         "moved teapot, bvh",
     );
 }
+
+/// The GPU walk visits exactly the nodes its CPU twin visits, ray by ray summed over the frame,
+/// and every pixel's counts reach the statistics (`glsl/common/pixel_counts.comp`): the primary
+/// rays' node visits equal the twin's over the very same rays (the AOVs), and every pixel traced
+/// one primary ray. Odd image sides leave a partial last block of `pixel_counts.comp`.
+#[test]
+fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
+    use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
+    use gpgpu_rt::reference::closest_among;
+    use std::ops::ControlFlow;
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let (w, h) = (47, 33);
+    let frame = render_gpu(&ctx, &scene, bvh_options(w, h, 0));
+    let primary = &frame.stats.ray_kinds["primary"];
+    assert_eq!(primary.count("rays"), (w * h) as u64, "a ray per pixel");
+    let twin = CpuBvh::new(scene.world_triangles());
+    let aovs = frame.aovs.as_ref().expect("AOVs");
+    let (mut nodes, mut tests) = (0u64, 0u64);
+    for (o, d) in aovs.ray_origin.iter().zip(&aovs.ray_direction) {
+        let (ro, rd) = (Vec3::from(*o), Vec3::from(*d));
+        let mut best = None;
+        nodes += twin.traverse(ro, rd, f32::INFINITY, |ids| {
+            let ids = ids.iter().map(|&i| i as usize);
+            closest_among(&mut best, twin.triangles(), ids, (ro, rd, -1), &mut tests);
+            ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))
+        });
+    }
+    assert_eq!(primary.count("intersect1"), tests, "triangle tests");
+    assert_eq!(primary.count("nodes_visited"), nodes, "nodes visited");
+    assert!(nodes > (w * h) as u64, "{nodes} nodes");
+}

@@ -6,26 +6,24 @@
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
 
-// the ray and its closest hit so far, for leafHit
+// the ray and its closest hit so far, for triangleHit
 vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float bestT = 0.0;
 int bestID = -1;
 float bestU = 0.0, bestV = 0.0;
 
-bool leafHit(int first, int count, inout float limit)
+bool triangleHit(int slot, inout float limit)
 {
-    for (int k = first; k < first + count; k++) {
-        int tri;
-        float t, u, v;
-        bool hit = intersectLeafTriangle(rayO, rayD, k, tri, t, u, v);
-        if (tri == rayLast) continue;
-        tests++;
-        if (hit && (t < bestT || (t == bestT && tri < bestID))) {
-            bestT = t;
-            bestID = tri;
-            bestU = u; bestV = v;
-        }
+    int tri;
+    float t, u, v;
+    bool hit = intersectLeafTriangle(rayO, rayD, slot, tri, t, u, v);
+    if (tri == rayLast) return false;
+    tests++;
+    if (hit && (t < bestT || (t == bestT && tri < bestID))) {
+        bestT = t;
+        bestID = tri;
+        bestU = u; bestV = v;
     }
     limit = bestT;
     return false;

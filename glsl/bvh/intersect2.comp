@@ -6,22 +6,19 @@
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
 
-// the feeler, for leafHit
+// the feeler, for triangleHit
 vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float rayLight = 0.0;
 
-bool leafHit(int first, int count, inout float limit)
+bool triangleHit(int slot, inout float limit)
 {
-    for (int k = first; k < first + count; k++) {
-        int tri;
-        float t, u, v;
-        bool hit = intersectLeafTriangle(rayO, rayD, k, tri, t, u, v);
-        if (tri == rayLast) continue;
-        tests++;
-        if (hit && t > SHADOW_OFFSET && t < rayLight) return true;
-    }
-    return false;
+    int tri;
+    float t, u, v;
+    bool hit = intersectLeafTriangle(rayO, rayD, slot, tri, t, u, v);
+    if (tri == rayLast) return false;
+    tests++;
+    return hit && t > SHADOW_OFFSET && t < rayLight;
 }
 
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)

@@ -17,17 +17,23 @@
 // plane, unless the ray points down the split axis — and every box missed, or beyond the
 // limit, and every leaf done is followed by its miss link: a depth-first walk, near side first,
 // pruned by the closest hit so far (or the light). On llvmpipe a per-invocation stack array
-// costs several times more than these loads (docs/results/bvh_steps.md). Each node is
-// visited at most once, so the loop is bounded by the node count; a walk cut short (llvmpipe's
-// loop limit, see loopLimit in common/intersect.glsl) counts the ray as truncated.
+// costs several times more than these loads (docs/results/bvh_steps.md).
 //
-// The including kernel defines leafHit (declared below), which tests a leaf's triangles, may
-// lower the limit, and returns true to end the walk.
+// One step per iteration: a node, or one triangle of the leaf the walk entered last (ours:
+// llvmpipe runs the 8 invocations of a SIMD group in lock step, so a leaf loop inside the node
+// loop kept the other lanes waiting while one tested its leaf; here a lane tests its triangles
+// while the others walk on). The node's words are all loaded before the box test, and the
+// outcome is chosen by selects. Each node is visited at most once and each leaf slot tested at
+// most once, so the loop is bounded by their sum; a walk cut short (llvmpipe's loop limit, see
+// loopLimit in common/intersect.glsl) counts the ray as truncated.
+//
+// The including kernel defines triangleHit (declared below), which tests one leaf slot's
+// triangle, may lower the limit, and returns true to end the walk.
 
 layout(r32ui, binding = IMAGE_BVH_NODES) readonly uniform uimageBuffer bvhNodes;
 layout(r32ui, binding = IMAGE_BVH_LEAF_TRIANGLES) readonly uniform uimageBuffer bvhLeafTriangles;
 
-bool leafHit(int first, int count, inout float limit);
+bool triangleHit(int slot, inout float limit);
 
 uint nodeWord(int at) { return imageLoad(bvhNodes, at).x; }
 float nodeFloat(int at) { return uintBitsToFloat(imageLoad(bvhNodes, at).x); }
@@ -57,27 +63,35 @@ bool intersectLeafTriangle(vec3 r0, vec3 rd, int slot, out int id, out float t, 
     return intersectEdges(r0, rd, leafVec3(at), leafVec3(at + 4), leafVec3(at + 8), t, u, v);
 }
 
-// true if leafHit ended the walk
+// true if triangleHit ended the walk
 bool traverse(vec3 ro, vec3 rd, float limit)
 {
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
     int node = 0;
-    int bound = imageSize(bvhNodes) / 16 + 1;
-    for (int guard = 0; guard < bound && node >= 0; guard++) {
+    // the leaf slots of the entered leaf still to test: slot .. slotEnd - 1
+    int slot = 0, slotEnd = 0;
+    int bound = imageSize(bvhNodes) / 16 + imageSize(bvhLeafTriangles) / 12 + 1;
+    for (int guard = 0; guard < bound && (node >= 0 || slot < slotEnd); guard++) {
+        if (slot < slotEnd) {
+            if (triangleHit(slot, limit)) return true;
+            slot++;
+            continue;
+        }
         nodesVisited++;
         int at = 16 * node;
-        vec3 lo = vec3(nodeFloat(at), nodeFloat(at + 1), nodeFloat(at + 2));
-        vec3 hi = vec3(nodeFloat(at + 4), nodeFloat(at + 5), nodeFloat(at + 6));
         int first = int(nodeWord(at + 3)), meta = int(nodeWord(at + 7));
         int next = int(nodeWord(at + 8 + octant));
-        if (boxEntered(lo, hi, ro, inv, limit)) {
-            // inner node: the near child next
-            if (meta < 0) next = first + ((octant >> (-1 - meta)) & 1);
-            else if (leafHit(first, meta, limit)) return true;
-        }
+        vec3 lo = vec3(nodeFloat(at), nodeFloat(at + 1), nodeFloat(at + 2));
+        vec3 hi = vec3(nodeFloat(at + 4), nodeFloat(at + 5), nodeFloat(at + 6));
+        bool entered = boxEntered(lo, hi, ro, inv, limit);
+        bool leaf = meta >= 0;
+        // an inner node entered: its near child next; a leaf entered: its triangles next
+        next = entered && !leaf ? first + ((octant >> (-1 - meta)) & 1) : next;
+        slot = entered && leaf ? first : slot;
+        slotEnd = entered && leaf ? first + meta : slotEnd;
         node = next;
     }
-    if (node >= 0) truncated = 1u;
+    if (node >= 0 || slot < slotEnd) truncated = 1u;
     return false;
 }
