@@ -116,7 +116,7 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     for (o, d) in aovs.ray_origin.iter().zip(&aovs.ray_direction) {
         let (ro, rd) = (Vec3::from(*o), Vec3::from(*d));
         let mut best = None;
-        nodes += twin.traverse(ro, rd, f32::INFINITY, |ids| {
+        nodes += twin.traverse(ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
             closest_among(&mut best, twin.triangles(), ids, (ro, rd, -1), &mut tests);
             ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))

@@ -34,7 +34,7 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
 {
     rayO = ro; rayD = rd; rayLast = lastTriID;
     bestT = t_min; bestID = triID; bestU = hit_u; bestV = hit_v;
-    traverse(ro, rd, bestT);
+    traverse(ro, rd, 0.0, bestT);
     t_min = bestT; triID = bestID; hit_u = bestU; hit_v = bestV;
 }
 

@@ -43,12 +43,14 @@ vec3 leafVec3(int at) { return vec3(leafFloat(at), leafFloat(at + 1), leafFloat(
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 
-// Listing 4.5: does the ray enter the box [lo, hi] at some 0 <= t <= limit?
-bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float limit)
+// Listing 4.5: does the ray enter the box [lo, hi] at some tMin <= t <= limit? (Wagner tests
+// t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
+// before the offset, skips the boxes around its origin that it leaves before the offset.)
+bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float tMin, float limit)
 {
     vec3 t0 = (lo - ro) * inv;
     vec3 t1 = (hi - ro) * inv;
-    float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), tMin));
     float tFar = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
     return tNear <= tFar && tNear <= limit;
 }
@@ -63,8 +65,8 @@ bool intersectLeafTriangle(vec3 r0, vec3 rd, int slot, out int id, out float t, 
     return intersectEdges(r0, rd, leafVec3(at), leafVec3(at + 4), leafVec3(at + 8), t, u, v);
 }
 
-// true if triangleHit ended the walk
-bool traverse(vec3 ro, vec3 rd, float limit)
+// The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it.
+bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
 {
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
@@ -84,7 +86,7 @@ bool traverse(vec3 ro, vec3 rd, float limit)
         int next = int(nodeWord(at + 8 + octant));
         vec3 lo = vec3(nodeFloat(at), nodeFloat(at + 1), nodeFloat(at + 2));
         vec3 hi = vec3(nodeFloat(at + 4), nodeFloat(at + 5), nodeFloat(at + 6));
-        bool entered = boxEntered(lo, hi, ro, inv, limit);
+        bool entered = boxEntered(lo, hi, ro, inv, tMin, limit);
         bool leaf = meta >= 0;
         // an inner node entered: its near child next; a leaf entered: its triangles next
         next = entered && !leaf ? first + ((octant >> (-1 - meta)) & 1) : next;

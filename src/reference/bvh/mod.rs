@@ -191,13 +191,14 @@ impl Bvh {
         &self.triangles
     }
 
-    /// Walk the nodes along ro + t·rd for 0 ≤ t ≤ `limit`, as `glsl/bvh/traverse.glsl`: every
+    /// Walk the nodes along ro + t·rd for `t_min` ≤ t ≤ `limit`, as `glsl/bvh/traverse.glsl`: every
     /// leaf whose box the ray enters goes to `leaf` (its triangle ids), which returns the new
     /// limit or breaks the walk. Returns the number of nodes visited (boxes tested).
     pub fn traverse(
         &self,
         ro: Vec3,
         rd: Vec3,
+        t_min: f32,
         mut limit: f32,
         mut leaf: impl FnMut(&[u32]) -> ControlFlow<(), f32>,
     ) -> u64 {
@@ -207,7 +208,7 @@ impl Bvh {
         while node != END {
             visited += 1;
             let n = &self.nodes[node as usize];
-            if self.enter(node as usize, ro, inv, limit).is_some() {
+            if self.enter(node as usize, ro, inv, t_min, limit).is_some() {
                 if !n.is_leaf() {
                     // the near child first: the right one when the ray points down the axis
                     node = n.first as i32 + (inv[n.axis()] < 0.0) as i32;
@@ -224,14 +225,15 @@ impl Bvh {
         visited
     }
 
-    /// The entry distance of the ray into node `n`'s box if it enters it at t ≤ `limit`
-    /// (the slab test of Wagner 2018, Listing 4.5, as `boxEntry` in the kernels).
-    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
+    /// The entry distance of the ray into node `n`'s box if it enters it at some
+    /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5, as `boxEntered` in the
+    /// kernels).
+    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, t_min: f32, limit: f32) -> Option<f32> {
         let node = &self.nodes[n];
         let t0 = (Vec3::from(node.lo) - ro) * inv;
         let t1 = (Vec3::from(node.hi) - ro) * inv;
         let near = t0.x.min(t1.x).max(t0.y.min(t1.y));
-        let near = near.max(t0.z.min(t1.z).max(0.0));
+        let near = near.max(t0.z.min(t1.z).max(t_min));
         let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z));
         (near <= far && near <= limit).then_some(near)
     }
@@ -285,7 +287,7 @@ fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
 impl CpuAccelerator for Bvh {
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
         let (mut best, mut tests): (Option<Hit>, u64) = (None, 0);
-        self.traverse(ro, rd, f32::INFINITY, |ids| {
+        self.traverse(ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
             closest_among(&mut best, &self.triangles, ids, (ro, rd, last), &mut tests);
             ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))
@@ -295,7 +297,9 @@ impl CpuAccelerator for Bvh {
 
     fn occluded(&self, feeler: &Feeler) -> (bool, u64) {
         let (mut blocked, mut tests) = (false, 0);
-        self.traverse(feeler.ro, feeler.rd, feeler.light_distance, |ids| {
+        // no hit before the offset counts, so neither do the boxes the feeler leaves before it
+        let (ro, rd) = (feeler.ro, feeler.rd);
+        self.traverse(ro, rd, feeler.offset, feeler.light_distance, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
             blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
             if blocked {
