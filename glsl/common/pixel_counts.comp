@@ -2,9 +2,9 @@
 // common/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
 // counts — (ray–triangle tests, BVH nodes visited, loops cut short, rays traced) — and adds the
 // sums to the counter slots `countSlots` through common/counters.glsl (one global atomic per
-// work group and counter). A pixel's counts are below 2^32 / PIXELS_PER_INVOCATION: a ray
-// tests each triangle and visits each node at most once, and the scene buffers' limit
-// (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, 128 MiB on llvmpipe) keeps both far below 2^28.
+// work group and counter). A pixel's counts are below 2^32 / PIXELS_PER_INVOCATION, so the
+// sums fit: a ray visits each node and tests each leaf slot at most once, and the host refuses
+// a structure with more of them (MAX_PIXEL_EVENTS in src/accel/mod.rs).
 layout(local_size_x = 64) in;
 
 #define COUNTER_SLOTS_PER_KERNEL 4

@@ -9,11 +9,13 @@
 use std::any::Any;
 use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
 use serde_json::json;
 
-use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
+use super::{
+    Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind, MAX_PIXEL_EVENTS,
+};
 use crate::frame::FrameStats;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
@@ -111,6 +113,15 @@ impl Bvh {
                 .map(Vec::as_slice)
                 .zip(models.iter().copied()),
         ));
+        let events = bvh.stats.nodes.max(bvh.tris.len()) as u64;
+        if events > MAX_PIXEL_EVENTS {
+            bail!(
+                "the BVH has {} nodes and {} leaf slots: a ray could count more than {MAX_PIXEL_EVENTS} \
+                 events, beyond the per-pixel counts' 32 bits; use a smaller scene",
+                bvh.stats.nodes,
+                bvh.tris.len()
+            );
+        }
         let buffers = upload(&self.gl, &bvh)?;
         if let Some(old) = self.buffers.replace(buffers) {
             old.delete(&self.gl);

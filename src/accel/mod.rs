@@ -35,6 +35,13 @@ use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::reference::CpuAccelerator;
 use crate::scene::Scene;
 
+/// Pixels each invocation of `glsl/common/pixel_counts.comp` sums (`PIXELS_PER_INVOCATION`
+/// there), for the accelerators whose kernels store per-pixel counts ([`Accelerator::records`]).
+pub const PIXELS_PER_INVOCATION: u32 = 16;
+/// The most events one pixel's walk may count (node visits, triangle tests) so that those sums
+/// fit in 32 bits: such an accelerator checks its structure against it.
+pub const MAX_PIXEL_EVENTS: u64 = (1 << 32) / PIXELS_PER_INVOCATION as u64 - 1;
+
 /// The GPU side of an accelerator.
 pub trait Accelerator {
     /// Rebuild from the freshly transformed scene, before the eye rays (the grids: every

@@ -112,6 +112,12 @@ impl Ssbo {
     }
 }
 
+/// Bind level 0 of `texture` (all layers) to image unit `unit` with `access` and `format`.
+fn bind_image_unit(gl: &Gl, unit: u32, texture: glow::Texture, access: u32, format: u32) {
+    // SAFETY: binding an existing texture to an image unit.
+    unsafe { gl.bind_image_texture(unit, Some(texture), 0, false, 0, access, format) };
+}
+
 /// A 2D texture used as an image (RGBA32F or RGBA32UI).
 pub struct Image2d {
     pub texture: glow::Texture,
@@ -155,18 +161,7 @@ impl Image2d {
     }
 
     pub fn bind_image(&self, gl: &Gl, unit: u32) {
-        // SAFETY: binding an existing texture to an image unit.
-        unsafe {
-            gl.bind_image_texture(
-                unit,
-                Some(self.texture),
-                0,
-                false,
-                0,
-                glow::READ_WRITE,
-                self.format,
-            )
-        };
+        bind_image_unit(gl, unit, self.texture, glow::READ_WRITE, self.format);
     }
 
     pub fn clear(&self, gl: &Gl) {
@@ -303,18 +298,7 @@ impl TextureBuffer {
     /// unit) readonly`). llvmpipe generates image loads inline, where it calls a function for
     /// every `texelFetch` of a format other than 8-bit RGBA (docs/results/bvh_steps.md).
     pub fn bind_image(&self, gl: &Gl, unit: u32) {
-        // SAFETY: binding our own texture to an image unit.
-        unsafe {
-            gl.bind_image_texture(
-                unit,
-                Some(self.texture),
-                0,
-                false,
-                0,
-                glow::READ_ONLY,
-                self.format,
-            )
-        };
+        bind_image_unit(gl, unit, self.texture, glow::READ_ONLY, self.format);
     }
 
     pub fn delete(&self, gl: &Gl) {

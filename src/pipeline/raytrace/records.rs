@@ -11,13 +11,12 @@
 use anyhow::Result;
 
 use super::COUNTERS;
+use crate::accel::PIXELS_PER_INVOCATION;
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 
-/// Pixels each invocation of `pixel_counts.comp` sums (`PIXELS_PER_INVOCATION` there) and its
-/// work group size.
-const PIXELS_PER_INVOCATION: u32 = 16;
+/// The work group size of `pixel_counts.comp`.
 const COUNT_GROUP: u32 = 64;
 
 /// The hit-record and count buffers and the two kernels that read them.
