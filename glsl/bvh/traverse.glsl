@@ -1,6 +1,6 @@
 // BVH traversal shared by glsl/bvh/intersect1.comp and intersect2.comp — ours, after Wagner
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
-// the CPU, ch. 3.2). CPU twin: src/reference/bvh.rs (Bvh::traverse), same order and counts.
+// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (Bvh::traverse), same order and counts.
 //
 // The hierarchy in image buffers of 32-bit words (R32UI), after Wagner's textures of Fig. 4.3
 // (his node bounds, node integers and per-leaf triangle ids):

@@ -1,7 +1,7 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
-//! (`reference::bvh`, binned SAH, rayon) and uploaded into three texture buffers (nodes, miss
-//! links, leaf triangles), traversed in the intersection kernels without a stack, near child
-//! first (`glsl/bvh/`). Objects
+//! (`reference::bvh`, binned SAH, rayon) and uploaded into two image buffers of 32-bit words
+//! (nodes with their miss links, leaf triangles), traversed in the intersection kernels
+//! without a stack, near child first (`glsl/bvh/`). Objects
 //! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
 //! matrix changed since the last build, and not otherwise. Its image equals the base
 //! tracer's. CPU twin: `reference::bvh::Bvh`.
@@ -34,7 +34,8 @@ pub const ENTRY: Entry = Entry {
     },
 };
 
-/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes, miss links, leaf triangles.
+/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the nodes with their miss links
+/// ([`CpuBvh::gpu_nodes`]) and the leaf triangles.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     let leaf_triangles = bvh.leaf_triangles();
     let nodes = bvh.gpu_nodes();

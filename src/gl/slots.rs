@@ -88,10 +88,9 @@ slot_table! {
         WAGNER_RAY = 2,
         WAGNER_NORMAL = 3,
         /// the SAH BVH's texture buffers, read as image buffers (glsl/bvh/traverse.glsl):
-        /// nodes, miss links, leaf triangles
+        /// the nodes with their miss links, the leaf triangles
         BVH_NODES = 8,
-        BVH_LINKS = 9,
-        BVH_LEAF_TRIANGLES = 10,
+        BVH_LEAF_TRIANGLES = 9,
     }
 }
 

@@ -6,14 +6,15 @@
 //! SAH, Wald 2007, his [13]) and build the two children in parallel (rayon) above
 //! [`PARALLEL_BUILD`] triangles.
 //!
-//! Layout for upload — Wagner's three textures of Fig. 4.3, as texture buffers, plus one:
-//! - [`Node`] (32 bytes, two RGBA32F texels): bounds min/max and either the index of the
+//! Layout for upload — after Wagner's three textures of Fig. 4.3, as two image buffers of
+//! 32-bit words ([`Bvh::gpu_nodes`], [`Bvh::leaf_triangles`]):
+//! - per node one 64-byte line: the [`Node`] (bounds min/max and either the index of the
 //!   left child (the right child follows it) and the split axis, or, in a leaf, its first
-//!   entry in [`Bvh::tris`] and its triangle count;
-//! - [`Bvh::links`]: per node and ray octant the node to go on with when the node is missed
-//!   or done (its *miss link*; [`END`] after the last);
-//! - [`Bvh::tris`], the triangle ids per leaf, and [`Bvh::leaf_triangles`], their vertices in
-//!   the same order as v0, edge1, edge2 (three RGBA32F texels; v0's w holds the id).
+//!   entry in [`Bvh::tris`] and its triangle count), then [`Bvh::links`] of the node: per ray
+//!   octant the node to go on with when the node is missed or done (its *miss link*; [`END`]
+//!   after the last);
+//! - per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as v0 and its id,
+//!   edge1, edge2 (12 words).
 //!
 //! Traversal (the kernels in `glsl/bvh/traverse.glsl`, and [`Bvh::traverse`] here, their CPU
 //! twin, in exactly the same order with the same counts): stackless. A ray walks the nodes in
