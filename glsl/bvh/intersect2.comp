@@ -11,11 +11,10 @@ vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float rayLight = 0.0;
 
-bool triangleHit(int slot, inout float limit)
+bool triangleHit(int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
 {
-    int tri;
     float t, u, v;
-    bool hit = intersectLeafTriangle(rayO, rayD, slot, tri, t, u, v);
+    bool hit = intersectEdges(rayO, rayD, v0, edge1, edge2, t, u, v);
     if (tri == rayLast) return false;
     tests++;
     return hit && t > SHADOW_OFFSET && t < rayLight;

@@ -1,6 +1,6 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
-//! (`reference::bvh`, binned SAH, rayon) and uploaded into two image buffers of 32-bit words
-//! (nodes with their miss links, leaf triangles), traversed in the intersection kernels
+//! (`reference::bvh`, binned SAH, rayon) and uploaded into one image buffer of 32-bit words
+//! (nodes with their miss links, then the leaf triangles), traversed in the intersection kernels
 //! without a stack, near child first (`glsl/bvh/`). Objects
 //! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
 //! matrix changed since the last build, and not otherwise. Its image equals the base
@@ -34,30 +34,27 @@ pub const ENTRY: Entry = Entry {
     },
 };
 
-/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the nodes with their miss links
-/// ([`CpuBvh::gpu_nodes`]) and the leaf triangles.
+/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes with their miss links and
+/// leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), addressed by
+/// word in the kernels' ints.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
-    let leaf_triangles = bvh.leaf_triangles();
-    let nodes = bvh.gpu_nodes();
+    let words = bvh.gpu_words();
+    if words.len() > i32::MAX as usize {
+        bail!(
+            "the BVH takes {} words, beyond the kernels' 32-bit word addresses; use a smaller scene",
+            words.len()
+        );
+    }
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
-        [
-            data(
-                "bvhNodes",
-                glow::R32UI,
-                4,
-                bytemuck::cast_slice(&nodes),
-                image::BVH_NODES,
-            ),
-            data(
-                "bvhLeafTriangles",
-                glow::R32UI,
-                4,
-                bytemuck::cast_slice(&leaf_triangles),
-                image::BVH_LEAF_TRIANGLES,
-            ),
-        ],
+        [data(
+            "bvh",
+            glow::R32UI,
+            4,
+            bytemuck::cast_slice(&words),
+            image::BVH,
+        )],
     )
 }
 

@@ -87,10 +87,9 @@ slot_table! {
         WAGNER_HIT = 1,
         WAGNER_RAY = 2,
         WAGNER_NORMAL = 3,
-        /// the SAH BVH's texture buffers, read as image buffers (glsl/bvh/traverse.glsl):
-        /// the nodes with their miss links, the leaf triangles
-        BVH_NODES = 8,
-        BVH_LEAF_TRIANGLES = 9,
+        /// the SAH BVH's texture buffer, read as an image buffer (glsl/bvh/traverse.glsl):
+        /// the nodes with their miss links, then the leaf triangles
+        BVH = 8,
     }
 }
 

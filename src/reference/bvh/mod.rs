@@ -93,7 +93,7 @@ pub struct BvhStats {
     /// SAH cost relative to the root: Σ inner A(n)/A(root) + Σ leaves A(l)/A(root)·N(l)
     /// (A: surface area; one unit per node traversal and per triangle test).
     pub sah_cost: f64,
-    /// Bytes of the nodes, links, triangle ids and leaf triangles as uploaded.
+    /// Bytes as uploaded ([`Bvh::gpu_words`]).
     pub bytes: usize,
     pub build_ms: f64,
 }
@@ -110,18 +110,10 @@ pub struct Bvh {
     pub stats: BvhStats,
 }
 
-/// One triangle of a leaf as uploaded (three RGBA32F texels): v0 and its id (as bits),
-/// edge1 = v1 − v0, edge2 = v2 − v0 — the differences Algorithm 1 forms first.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct LeafTriangle {
-    pub v0: [f32; 3],
-    pub id: u32,
-    pub edge1: [f32; 3],
-    pub pad1: u32,
-    pub edge2: [f32; 3],
-    pub pad2: u32,
-}
+/// Words of one node in [`Bvh::gpu_words`] (one 64-byte cache line).
+pub const NODE_WORDS: usize = 16;
+/// Words of one leaf triangle in [`Bvh::gpu_words`].
+pub const TRIANGLE_WORDS: usize = 12;
 
 impl Bvh {
     /// Build the hierarchy over `triangles` (triangle id = index).
@@ -134,9 +126,7 @@ impl Bvh {
         let mut stats = BvhStats {
             nodes: nodes.len(),
             leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
-            bytes: nodes.len() * std::mem::size_of::<Node>()
-                + 4 * links.len()
-                + ids.len() * (4 + std::mem::size_of::<LeafTriangle>()),
+            bytes: 4 * (NODE_WORDS * nodes.len() + TRIANGLE_WORDS * ids.len()),
             ..BvhStats::default()
         };
         build::measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
@@ -150,41 +140,45 @@ impl Bvh {
         }
     }
 
-    /// The nodes as uploaded: one 64-byte cache line per node, 16 words: lo.xyz, first,
-    /// hi.xyz, meta (the floats as bits), then the node's miss link for each of the 8 octants.
-    pub fn gpu_nodes(&self) -> Vec<u32> {
-        let mut out = Vec::with_capacity(16 * self.nodes.len());
+    /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) addressed
+    /// by word, so that a node and a leaf triangle are read by the same loads
+    /// (`glsl/bvh/traverse.glsl`):
+    /// - per node [`NODE_WORDS`]: lo.xyz, first, hi.xyz, meta, then the node's miss link for
+    ///   each of the 8 octants — `first` and the links as word addresses (an inner node's left
+    ///   child, the right one follows it; a leaf's first triangle; [`END`] stays −1);
+    /// - after the nodes, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]: v0 and the triangle
+    ///   id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences Algorithm 1 forms
+    ///   first.
+    pub fn gpu_words(&self) -> Vec<u32> {
+        let base = NODE_WORDS * self.nodes.len();
+        let node_at = |n: i32| match n {
+            END => END as u32,
+            n => (NODE_WORDS * n as usize) as u32,
+        };
+        let mut out = Vec::with_capacity(base + TRIANGLE_WORDS * self.tris.len());
         for (n, node) in self.nodes.iter().enumerate() {
+            let first = match node.is_leaf() {
+                true => base + TRIANGLE_WORDS * node.first as usize,
+                false => NODE_WORDS * node.first as usize,
+            };
             out.extend(node.lo.map(f32::to_bits));
-            out.push(node.first);
+            out.push(first as u32);
             out.extend(node.hi.map(f32::to_bits));
             out.push(node.meta as u32);
-            out.extend(
-                self.links[OCTANTS * n..OCTANTS * (n + 1)]
-                    .iter()
-                    .map(|&l| l as u32),
-            );
+            let links = &self.links[OCTANTS * n..OCTANTS * (n + 1)];
+            out.extend(links.iter().map(|&l| node_at(l)));
+        }
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for &id in &self.tris {
+            let [v0, v1, v2] = self.triangles[id as usize];
+            out.extend(bits(v0));
+            out.push(id);
+            out.extend(bits(v1 - v0));
+            out.push(0);
+            out.extend(bits(v2 - v0));
+            out.push(0);
         }
         out
-    }
-
-    /// The triangles of the leaves in leaf order, as uploaded.
-    pub fn leaf_triangles(&self) -> Vec<LeafTriangle> {
-        let sub = |a: Vec3, b: Vec3| (a - b).to_array();
-        self.tris
-            .iter()
-            .map(|&id| {
-                let [v0, v1, v2] = self.triangles[id as usize];
-                LeafTriangle {
-                    v0: v0.to_array(),
-                    id,
-                    edge1: sub(v1, v0),
-                    pad1: 0,
-                    edge2: sub(v2, v0),
-                    pad2: 0,
-                }
-            })
-            .collect()
     }
 
     /// The triangles it was built over.
