@@ -35,13 +35,11 @@
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its id, v0 and edges), may lower the limit, and returns true to end the walk.
 
-layout(r32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
+layout(rgba32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
 
 bool triangleHit(int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
 
-uint bvhWord(int at) { return imageLoad(bvh, at).x; }
-float bvhFloat(int at) { return uintBitsToFloat(bvhWord(at)); }
-vec3 bvhVec3(int at) { return vec3(bvhFloat(at), bvhFloat(at + 1), bvhFloat(at + 2)); }
+uvec4 bvhTexel(int at) { return imageLoad(bvh, at >> 2); }
 
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
@@ -67,21 +65,23 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     // the words of the entered leaf's triangles still to test: slot .. slotEnd - 1
     int slot = 0, slotEnd = 0;
     // every node visited and every leaf triangle tested at most once (16 and 12 words each)
-    int bound = imageSize(bvh) / 12 + 1;
+    int bound = imageSize(bvh) / 3 + 1;
     for (int guard = 0; guard < bound && (node >= 0 || slot < slotEnd); guard++) {
         bool tri = slot < slotEnd;
         int at = tri ? slot : node;
-        vec3 a = bvhVec3(at);                           // lo | v0
-        int first = int(bvhWord(at + 3));               // first | triangle id
-        vec3 b = bvhVec3(at + 4);                       // hi | edge1
-        int meta = int(bvhWord(at + 7));                // meta | 0
-        uint link = bvhWord(at + (tri ? 8 : 8 + octant)); // the octant's miss link | edge2.x
+        uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4);
+        uvec4 t2 = bvhTexel(at + (tri ? 8 : 8 + (octant & 4)));
+        vec3 a = uintBitsToFloat(t0.xyz);               // lo | v0
+        int first = int(t0.w);                          // first | triangle id
+        vec3 b = uintBitsToFloat(t1.xyz);               // hi | edge1
+        int meta = int(t1.w);                           // meta | 0
         if (tri) {
-            vec3 edge2 = vec3(uintBitsToFloat(link), bvhFloat(at + 9), bvhFloat(at + 10));
-            if (triangleHit(first, a, b, edge2, limit)) return true;
+            if (triangleHit(first, a, b, uintBitsToFloat(t2.xyz), limit)) return true;
             slot += 12;
             continue;
         }
+        int o = octant & 3;
+        uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
         nodesVisited++;
         bool entered = boxEntered(a, b, ro, inv, tMin, limit);
         bool leaf = meta >= 0;

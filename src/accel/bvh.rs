@@ -50,8 +50,8 @@ fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
         gl,
         [data(
             "bvh",
-            glow::R32UI,
-            4,
+            glow::RGBA32UI,
+            16,
             bytemuck::cast_slice(&words),
             image::BVH,
         )],
