@@ -24,6 +24,21 @@ layout(rgba32f, binding = IMAGE_PRIMARY_HIT) uniform image2D primaryHitTexture;
 // driver watchdog to kill it; tileOffset is the tile's lower-left pixel.
 uniform ivec2 tileOffset;
 
+// The order of the work-group rows of a tile (ours, not in the thesis): Mesa's llvmpipe hands
+// each of its N threads one contiguous 1/N of a dispatch's work groups, row after row, so with
+// an object in the middle of the image one thread got the busy rows and the others waited (the
+// bunny's BVH intersect1: 34 ms on two threads, 26 ms with LP_NUM_THREADS=3 on the same two
+// cores). Work-group row y therefore covers the tile's row y·tileRowStride mod rows, the
+// stride coprime to the rows (the host's choice, near rows/φ: PixelGrid::row_stride), so that
+// every contiguous share of a dispatch spreads over the whole tile. A GPU does not care.
+uniform int tileRowStride;
+
 // The pixel this invocation works on (storePos in the thesis, ch. 4).
-ivec2 pixelPosition() { return ivec2(gl_GlobalInvocationID.xy) + tileOffset; }
+ivec2 pixelPosition()
+{
+    int rows = int(gl_NumWorkGroups.y);
+    int row = int(gl_WorkGroupID.y) * max(tileRowStride, 1) % rows;
+    ivec2 local = ivec2(gl_LocalInvocationID.xy);
+    return ivec2(gl_GlobalInvocationID.x, row * int(gl_WorkGroupSize.y) + local.y) + tileOffset;
+}
 bool insideImage(ivec2 p) { return all(lessThan(p, imageSize(rayOriginTexture))); }

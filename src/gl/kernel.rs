@@ -48,6 +48,16 @@ impl PixelGrid {
         })
     }
 
+    /// The stride through `rows` work-group rows of a tile (`tileRowStride` in
+    /// `glsl/common/images.glsl`): the integer nearest rows/φ that is coprime to `rows`, so that
+    /// y·stride mod rows visits every row once and consecutive rows land far apart.
+    pub fn row_stride(rows: u32) -> u32 {
+        let start = ((rows as f64) * 0.618_033_988_75).round().max(1.0) as u32;
+        (start..)
+            .find(|&s| gcd(s, rows) == 1)
+            .expect("rows + 1 is coprime to rows")
+    }
+
     /// The tiles as (x, y, width, height), row by row.
     pub fn tiles(&self) -> Vec<(u32, u32, u32, u32)> {
         let (w, h) = (self.width, self.height);
@@ -174,6 +184,8 @@ impl Kernel {
         let gl = &self.gl;
         for (tx, ty, tw, th) in grid.tiles() {
             self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
+            let rows = th.div_ceil(group);
+            self.set_i32("tileRowStride", PixelGrid::row_stride(rows) as i32);
             timers.time(gl, self.timer, || {
                 // SAFETY: dispatch of the program in use.
                 unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
@@ -216,9 +228,41 @@ pub fn barrier(gl: &Gl) {
     };
 }
 
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn row_strides_visit_every_row_once_and_spread_each_half() {
+        for rows in 1..=300u32 {
+            let s = PixelGrid::row_stride(rows);
+            let mut seen: Vec<u32> = (0..rows).map(|y| y * s % rows).collect();
+            // each half of the dispatch's rows (two threads' shares) covers rows of both
+            // halves of the tile about equally
+            let top = seen[..(rows / 2) as usize]
+                .iter()
+                .filter(|&&r| r < rows / 2)
+                .count() as f64;
+            seen.sort_unstable();
+            assert_eq!(
+                seen,
+                (0..rows).collect::<Vec<_>>(),
+                "{rows} rows, stride {s}"
+            );
+            if rows >= 16 {
+                let share = top / (rows / 2) as f64;
+                assert!((0.3..=0.7).contains(&share), "{rows} rows: {share}");
+            }
+        }
+    }
 
     #[test]
     fn tiles_cover_the_image_once() {
