@@ -56,6 +56,25 @@ bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float tMin, float limit)
     return tNear <= tFar && tNear <= limit;
 }
 
+// One node step: the box test of the node whose texels are t0, t1 and (its octant's miss links)
+// t2, and where the walk goes next.
+void nodeStep(uvec4 t0, uvec4 t1, uvec4 t2, vec3 ro, vec3 inv, int octant, float tMin,
+              float limit, inout int node, inout int slot, inout int slotEnd)
+{
+    int o = octant & 3;
+    uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
+    nodesVisited++;
+    bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv, tMin, limit);
+    int first = int(t0.w), meta = int(t1.w);
+    bool leaf = meta >= 0;
+    // an inner node entered: its near child next; a leaf entered: its triangles next
+    int next = int(link);
+    next = entered && !leaf ? first + 16 * ((octant >> (-1 - meta)) & 1) : next;
+    slot = entered && leaf ? first : slot;
+    slotEnd = entered && leaf ? first + 12 * meta : slotEnd;
+    node = next;
+}
+
 // The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it.
 bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
 {
@@ -71,26 +90,19 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
         int at = tri ? slot : node;
         uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4);
         uvec4 t2 = bvhTexel(at + (tri ? 8 : 8 + (octant & 4)));
-        vec3 a = uintBitsToFloat(t0.xyz);               // lo | v0
-        int first = int(t0.w);                          // first | triangle id
-        vec3 b = uintBitsToFloat(t1.xyz);               // hi | edge1
-        int meta = int(t1.w);                           // meta | 0
         if (tri) {
-            if (triangleHit(first, a, b, uintBitsToFloat(t2.xyz), limit)) return true;
+            if (triangleHit(int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
+                            uintBitsToFloat(t2.xyz), limit))
+                return true;
             slot += 12;
-            continue;
+        } else {
+            nodeStep(t0, t1, t2, ro, inv, octant, tMin, limit, node, slot, slotEnd);
         }
-        int o = octant & 3;
-        uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
-        nodesVisited++;
-        bool entered = boxEntered(a, b, ro, inv, tMin, limit);
-        bool leaf = meta >= 0;
-        // an inner node entered: its near child next; a leaf entered: its triangles next
-        int next = int(link);
-        next = entered && !leaf ? first + 16 * ((octant >> (-1 - meta)) & 1) : next;
-        slot = entered && leaf ? first : slot;
-        slotEnd = entered && leaf ? first + 12 * meta : slotEnd;
-        node = next;
+        if (slot >= slotEnd && node >= 0) {
+            t0 = bvhTexel(node); t1 = bvhTexel(node + 4);
+            t2 = bvhTexel(node + 8 + (octant & 4));
+            nodeStep(t0, t1, t2, ro, inv, octant, tMin, limit, node, slot, slotEnd);
+        }
     }
     if (node >= 0 || slot < slotEnd) truncated = 1u;
     return false;
