@@ -2,17 +2,19 @@
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
 // the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (Bvh::traverse), same order and counts.
 //
-// The hierarchy in one image buffer of 32-bit words (R32UI), after Wagner's textures of Fig. 4.3
-// (his node bounds, node integers and per-leaf triangle ids), addressed by word
-// (Bvh::gpu_words in src/reference/bvh/mod.rs):
+// The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
+// node bounds, node integers and per-leaf triangle ids), addressed by word (Bvh::gpu_words in
+// src/reference/bvh/mod.rs) and read as RGBA32UI texels of 4 words:
 //   per node 16 words (one 64-byte cache line): lo.xyz, first, hi.xyz, meta, and the node's miss
 //             link for each of the 8 ray octants — where a ray of that octant goes on when it
 //             misses the node or is done with it (−1: the walk is over); an inner node's left
 //             child is at `first`, its right child at first + 16, its meta −1 − the split axis;
 //             a leaf's meta is its triangle count and its triangles start at `first`
 //   after the nodes, per leaf triangle 12 words: v0, triangle id, edge1, 0, edge2, 0
-// A node and a triangle thus have their bounds / v0 at words 0–2, first / id at 3, hi / edge1 at
-// 4–6 and the miss link / edge2 from 8 on, and a step reads either with the same 11 loads.
+// A node and a triangle thus have their bounds / v0 in texel 0 (first / id in its w), hi / edge1
+// in texel 1 and the miss links / edge2 from texel 2 on, and a step reads either with the same
+// three texel loads (on llvmpipe: eight 128-bit loads and a transpose each, where a 32-bit word
+// costs a gather with its bounds check).
 //
 // Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
 // and from a stack walk): stackless. Every inner node whose box the ray enters (at some
@@ -25,12 +27,14 @@
 // One step per iteration: a node, or one triangle of the leaf the walk entered last (ours:
 // llvmpipe runs the 8 invocations of a SIMD group in lock step, so a leaf loop inside the node
 // loop kept the other lanes waiting while one tested its leaf; here a lane tests its triangles
-// while the others walk on). llvmpipe executes both sides of an `if` under a lane mask, so a
-// step loads its words once, before it knows whether they are a node's or a triangle's (one
-// gather per word for the 8 lanes, instead of a node's 9 and a triangle's 10), and the outcome
-// of the box test is chosen by selects. Each node is visited at most once and each leaf slot tested at
-// most once, so the loop is bounded by their sum; a walk cut short (llvmpipe's loop limit, see
-// loopLimit in common/intersect.glsl) counts the ray as truncated.
+// while the others walk on). llvmpipe executes both sides of an `if` under a lane mask, so the
+// step loads its texels once, before it knows whether they are a node's or a triangle's, and
+// the outcome of the box test is chosen by selects. Since that step's triangle test costs every
+// lane, an iteration then takes a second, node-only step for the lanes still walking (a third
+// did not pay: docs/results/bvh_steps.md). Each node is visited at most once and each leaf
+// triangle tested at most once, and every iteration takes at least one step, so the loop is
+// bounded by their sum; a walk cut short (llvmpipe's loop limit, see loopLimit in
+// common/intersect.glsl) counts the ray as truncated.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its id, v0 and edges), may lower the limit, and returns true to end the walk.
@@ -64,7 +68,8 @@ void nodeStep(uvec4 t0, uvec4 t1, uvec4 t2, vec3 ro, vec3 inv, int octant, float
     int o = octant & 3;
     uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
     nodesVisited++;
-    bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv, tMin, limit);
+    vec3 lo = uintBitsToFloat(t0.xyz), hi = uintBitsToFloat(t1.xyz);
+    bool entered = boxEntered(lo, hi, ro, inv, tMin, limit);
     int first = int(t0.w), meta = int(t1.w);
     bool leaf = meta >= 0;
     // an inner node entered: its near child next; a leaf entered: its triangles next
@@ -81,7 +86,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
     int node = 0;
-    // the words of the entered leaf's triangles still to test: slot .. slotEnd - 1
+    // the entered leaf's triangles still to test: at words slot, slot + 12, ... below slotEnd
     int slot = 0, slotEnd = 0;
     // every node visited and every leaf triangle tested at most once (16 and 12 words each)
     int bound = imageSize(bvh) / 3 + 1;

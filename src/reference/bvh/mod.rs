@@ -6,15 +6,15 @@
 //! SAH, Wald 2007, his [13]) and build the two children in parallel (rayon) above
 //! [`PARALLEL_BUILD`] triangles.
 //!
-//! Layout for upload — after Wagner's three textures of Fig. 4.3, as two image buffers of
-//! 32-bit words ([`Bvh::gpu_nodes`], [`Bvh::leaf_triangles`]):
-//! - per node one 64-byte line: the [`Node`] (bounds min/max and either the index of the
-//!   left child (the right child follows it) and the split axis, or, in a leaf, its first
-//!   entry in [`Bvh::tris`] and its triangle count), then [`Bvh::links`] of the node: per ray
+//! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
+//! words addressed by word ([`Bvh::gpu_words`]):
+//! - per node one 64-byte line: the [`Node`] (bounds min/max and either the address of the
+//!   left child (the right child follows it) and the split axis, or, in a leaf, the address of
+//!   its first triangle and its triangle count), then [`Bvh::links`] of the node: per ray
 //!   octant the node to go on with when the node is missed or done (its *miss link*; [`END`]
 //!   after the last);
-//! - per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as v0 and its id,
-//!   edge1, edge2 (12 words).
+//! - after the nodes, per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as v0
+//!   and its id, edge1, edge2 (12 words).
 //!
 //! Traversal (the kernels in `glsl/bvh/traverse.glsl`, and [`Bvh::traverse`] here, their CPU
 //! twin, in exactly the same order with the same counts): stackless. A ray walks the nodes in
@@ -54,7 +54,8 @@ pub const OCTANTS: usize = 8;
 /// Subtrees of more triangles build their two children in parallel.
 pub const PARALLEL_BUILD: usize = 4096;
 
-/// One node as uploaded: two RGBA32F texels, (lo, first) and (hi, meta), the integers as bits.
+/// One node: its bounds and integers (the first 8 of its words in [`Bvh::gpu_words`], where
+/// `first` becomes a word address).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct Node {
