@@ -43,7 +43,7 @@ void traceAndCount(int testsSlot)
     ivec2 storePos = pixelPosition();
     if (insideImage(storePos)) {
         trace(storePos);
-        pixelCounts[pixelIndex(storePos)] = uvec4(tests, nodesVisited, truncated, raysTraced);
+        pixelCounts[pixelIndex(storePos)] = packCounts(tests, nodesVisited, truncated, raysTraced);
     }
 #else
     countersBegin();

@@ -9,7 +9,20 @@
 // component, and a shared-memory atomic lane by lane (docs/results/bvh_steps.md), which made
 // them cost more than the BVH walk itself.
 layout(std430, binding = SSBO_HIT_RECORDS) buffer HitRecordBuffer { vec4 hitRecord[]; };
-layout(std430, binding = SSBO_PIXEL_COUNTS) buffer PixelCountBuffer { uvec4 pixelCounts[]; };
+layout(std430, binding = SSBO_PIXEL_COUNTS) buffer PixelCountBuffer { uvec2 pixelCounts[]; };
+
+// A pixel's counts in two words, as each stored component costs a loop over the 8 lanes on
+// llvmpipe: (tests | truncated << 31, nodes | traced << 31). A pixel counts fewer than 2^28 tests
+// and nodes (MAX_PIXEL_EVENTS in src/accel/mod.rs), and truncated and traced are 0 or 1.
+uvec2 packCounts(uint tests, uint nodes, uint truncated, uint traced)
+{
+    return uvec2(tests | (truncated << 31), nodes | (traced << 31));
+}
+// (tests, nodes, truncated, traced)
+uvec4 unpackCounts(uvec2 c)
+{
+    return uvec4(c & 0x7fffffffu, c >> 31);
+}
 
 // IMAGE_WIDTH × IMAGE_HEIGHT: the image size (#defines of the pipeline); one record per pixel
 int pixelIndex(ivec2 storePos) { return storePos.y * IMAGE_WIDTH + storePos.x; }

@@ -41,12 +41,13 @@ impl Records {
         defines: &Defines,
         (w, h): (u32, u32),
     ) -> Result<Records> {
-        let bytes = 16 * (w as usize) * (h as usize);
+        let pixels = (w as usize) * (h as usize);
         let max = info.max_ssbo_block_size;
         let compute = |file, timer| Kernel::compute(gl, shaders, file, defines, timer);
         Ok(Records {
-            hits: Ssbo::new(gl, "hit records", bytes, None, max)?,
-            counts: Ssbo::new(gl, "pixel counts", bytes, None, max)?,
+            // a vec4 (t, triangle id, u, v) and two words of counts per pixel (records.glsl)
+            hits: Ssbo::new(gl, "hit records", 16 * pixels, None, max)?,
+            counts: Ssbo::new(gl, "pixel counts", 8 * pixels, None, max)?,
             evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,
             pixels: w * h,
