@@ -389,6 +389,52 @@ mod tests {
     }
 
     #[test]
+    fn gpu_words_hold_every_node_and_leaf_triangle_at_its_address() {
+        let bvh = Bvh::new(soup());
+        let words = bvh.gpu_words();
+        let base = NODE_WORDS * bvh.nodes.len();
+        assert_eq!(words.len(), base + TRIANGLE_WORDS * bvh.tris.len());
+        assert_eq!(4 * words.len(), bvh.stats.bytes);
+        let f = |w: &[u32]| {
+            Vec3::new(
+                f32::from_bits(w[0]),
+                f32::from_bits(w[1]),
+                f32::from_bits(w[2]),
+            )
+        };
+        for (n, node) in bvh.nodes.iter().enumerate() {
+            let w = &words[NODE_WORDS * n..NODE_WORDS * (n + 1)];
+            assert_eq!((f(&w[0..3]), f(&w[4..7])), (node.lo.into(), node.hi.into()));
+            assert_eq!(w[7] as i32, node.meta);
+            let first = w[3] as usize;
+            if node.is_leaf() {
+                // the leaf's triangles: v0, id, edge1, 0, edge2, 0 each
+                assert_eq!(first, base + TRIANGLE_WORDS * node.first as usize);
+                for k in 0..node.count() as usize {
+                    let t = &words[first + TRIANGLE_WORDS * k..][..TRIANGLE_WORDS];
+                    let id = bvh.tris[node.first as usize + k];
+                    let [v0, v1, v2] = bvh.triangles[id as usize];
+                    assert_eq!(
+                        (f(&t[0..3]), t[3], f(&t[4..7]), f(&t[8..11])),
+                        (v0, id, v1 - v0, v2 - v0)
+                    );
+                }
+            } else {
+                assert_eq!(first, NODE_WORDS * node.first as usize);
+            }
+            for octant in 0..OCTANTS {
+                let link = bvh.links[OCTANTS * n + octant];
+                let want = if link == END {
+                    END as u32
+                } else {
+                    (NODE_WORDS * link as usize) as u32
+                };
+                assert_eq!(w[8 + octant], want);
+            }
+        }
+    }
+
+    #[test]
     fn miss_links_thread_every_node_once_per_octant() {
         let bvh = Bvh::new(soup());
         for octant in 0..OCTANTS {
