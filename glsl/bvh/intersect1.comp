@@ -6,14 +6,19 @@
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
 
-// the ray and its closest hit so far, for triangleHit
+#if !HIT_RECORDS
+#error "the BVH's intersect1 stores hit records (bvh/hit_record.glsl): it keeps no u, v"
+#endif
+
+// the ray and its closest hit so far, for triangleHit: its distance, triangle id and the word
+// address of its leaf triangle (the hit record; u and v are found again from it)
 vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float bestT = 0.0;
 int bestID = -1;
-float bestU = 0.0, bestV = 0.0;
+int bestAt = -1;
 
-bool triangleHit(int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
+bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
 {
     float t, u, v;
     bool hit = intersectEdges(rayO, rayD, v0, edge1, edge2, t, u, v);
@@ -22,7 +27,7 @@ bool triangleHit(int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
     if (hit && (t < bestT || (t == bestT && tri < bestID))) {
         bestT = t;
         bestID = tri;
-        bestU = u; bestV = v;
+        bestAt = at;
     }
     limit = bestT;
     return false;
@@ -32,9 +37,10 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
                 inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 {
     rayO = ro; rayD = rd; rayLast = lastTriID;
-    bestT = t_min; bestID = triID; bestU = hit_u; bestV = hit_v;
+    bestT = t_min; bestID = triID;
     traverse(ro, rd, 0.0, bestT);
-    t_min = bestT; triID = bestID; hit_u = bestU; hit_v = bestV;
+    t_min = bestT; triID = bestID;
+    closestHitRecord = bestAt;
 }
 
 #include "../common/intersect1_main.glsl"

@@ -11,7 +11,7 @@ vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 float rayLight = 0.0;
 
-bool triangleHit(int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
+bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
 {
     float t, u, v;
     bool hit = intersectEdges(rayO, rayD, v0, edge1, edge2, t, u, v);

@@ -37,13 +37,11 @@
 // common/intersect.glsl) counts the ray as truncated.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
-// (its id, v0 and edges), may lower the limit, and returns true to end the walk.
+// (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
 
-layout(rgba32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
+#include "words.glsl"
 
-bool triangleHit(int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
-
-uvec4 bvhTexel(int at) { return imageLoad(bvh, at >> 2); }
+bool triangleHit(int at, int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
 
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
@@ -96,7 +94,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
         uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4);
         uvec4 t2 = bvhTexel(at + (tri ? 8 : 8 + (octant & 4)));
         if (tri) {
-            if (triangleHit(int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
+            if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                             uintBitsToFloat(t2.xyz), limit))
                 return true;
             slot += 12;

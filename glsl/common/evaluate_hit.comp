@@ -2,16 +2,19 @@
 // Listings 13 and 14, which the thesis runs at the end of intersect1 (evaluateHit in
 // common/intersect1_hit.glsl, unchanged). For the designs whose intersect1 stores hit records
 // (HIT_RECORDS, common/records.glsl): one invocation per pixel reads its ray from the
-// ray-state textures and its closest hit (t, triangle id, u, v) from the hit record, and
-// evaluates it exactly as the thesis' intersect1 does; an inactive ray (rayState <= 0) gets an
+// ray-state textures, finds its closest hit (t, triangle id, u, v) again from the hit record
+// (bvh/hit_record.glsl), and evaluates it exactly as the thesis' intersect1 does; an inactive ray (rayState <= 0) gets an
 // empty colour buffer. The host dispatches it right after intersect1, under the same ray kind.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
 #include "scene.glsl"
 #include "images.glsl"
+#include "intersect.glsl"
 #include "records.glsl"
 #include "intersect1_hit.glsl"
+// the hit records are the SAH BVH's (the one design that stores them): a leaf-triangle address
+#include "../bvh/hit_record.glsl"
 
 void main()
 {
@@ -23,8 +26,10 @@ void main()
         emptyColorBuffer(storePos);
         return;
     }
+    vec3 ro = originState.xyz;
     vec3 rd = imageLoad(rayDirTexture, storePos).xyz;
-    vec4 hit = hitRecord[pixelIndex(storePos)];
-    evaluateHit(storePos, originState.xyz, rd, rayState, hit.x, floatBitsToInt(hit.y), hit.z,
-                hit.w);
+    float t, u, v;
+    int id;
+    hitFromRecord(hitRecord[pixelIndex(storePos)], ro, rd, t, id, u, v);
+    evaluateHit(storePos, ro, rd, rayState, t, id, u, v);
 }

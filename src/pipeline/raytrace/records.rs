@@ -45,8 +45,9 @@ impl Records {
         let max = info.max_ssbo_block_size;
         let compute = |file, timer| Kernel::compute(gl, shaders, file, defines, timer);
         Ok(Records {
-            // a vec4 (t, triangle id, u, v) and two words of counts per pixel (records.glsl)
-            hits: Ssbo::new(gl, "hit records", 16 * pixels, None, max)?,
+            // one word (the hit's leaf-triangle address) and two words of counts per pixel
+            // (records.glsl)
+            hits: Ssbo::new(gl, "hit records", 4 * pixels, None, max)?,
             counts: Ssbo::new(gl, "pixel counts", 8 * pixels, None, max)?,
             evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,

@@ -1,0 +1,19 @@
+// The SAH BVH's hit record (ours; common/records.glsl): intersect1 stores the word address of
+// the closest hit's leaf triangle in the BVH's buffer (−1: no hit), one word per pixel instead
+// of (t, triangle id, u, v) — on llvmpipe each stored component is a loop over the 8 lanes —
+// and common/evaluate_hit.comp finds the hit again here: the same Algorithm 1 (intersectEdges of
+// common/intersect.glsl) on the same ray and the same words as the walk's triangleHit, so the
+// same t, u and v.
+#include "words.glsl"
+
+void hitFromRecord(int at, vec3 ro, vec3 rd, out float t, out int id, out float u, out float v)
+{
+    t = 1.0 / 0.0; // +inf: no hit, as intersect1 starts
+    id = -1;
+    u = 0.0; v = 0.0;
+    if (at < 0) return;
+    uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4), t2 = bvhTexel(at + 8);
+    id = int(t0.w);
+    intersectEdges(ro, rd, uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
+                   uintBitsToFloat(t2.xyz), t, u, v);
+}
