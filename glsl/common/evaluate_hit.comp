@@ -30,6 +30,6 @@ void main()
     vec3 rd = imageLoad(rayDirTexture, storePos).xyz;
     float t, u, v;
     int id;
-    hitFromRecord(hitRecord[pixelIndex(storePos)], ro, rd, t, id, u, v);
+    hitFromRecord(int(pixelRecord[pixelIndex(storePos)].z), ro, rd, t, id, u, v);
     evaluateHit(storePos, ro, rd, rayState, t, id, u, v);
 }

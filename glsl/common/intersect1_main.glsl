@@ -32,7 +32,7 @@ void trace(ivec2 storePos)
     float hit_u = 0.0, hit_v = 0.0;
     closestHit(storePos, ro, rd, lastTriID, t_min, triID, hit_u, hit_v);
 #if HIT_RECORDS
-    hitRecord[pixelIndex(storePos)] = closestHitRecord;
+    // closestHit left closestHitRecord: traceAndCount stores it with the counts
 #else
     evaluateHit(storePos, ro, rd, rayState, t_min, triID, hit_u, hit_v);
 #endif

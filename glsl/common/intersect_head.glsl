@@ -43,7 +43,15 @@ void traceAndCount(int testsSlot)
     ivec2 storePos = pixelPosition();
     if (insideImage(storePos)) {
         trace(storePos);
-        pixelCounts[pixelIndex(storePos)] = packCounts(tests, nodesVisited, truncated, raysTraced);
+        uvec2 counts = packCounts(tests, nodesVisited, truncated, raysTraced);
+        int at = pixelIndex(storePos);
+#if HIT_RECORDS
+        // (a constant condition: one of the two stores is compiled)
+        if (testsSlot == COUNTER_INTERSECT1) pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
+        else pixelRecord[at].xy = counts;
+#else
+        pixelRecord[at].xy = counts;
+#endif
     }
 #else
     countersBegin();

@@ -21,7 +21,7 @@ void main()
     uvec4 sum = uvec4(0u);
     int first = int(gl_GlobalInvocationID.x) * PIXELS_PER_INVOCATION;
     int end = min(first + PIXELS_PER_INVOCATION, IMAGE_WIDTH * IMAGE_HEIGHT);
-    for (int k = first; k < end; k++) sum += unpackCounts(pixelCounts[k]);
+    for (int k = first; k < end; k++) sum += unpackCounts(pixelRecord[k].xy);
     for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
     for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);
 }

@@ -1,21 +1,19 @@
-// Hit records and per-pixel work counts (ours; not in the thesis). A design whose intersect1
-// writes hit records (HIT_RECORDS 1) keeps the closest-hit search apart from the evaluation of
-// the hit: intersect1 stores one word per pixel from which common/evaluate_hit.comp finds the
-// hit again (t, triangle id, u, v) and then does what Listings 13 and 14 do inside the thesis'
-// intersect1. A design whose
-// intersection kernels write per-pixel counts (PIXEL_COUNTS 1) stores each invocation's work
-// — ray–triangle tests, BVH nodes visited, a loop cut short, the ray traced — in one uvec4 per
-// pixel, which common/pixel_counts.comp adds to the 64-bit counters after the dispatch.
+// Per-pixel records: work counts and hit records (ours; not in the thesis). A design whose
+// intersection kernels count per pixel (PIXEL_COUNTS 1) stores each invocation's work —
+// ray–triangle tests, BVH nodes visited, a loop cut short, the ray traced — in its pixel's
+// record, which common/pixel_counts.comp adds to the 64-bit counters after the dispatch. A
+// design whose intersect1 stores hit records (HIT_RECORDS 1: the SAH BVH) keeps the closest-hit
+// search apart from the evaluation of the hit: its intersect1 stores with the counts one word
+// from which common/evaluate_hit.comp finds the hit again (t, triangle id, u, v;
+// bvh/hit_record.glsl) and then does what Listings 13 and 14 do inside the thesis' intersect1.
 // Both are plain vector stores: on llvmpipe an image store goes lane by lane and component by
 // component, and a shared-memory atomic lane by lane (docs/results/bvh_steps.md), which made
 // them cost more than the BVH walk itself.
-layout(std430, binding = SSBO_HIT_RECORDS) buffer HitRecordBuffer { int hitRecord[]; };
-
-// What intersect1's closestHit leaves for evaluate_hit.comp to find its hit again — the SAH
-// BVH, the one design with hit records: the word address of the hit's leaf triangle
-// (bvh/hit_record.glsl), −1 for none.
-int closestHitRecord = -1;
-layout(std430, binding = SSBO_PIXEL_COUNTS) buffer PixelCountBuffer { uvec2 pixelCounts[]; };
+// One record per pixel: xy its counts (packCounts), z its hit record (intersect1 only). One
+// store per invocation: on llvmpipe every store costs a loop over the 8 lanes per component
+// and about as much again for the store itself (a second store of the hit record cost ~1 ms
+// of the bunny's intersect1, docs/results/bvh_steps.md).
+layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordBuffer { uvec4 pixelRecord[]; };
 
 // A pixel's counts in two words, as each stored component costs a loop over the 8 lanes on
 // llvmpipe: (tests | truncated << 31, nodes | traced << 31). A pixel counts fewer than 2^28 tests

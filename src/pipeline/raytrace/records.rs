@@ -19,10 +19,9 @@ use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 /// The work group size of `pixel_counts.comp`.
 const COUNT_GROUP: u32 = 64;
 
-/// The hit-record and count buffers and the two kernels that read them.
+/// The per-pixel record buffer (counts and hit record) and the two kernels that read it.
 pub struct Records {
-    hits: Ssbo,
-    counts: Ssbo,
+    records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
     pixels: u32,
@@ -45,10 +44,8 @@ impl Records {
         let max = info.max_ssbo_block_size;
         let compute = |file, timer| Kernel::compute(gl, shaders, file, defines, timer);
         Ok(Records {
-            // one word (the hit's leaf-triangle address) and two words of counts per pixel
-            // (records.glsl)
-            hits: Ssbo::new(gl, "hit records", 4 * pixels, None, max)?,
-            counts: Ssbo::new(gl, "pixel counts", 8 * pixels, None, max)?,
+            // a uvec4 per pixel: two words of counts, the hit record (records.glsl)
+            records: Ssbo::new(gl, "pixel records", 16 * pixels, None, max)?,
             evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,
             pixels: w * h,
@@ -56,8 +53,7 @@ impl Records {
     }
 
     pub fn bind(&self, gl: &Gl) {
-        self.hits.bind(gl, ssbo::HIT_RECORDS);
-        self.counts.bind(gl, ssbo::PIXEL_COUNTS);
+        self.records.bind(gl, ssbo::PIXEL_RECORDS);
     }
 
     /// After intersect1: evaluate the hits (Listings 13, 14), then count.
@@ -97,7 +93,6 @@ impl Records {
     }
 
     pub fn delete(&self, gl: &Gl) {
-        self.hits.delete(gl);
-        self.counts.delete(gl);
+        self.records.delete(gl);
     }
 }
