@@ -49,21 +49,12 @@ float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 // Listing 4.5: does the ray enter the box [lo, hi] at some tMin <= t <= limit? (Wagner tests
 // t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
 // before the offset, skips the boxes around its origin that it leaves before the offset.)
-//
-// The smaller and the larger of two floats as selects: llvmpipe's min and max also handle NaN
-// (three instructions each, where a select is one or two), and no NaN reaches the slab test —
-// inv is finite (safeInverse) and so are the bounds. For numbers they equal min and max (the
-// twin's f32::min, f32::max), but for the sign of a zero, which no comparison below sees.
-float smaller(float a, float b) { return a < b ? a : b; }
-float larger(float a, float b) { return a > b ? a : b; }
-
 bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float tMin, float limit)
 {
     vec3 t0 = (lo - ro) * inv;
     vec3 t1 = (hi - ro) * inv;
-    float tNear = larger(larger(smaller(t0.x, t1.x), smaller(t0.y, t1.y)),
-                         larger(smaller(t0.z, t1.z), tMin));
-    float tFar = smaller(smaller(larger(t0.x, t1.x), larger(t0.y, t1.y)), larger(t0.z, t1.z));
+    float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), tMin));
+    float tFar = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
     return tNear <= tFar && tNear <= limit;
 }
 
