@@ -49,12 +49,18 @@ float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 // Listing 4.5: does the ray enter the box [lo, hi] at some tMin <= t <= limit? (Wagner tests
 // t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
 // before the offset, skips the boxes around its origin that it leaves before the offset.)
-bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float tMin, float limit)
+//
+// Ours: the near and far plane of each slab chosen by the ray's direction (down: the axes the
+// ray points down, 1/rd < 0) instead of by min and max of the two distances — the same values
+// (lo <= hi and rounding is monotonic, so (lo − ro)·inv <= (hi − ro)·inv for inv > 0), which
+// the CPU twin computes with min and max, in fewer instructions: llvmpipe's min and max are
+// NaN-aware, three instructions each, a select one (docs/results/bvh_steps.md).
+bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, bvec3 down, float tMin, float limit)
 {
-    vec3 t0 = (lo - ro) * inv;
-    vec3 t1 = (hi - ro) * inv;
-    float tNear = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), tMin));
-    float tFar = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    vec3 tNears = (mix(lo, hi, down) - ro) * inv;
+    vec3 tFars = (mix(hi, lo, down) - ro) * inv;
+    float tNear = max(max(tNears.x, tNears.y), max(tNears.z, tMin));
+    float tFar = min(min(tFars.x, tFars.y), tFars.z);
     return tNear <= tFar && tNear <= limit;
 }
 
@@ -63,11 +69,12 @@ bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, float tMin, float limit)
 void nodeStep(uvec4 t0, uvec4 t1, uvec4 t2, vec3 ro, vec3 inv, int octant, float tMin,
               float limit, inout int node, inout int slot, inout int slotEnd)
 {
+    bvec3 down = lessThan(inv, vec3(0.0)); // the axes of the octant's bits
     int o = octant & 3;
     uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
     nodesVisited++;
     vec3 lo = uintBitsToFloat(t0.xyz), hi = uintBitsToFloat(t1.xyz);
-    bool entered = boxEntered(lo, hi, ro, inv, tMin, limit);
+    bool entered = boxEntered(lo, hi, ro, inv, down, tMin, limit);
     int first = int(t0.w), meta = int(t1.w);
     bool leaf = meta >= 0;
     // an inner node entered: its near child next; a leaf entered: its triangles next
