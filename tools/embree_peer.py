@@ -20,8 +20,8 @@ one call uses one core; Embree's build (rtcCommitScene) uses all cores (TBB). Th
 times Embree on 1 thread and on --threads Python threads (default: all cores) that each trace
 chunks of the rays; the ratio column compares with the latter. Times are the median of
 --repeats runs (best in the details); ours the median of --repeats renders (the first with the
-AOVs, the others only timed), each timed in its last frame. Scenes whose render.shadows picks the soft-shadow
-pipeline give their G-buffer's first hits: agreement only, no Mrays/s.
+AOVs, the others only timed), each timed in its last frame. Scenes whose render.shadows picks
+the soft-shadow pipeline give their G-buffer's first hits: agreement only, no Mrays/s.
 
 Writes a markdown table (--out, default docs/results/embree_peer.md) and the same numbers as
 JSON beside it; exits 1 if a scene's first hits (ties included) agree on less than

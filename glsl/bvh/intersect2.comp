@@ -1,7 +1,8 @@
 // intersect2 kernel of the BVH — ours, after Wagner 2018 ch. 4.2 (hard shadows: a shadow ray
 // towards the one light through the same BVH): the shadow feeler walks the BVH
 // (bvh/traverse.glsl, nodes beyond the light and those it leaves before the shadow offset
-// pruned) and tests the triangles of each leaf until the first occluder (any hit). Deviations: see traverse.glsl; any number of lights.
+// pruned) and tests the triangles of each leaf until the first occluder (any hit).
+// Deviations: see traverse.glsl; any number of lights.
 // Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"

@@ -5,12 +5,15 @@
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), addressed by word (Bvh::gpu_words in
 // src/reference/bvh/mod.rs) and read as RGBA32UI texels of 4 words:
-//   per node 16 words (one 64-byte cache line): lo.xyz, first, hi.xyz, meta, and the node's miss
-//             link for each of the 8 ray octants — where a ray of that octant goes on when it
-//             misses the node or is done with it (−1: the walk is over); an inner node's left
-//             child is at `first`, its right child at first + 16, its meta −1 − the split axis;
-//             a leaf's meta is its triangle count and its triangles start at `first`
-//   after the nodes, per leaf triangle 12 words: v0, triangle id, edge1, 0, edge2, 0
+//   per node 16 words (BVH_NODE_WORDS, one 64-byte cache line): lo.xyz, first, hi.xyz, meta,
+//             and the node's miss link for each of the 8 ray octants — where a ray of that
+//             octant goes on when it misses the node or is done with it (−1: the walk is over);
+//             an inner node's left child is at `first`, its right child at first + 16, its
+//             meta −1 − the split axis; a leaf's meta is its triangle count and its triangles
+//             start at `first`
+//   after the nodes, per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0,
+//             edge2, 0
+// (BVH_NODE_WORDS and BVH_TRIANGLE_WORDS: #defines of the host, src/accel/bvh.rs.)
 // A node and a triangle thus have their bounds / v0 in texel 0 (first / id in its w), hi / edge1
 // in texel 1 and the miss links / edge2 from texel 2 on, and a step reads either with the same
 // three texel loads (on llvmpipe: eight 128-bit loads and a transpose each, where a 32-bit word
@@ -79,9 +82,9 @@ void nodeStep(uvec4 t0, uvec4 t1, uvec4 t2, vec3 ro, vec3 inv, int octant, float
     bool leaf = meta >= 0;
     // an inner node entered: its near child next; a leaf entered: its triangles next
     int next = int(link);
-    next = entered && !leaf ? first + 16 * ((octant >> (-1 - meta)) & 1) : next;
+    next = entered && !leaf ? first + BVH_NODE_WORDS * ((octant >> (-1 - meta)) & 1) : next;
     slot = entered && leaf ? first : slot;
-    slotEnd = entered && leaf ? first + 12 * meta : slotEnd;
+    slotEnd = entered && leaf ? first + BVH_TRIANGLE_WORDS * meta : slotEnd;
     node = next;
 }
 
@@ -91,10 +94,12 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
     int node = 0;
-    // the entered leaf's triangles still to test: at words slot, slot + 12, ... below slotEnd
+    // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
+    // below slotEnd
     int slot = 0, slotEnd = 0;
-    // every node visited and every leaf triangle tested at most once (16 and 12 words each)
-    int bound = imageSize(bvh) / 3 + 1;
+    // every node visited and every leaf triangle tested at most once; each takes at least
+    // BVH_TRIANGLE_WORDS of the buffer's 4 words a texel
+    int bound = 4 * imageSize(bvh) / BVH_TRIANGLE_WORDS + 1;
     for (int guard = 0; guard < bound && (node >= 0 || slot < slotEnd); guard++) {
         bool tri = slot < slotEnd;
         int at = tri ? slot : node;
@@ -104,7 +109,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
             if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                             uintBitsToFloat(t2.xyz), limit))
                 return true;
-            slot += 12;
+            slot += BVH_TRIANGLE_WORDS;
         } else {
             nodeStep(t0, t1, t2, ro, inv, octant, tMin, limit, node, slot, slotEnd);
         }

@@ -3,8 +3,9 @@
 // common/intersect1_hit.glsl, unchanged). For the designs whose intersect1 stores hit records
 // (HIT_RECORDS, common/records.glsl): one invocation per pixel reads its ray from the
 // ray-state textures, finds its closest hit (t, triangle id, u, v) again from the hit record
-// (bvh/hit_record.glsl), and evaluates it exactly as the thesis' intersect1 does; an inactive ray (rayState <= 0) gets an
-// empty colour buffer. The host dispatches it right after intersect1, under the same ray kind.
+// (bvh/hit_record.glsl), and evaluates it exactly as the thesis' intersect1 does; an inactive
+// ray (rayState <= 0) gets an empty colour buffer. The host dispatches it right after
+// intersect1, under the same ray kind, with the BVH's word buffer still bound.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly

@@ -47,8 +47,10 @@ void traceAndCount(int testsSlot)
         int at = pixelIndex(storePos);
 #if HIT_RECORDS
         // (a constant condition: one of the two stores is compiled)
-        if (testsSlot == COUNTER_INTERSECT1) pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
-        else pixelRecord[at].xy = counts;
+        if (testsSlot == COUNTER_INTERSECT1)
+            pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
+        else
+            pixelRecord[at].xy = counts;
 #else
         pixelRecord[at].xy = counts;
 #endif

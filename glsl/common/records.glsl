@@ -9,6 +9,7 @@
 // Both are plain vector stores: on llvmpipe an image store goes lane by lane and component by
 // component, and a shared-memory atomic lane by lane (docs/results/bvh_steps.md), which made
 // them cost more than the BVH walk itself.
+
 // What intersect1's closestHit leaves for evaluate_hit.comp to find its hit again — the SAH
 // BVH, the one design with hit records: the word address of the hit's leaf triangle
 // (bvh/hit_record.glsl), −1 for none.

@@ -20,7 +20,7 @@ use crate::frame::FrameStats;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, Kernel};
-use crate::reference::bvh::{Bvh as CpuBvh, BvhStats};
+use crate::reference::bvh::{Bvh as CpuBvh, BvhStats, NODE_WORDS, TRIANGLE_WORDS};
 use crate::reference::CpuAccelerator;
 use crate::scene::{transform_triangles, Scene};
 
@@ -36,15 +36,10 @@ pub const ENTRY: Entry = Entry {
 
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes with their miss links and
 /// leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), addressed by
-/// word in the kernels' ints.
+/// word in the kernels' ints — which cannot overflow: `TextureBuffer::new` refuses a buffer of
+/// 2^31 bytes or more (or beyond `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     let words = bvh.gpu_words();
-    if words.len() > i32::MAX as usize {
-        bail!(
-            "the BVH takes {} words, beyond the kernels' 32-bit word addresses; use a smaller scene",
-            words.len()
-        );
-    }
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
@@ -58,9 +53,15 @@ fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     )
 }
 
-/// The kernels store hit records and per-pixel counts (`Accelerator::records`).
-fn records_defines() -> [(&'static str, String); 2] {
-    [("HIT_RECORDS", "1".into()), ("PIXEL_COUNTS", "1".into())]
+/// The kernels' #defines: the word buffer's record sizes ([`NODE_WORDS`], [`TRIANGLE_WORDS`]),
+/// and they store hit records and per-pixel counts (`Accelerator::records`).
+fn kernel_defines() -> [(&'static str, String); 4] {
+    [
+        ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
+        ("BVH_TRIANGLE_WORDS", TRIANGLE_WORDS.to_string()),
+        ("HIT_RECORDS", "1".into()),
+        ("PIXEL_COUNTS", "1".into()),
+    ]
 }
 
 pub struct Bvh {
@@ -83,7 +84,7 @@ pub struct Bvh {
 
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        let defs = records_defines();
+        let defs = kernel_defines();
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,

@@ -16,7 +16,7 @@ use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 
-/// The work group size of `pixel_counts.comp`.
+/// The work group size of `pixel_counts.comp` (its `COUNT_GROUP`).
 const COUNT_GROUP: u32 = 64;
 
 /// The per-pixel record buffer (counts and hit record) and the two kernels that read it.
@@ -42,7 +42,11 @@ impl Records {
     ) -> Result<Records> {
         let pixels = (w as usize) * (h as usize);
         let max = info.max_ssbo_block_size;
-        let compute = |file, timer| Kernel::compute(gl, shaders, file, defines, timer);
+        let defines = defines
+            .clone()
+            .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
+            .set("COUNT_GROUP", COUNT_GROUP);
+        let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
             // a uvec4 per pixel: two words of counts, the hit record (records.glsl)
             records: Ssbo::new(gl, "pixel records", 16 * pixels, None, max)?,
