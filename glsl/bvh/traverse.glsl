@@ -5,19 +5,26 @@
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), addressed by word (Bvh::gpu_words in
 // src/reference/bvh/mod.rs) and read as RGBA32UI texels of 4 words:
-//   per node 16 words (BVH_NODE_WORDS, one 64-byte cache line): lo.xyz, first, hi.xyz, meta,
-//             and the node's miss link for each of the 8 ray octants — where a ray of that
-//             octant goes on when it misses the node or is done with it (−1: the walk is over);
-//             an inner node's left child is at `first`, its right child at first + 16, its
-//             meta −1 − the split axis; a leaf's meta is its triangle count and its triangles
-//             start at `first`
-//   after the nodes, per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0,
-//             edge2, 0
-// (BVH_NODE_WORDS and BVH_TRIANGLE_WORDS: #defines of the host, src/accel/bvh.rs.)
-// A node and a triangle thus have their bounds / v0 in texel 0 (first / id in its w), hi / edge1
-// in texel 1 and the miss links / edge2 from texel 2 on, and a step reads either with the same
-// three texel loads (on llvmpipe: eight 128-bit loads and a transpose each, where a 32-bit word
-// costs a gather with its bounds check).
+//   a header of 4 words (BVH_HEADER_WORDS): the node count N, the word address of the first
+//             leaf triangle, 0, 0;
+//   for each ray octant o (bit a set: the ray points down axis a) a copy of the N nodes in
+//             that octant's depth-first order (the near child of every split first) from word
+//             BVH_HEADER_WORDS + o·BVH_NODE_WORDS·N on, 8 words each (BVH_NODE_WORDS):
+//             near.xyz, leaf, far.xyz, link — the box as the planes where rays of the octant
+//             enter and leave its slabs, the miss link (the word address of the record where
+//             such a ray goes on when it misses the node or is done with it; −1: the walk is
+//             over), and in a leaf −1 − (s·32 + count), its triangles from entry s of the leaf
+//             triangles on (an inner node: 0; its near child is the next record, its far child
+//             the near child's miss link);
+//   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0
+// (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
+// host, src/accel/bvh.rs.) A node record and a triangle thus have their near planes / v0 in
+// texel 0 (the leaf reference / id in its w) and their far planes / edge1 in texel 1, and a
+// step reads either with the same loads (on llvmpipe: eight 128-bit loads, a transpose and a
+// bounds check each, where a 32-bit word costs a gather with its bounds check). Ours: the
+// copies per octant (4× the memory of one 64-byte node with 8 links) save the third texel of
+// a node step (the links), the choice of the octant's link and near child, and the slab
+// test's choice of planes (docs/results/bvh_steps.md, step 16).
 //
 // Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
 // and from a stack walk): stackless. Every inner node whose box the ray enters (at some
@@ -46,46 +53,48 @@
 
 bool triangleHit(int at, int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
 
+// the word address of the first leaf triangle (the header's second word)
+int triangleBase = 0;
+
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 
-// Listing 4.5: does the ray enter the box [lo, hi] at some tMin <= t <= limit? (Wagner tests
-// t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
-// before the offset, skips the boxes around its origin that it leaves before the offset.)
+// Listing 4.5: does the ray enter the box whose slabs it enters at the planes `near` and
+// leaves at `far` at some tMin <= t <= limit? (Wagner tests t >= 0; ours: a shadow feeler from
+// tMin = SHADOW_OFFSET on, since intersect2 takes no hit before the offset, skips the boxes
+// around its origin that it leaves before the offset.)
 //
-// Ours: the near and far plane of each slab chosen by the ray's direction (down: the axes the
-// ray points down, 1/rd < 0) instead of by min and max of the two distances — the same values
-// (lo <= hi and rounding is monotonic, so (lo − ro)·inv <= (hi − ro)·inv for inv > 0), which
-// the CPU twin computes with min and max, in fewer instructions: llvmpipe's min and max are
-// NaN-aware, three instructions each, a select one (docs/results/bvh_steps.md).
-bool boxEntered(vec3 lo, vec3 hi, vec3 ro, vec3 inv, bvec3 down, float tMin, float limit)
+// Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
+// bits — llvmpipe's float min and max are NaN-aware, three instructions each, the integer ones
+// one. For t >= +0 the bits are in the order of the floats; the entry distance is at least
+// tMin >= +0, and where an exit distance is negative so is the smallest of the bits: the box is
+// missed either way (an exit at exactly −0.0 too: a box the ray leaves at its origin). No
+// distance is NaN (safeInverse). The CPU twin (Bvh::enter) computes the same bits.
+bool boxEntered(vec3 near, vec3 far, vec3 ro, vec3 inv, float tMin, float limit)
 {
-    vec3 tNears = (mix(lo, hi, down) - ro) * inv;
-    vec3 tFars = (mix(hi, lo, down) - ro) * inv;
-    float tNear = max(max(tNears.x, tNears.y), max(tNears.z, tMin));
-    float tFar = min(min(tFars.x, tFars.y), tFars.z);
-    return tNear <= tFar && tNear <= limit;
+    ivec3 tNears = floatBitsToInt((near - ro) * inv);
+    ivec3 tFars = floatBitsToInt((far - ro) * inv);
+    int tNear = max(max(tNears.x, tNears.y), max(tNears.z, floatBitsToInt(tMin)));
+    int tFar = min(min(tFars.x, tFars.y), min(tFars.z, floatBitsToInt(limit)));
+    return tNear <= tFar;
 }
 
-// One node step: the box test of the node whose texels are t0, t1 and (its octant's miss links)
-// t2, and where the walk goes next.
-void nodeStep(uvec4 t0, uvec4 t1, uvec4 t2, vec3 ro, vec3 inv, int octant, float tMin,
-              float limit, inout int node, inout int slot, inout int slotEnd)
+// One node step: the box test of the record at word `node` whose texels are t0 and t1, and
+// where the walk goes next — the near child (the next record) after an inner node entered, the
+// miss link after a node missed or a leaf entered, whose triangles are then the slots.
+void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
+              inout int node, inout int slot, inout int slotEnd)
 {
-    bvec3 down = lessThan(inv, vec3(0.0)); // the axes of the octant's bits
-    int o = octant & 3;
-    uint link = o == 0 ? t2.x : o == 1 ? t2.y : o == 2 ? t2.z : t2.w;
     nodesVisited++;
-    vec3 lo = uintBitsToFloat(t0.xyz), hi = uintBitsToFloat(t1.xyz);
-    bool entered = boxEntered(lo, hi, ro, inv, down, tMin, limit);
-    int first = int(t0.w), meta = int(t1.w);
-    bool leaf = meta >= 0;
-    // an inner node entered: its near child next; a leaf entered: its triangles next
-    int next = int(link);
-    next = entered && !leaf ? first + BVH_NODE_WORDS * ((octant >> (-1 - meta)) & 1) : next;
-    slot = entered && leaf ? first : slot;
-    slotEnd = entered && leaf ? first + BVH_TRIANGLE_WORDS * meta : slotEnd;
-    node = next;
+    bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv,
+                              tMin, limit);
+    int leaf = -1 - int(t0.w); // s·32 + count in a leaf, −1 in an inner node
+    bool inner = leaf < 0;
+    int first = triangleBase + BVH_TRIANGLE_WORDS * (leaf >> BVH_LEAF_COUNT_BITS);
+    int count = leaf & ((1 << BVH_LEAF_COUNT_BITS) - 1);
+    slot = entered && !inner ? first : slot;
+    slotEnd = entered && !inner ? first + BVH_TRIANGLE_WORDS * count : slotEnd;
+    node = entered && inner ? node + BVH_NODE_WORDS : int(t1.w);
 }
 
 // The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it.
@@ -93,30 +102,31 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
 {
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
-    int node = 0;
+    uvec4 header = bvhTexel(0);
+    triangleBase = int(header.y);
+    // the root: the first record of the octant's copy
+    int node = BVH_HEADER_WORDS + octant * BVH_NODE_WORDS * int(header.x);
     // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
     // below slotEnd
     int slot = 0, slotEnd = 0;
-    // every node visited and every leaf triangle tested at most once; each takes at least
-    // BVH_TRIANGLE_WORDS of the buffer's 4 words a texel
-    int bound = 4 * imageSize(bvh) / BVH_TRIANGLE_WORDS + 1;
+    // every node of the octant visited and every leaf triangle tested at most once; each takes
+    // at least BVH_NODE_WORDS of the buffer's 4 words a texel
+    int bound = 4 * imageSize(bvh) / BVH_NODE_WORDS + 1;
     for (int guard = 0; guard < bound && (node >= 0 || slot < slotEnd); guard++) {
         bool tri = slot < slotEnd;
         int at = tri ? slot : node;
-        uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4);
-        uvec4 t2 = bvhTexel(at + (tri ? 8 : 8 + (octant & 4)));
+        uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4), t2 = bvhTexel(at + 8);
         if (tri) {
             if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                             uintBitsToFloat(t2.xyz), limit))
                 return true;
             slot += BVH_TRIANGLE_WORDS;
         } else {
-            nodeStep(t0, t1, t2, ro, inv, octant, tMin, limit, node, slot, slotEnd);
+            nodeStep(t0, t1, ro, inv, tMin, limit, node, slot, slotEnd);
         }
         if (slot >= slotEnd && node >= 0) {
             t0 = bvhTexel(node); t1 = bvhTexel(node + 4);
-            t2 = bvhTexel(node + 8 + (octant & 4));
-            nodeStep(t0, t1, t2, ro, inv, octant, tMin, limit, node, slot, slotEnd);
+            nodeStep(t0, t1, ro, inv, tMin, limit, node, slot, slotEnd);
         }
     }
     if (node >= 0 || slot < slotEnd) truncated = 1u;

@@ -1,6 +1,6 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
 //! (`reference::bvh`, binned SAH, rayon) and uploaded into one image buffer of 32-bit words
-//! (nodes with their miss links, then the leaf triangles), traversed in the intersection kernels
+//! (a copy of the nodes for each ray octant, then the leaf triangles), traversed in the intersection kernels
 //! without a stack, near child first (`glsl/bvh/`). Objects
 //! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
 //! matrix changed since the last build, and not otherwise. Its image equals the base
@@ -20,7 +20,9 @@ use crate::frame::FrameStats;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, Kernel};
-use crate::reference::bvh::{Bvh as CpuBvh, BvhStats, NODE_WORDS, TRIANGLE_WORDS};
+use crate::reference::bvh::{
+    Bvh as CpuBvh, BvhStats, HEADER_WORDS, LEAF_COUNT_BITS, NODE_WORDS, TRIANGLE_WORDS,
+};
 use crate::reference::CpuAccelerator;
 use crate::scene::{transform_triangles, Scene};
 
@@ -34,8 +36,8 @@ pub const ENTRY: Entry = Entry {
     },
 };
 
-/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): nodes with their miss links and
-/// leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), addressed by
+/// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the node records of every octant and
+/// the leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), addressed by
 /// word in the kernels' ints — which cannot overflow: `TextureBuffer::new` refuses a buffer of
 /// 2^31 bytes or more (or beyond `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
@@ -53,11 +55,14 @@ fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     )
 }
 
-/// The kernels' #defines: the word buffer's record sizes ([`NODE_WORDS`], [`TRIANGLE_WORDS`]),
-/// and they store hit records and per-pixel counts (`Accelerator::records`).
-fn kernel_defines() -> [(&'static str, String); 4] {
+/// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
+/// [`TRIANGLE_WORDS`]) and leaf references ([`LEAF_COUNT_BITS`]), and they store hit records
+/// and per-pixel counts (`Accelerator::records`).
+fn kernel_defines() -> [(&'static str, String); 6] {
     [
+        ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
+        ("BVH_LEAF_COUNT_BITS", LEAF_COUNT_BITS.to_string()),
         ("BVH_TRIANGLE_WORDS", TRIANGLE_WORDS.to_string()),
         ("HIT_RECORDS", "1".into()),
         ("PIXEL_COUNTS", "1".into()),

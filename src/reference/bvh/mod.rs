@@ -8,13 +8,15 @@
 //!
 //! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
 //! words addressed by word ([`Bvh::gpu_words`]):
-//! - per node one 64-byte line: the [`Node`] (bounds min/max and either the address of the
-//!   left child (the right child follows it) and the split axis, or, in a leaf, the address of
-//!   its first triangle and its triangle count), then [`Bvh::links`] of the node: per ray
-//!   octant the node to go on with when the node is missed or done (its *miss link*; [`END`]
-//!   after the last);
-//! - after the nodes, per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as v0
-//!   and its id, edge1, edge2 (12 words).
+//! - a header: the node count and where the triangles start;
+//! - for each of the 8 ray octants a copy of the nodes in that octant's depth-first order (the
+//!   near child of every split first), one 32-byte record each: the box as its near and far
+//!   planes for rays of that octant, the node's miss link for that octant (the record to go on
+//!   with when the node is missed or done; [`END`] after the last), and in a leaf the place
+//!   and count of its triangles — an inner node's near child is the record after it, its far
+//!   child the near child's miss link;
+//! - after the records, per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as
+//!   v0 and its id, edge1, edge2 (12 words).
 //!
 //! Traversal (the kernels in `glsl/bvh/traverse.glsl`, and [`Bvh::traverse`] here, their CPU
 //! twin, in exactly the same order with the same counts): stackless. A ray walks the nodes in
@@ -54,8 +56,7 @@ pub const OCTANTS: usize = 8;
 /// Subtrees of more triangles build their two children in parallel.
 pub const PARALLEL_BUILD: usize = 4096;
 
-/// One node: its bounds and integers (the first 8 of its words in [`Bvh::gpu_words`], where
-/// `first` becomes a word address).
+/// One node: its bounds and integers (in [`Bvh::gpu_words`] as one record per octant).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct Node {
@@ -111,10 +112,15 @@ pub struct Bvh {
     pub stats: BvhStats,
 }
 
-/// Words of one node in [`Bvh::gpu_words`] (one 64-byte cache line).
-pub const NODE_WORDS: usize = 16;
+/// Words of the header of [`Bvh::gpu_words`]: the node count, the word address of the first
+/// leaf triangle, two zeros.
+pub const HEADER_WORDS: usize = 4;
+/// Words of one node record of one octant in [`Bvh::gpu_words`].
+pub const NODE_WORDS: usize = 8;
 /// Words of one leaf triangle in [`Bvh::gpu_words`].
 pub const TRIANGLE_WORDS: usize = 12;
+/// Bits of a leaf record's triangle count in its reference word ([`Bvh::gpu_words`]).
+pub const LEAF_COUNT_BITS: u32 = 5;
 
 impl Bvh {
     /// Build the hierarchy over `triangles` (triangle id = index).
@@ -127,7 +133,8 @@ impl Bvh {
         let mut stats = BvhStats {
             nodes: nodes.len(),
             leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
-            bytes: 4 * (NODE_WORDS * nodes.len() + TRIANGLE_WORDS * ids.len()),
+            bytes: 4
+                * (HEADER_WORDS + OCTANTS * NODE_WORDS * nodes.len() + TRIANGLE_WORDS * ids.len()),
             ..BvhStats::default()
         };
         build::measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
@@ -144,42 +151,75 @@ impl Bvh {
     /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) addressed
     /// by word, so that a node and a leaf triangle are read by the same loads
     /// (`glsl/bvh/traverse.glsl`):
-    /// - per node [`NODE_WORDS`]: lo.xyz, first, hi.xyz, meta, then the node's miss link for
-    ///   each of the 8 octants — `first` and the links as word addresses (an inner node's left
-    ///   child, the right one follows it; a leaf's first triangle; [`END`] stays −1);
-    /// - after the nodes, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]: v0 and the triangle
-    ///   id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences Algorithm 1 forms
-    ///   first.
+    /// - [`HEADER_WORDS`]: the node count N, the word address of the first leaf triangle, 0, 0;
+    /// - for each octant o = 0..8, from word `HEADER_WORDS + o·NODE_WORDS·N` on, the N nodes in
+    ///   the depth-first order of that octant (the order of [`Bvh::links`]: the near child of
+    ///   every split first), [`NODE_WORDS`] each: the near planes x, y, z (for each axis the
+    ///   box's low bound, or its high bound where rays of the octant point down the axis), the
+    ///   leaf reference, the far planes x, y, z, the miss link (the word address of the record
+    ///   of `links[OCTANTS·n + o]`; [`END`] stays −1). The leaf reference of a leaf is
+    ///   −1 − (s·2^[`LEAF_COUNT_BITS`] + count) with s its first entry in [`Bvh::tris`], of an
+    ///   inner node 0: its near child is the next record;
+    /// - from that first-triangle address on, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]:
+    ///   v0 and the triangle id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences
+    ///   Algorithm 1 forms first.
+    ///
+    /// (s < 2^26 always: `TextureBuffer::new` refuses a buffer of 2^31 bytes, and each entry
+    /// takes 48.)
     pub fn gpu_words(&self) -> Vec<u32> {
-        let base = NODE_WORDS * self.nodes.len();
-        let node_at = |n: i32| match n {
-            END => END as u32,
-            n => (NODE_WORDS * n as usize) as u32,
-        };
-        let mut out = Vec::with_capacity(base + TRIANGLE_WORDS * self.tris.len());
-        for (n, node) in self.nodes.iter().enumerate() {
-            let first = match node.is_leaf() {
-                true => base + TRIANGLE_WORDS * node.first as usize,
-                false => NODE_WORDS * node.first as usize,
-            };
-            out.extend(node.lo.map(f32::to_bits));
-            out.push(first as u32);
-            out.extend(node.hi.map(f32::to_bits));
-            out.push(node.meta as u32);
-            let links = &self.links[OCTANTS * n..OCTANTS * (n + 1)];
-            out.extend(links.iter().map(|&l| node_at(l)));
-        }
+        use rayon::prelude::*;
+        let n = self.nodes.len();
+        let records = OCTANTS * NODE_WORDS * n;
+        let mut out = vec![0u32; HEADER_WORDS + records + TRIANGLE_WORDS * self.tris.len()];
+        let (head, rest) = out.split_at_mut(HEADER_WORDS);
+        head[0] = n as u32;
+        head[1] = (HEADER_WORDS + records) as u32;
+        let (octants, triangles) = rest.split_at_mut(records);
+        octants
+            .par_chunks_mut(NODE_WORDS * n)
+            .enumerate()
+            .for_each(|(o, w)| self.octant_records(o, HEADER_WORDS + o * NODE_WORDS * n, w));
         let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-        for &id in &self.tris {
-            let [v0, v1, v2] = self.triangles[id as usize];
-            out.extend(bits(v0));
-            out.push(id);
-            out.extend(bits(v1 - v0));
-            out.push(0);
-            out.extend(bits(v2 - v0));
-            out.push(0);
-        }
+        triangles
+            .par_chunks_mut(TRIANGLE_WORDS)
+            .zip(self.tris.par_iter())
+            .for_each(|(w, &id)| {
+                let [v0, v1, v2] = self.triangles[id as usize];
+                w[0..3].copy_from_slice(&bits(v0));
+                w[3] = id;
+                w[4..7].copy_from_slice(&bits(v1 - v0));
+                w[8..11].copy_from_slice(&bits(v2 - v0));
+            });
         out
+    }
+
+    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`, whose first word has
+    /// the word address `base`.
+    fn octant_records(&self, o: usize, base: usize, out: &mut [u32]) {
+        let order = depth_first(&self.nodes, o);
+        let mut record = vec![0u32; self.nodes.len()];
+        for (i, &k) in order.iter().enumerate() {
+            record[k as usize] = (base + NODE_WORDS * i) as u32;
+        }
+        for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
+            let node = &self.nodes[k as usize];
+            let (mut near, mut far) = (node.lo, node.hi);
+            for axis in 0..3 {
+                if (o >> axis) & 1 == 1 {
+                    std::mem::swap(&mut near[axis], &mut far[axis]);
+                }
+            }
+            w[0..3].copy_from_slice(&near.map(f32::to_bits));
+            w[3] = match node.is_leaf() {
+                true => (-1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32)) as u32,
+                false => 0,
+            };
+            w[4..7].copy_from_slice(&far.map(f32::to_bits));
+            w[7] = match self.links[OCTANTS * k as usize + o] {
+                END => END as u32,
+                l => record[l as usize],
+            };
+        }
     }
 
     /// The triangles it was built over.
@@ -204,7 +244,7 @@ impl Bvh {
         while node != END {
             visited += 1;
             let n = &self.nodes[node as usize];
-            if self.enter(node as usize, ro, inv, t_min, limit).is_some() {
+            if self.enter(node as usize, ro, inv, t_min, limit) {
                 if !n.is_leaf() {
                     // the near child first: the right one when the ray points down the axis
                     node = n.first as i32 + (inv[n.axis()] < 0.0) as i32;
@@ -221,17 +261,25 @@ impl Bvh {
         visited
     }
 
-    /// The entry distance of the ray into node `n`'s box if it enters it at some
-    /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5, as `boxEntered` in the
-    /// kernels).
-    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, t_min: f32, limit: f32) -> Option<f32> {
+    /// Whether the ray enters node `n`'s box at some `t_min` ≤ t ≤ `limit` (the slab test of
+    /// Wagner 2018, Listing 4.5), bit for bit as `boxEntered` in the kernels: each slab's near
+    /// plane is its low bound, or its high bound where the ray points down the axis (as the
+    /// records of [`Bvh::gpu_words`] store them), and the largest entry and the smallest exit
+    /// distance are taken by integer max and min of the floats' bits. For t ≥ +0 the order of
+    /// the bits is the order of the floats; the entry distance is at least `t_min` ≥ +0, and
+    /// where an exit distance is negative so is the smallest of the bits — the box is missed
+    /// either way (an exit at exactly −0.0 too, a box the ray leaves at its origin). No
+    /// distance is NaN: 1/rd is finite ([`safe_inverse`]).
+    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, t_min: f32, limit: f32) -> bool {
         let node = &self.nodes[n];
-        let t0 = (Vec3::from(node.lo) - ro) * inv;
-        let t1 = (Vec3::from(node.hi) - ro) * inv;
-        let near = t0.x.min(t1.x).max(t0.y.min(t1.y));
-        let near = near.max(t0.z.min(t1.z).max(t_min));
-        let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z));
-        (near <= far && near <= limit).then_some(near)
+        let down = inv.cmplt(Vec3::ZERO);
+        let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
+        let bits = |v: Vec3| v.to_array().map(|f| f.to_bits() as i32);
+        let near = bits((Vec3::select(down, hi, lo) - ro) * inv);
+        let far = bits((Vec3::select(down, lo, hi) - ro) * inv);
+        let t_near = near.iter().fold(t_min.to_bits() as i32, |m, &t| m.max(t));
+        let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
+        t_near <= t_far
     }
 }
 
@@ -260,7 +308,25 @@ fn miss_links(nodes: &[Node]) -> Vec<i32> {
         .collect()
 }
 
-/// The miss link of every node in the depth-first order of one octant.
+/// The nodes in the depth-first order of one octant: every node before its subtree, the near
+/// child's subtree before the far child's.
+fn depth_first(nodes: &[Node], octant: usize) -> Vec<u32> {
+    let mut order = Vec::with_capacity(nodes.len());
+    let mut todo = vec![0u32];
+    while let Some(n) = todo.pop() {
+        order.push(n);
+        let node = &nodes[n as usize];
+        if !node.is_leaf() {
+            let down = ((octant >> node.axis()) & 1) as u32;
+            todo.push(node.first + 1 - down);
+            todo.push(node.first + down);
+        }
+    }
+    order
+}
+
+/// The miss link of every node in the depth-first order of one octant: the node after its
+/// subtree.
 fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
     let mut links = vec![END; nodes.len()];
     // (node, its miss link): the far child's miss link is its parent's, the near child's is
@@ -392,44 +458,61 @@ mod tests {
     fn gpu_words_hold_every_node_and_leaf_triangle_at_its_address() {
         let bvh = Bvh::new(soup());
         let words = bvh.gpu_words();
-        let base = NODE_WORDS * bvh.nodes.len();
+        let n = bvh.nodes.len();
+        let base = HEADER_WORDS + OCTANTS * NODE_WORDS * n;
         assert_eq!(words.len(), base + TRIANGLE_WORDS * bvh.tris.len());
         assert_eq!(4 * words.len(), bvh.stats.bytes);
-        let f = |w: &[u32]| {
-            Vec3::new(
-                f32::from_bits(w[0]),
-                f32::from_bits(w[1]),
-                f32::from_bits(w[2]),
-            )
-        };
-        for (n, node) in bvh.nodes.iter().enumerate() {
-            let w = &words[NODE_WORDS * n..NODE_WORDS * (n + 1)];
-            assert_eq!((f(&w[0..3]), f(&w[4..7])), (node.lo.into(), node.hi.into()));
-            assert_eq!(w[7] as i32, node.meta);
-            let first = w[3] as usize;
-            if node.is_leaf() {
-                // the leaf's triangles: v0, id, edge1, 0, edge2, 0 each
-                assert_eq!(first, base + TRIANGLE_WORDS * node.first as usize);
-                for k in 0..node.count() as usize {
-                    let t = &words[first + TRIANGLE_WORDS * k..][..TRIANGLE_WORDS];
-                    let id = bvh.tris[node.first as usize + k];
-                    let [v0, v1, v2] = bvh.triangles[id as usize];
-                    assert_eq!(
-                        (f(&t[0..3]), t[3], f(&t[4..7]), f(&t[8..11])),
-                        (v0, id, v1 - v0, v2 - v0)
-                    );
+        assert_eq!(words[..HEADER_WORDS], [n as u32, base as u32, 0, 0]);
+        let f = |w: &[u32]| Vec3::from_array([0, 1, 2].map(|k| f32::from_bits(w[k])));
+        for octant in 0..OCTANTS {
+            // the octant's records, near child right after its parent: where each node is
+            let mut at = vec![usize::MAX; n];
+            let mut next = HEADER_WORDS + octant * NODE_WORDS * n;
+            let mut todo = vec![0usize];
+            while let Some(k) = todo.pop() {
+                at[k] = next;
+                next += NODE_WORDS;
+                let node = &bvh.nodes[k];
+                if !node.is_leaf() {
+                    let near = node.first as usize + ((octant >> node.axis()) & 1);
+                    todo.push(2 * node.first as usize + 1 - near);
+                    todo.push(near);
                 }
-            } else {
-                assert_eq!(first, NODE_WORDS * node.first as usize);
             }
-            for octant in 0..OCTANTS {
-                let link = bvh.links[OCTANTS * n + octant];
+            assert_eq!(next, HEADER_WORDS + (octant + 1) * NODE_WORDS * n);
+            for (k, node) in bvh.nodes.iter().enumerate() {
+                let w = &words[at[k]..at[k] + NODE_WORDS];
+                // the planes where rays of the octant enter and leave the slabs
+                let down = [0, 1, 2].map(|a| (octant >> a) & 1 == 1);
+                let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
+                let down = glam::BVec3::from(down);
+                assert_eq!(f(&w[0..3]), Vec3::select(down, hi, lo));
+                assert_eq!(f(&w[4..7]), Vec3::select(down, lo, hi));
+                let link = bvh.links[OCTANTS * k + octant];
                 let want = if link == END {
                     END as u32
                 } else {
-                    (NODE_WORDS * link as usize) as u32
+                    at[link as usize] as u32
                 };
-                assert_eq!(w[8 + octant], want);
+                assert_eq!(w[7], want, "miss link of node {k}, octant {octant}");
+                if !node.is_leaf() {
+                    assert_eq!(w[3], 0);
+                    continue;
+                }
+                // the leaf's triangles: v0, id, edge1, 0, edge2, 0 each
+                let reference = -1 - w[3] as i32;
+                let count = reference & ((1 << LEAF_COUNT_BITS) - 1);
+                let first = (reference >> LEAF_COUNT_BITS) as usize;
+                assert_eq!((first, count as u32), (node.first as usize, node.count()));
+                for s in first..first + count as usize {
+                    let t = &words[base + TRIANGLE_WORDS * s..][..TRIANGLE_WORDS];
+                    let id = bvh.tris[s];
+                    let [v0, v1, v2] = bvh.triangles[id as usize];
+                    assert_eq!(
+                        (f(&t[0..3]), t[3], f(&t[4..7]), t[7], f(&t[8..11]), t[11]),
+                        (v0, id, v1 - v0, 0, v2 - v0, 0)
+                    );
+                }
             }
         }
     }
