@@ -203,6 +203,7 @@ impl Bvh {
         }
         for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
             let node = &self.nodes[k as usize];
+            debug_assert!(node.first < 1 << (31 - LEAF_COUNT_BITS), "see gpu_words");
             let (mut near, mut far) = (node.lo, node.hi);
             for axis in 0..3 {
                 if (o >> axis) & 1 == 1 {
