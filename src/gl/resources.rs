@@ -252,8 +252,15 @@ impl TextureBuffer {
     ) -> Result<TextureBuffer> {
         // at least one texel: an empty list still makes a valid texture
         let texels = data.len().div_ceil(texel_bytes).max(1);
-        let mut padded = data.to_vec();
-        padded.resize(texels * texel_bytes, 0);
+        // the data itself where it fills whole texels (no copy of a large buffer), else a
+        // padded copy
+        let padded: std::borrow::Cow<[u8]> = if data.len() == texels * texel_bytes {
+            data.into()
+        } else {
+            let mut v = data.to_vec();
+            v.resize(texels * texel_bytes, 0);
+            v.into()
+        };
         // SAFETY: a limit query on a current context.
         let max = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
         if texels as i64 > max || padded.len() > i32::MAX as usize {
