@@ -34,17 +34,21 @@
 // pruned by the closest hit so far (or the light). On llvmpipe a per-invocation stack array
 // costs several times more than these loads (docs/results/bvh_steps.md).
 //
-// One step per iteration: a node, or one triangle of the leaf the walk entered last (ours:
-// llvmpipe runs the 8 invocations of a SIMD group in lock step, so a leaf loop inside the node
-// loop kept the other lanes waiting while one tested its leaf; here a lane tests its triangles
-// while the others walk on). llvmpipe executes both sides of an `if` under a lane mask, so the
-// step loads its texels once, before it knows whether they are a node's or a triangle's, and
-// the outcome of the box test is chosen by selects. Since that step's triangle test costs every
-// lane, an iteration then takes a second, node-only step for the lanes still walking (a third
-// did not pay: docs/results/bvh_steps.md). Each node is visited at most once and each leaf
-// triangle tested at most once, and every iteration takes at least one step, so the loop is
-// bounded by their sum; a walk cut short (llvmpipe's loop limit, see loopLimit in
-// common/intersect.glsl) counts the ray as truncated.
+// Two loops in a loop (ours; "while-while", Aila and Laine 2009): the inner node loop walks
+// until the lane has entered a leaf or is done, the inner triangle loop then tests that
+// leaf's triangles, and the outer loop goes on while the walk does. llvmpipe runs the 8
+// invocations of a SIMD group in lock step and executes both sides of an `if` under a lane
+// mask, so each inner loop runs until its last lane leaves it, the others waiting: a lane that
+// entered a leaf waits for the group's other lanes to enter theirs. Until step 16 a single
+// loop whose every iteration took a node step or a triangle, then a second node step, paid
+// less (a lane tested its triangles while the others walked on); since a node step reads only
+// two texels (the octant's records), the node loop is a third of that iteration — Algorithm 1
+// and the triangle's third texel no longer paid in every step — and the waiting costs less
+// than it (docs/results/bvh_steps.md, step 17). The walk's order and counts are the same
+// either way. Each node is visited at most once and each leaf triangle tested at most once,
+// and every pass of either inner loop takes one of them, so the loops together are bounded by
+// their sum (`guard`); a walk cut short (that bound, or llvmpipe's loop limit, see loopLimit
+// in common/intersect.glsl) counts the ray as truncated.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
@@ -80,20 +84,18 @@ bool boxEntered(vec3 near, vec3 far, vec3 ro, vec3 inv, float tMin, float limit)
 }
 
 // One node step: the box test of the record at word `node` whose texels are t0 and t1, and
-// where the walk goes next — the near child (the next record) after an inner node entered, the
-// miss link after a node missed or a leaf entered, whose triangles are then the slots.
+// where the walk goes next — the near child (the next record) after an inner node entered,
+// the miss link after a node missed or a leaf entered, whose leaf reference then goes to
+// `leaf` (the triangles follow in the triangle loop).
 void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
-              inout int node, inout int slot, inout int slotEnd)
+              inout int node, inout int leaf)
 {
     nodesVisited++;
     bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv,
                               tMin, limit);
-    int leaf = -1 - int(t0.w); // s·32 + count in a leaf, −1 in an inner node
-    bool inner = leaf < 0;
-    int first = triangleBase + BVH_TRIANGLE_WORDS * (leaf >> BVH_LEAF_COUNT_BITS);
-    int count = leaf & ((1 << BVH_LEAF_COUNT_BITS) - 1);
-    slot = entered && !inner ? first : slot;
-    slotEnd = entered && !inner ? first + BVH_TRIANGLE_WORDS * count : slotEnd;
+    int reference = int(t0.w); // −1 − (s·32 + count) in a leaf, 0 in an inner node
+    bool inner = reference >= 0;
+    leaf = entered && !inner ? reference : leaf;
     node = entered && inner ? node + BVH_NODE_WORDS : int(t1.w);
 }
 
@@ -112,21 +114,24 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     // every node of the octant visited and every leaf triangle tested at most once; each takes
     // at least BVH_NODE_WORDS of the buffer's 4 words a texel
     int bound = 4 * imageSize(bvh) / BVH_NODE_WORDS + 1;
-    for (int guard = 0; guard < bound && (node >= 0 || slot < slotEnd); guard++) {
-        bool tri = slot < slotEnd;
-        int at = tri ? slot : node;
-        uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4), t2 = bvhTexel(at + 8);
-        if (tri) {
+    int guard = 0;
+    while (guard < bound && node >= 0) {
+        int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
+        while (guard < bound && node >= 0 && leaf == 0) {
+            guard++;
+            nodeStep(bvhTexel(node), bvhTexel(node + 4), ro, inv, tMin, limit, node, leaf);
+        }
+        int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
+        slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS) : 0;
+        int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
+        slotEnd = slot + BVH_TRIANGLE_WORDS * count;
+        while (guard < bound && slot < slotEnd) {
+            guard++;
+            uvec4 t0 = bvhTexel(slot), t1 = bvhTexel(slot + 4), t2 = bvhTexel(slot + 8);
             if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                             uintBitsToFloat(t2.xyz), limit))
                 return true;
             slot += BVH_TRIANGLE_WORDS;
-        } else {
-            nodeStep(t0, t1, ro, inv, tMin, limit, node, slot, slotEnd);
-        }
-        if (slot >= slotEnd && node >= 0) {
-            t0 = bvhTexel(node); t1 = bvhTexel(node + 4);
-            nodeStep(t0, t1, ro, inv, tMin, limit, node, slot, slotEnd);
         }
     }
     if (node >= 0 || slot < slotEnd) truncated = 1u;
