@@ -18,10 +18,9 @@
 //             the near child's miss link);
 //   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh.rs.) A node record and a triangle thus have their near planes / v0 in
-// texel 0 (the leaf reference / id in its w) and their far planes / edge1 in texel 1, and a
-// step reads either with the same loads (on llvmpipe: eight 128-bit loads, a transpose and a
-// bounds check each, where a 32-bit word costs a gather with its bounds check). Ours: the
+// host, src/accel/bvh.rs.) A node step reads two texels, a triangle three (on llvmpipe each
+// eight 128-bit loads, a transpose and a bounds check, where a 32-bit word costs a gather with
+// its bounds check). Ours: the
 // copies per octant (4× the memory of one 64-byte node with 8 links) save the third texel of
 // a node step (the links), the choice of the octant's link and near child, and the slab
 // test's choice of planes (docs/results/bvh_steps.md, step 16).
