@@ -27,7 +27,7 @@
 //
 // Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
 // and from a stack walk): stackless. Every inner node whose box the ray enters (at some
-// 0 <= t <= limit) is followed by its near child — the left one, on the low side of the split
+// tMin <= t <= limit) is followed by its near child — the left one, on the low side of the split
 // plane, unless the ray points down the split axis — and every box missed, or beyond the
 // limit, and every leaf done is followed by its miss link: a depth-first walk, near side first,
 // pruned by the closest hit so far (or the light). On llvmpipe a per-invocation stack array

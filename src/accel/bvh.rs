@@ -1,10 +1,10 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
 //! (`reference::bvh`, binned SAH, rayon) and uploaded into one image buffer of 32-bit words
-//! (a copy of the nodes for each ray octant, then the leaf triangles), traversed in the intersection kernels
-//! without a stack, near child first (`glsl/bvh/`). Objects
-//! move every frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model
-//! matrix changed since the last build, and not otherwise. Its image equals the base
-//! tracer's. CPU twin: `reference::bvh::Bvh`.
+//! (a copy of the nodes for each ray octant, then the leaf triangles), traversed in the
+//! intersection kernels without a stack, near child first (`glsl/bvh/`). Objects move every
+//! frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model matrix changed
+//! since the last build, and not otherwise. Its image equals the base tracer's. CPU twin:
+//! `reference::bvh::Bvh`.
 
 use std::any::Any;
 use std::sync::Arc;
@@ -83,7 +83,7 @@ pub struct Bvh {
     builds: u64,
     /// whether the last frame rebuilt
     rebuilt: bool,
-    /// the last build's world transform, leaf triangles and upload, ms
+    /// the last build's world transform, words (octant records, leaf triangles) and upload, ms
     upload_ms: f64,
 }
 
@@ -131,7 +131,7 @@ impl Bvh {
             old.delete(&self.gl);
         }
         self.stats = bvh.stats;
-        // the rest: the world transform, the leaf triangles and the upload
+        // the rest: the world transform, the words (octant records, leaf triangles), the upload
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
         self.built_for = Some(models.to_vec());
         self.builds += 1;

@@ -121,6 +121,10 @@ pub const NODE_WORDS: usize = 8;
 pub const TRIANGLE_WORDS: usize = 12;
 /// Bits of a leaf record's triangle count in its reference word ([`Bvh::gpu_words`]).
 pub const LEAF_COUNT_BITS: u32 = 5;
+const _: () = assert!(
+    MAX_LEAF < 1 << LEAF_COUNT_BITS,
+    "a leaf's count fits its bits"
+);
 
 impl Bvh {
     /// Build the hierarchy over `triangles` (triangle id = index).
@@ -149,8 +153,7 @@ impl Bvh {
     }
 
     /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) addressed
-    /// by word, so that a node and a leaf triangle are read by the same loads
-    /// (`glsl/bvh/traverse.glsl`):
+    /// by word and read as texels of 4 words (`glsl/bvh/traverse.glsl`):
     /// - [`HEADER_WORDS`]: the node count N, the word address of the first leaf triangle, 0, 0;
     /// - for each octant o = 0..8, from word `HEADER_WORDS + o·NODE_WORDS·N` on, the N nodes in
     ///   the depth-first order of that octant (the order of [`Bvh::links`]: the near child of
