@@ -20,10 +20,9 @@
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
 // host, src/accel/bvh.rs.) A node step reads two texels, a triangle three (on llvmpipe each
 // eight 128-bit loads, a transpose and a bounds check, where a 32-bit word costs a gather with
-// its bounds check). Ours: the
-// copies per octant (4× the memory of one 64-byte node with 8 links) save the third texel of
-// a node step (the links), the choice of the octant's link and near child, and the slab
-// test's choice of planes (docs/results/bvh_steps.md, step 16).
+// its bounds check). Ours: the copies per octant (4× the memory of one 64-byte node with 8
+// links) save the third texel of a node step (the links), the choice of the octant's link and
+// near child, and the slab test's choice of planes (docs/results/bvh_steps.md, step 16).
 //
 // Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
 // and from a stack walk): stackless. Every inner node whose box the ray enters (at some

@@ -36,7 +36,8 @@ use crate::reference::CpuAccelerator;
 use crate::scene::Scene;
 
 /// Pixels each invocation of `glsl/common/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
-/// a #define of `pipeline::raytrace::records`), for the accelerators whose kernels store per-pixel counts ([`Accelerator::records`]).
+/// a #define of `pipeline::raytrace::records`), for the accelerators whose kernels store
+/// per-pixel counts ([`Accelerator::records`]).
 pub const PIXELS_PER_INVOCATION: u32 = 16;
 /// The most events one pixel's walk may count (node visits, triangle tests) so that those sums
 /// fit in 32 bits: such an accelerator checks its structure against it.

@@ -86,8 +86,8 @@ slot_table! {
         WAGNER_HIT = 1,
         WAGNER_RAY = 2,
         WAGNER_NORMAL = 3,
-        /// the SAH BVH's texture buffer, read as an image buffer (glsl/bvh/traverse.glsl):
-        /// the nodes with their miss links, then the leaf triangles
+        /// the SAH BVH's texture buffer, read as an image buffer (glsl/bvh/words.glsl): the
+        /// node records of every ray octant, then the leaf triangles
         BVH = 8,
     }
 }

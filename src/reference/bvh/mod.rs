@@ -199,7 +199,7 @@ impl Bvh {
     /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`, whose first word has
     /// the word address `base`.
     fn octant_records(&self, o: usize, base: usize, out: &mut [u32]) {
-        let order = depth_first(&self.nodes, o);
+        let (order, _) = depth_first(&self.nodes, o);
         let mut record = vec![0u32; self.nodes.len()];
         for (i, &k) in order.iter().enumerate() {
             record[k as usize] = (base + NODE_WORDS * i) as u32;
@@ -305,49 +305,34 @@ fn miss_links(nodes: &[Node]) -> Vec<i32> {
     use rayon::prelude::*;
     let per_octant: Vec<Vec<i32>> = (0..OCTANTS)
         .into_par_iter()
-        .map(|octant| octant_links(nodes, octant))
+        .map(|octant| depth_first(nodes, octant).1)
         .collect();
     (0..OCTANTS * nodes.len())
         .map(|k| per_octant[k % OCTANTS][k / OCTANTS])
         .collect()
 }
 
-/// The nodes in the depth-first order of one octant: every node before its subtree, the near
-/// child's subtree before the far child's.
-fn depth_first(nodes: &[Node], octant: usize) -> Vec<u32> {
+/// The nodes in the depth-first order of one octant — every node before its subtree, the near
+/// child's subtree before the far child's — and every node's miss link in it (the node after
+/// its subtree; [`END`] after the last).
+fn depth_first(nodes: &[Node], octant: usize) -> (Vec<u32>, Vec<i32>) {
     let mut order = Vec::with_capacity(nodes.len());
-    let mut todo = vec![0u32];
-    while let Some(n) = todo.pop() {
-        order.push(n);
-        let node = &nodes[n as usize];
-        if !node.is_leaf() {
-            let down = ((octant >> node.axis()) & 1) as u32;
-            todo.push(node.first + 1 - down);
-            todo.push(node.first + down);
-        }
-    }
-    order
-}
-
-/// The miss link of every node in the depth-first order of one octant: the node after its
-/// subtree.
-fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
     let mut links = vec![END; nodes.len()];
     // (node, its miss link): the far child's miss link is its parent's, the near child's is
     // the far child
-    let mut todo = vec![(0usize, END)];
+    let mut todo = vec![(0u32, END)];
     while let Some((n, miss)) = todo.pop() {
-        links[n] = miss;
-        let node = &nodes[n];
+        order.push(n);
+        links[n as usize] = miss;
+        let node = &nodes[n as usize];
         if !node.is_leaf() {
-            let down = (octant >> node.axis()) & 1;
-            let near = node.first as usize + down;
-            let far = node.first as usize + 1 - down;
+            let down = ((octant >> node.axis()) & 1) as u32;
+            let (near, far) = (node.first + down, node.first + 1 - down);
             todo.push((far, miss));
             todo.push((near, far as i32));
         }
     }
-    links
+    (order, links)
 }
 
 impl CpuAccelerator for Bvh {
