@@ -48,6 +48,18 @@
 // their sum (`guard`); a walk cut short (that bound, or llvmpipe's loop limit, see loopLimit
 // in common/intersect.glsl) counts the ray as truncated.
 //
+// The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the
+// end of an iteration, and an `if` around a loop did not skip it, so a loop entered with no
+// lane left to run, or a `while` whose last lanes leave at its top, still executes one whole
+// pass under an empty mask. Counted per instruction (callgrind, bunny): the while loops ran
+// 20.5 node passes and 4.9 triangle passes per SIMD group where the group needs 17.9 and 2.3.
+// As do-whiles — entered where every active lane has work (the first step of a walk, of its
+// next leaf search), the triangle loop behind the lanes that entered a leaf — each loop's exit
+// test is its back edge, and what is left is one triangle pass per SIMD group (the last outer
+// pass, whose lanes all end their walk without a leaf) (docs/results/bvh_steps.md, step 18).
+// The first passes need no test: a walk starts at its octant's root (node >= 0, guard = 0 <
+// bound), and the outer loop goes on only with node >= 0 and guard < bound.
+//
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
 
@@ -97,6 +109,23 @@ void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
     node = entered && inner ? node + BVH_NODE_WORDS : int(t1.w);
 }
 
+// The triangle loop: the entered leaf's triangles at words slot, slot + BVH_TRIANGLE_WORDS, ...
+// below slotEnd, one per pass (a do-while, entered only by lanes with a triangle to test);
+// true if triangleHit ended the walk.
+bool leafTriangles(inout int slot, int slotEnd, inout int guard, int bound, inout float limit)
+{
+    if (guard >= bound || slot >= slotEnd) return false;
+    do {
+        guard++;
+        uvec4 t0 = bvhTexel(slot), t1 = bvhTexel(slot + 4), t2 = bvhTexel(slot + 8);
+        if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
+                        uintBitsToFloat(t2.xyz), limit))
+            return true;
+        slot += BVH_TRIANGLE_WORDS;
+    } while (guard < bound && slot < slotEnd);
+    return false;
+}
+
 // The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it.
 bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
 {
@@ -113,25 +142,25 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     // at least BVH_NODE_WORDS of the buffer's 4 words a texel
     int bound = 4 * imageSize(bvh) / BVH_NODE_WORDS + 1;
     int guard = 0;
-    while (guard < bound && node >= 0) {
-        int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
-        while (guard < bound && node >= 0 && leaf == 0) {
-            guard++;
-            nodeStep(bvhTexel(node), bvhTexel(node + 4), ro, inv, tMin, limit, node, leaf);
+    do {
+        // The outer loop's own test, again (it holds in every pass a lane takes): without it
+        // llvmpipe changed the state of lanes that had left the loop at the end of an earlier
+        // pass while other lanes went on — a lane whose walk ended at the leaf it entered
+        // (miss link END) was left with untested triangles (tests/edge_cases.rs, the tie scene).
+        if (guard < bound && node >= 0) {
+            int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
+            do {
+                guard++;
+                nodeStep(bvhTexel(node), bvhTexel(node + 4), ro, inv, tMin, limit, node, leaf);
+            } while (guard < bound && node >= 0 && leaf == 0);
+            int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
+            slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS)
+                            : 0;
+            int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
+            slotEnd = slot + BVH_TRIANGLE_WORDS * count;
+            if (leafTriangles(slot, slotEnd, guard, bound, limit)) return true;
         }
-        int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
-        slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS) : 0;
-        int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
-        slotEnd = slot + BVH_TRIANGLE_WORDS * count;
-        while (guard < bound && slot < slotEnd) {
-            guard++;
-            uvec4 t0 = bvhTexel(slot), t1 = bvhTexel(slot + 4), t2 = bvhTexel(slot + 8);
-            if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
-                            uintBitsToFloat(t2.xyz), limit))
-                return true;
-            slot += BVH_TRIANGLE_WORDS;
-        }
-    }
+    } while (guard < bound && node >= 0);
     if (node >= 0 || slot < slotEnd) truncated = 1u;
     return false;
 }
