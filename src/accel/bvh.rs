@@ -55,12 +55,29 @@ fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     )
 }
 
+/// Bits of a texel index of the word buffer: its 16-byte texels number fewer than 2^27, as
+/// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more. `glsl/bvh/words.glsl` masks the
+/// index to them (no valid index changes), which lets llvmpipe's LLVM see that it is not
+/// negative (`docs/results/bvh_steps.md`, step 19).
+const TEXEL_INDEX_BITS: u32 = 27;
+
+/// `BVH_TEXEL_INDEX_MASK` ([`TEXEL_INDEX_BITS`]) for every kernel that reads the word buffer
+/// (`glsl/bvh/words.glsl`): the BVH's own, and `evaluate_hit` (`glsl/bvh/hit_record.glsl`).
+pub fn texel_index_mask() -> (&'static str, String) {
+    (
+        "BVH_TEXEL_INDEX_MASK",
+        format!("{:#x}u", (1u32 << TEXEL_INDEX_BITS) - 1),
+    )
+}
+
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
-/// [`TRIANGLE_WORDS`]) and leaf references ([`LEAF_COUNT_BITS`]), and they store hit records
-/// and per-pixel counts (`Accelerator::records`).
-fn kernel_defines() -> [(&'static str, String); 6] {
+/// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]) and texel indices
+/// ([`TEXEL_INDEX_BITS`]), and they store hit records and per-pixel counts
+/// (`Accelerator::records`).
+fn kernel_defines() -> [(&'static str, String); 7] {
     [
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
+        texel_index_mask(),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
         ("BVH_LEAF_COUNT_BITS", LEAF_COUNT_BITS.to_string()),
         ("BVH_TRIANGLE_WORDS", TRIANGLE_WORDS.to_string()),

@@ -42,10 +42,12 @@ impl Records {
     ) -> Result<Records> {
         let pixels = (w as usize) * (h as usize);
         let max = info.max_ssbo_block_size;
+        let (mask, mask_value) = crate::accel::bvh::texel_index_mask();
         let defines = defines
             .clone()
             .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
-            .set("COUNT_GROUP", COUNT_GROUP);
+            .set("COUNT_GROUP", COUNT_GROUP)
+            .set(mask, mask_value);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
             // a uvec4 per pixel: two words of counts, the hit record (records.glsl)
