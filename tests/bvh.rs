@@ -98,7 +98,8 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
 /// The GPU walk visits exactly the nodes its CPU twin visits, ray by ray summed over the frame,
 /// and every pixel's counts reach the statistics (`glsl/common/pixel_counts.comp`): the primary
 /// rays' node visits equal the twin's over the very same rays (the AOVs), and every pixel traced
-/// one primary ray. Odd image sides leave a partial last block of `pixel_counts.comp`.
+/// one primary ray, and so do the shadow feelers from their first hits (those that found an
+/// occluder included). Odd image sides leave a partial last block of `pixel_counts.comp`.
 #[test]
 fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
@@ -125,4 +126,52 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     assert_eq!(primary.count("intersect1"), tests, "triangle tests");
     assert_eq!(primary.count("nodes_visited"), nodes, "nodes visited");
     assert!(nodes > (w * h) as u64, "{nodes} nodes");
+    // the shadow feelers from the same first hits (Listing 15, as intersect2_main.glsl sets
+    // them up): the same nodes, those of a feeler that found an occluder included
+    let light = scene.lights[0].position;
+    let offset = scene.settings.shadow_offset;
+    let (mut feelers, mut blocked, mut nodes, mut tests) = (0u64, 0u64, 0u64, 0u64);
+    for (i, (o, d)) in aovs.ray_origin.iter().zip(&aovs.ray_direction).enumerate() {
+        let Ok(last) = usize::try_from(aovs.triangle_id[i]) else {
+            continue;
+        };
+        let p = Vec3::from(*o) + aovs.hit_t[i] * Vec3::from(*d);
+        let to_light = light - p;
+        let dist = to_light.length();
+        let rd = to_light / dist;
+        if Vec3::from(aovs.normal[i]).dot(rd) <= 0.0 {
+            continue;
+        }
+        feelers += 1;
+        let feeler = gpgpu_rt::reference::Feeler {
+            ro: p,
+            rd,
+            light_distance: dist,
+            offset,
+            last: last as i32,
+        };
+        let mut hit = false;
+        nodes += twin.traverse(p, rd, offset, dist, |ids| {
+            let ids = ids.iter().map(|&i| i as usize);
+            hit = feeler.blocked_among(twin.triangles(), ids, &mut tests);
+            if hit {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(dist)
+            }
+        });
+        blocked += hit as u64;
+    }
+    let shadow = &frame.stats.ray_kinds["shadow_first_light"];
+    assert_eq!(shadow.count("rays"), feelers, "feelers traced");
+    assert!(
+        blocked > 0 && blocked < feelers,
+        "{blocked} of {feelers} feelers blocked"
+    );
+    assert_eq!(shadow.count("intersect2"), tests, "feelers' triangle tests");
+    assert_eq!(
+        shadow.count("nodes_visited"),
+        nodes,
+        "feelers' nodes visited"
+    );
 }

@@ -43,10 +43,11 @@
 // two texels (the octant's records), the node loop is a third of that iteration — Algorithm 1
 // and the triangle's third texel no longer paid in every step — and the waiting costs less
 // than it (docs/results/bvh_steps.md, step 17). The walk's order and counts are the same
-// either way. Each node is visited at most once and each leaf triangle tested at most once,
-// and every pass of either inner loop takes one of them, so the loops together are bounded by
-// their sum (`guard`); a walk cut short (that bound, or llvmpipe's loop limit, see loopLimit
-// in common/intersect.glsl) counts the ray as truncated.
+// either way. Each node is visited at most once, so the node steps are bounded by the records
+// (`guard`, which also counts the nodes visited: no counter in the node loop), the triangle
+// loop by its leaf's count (below 2^BVH_LEAF_COUNT_BITS), and the outer loop by the node steps,
+// as each of its passes takes one; a walk cut short (that bound, or llvmpipe's loop limit, see
+// loopLimit in common/intersect.glsl) counts the ray as truncated.
 //
 // The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the
 // end of an iteration, and an `if` around a loop did not skip it, so a loop entered with no
@@ -100,7 +101,6 @@ bool boxEntered(vec3 near, vec3 far, vec3 ro, vec3 inv, float tMin, float limit)
 void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
               inout int node, inout int leaf)
 {
-    nodesVisited++;
     bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv,
                               tMin, limit);
     int reference = int(t0.w); // −1 − (s·32 + count) in a leaf, 0 in an inner node
@@ -110,19 +110,18 @@ void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
 }
 
 // The triangle loop: the entered leaf's triangles at words slot, slot + BVH_TRIANGLE_WORDS, ...
-// below slotEnd, one per pass (a do-while, entered only by lanes with a triangle to test);
-// true if triangleHit ended the walk.
-bool leafTriangles(inout int slot, int slotEnd, inout int guard, int bound, inout float limit)
+// below slotEnd, one per pass (a do-while, entered only by lanes with a triangle to test; at
+// most a leaf's count of passes); true if triangleHit ended the walk.
+bool leafTriangles(inout int slot, int slotEnd, inout float limit)
 {
-    if (guard >= bound || slot >= slotEnd) return false;
+    if (slot >= slotEnd) return false;
     do {
-        guard++;
         uvec4 t0 = bvhTexel(slot), t1 = bvhTexel(slot + 4), t2 = bvhTexel(slot + 8);
         if (triangleHit(slot, int(t0.w), uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                         uintBitsToFloat(t2.xyz), limit))
             return true;
         slot += BVH_TRIANGLE_WORDS;
-    } while (guard < bound && slot < slotEnd);
+    } while (slot < slotEnd);
     return false;
 }
 
@@ -138,8 +137,8 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
     // below slotEnd
     int slot = 0, slotEnd = 0;
-    // every node of the octant visited and every leaf triangle tested at most once; each takes
-    // at least BVH_NODE_WORDS of the buffer's 4 words a texel
+    // every node of the octant visited at most once, and each takes BVH_NODE_WORDS of the
+    // buffer's 4 words a texel; guard: the node steps so far (the nodes visited)
     int bound = 4 * imageSize(bvh) / BVH_NODE_WORDS + 1;
     int guard = 0;
     do {
@@ -158,9 +157,13 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
                             : 0;
             int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
             slotEnd = slot + BVH_TRIANGLE_WORDS * count;
-            if (leafTriangles(slot, slotEnd, guard, bound, limit)) return true;
+            if (leafTriangles(slot, slotEnd, limit)) {
+                nodesVisited += uint(guard);
+                return true;
+            }
         }
     } while (guard < bound && node >= 0);
+    nodesVisited += uint(guard);
     if (node >= 0 || slot < slotEnd) truncated = 1u;
     return false;
 }
