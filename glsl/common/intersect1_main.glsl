@@ -11,10 +11,37 @@
 // common/evaluate_hit.comp evaluates it.
 #include "intersect1_hit.glsl"
 
+// Latency hiding on llvmpipe (ours; PREFETCH_RAYS, set by the host where GL_RENDERER names
+// llvmpipe): each invocation also loads the ray texels of its place in the next work group, 8
+// pixels on in x — the group the same llvmpipe thread runs next (its share of a dispatch is a
+// contiguous run of work groups, row by row) — so that they are in the core's caches when that
+// group starts. The first use of an invocation's own ray texels was the kernel's one hot spot
+// outside the walk (15 % of the BVH intersect1's samples, bunny), as a SIMD group's walk waits
+// for its ray; with the loads, the BVH intersect1 took 0.93 of the time (paired alternating
+// renders; two work groups ahead: 1.12; in intersect2, or for the pixel records, no gain)
+// (docs/results/bvh_steps.md, step 21). Their values are folded into `truncated` through
+// prefetchZero, a uniform the host never sets (GL makes it 0 at link time), so that the
+// compiler must keep the loads and nothing changes. Out of the image, imageLoad reads zeros.
+#if PREFETCH_RAYS
+uniform uint prefetchZero;
+#endif
+uint prefetchNextGroup(ivec2 storePos)
+{
+#if PREFETCH_RAYS
+    ivec2 next = storePos + ivec2(8, 0); // gl_WorkGroupSize.x (common/intersect_head.glsl)
+    uint o = floatBitsToUint(imageLoad(rayOriginTexture, next).w);
+    uint d = floatBitsToUint(imageLoad(rayDirTexture, next).w);
+    return (o ^ d) & prefetchZero;
+#else
+    return 0u;
+#endif
+}
+
 void trace(ivec2 storePos)
 {
     vec4 originState = imageLoad(rayOriginTexture, storePos);
     vec4 dirTri = imageLoad(rayDirTexture, storePos);
+    truncated |= prefetchNextGroup(storePos);
     float rayState = originState.w;
     if (rayState <= 0.0) {
 #if !HIT_RECORDS

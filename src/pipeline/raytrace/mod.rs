@@ -97,9 +97,11 @@ pub const COUNTERS: &[&str] = &[
 /// The counters that count ray–triangle tests (the rest count events).
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
-/// `#define`s every kernel gets: counter slots and the shadow-flag layout.
-pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
+/// `#define`s every kernel gets: counter slots, the shadow-flag layout, and on llvmpipe the
+/// loads of the next work group's rays (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
+pub fn kernel_defines(scene: &Scene, options: &RenderOptions, info: &GlInfo) -> Defines {
     let mut d = Defines::new()
+        .set("PREFETCH_RAYS", info.renderer.contains("llvmpipe") as i32)
         .set(
             "SHADOW_BITS",
             (options.shadow_flags == ShadowFlags::Bits) as i32,
@@ -206,7 +208,7 @@ impl RayTracer {
         let pixels = check_options(info, scene, &options)?;
         let entry = accel::entry(options.tracer, &options.grid)?;
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
-        let defines = kernel_defines(scene, &options);
+        let defines = kernel_defines(scene, &options, info);
         let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
         let kernels = Kernels {
             eye_ray_generation: compute(
