@@ -3,6 +3,9 @@
 // by an ordered traversal of the CPU-built BVH (bvh/traverse.glsl). Deviations: see there;
 // equal distances go to the lower triangle id, as in the base tracer's loop, so the image
 // equals the base tracer's. Listings 13, 14 of Müller 2015: common/intersect1_main.glsl.
+#if RECORD_STORE_64
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
 

@@ -4,6 +4,9 @@
 // pruned) and tests the triangles of each leaf until the first occluder (any hit).
 // Deviations: see traverse.glsl; any number of lights.
 // Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
+#if RECORD_STORE_64
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
 

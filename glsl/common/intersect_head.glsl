@@ -47,10 +47,16 @@ void traceAndCount(int testsSlot)
         int at = pixelIndex(storePos);
 #if HIT_RECORDS
         // (a constant condition: one of the two stores is compiled)
-        if (testsSlot == COUNTER_INTERSECT1)
+        if (testsSlot == COUNTER_INTERSECT1) {
+#if RECORD_STORE_64
+            uint64_t record = uint64_t(uint(closestHitRecord));
+            pixelRecordWords[at] = u64vec2(packUint2x32(counts), record);
+#else
             pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
-        else
+#endif
+        } else {
             pixelRecord[at].xy = counts;
+        }
 #else
         pixelRecord[at].xy = counts;
 #endif

@@ -19,7 +19,7 @@ use super::{
 use crate::frame::FrameStats;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
-use crate::gl::{Gl, Kernel};
+use crate::gl::{Gl, GlInfo, Kernel};
 use crate::reference::bvh::{
     Bvh as CpuBvh, BvhStats, HEADER_WORDS, LEAF_COUNT_BITS, NODE_WORDS, TRIANGLE_WORDS,
 };
@@ -73,9 +73,11 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]) and texel indices
 /// ([`TEXEL_INDEX_BITS`]), and they store hit records and per-pixel counts
-/// (`Accelerator::records`).
-fn kernel_defines() -> [(&'static str, String); 7] {
+/// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
+/// 64-bit integers (`RECORD_STORE_64`).
+fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 8] {
     [
+        ("RECORD_STORE_64", (info.int64 as i32).to_string()),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
         texel_index_mask(),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
@@ -106,7 +108,7 @@ pub struct Bvh {
 
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        let defs = kernel_defines();
+        let defs = kernel_defines(b.info);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,

@@ -38,6 +38,9 @@ pub struct GlInfo {
     pub max_image_units: i32,
     pub max_array_texture_layers: i32,
     pub timer_query_bits: i32,
+    /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH stores a pixel's
+    /// record in one store of two 64-bit words, `glsl/common/intersect_head.glsl`).
+    pub int64: bool,
 }
 
 /// A current GL context. Dropping it releases the context.
@@ -188,6 +191,9 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
             max_image_units: int(glow::MAX_IMAGE_UNITS),
             max_array_texture_layers: int(glow::MAX_ARRAY_TEXTURE_LAYERS),
             timer_query_bits: timer_bits,
+            int64: gl
+                .supported_extensions()
+                .contains("GL_ARB_gpu_shader_int64"),
         }
     }
 }

@@ -114,7 +114,8 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions, info: &GlInfo) -> 
         .set("IMAGE_WIDTH", options.width)
         .set("IMAGE_HEIGHT", options.height)
         .set("HIT_RECORDS", 0)
-        .set("PIXEL_COUNTS", 0);
+        .set("PIXEL_COUNTS", 0)
+        .set("RECORD_STORE_64", 0);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
