@@ -55,7 +55,11 @@ void traceAndCount(int testsSlot)
             pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
 #endif
         } else {
+#if RECORD_STORE_64
+            pixelRecordWords[at].x = packUint2x32(counts);
+#else
             pixelRecord[at].xy = counts;
+#endif
         }
 #else
         pixelRecord[at].xy = counts;
