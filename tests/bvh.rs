@@ -1,6 +1,8 @@
 //! The SAH BVH (`--tracer bvh`, ours after Wagner 2018 ch. 3.2, 4.2): its image equals the base
 //! tracer's on the teapot and the bunny, with far fewer triangle tests; a moved object is
-//! rebuilt (and an unmoved scene is not) and still gives the base tracer's image. The builder's
+//! rebuilt (and an unmoved scene is not) and still gives the base tracer's image; the walks
+//! visit the twin's nodes; the kernels' paths for GL implementations without 64-bit integers or
+//! llvmpipe give the same frame. The builder's
 //! invariants are unit tests in `src/reference/bvh.rs`; the GPU against its CPU twin (test
 //! counts included) is in `tests/accel.rs`.
 
@@ -174,4 +176,35 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
         nodes,
         "feelers' nodes visited"
     );
+}
+
+/// The paths for other GL implementations: without `GL_ARB_gpu_shader_int64` the records are
+/// stored as 32-bit words, and off llvmpipe `intersect1` loads no rays ahead
+/// (`RECORD_STORE_64`, `PREFETCH_RAYS`) — the same ids, colours and counts as the paths this
+/// machine takes, where the suite would otherwise never compile them.
+#[test]
+fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let opts = bvh_options(47, 33, 1);
+    let mut other = ctx.info.clone();
+    other.int64 = false;
+    other.renderer = "another GL implementation".into();
+    let shaders = gpgpu_rt::gl::ShaderSource::default();
+    let mut tracer =
+        gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &other, &scene, &shaders, opts.clone())
+            .expect("a tracer");
+    let plain = tracer.render(&scene.camera).expect("frame");
+    let this = render_gpu(&ctx, &scene, opts);
+    assert_eq!(
+        plain.aovs.as_ref().unwrap().triangle_id,
+        this.aovs.as_ref().unwrap().triangle_id
+    );
+    assert_eq!(plain.color, this.color);
+    for kind in ["primary", "reflection", "shadow_first_light"] {
+        let (a, b) = (&plain.stats.ray_kinds[kind], &this.stats.ray_kinds[kind]);
+        for name in ["rays", "nodes_visited", "intersect1", "intersect2"] {
+            assert_eq!(a.count(name), b.count(name), "{kind}: {name}");
+        }
+    }
 }
