@@ -164,6 +164,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
         }
     } while (guard < bound && node >= 0);
     nodesVisited += uint(guard);
+    // (slot < slotEnd: llvmpipe's loop limit can still cut a triangle loop short)
     if (node >= 0 || slot < slotEnd) truncated = 1u;
     return false;
 }

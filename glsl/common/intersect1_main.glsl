@@ -11,13 +11,14 @@
 // common/evaluate_hit.comp evaluates it.
 #include "intersect1_hit.glsl"
 
-// Latency hiding on llvmpipe (ours; PREFETCH_RAYS, set by the host where GL_RENDERER names
-// llvmpipe): each invocation also loads the ray texels of its place in the next work group, 8
+// Latency hiding on llvmpipe (ours; PREFETCH_RAYS, set by the host for the SAH BVH's intersect1
+// where GL_RENDERER names llvmpipe — the grids' intersect1 keep the thesis' loads): each
+// invocation also loads the ray texels of its place in the next work group, 8
 // pixels on in x — the group the same llvmpipe thread runs next (its share of a dispatch is a
 // contiguous run of work groups, row by row) — so that they are in the core's caches when that
 // group starts. The first use of an invocation's own ray texels was the kernel's one hot spot
-// outside the walk (15 % of the BVH intersect1's samples, bunny), as a SIMD group's walk waits
-// for its ray; with the loads, the BVH intersect1 took 0.93 of the time (paired alternating
+// outside the walk (15 % of the BVH intersect1's samples, bunny), where a SIMD group's walk
+// waits for its ray; with the loads, the BVH intersect1 took 0.93 of the time (paired alternating
 // renders; two work groups ahead: 1.12; in intersect2, or for the pixel records, no gain)
 // (docs/results/bvh_steps.md, step 21). Their values are folded into `truncated` through
 // prefetchZero, a uniform the host never sets (GL makes it 0 at link time), so that the

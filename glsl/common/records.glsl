@@ -23,10 +23,13 @@ layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordBuffer { uvec4 pi
 #if RECORD_STORE_64
 // The same records as two 64-bit words (GL_ARB_gpu_shader_int64, which the including kernel
 // enables): the counts' two words and the hit record's (its high half 0), for the stores of
-// intersect_head.glsl (intersect1: both, one store of two components; intersect2: the counts) — on llvmpipe a store costs a loop over the 8 lanes per
-// component, and the BVH's intersect1 took 0.95 of the time with two components instead of
-// three (docs/results/bvh_steps.md, step 22).
-layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordWords { u64vec2 pixelRecordWords[]; };
+// intersect_head.glsl (intersect1: both, one store of two components; intersect2: the
+// counts) — on llvmpipe a store costs a loop over the 8 lanes per component, and the BVH's
+// intersect1 took 0.95 of the time with two components instead of three
+// (docs/results/bvh_steps.md, step 22).
+layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordWords {
+    u64vec2 pixelRecordWords[];
+};
 #endif
 
 // A pixel's counts in two words, as each stored component costs a loop over the 8 lanes on

@@ -74,10 +74,15 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]) and texel indices
 /// ([`TEXEL_INDEX_BITS`]), and they store hit records and per-pixel counts
 /// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
-/// 64-bit integers (`RECORD_STORE_64`).
-fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 8] {
+/// 64-bit integers (`RECORD_STORE_64`); on llvmpipe intersect1 loads the next work group's rays
+/// ahead (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
+fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 9] {
     [
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
+        (
+            "PREFETCH_RAYS",
+            (info.renderer.contains("llvmpipe") as i32).to_string(),
+        ),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
         texel_index_mask(),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),

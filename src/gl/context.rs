@@ -38,8 +38,9 @@ pub struct GlInfo {
     pub max_image_units: i32,
     pub max_array_texture_layers: i32,
     pub timer_query_bits: i32,
-    /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH stores a pixel's
-    /// record in one store of two 64-bit words, `glsl/common/intersect_head.glsl`).
+    /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH's intersect1 stores
+    /// a pixel's record as two 64-bit words in one store, its intersect2 the counts as one
+    /// word: `glsl/common/intersect_head.glsl`).
     pub int64: bool,
 }
 

@@ -97,11 +97,11 @@ pub const COUNTERS: &[&str] = &[
 /// The counters that count ray–triangle tests (the rest count events).
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
-/// `#define`s every kernel gets: counter slots, the shadow-flag layout, and on llvmpipe the
-/// loads of the next work group's rays (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
-pub fn kernel_defines(scene: &Scene, options: &RenderOptions, info: &GlInfo) -> Defines {
+/// `#define`s every kernel gets: counter slots and the shadow-flag layout; the SAH BVH's kernels
+/// override the last three (`accel::bvh`: hit records, 64-bit record stores, the next work
+/// group's rays loaded ahead on llvmpipe).
+pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
     let mut d = Defines::new()
-        .set("PREFETCH_RAYS", info.renderer.contains("llvmpipe") as i32)
         .set(
             "SHADOW_BITS",
             (options.shadow_flags == ShadowFlags::Bits) as i32,
@@ -115,7 +115,8 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions, info: &GlInfo) -> 
         .set("IMAGE_HEIGHT", options.height)
         .set("HIT_RECORDS", 0)
         .set("PIXEL_COUNTS", 0)
-        .set("RECORD_STORE_64", 0);
+        .set("RECORD_STORE_64", 0)
+        .set("PREFETCH_RAYS", 0);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -209,7 +210,7 @@ impl RayTracer {
         let pixels = check_options(info, scene, &options)?;
         let entry = accel::entry(options.tracer, &options.grid)?;
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
-        let defines = kernel_defines(scene, &options, info);
+        let defines = kernel_defines(scene, &options);
         let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
         let kernels = Kernels {
             eye_ray_generation: compute(
