@@ -105,7 +105,7 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
 #[test]
 fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
-    use gpgpu_rt::reference::closest_among;
+    use gpgpu_rt::reference::{closest_among, Feeler};
     use std::ops::ControlFlow;
     let ctx = context();
     let scene = load("bunny.toml");
@@ -138,31 +138,15 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
             continue;
         };
         let p = Vec3::from(*o) + aovs.hit_t[i] * Vec3::from(*d);
-        let to_light = light - p;
-        let dist = to_light.length();
-        let rd = to_light / dist;
-        if Vec3::from(aovs.normal[i]).dot(rd) <= 0.0 {
+        let n = Vec3::from(aovs.normal[i]);
+        let Some(feeler) = Feeler::towards(p, n, last as i32, light, offset) else {
             continue;
-        }
-        feelers += 1;
-        let feeler = gpgpu_rt::reference::Feeler {
-            ro: p,
-            rd,
-            light_distance: dist,
-            offset,
-            last: last as i32,
         };
-        let mut hit = false;
-        nodes += twin.traverse(p, rd, offset, dist, |ids| {
-            let ids = ids.iter().map(|&i| i as usize);
-            hit = feeler.blocked_among(twin.triangles(), ids, &mut tests);
-            if hit {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(dist)
-            }
-        });
+        feelers += 1;
+        let (hit, feeler_tests, feeler_nodes) = twin.feeler_walk(&feeler);
         blocked += hit as u64;
+        tests += feeler_tests;
+        nodes += feeler_nodes;
     }
     let shadow = &frame.stats.ray_kinds["shadow_first_light"];
     assert_eq!(shadow.count("rays"), feelers, "feelers traced");

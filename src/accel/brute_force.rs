@@ -37,7 +37,7 @@ pub const TRIANGLES_PER_DISPATCH: u32 = 60_000;
 /// The triangles one dispatch tests on this GL implementation: [`TRIANGLES_PER_DISPATCH`] on
 /// Mesa's llvmpipe (GL_RENDERER names it), else all of them (`u32::MAX`).
 pub fn triangles_per_dispatch(info: &GlInfo) -> u32 {
-    if info.renderer.contains("llvmpipe") {
+    if info.is_llvmpipe() {
         TRIANGLES_PER_DISPATCH
     } else {
         u32::MAX

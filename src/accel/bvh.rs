@@ -79,10 +79,7 @@ pub fn texel_index_mask() -> (&'static str, String) {
 fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 9] {
     [
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
-        (
-            "PREFETCH_RAYS",
-            (info.renderer.contains("llvmpipe") as i32).to_string(),
-        ),
+        ("PREFETCH_RAYS", (info.is_llvmpipe() as i32).to_string()),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
         texel_index_mask(),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),

@@ -44,6 +44,14 @@ pub struct GlInfo {
     pub int64: bool,
 }
 
+impl GlInfo {
+    /// Whether this is Mesa's llvmpipe (GL_RENDERER names it): the CPU rasteriser whose loop
+    /// limit and code generation some kernels adapt to.
+    pub fn is_llvmpipe(&self) -> bool {
+        self.renderer.contains("llvmpipe")
+    }
+}
+
 /// A current GL context. Dropping it releases the context.
 pub struct GlContext {
     pub gl: Arc<Gl>,

@@ -55,6 +55,22 @@ pub struct Feeler {
 }
 
 impl Feeler {
+    /// The feeler of Listing 15 from the hit point `p` (normal `n`, triangle `last`) towards a
+    /// point light, as `common/intersect2_main.glsl` sets it up; `None` where the light is in
+    /// the back half-space of the hit point (shadow without a test).
+    pub fn towards(p: Vec3, n: Vec3, last: i32, light: Vec3, offset: f32) -> Option<Feeler> {
+        let to_light = light - p;
+        let dist = to_light.length();
+        let rd = to_light / dist;
+        (n.dot(rd) > 0.0).then_some(Feeler {
+            ro: p,
+            rd,
+            light_distance: dist,
+            offset,
+            last,
+        })
+    }
+
     /// Whether one of the triangles `ids` (in order, `last` skipped) blocks the feeler,
     /// stopping at the first that does; every test made is added to `tests`.
     pub fn blocked_among(
@@ -208,20 +224,13 @@ impl Reference {
     /// The shadow feeler of Listing 15: (in shadow, tests, whether it was traced — not when
     /// the light is behind the surface).
     fn shadowed(&self, p: Vec3, n: Vec3, last: usize, light: Vec3) -> (bool, u64, bool) {
-        let to_light = light - p;
-        let dist = to_light.length();
-        let rd = to_light / dist;
-        if n.dot(rd) <= 0.0 {
-            return (true, 0, false);
+        match Feeler::towards(p, n, last as i32, light, self.shadow_offset) {
+            None => (true, 0, false),
+            Some(feeler) => {
+                let (shadow, tests) = self.accel.occluded(&feeler);
+                (shadow, tests, true)
+            }
         }
-        let (shadow, tests) = self.accel.occluded(&Feeler {
-            ro: p,
-            rd,
-            light_distance: dist,
-            offset: self.shadow_offset,
-            last: last as i32,
-        });
-        (shadow, tests, true)
     }
 
     /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.

@@ -83,6 +83,12 @@ impl Node {
     pub fn axis(&self) -> usize {
         (-1 - self.meta).clamp(0, 2) as usize
     }
+
+    /// An inner node's near child for rays of `octant` (bit a set: the ray points down axis
+    /// a): the left one, on the low side of the split, unless the ray points down the axis.
+    pub fn near_child(&self, octant: usize) -> u32 {
+        self.first + ((octant >> self.axis()) & 1) as u32
+    }
 }
 
 /// The facts of a build, for the statistics.
@@ -199,7 +205,18 @@ impl Bvh {
     /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`, whose first word has
     /// the word address `base`.
     fn octant_records(&self, o: usize, base: usize, out: &mut [u32]) {
-        let (order, _) = depth_first(&self.nodes, o);
+        // the octant's depth-first order, from its miss links: after an inner node its near
+        // child, after a leaf (a subtree of one) its miss link
+        let mut order = Vec::with_capacity(self.nodes.len());
+        let mut k = 0i32;
+        while k != END {
+            order.push(k as u32);
+            let node = &self.nodes[k as usize];
+            k = match node.is_leaf() {
+                true => self.links[OCTANTS * k as usize + o],
+                false => node.near_child(o) as i32,
+            };
+        }
         let mut record = vec![0u32; self.nodes.len()];
         for (i, &k) in order.iter().enumerate() {
             record[k as usize] = (base + NODE_WORDS * i) as u32;
@@ -224,6 +241,24 @@ impl Bvh {
                 l => record[l as usize],
             };
         }
+    }
+
+    /// The shadow feeler's walk, as intersect2's: whether it is blocked, its triangle tests and
+    /// its nodes visited. No hit before the offset counts, so neither do the boxes the feeler
+    /// leaves before it.
+    pub fn feeler_walk(&self, feeler: &Feeler) -> (bool, u64, u64) {
+        let (mut blocked, mut tests) = (false, 0);
+        let (ro, rd) = (feeler.ro, feeler.rd);
+        let nodes = self.traverse(ro, rd, feeler.offset, feeler.light_distance, |ids| {
+            let ids = ids.iter().map(|&i| i as usize);
+            blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
+            if blocked {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(feeler.light_distance)
+            }
+        });
+        (blocked, tests, nodes)
     }
 
     /// The triangles it was built over.
@@ -251,6 +286,8 @@ impl Bvh {
             if self.enter(node as usize, ro, inv, t_min, limit) {
                 if !n.is_leaf() {
                     // the near child first: the right one when the ray points down the axis
+                    // (from the ray itself, not Node::near_child, which lays out the records
+                    // the kernels walk: the twin checks it)
                     node = n.first as i32 + (inv[n.axis()] < 0.0) as i32;
                     continue;
                 }
@@ -305,34 +342,32 @@ fn miss_links(nodes: &[Node]) -> Vec<i32> {
     use rayon::prelude::*;
     let per_octant: Vec<Vec<i32>> = (0..OCTANTS)
         .into_par_iter()
-        .map(|octant| depth_first(nodes, octant).1)
+        .map(|octant| octant_links(nodes, octant))
         .collect();
     (0..OCTANTS * nodes.len())
         .map(|k| per_octant[k % OCTANTS][k / OCTANTS])
         .collect()
 }
 
-/// The nodes in the depth-first order of one octant — every node before its subtree, the near
-/// child's subtree before the far child's — and every node's miss link in it (the node after
-/// its subtree; [`END`] after the last).
-fn depth_first(nodes: &[Node], octant: usize) -> (Vec<u32>, Vec<i32>) {
-    let mut order = Vec::with_capacity(nodes.len());
+/// Every node's miss link in the depth-first order of one octant — every node before its
+/// subtree, the near child's subtree before the far child's: the node after its subtree
+/// ([`END`] after the last).
+fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
     let mut links = vec![END; nodes.len()];
     // (node, its miss link): the far child's miss link is its parent's, the near child's is
     // the far child
     let mut todo = vec![(0u32, END)];
     while let Some((n, miss)) = todo.pop() {
-        order.push(n);
         links[n as usize] = miss;
         let node = &nodes[n as usize];
         if !node.is_leaf() {
-            let down = ((octant >> node.axis()) & 1) as u32;
-            let (near, far) = (node.first + down, node.first + 1 - down);
+            let near = node.near_child(octant);
+            let far = 2 * node.first + 1 - near;
             todo.push((far, miss));
             todo.push((near, far as i32));
         }
     }
-    (order, links)
+    links
 }
 
 impl CpuAccelerator for Bvh {
@@ -347,18 +382,7 @@ impl CpuAccelerator for Bvh {
     }
 
     fn occluded(&self, feeler: &Feeler) -> (bool, u64) {
-        let (mut blocked, mut tests) = (false, 0);
-        // no hit before the offset counts, so neither do the boxes the feeler leaves before it
-        let (ro, rd) = (feeler.ro, feeler.rd);
-        self.traverse(ro, rd, feeler.offset, feeler.light_distance, |ids| {
-            let ids = ids.iter().map(|&i| i as usize);
-            blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
-            if blocked {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(feeler.light_distance)
-            }
-        });
+        let (blocked, tests, _) = self.feeler_walk(feeler);
         (blocked, tests)
     }
 }
