@@ -3,26 +3,31 @@
 // the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (Bvh::traverse), same order and counts.
 //
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
-// node bounds, node integers and per-leaf triangle ids), addressed by word (Bvh::gpu_words in
-// src/reference/bvh/mod.rs) and read as RGBA32UI texels of 4 words:
-//   a header of 4 words (BVH_HEADER_WORDS): the node count N, the word address of the first
-//             leaf triangle, 0, 0;
+// node bounds, node integers and per-leaf triangle ids), read as RGBA32UI texels of 4 words
+// (Bvh::gpu_words in src/reference/bvh/mod.rs):
+//   a header of 8 words (BVH_HEADER_WORDS): the node count N, the grid's origin x, y, z, its
+//             steps x, y, z, 0 (plane q of axis a lies at origin[a] + q·step[a]);
 //   for each ray octant o (bit a set: the ray points down axis a) a copy of the N nodes in
-//             that octant's depth-first order (the near child of every split first) from word
-//             BVH_HEADER_WORDS + o·BVH_NODE_WORDS·N on, 8 words each (BVH_NODE_WORDS):
-//             near.xyz, leaf, far.xyz, link — the box as the planes where rays of the octant
-//             enter and leave its slabs, the miss link (the word address of the record where
-//             such a ray goes on when it misses the node or is done with it; −1: the walk is
-//             over), and in a leaf −1 − (s·32 + count), its triangles from entry s of the leaf
-//             triangles on (an inner node: 0; its near child is the next record, its far child
-//             the near child's miss link);
-//   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0
+//             that octant's depth-first order (the near child of every split first), one
+//             texel each (BVH_NODE_WORDS), octant o's from texel 2 + o·N on: the box as the
+//             planes where rays of the octant enter its slabs (near.xyz) and leave them
+//             (far.xyz), 16-bit step counts on the grid —
+//             near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth
+//             word: in an inner node its miss link (the texel of the record where a ray goes
+//             on when it misses the node; 2 + o·N + N: the walk is over), in a leaf
+//             −1 − (s·32 + count), its triangles from entry s of the leaf triangles on. An inner
+//             node's near child is the next record, its far child the near child's miss link,
+//             and a leaf's miss link is the next record;
+//   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0.
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh.rs.) A node step reads two texels, a triangle three (on llvmpipe each
-// eight 128-bit loads, a transpose and a bounds check, where a 32-bit word costs a gather with
-// its bounds check). Ours: the copies per octant (4× the memory of one 64-byte node with 8
-// links) save the third texel of a node step (the links), the choice of the octant's link and
-// near child, and the slab test's choice of planes (docs/results/bvh_steps.md, step 16).
+// host, src/accel/bvh.rs. The header as uniforms took more instructions on llvmpipe than its
+// two texels: docs/results/bvh_steps.md, step 23.) A node step reads one texel, a triangle
+// three (on llvmpipe each eight 128-bit loads, a transpose and a bounds check, where a 32-bit
+// word costs a gather with its bounds check). Ours: the copies per octant (twice the memory of
+// one 64-byte node with 8 links) save the texel of the links, the choice of the octant's link
+// and near child, and the slab test's choice of planes (docs/results/bvh_steps.md, step 16);
+// the 16-bit planes (the box on the grid holds the node's float box: low planes rounded down,
+// high ones up) save the second texel of a node, for two instructions more per plane (step 23).
 //
 // Order (a deviation from Wagner, who visits both children and goes on with the nearer hit,
 // and from a stack walk): stackless. Every inner node whose box the ray enters (at some
@@ -58,8 +63,8 @@
 // next leaf search), the triangle loop behind the lanes that entered a leaf — each loop's exit
 // test is its back edge, and what is left is one triangle pass per SIMD group (the last outer
 // pass, whose lanes all end their walk without a leaf) (docs/results/bvh_steps.md, step 18).
-// The first passes need no test: a walk starts at its octant's root (node >= 0, guard = 0 <
-// bound), and the outer loop goes on only with node >= 0 and guard < bound.
+// The first passes need no test: a walk starts at its octant's root (node < end, guard = 0 <
+// bound), and the outer loop goes on only with node < end and guard < bound.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
@@ -68,45 +73,54 @@
 
 bool triangleHit(int at, int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
 
-// the word address of the first leaf triangle (the header's second word)
+// the word address of the first leaf triangle (after the records)
 int triangleBase = 0;
 
 // 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
 float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 
-// Listing 4.5: does the ray enter the box whose slabs it enters at the planes `near` and
-// leaves at `far` at some tMin <= t <= limit? (Wagner tests t >= 0; ours: a shadow feeler from
-// tMin = SHADOW_OFFSET on, since intersect2 takes no hit before the offset, skips the boxes
-// around its origin that it leaves before the offset.)
+// Listing 4.5: does the ray enter the box of `record` (its planes where the ray enters and
+// leaves the slabs, 16-bit step counts on the grid) at some tMin <= t <= limit? (Wagner tests
+// t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
+// before the offset, skips the boxes around its origin that it leaves before the offset.)
+//
+// Ours: the distance to plane q of axis a, (bvhGridOrigin[a] + q·bvhGridStep[a] − ro[a])/rd[a],
+// as q·gridA[a] + gridB[a] (a multiply and an add on llvmpipe, whose Mesa lowers fma so; a GL
+// implementation may fuse them, which moves a distance by a rounding). Its rounding error is
+// that of (plane − ro)·inv for rays that start within the scene's box and grows with the
+// origin's distance from the grid as the latter's does with its distance from the plane; the
+// boxes are padded by 1e-5 of the scene's extent (src/reference/bvh/build.rs).
 //
 // Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
 // bits — llvmpipe's float min and max are NaN-aware, three instructions each, the integer ones
 // one. For t >= +0 the bits are in the order of the floats; the entry distance is at least
 // tMin >= +0, and where an exit distance is negative so is the smallest of the bits: the box is
 // missed either way (an exit at exactly −0.0 too: a box the ray leaves at its origin). No
-// distance is NaN (safeInverse). The CPU twin (Bvh::enter) computes the same bits.
-bool boxEntered(vec3 near, vec3 far, vec3 ro, vec3 inv, float tMin, float limit)
+// distance is NaN (safeInverse: gridA and gridB are finite). The CPU twin (Bvh::enter,
+// RayGrid::t) computes the same bits.
+bool boxEntered(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit)
 {
-    ivec3 tNears = floatBitsToInt((near - ro) * inv);
-    ivec3 tFars = floatBitsToInt((far - ro) * inv);
+    vec3 near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));
+    vec3 far = vec3(ivec3(record.y >> 16u, record.z & 0xffffu, record.z >> 16u));
+    ivec3 tNears = floatBitsToInt(near * gridA + gridB);
+    ivec3 tFars = floatBitsToInt(far * gridA + gridB);
     int tNear = max(max(tNears.x, tNears.y), max(tNears.z, floatBitsToInt(tMin)));
     int tFar = min(min(tFars.x, tFars.y), min(tFars.z, floatBitsToInt(limit)));
     return tNear <= tFar;
 }
 
-// One node step: the box test of the record at word `node` whose texels are t0 and t1, and
-// where the walk goes next — the near child (the next record) after an inner node entered,
-// the miss link after a node missed or a leaf entered, whose leaf reference then goes to
-// `leaf` (the triangles follow in the triangle loop).
-void nodeStep(uvec4 t0, uvec4 t1, vec3 ro, vec3 inv, float tMin, float limit,
+// One node step: the box test of the record at texel `node`, and where the walk goes next —
+// the next record after an inner node entered (its near child) or a leaf (entered or not: a
+// leaf's miss link is the next record), the miss link after an inner node missed. An entered
+// leaf's reference goes to `leaf` (the triangles follow in the triangle loop).
+void nodeStep(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit,
               inout int node, inout int leaf)
 {
-    bool entered = boxEntered(uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz), ro, inv,
-                              tMin, limit);
-    int reference = int(t0.w); // −1 − (s·32 + count) in a leaf, 0 in an inner node
+    bool entered = boxEntered(record, gridA, gridB, tMin, limit);
+    int reference = int(record.w); // the miss link of an inner node, −1 − (s·32 + count) of a leaf
     bool inner = reference >= 0;
     leaf = entered && !inner ? reference : leaf;
-    node = entered && inner ? node + BVH_NODE_WORDS : int(t1.w);
+    node = !entered && inner ? reference : node + 1;
 }
 
 // The triangle loop: the entered leaf's triangles at words slot, slot + BVH_TRIANGLE_WORDS, ...
@@ -130,28 +144,34 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
 {
     vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
     int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
+    // the header: the node count N and the grid (plane q of axis a at origin[a] + q·step[a])
     uvec4 header = bvhTexel(0);
-    triangleBase = int(header.y);
-    // the root: the first record of the octant's copy
-    int node = BVH_HEADER_WORDS + octant * BVH_NODE_WORDS * int(header.x);
+    vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhTexel(4).xyz);
+    int nodes = int(header.x);
+    triangleBase = BVH_HEADER_WORDS + 8 * BVH_NODE_WORDS * nodes;
+    // a slab's distances: q·gridA + gridB for its planes q (boxEntered)
+    vec3 gridA = gridStep * inv, gridB = (gridOrigin - ro) * inv;
+    // the root: the first record of the octant's copy; end: the texel after its last
+    int node = BVH_HEADER_WORDS / 4 + octant * nodes;
+    int end = node + nodes;
     // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
     // below slotEnd
     int slot = 0, slotEnd = 0;
-    // every node of the octant visited at most once, and each takes BVH_NODE_WORDS of the
-    // buffer's 4 words a texel; guard: the node steps so far (the nodes visited)
-    int bound = 4 * imageSize(bvh) / BVH_NODE_WORDS + 1;
+    // every node of the octant visited at most once, and each takes one of the buffer's
+    // texels; guard: the node steps so far (the nodes visited)
+    int bound = imageSize(bvh) + 1;
     int guard = 0;
     do {
         // The outer loop's own test, again (it holds in every pass a lane takes): without it
         // llvmpipe changed the state of lanes that had left the loop at the end of an earlier
         // pass while other lanes went on — a lane whose walk ended at the leaf it entered
         // (miss link END) was left with untested triangles (tests/edge_cases.rs, the tie scene).
-        if (guard < bound && node >= 0) {
+        if (guard < bound && node < end) {
             int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
             do {
                 guard++;
-                nodeStep(bvhTexel(node), bvhTexel(node + 4), ro, inv, tMin, limit, node, leaf);
-            } while (guard < bound && node >= 0 && leaf == 0);
+                nodeStep(bvhRecord(node), gridA, gridB, tMin, limit, node, leaf);
+            } while (guard < bound && node < end && leaf == 0);
             int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
             slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS)
                             : 0;
@@ -162,9 +182,9 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
                 return true;
             }
         }
-    } while (guard < bound && node >= 0);
+    } while (guard < bound && node < end);
     nodesVisited += uint(guard);
     // (slot < slotEnd: llvmpipe's loop limit can still cut a triangle loop short)
-    if (node >= 0 || slot < slotEnd) truncated = 1u;
+    if (node < end || slot < slotEnd) truncated = 1u;
     return false;
 }

@@ -9,3 +9,5 @@ layout(rgba32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
 // sign-extended them (8 `movslq` per texel load; the node loop 160 -> 146 instructions a pass,
 // docs/results/bvh_steps.md, step 19).
 uvec4 bvhTexel(int at) { return imageLoad(bvh, int((uint(at) >> 2u) & BVH_TEXEL_INDEX_MASK)); }
+// The texel of index `texel` (a node record), masked as bvhTexel's.
+uvec4 bvhRecord(int texel) { return imageLoad(bvh, int(uint(texel) & BVH_TEXEL_INDEX_MASK)); }

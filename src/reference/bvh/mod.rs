@@ -8,13 +8,15 @@
 //!
 //! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
 //! words addressed by word ([`Bvh::gpu_words`]):
-//! - a header: the node count and where the triangles start;
+//! - a header: the node count and the grid of the records' planes ([`Grid`], over the root's
+//!   box);
 //! - for each of the 8 ray octants a copy of the nodes in that octant's depth-first order (the
-//!   near child of every split first), one 32-byte record each: the box as its near and far
-//!   planes for rays of that octant, the node's miss link for that octant (the record to go on
-//!   with when the node is missed or done; [`END`] after the last), and in a leaf the place
-//!   and count of its triangles — an inner node's near child is the record after it, its far
-//!   child the near child's miss link;
+//!   near child of every split first), one 16-byte record each: the box as its near and far
+//!   planes for rays of that octant, 16-bit step counts on the grid ([`Bvh::planes`]), and in
+//!   an inner node its miss link for that octant (the record to go on with when the node is
+//!   missed), in a leaf the place and count of its triangles — an inner node's near child is
+//!   the record after it, its far child the near child's miss link, a leaf's miss link the
+//!   record after it;
 //! - after the records, per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as
 //!   v0 and its id, edge1, edge2 (12 words).
 //!
@@ -37,6 +39,8 @@ pub use super::aabb::Aabb;
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 mod build;
+mod planes;
+pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 
 /// Bins per axis of the binned SAH.
 pub const BINS: usize = 16;
@@ -115,14 +119,18 @@ pub struct Bvh {
     pub links: Vec<i32>,
     /// Triangle ids in leaf order.
     pub tris: Vec<u32>,
+    /// The grid over the root's box on which the records store the boxes.
+    pub grid: Grid,
+    /// Every node's box on the grid, as the kernels and [`Bvh::traverse`] test it.
+    pub planes: Vec<Planes>,
     pub stats: BvhStats,
 }
 
-/// Words of the header of [`Bvh::gpu_words`]: the node count, the word address of the first
-/// leaf triangle, two zeros.
-pub const HEADER_WORDS: usize = 4;
-/// Words of one node record of one octant in [`Bvh::gpu_words`].
-pub const NODE_WORDS: usize = 8;
+/// Words of the header of [`Bvh::gpu_words`]: the node count and the grid's origin x, y, z; the
+/// grid's steps x, y, z and 0.
+pub const HEADER_WORDS: usize = 8;
+/// Words of one node record of one octant in [`Bvh::gpu_words`]: one texel.
+pub const NODE_WORDS: usize = 4;
 /// Words of one leaf triangle in [`Bvh::gpu_words`].
 pub const TRIANGLE_WORDS: usize = 12;
 /// Bits of a leaf record's triangle count in its reference word ([`Bvh::gpu_words`]).
@@ -140,6 +148,11 @@ impl Bvh {
         let mut nodes = vec![Node::zeroed()];
         build::layout(&tree, 0, &mut nodes);
         let links = miss_links(&nodes);
+        let grid = Grid::over(&Aabb {
+            lo: nodes[0].lo.into(),
+            hi: nodes[0].hi.into(),
+        });
+        let planes = nodes.iter().map(|n| grid.planes(n)).collect();
         let mut stats = BvhStats {
             nodes: nodes.len(),
             leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
@@ -154,22 +167,27 @@ impl Bvh {
             nodes,
             links,
             tris: ids,
+            grid,
+            planes,
             stats,
         }
     }
 
-    /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) addressed
-    /// by word and read as texels of 4 words (`glsl/bvh/traverse.glsl`):
-    /// - [`HEADER_WORDS`]: the node count N, the word address of the first leaf triangle, 0, 0;
-    /// - for each octant o = 0..8, from word `HEADER_WORDS + o·NODE_WORDS·N` on, the N nodes in
-    ///   the depth-first order of that octant (the order of [`Bvh::links`]: the near child of
-    ///   every split first), [`NODE_WORDS`] each: the near planes x, y, z (for each axis the
-    ///   box's low bound, or its high bound where rays of the octant point down the axis), the
-    ///   leaf reference, the far planes x, y, z, the miss link (the word address of the record
-    ///   of `links[OCTANTS·n + o]`; [`END`] stays −1). The leaf reference of a leaf is
-    ///   −1 − (s·2^[`LEAF_COUNT_BITS`] + count) with s its first entry in [`Bvh::tris`], of an
-    ///   inner node 0: its near child is the next record;
-    /// - from that first-triangle address on, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]:
+    /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) read as
+    /// texels of 4 words (`glsl/bvh/traverse.glsl`):
+    /// - [`HEADER_WORDS`]: the node count N, the grid's origin x, y, z, its steps x, y, z, 0;
+    /// - for each octant o = 0..8, from texel [`Bvh::root_texel`] on, the N nodes in the
+    ///   depth-first order of that octant (the order of [`Bvh::links`]: the near child of every
+    ///   split first), one texel each ([`NODE_WORDS`]): the near planes x, y, z (for each axis
+    ///   the box's low plane, or its high plane where rays of the octant point down the axis)
+    ///   and the far planes x, y, z, as the 16-bit step counts of [`Bvh::planes`] —
+    ///   near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth word:
+    ///   of an inner node its miss link (the texel of the record of `links[OCTANTS·n + o]`;
+    ///   [`END`]: the texel after the octant's last record), of a leaf −1 −
+    ///   (s·2^[`LEAF_COUNT_BITS`] + count) with s its first entry in [`Bvh::tris`]. An inner
+    ///   node's near child is the next record; a leaf's miss link is always the next record
+    ///   (the octant's depth-first order goes on there after a subtree of one);
+    /// - from word [`Bvh::triangle_base`] on, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]:
     ///   v0 and the triangle id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences
     ///   Algorithm 1 forms first.
     ///
@@ -181,14 +199,15 @@ impl Bvh {
         let records = OCTANTS * NODE_WORDS * n;
         let mut out = vec![0u32; HEADER_WORDS + records + TRIANGLE_WORDS * self.tris.len()];
         let (head, rest) = out.split_at_mut(HEADER_WORDS);
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
         head[0] = n as u32;
-        head[1] = (HEADER_WORDS + records) as u32;
+        head[1..4].copy_from_slice(&bits(self.grid.origin));
+        head[4..7].copy_from_slice(&bits(self.grid.step));
         let (octants, triangles) = rest.split_at_mut(records);
         octants
             .par_chunks_mut(NODE_WORDS * n)
             .enumerate()
-            .for_each(|(o, w)| self.octant_records(o, HEADER_WORDS + o * NODE_WORDS * n, w));
-        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            .for_each(|(o, w)| self.octant_records(o, w));
         triangles
             .par_chunks_mut(TRIANGLE_WORDS)
             .zip(self.tris.par_iter())
@@ -202,9 +221,8 @@ impl Bvh {
         out
     }
 
-    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`, whose first word has
-    /// the word address `base`.
-    fn octant_records(&self, o: usize, base: usize, out: &mut [u32]) {
+    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`.
+    fn octant_records(&self, o: usize, out: &mut [u32]) {
         // the octant's depth-first order, from its miss links: after an inner node its near
         // child, after a leaf (a subtree of one) its miss link
         let mut order = Vec::with_capacity(self.nodes.len());
@@ -217,30 +235,36 @@ impl Bvh {
                 false => node.near_child(o) as i32,
             };
         }
+        let base = self.root_texel(o);
         let mut record = vec![0u32; self.nodes.len()];
         for (i, &k) in order.iter().enumerate() {
-            record[k as usize] = (base + NODE_WORDS * i) as u32;
+            record[k as usize] = (base + i) as u32;
         }
+        let end = (base + self.nodes.len()) as u32;
         for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
             let node = &self.nodes[k as usize];
             debug_assert!(node.first < 1 << (31 - LEAF_COUNT_BITS), "see gpu_words");
-            let (mut near, mut far) = (node.lo, node.hi);
-            for axis in 0..3 {
-                if (o >> axis) & 1 == 1 {
-                    std::mem::swap(&mut near[axis], &mut far[axis]);
-                }
-            }
-            w[0..3].copy_from_slice(&near.map(f32::to_bits));
-            w[3] = match node.is_leaf() {
-                true => (-1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32)) as u32,
-                false => 0,
-            };
-            w[4..7].copy_from_slice(&far.map(f32::to_bits));
-            w[7] = match self.links[OCTANTS * k as usize + o] {
-                END => END as u32,
-                l => record[l as usize],
+            let [near, far] = octant_planes(&self.planes[k as usize], o).map(|p| p.map(u32::from));
+            w[0] = near[0] | near[1] << 16;
+            w[1] = near[2] | far[0] << 16;
+            w[2] = far[1] | far[2] << 16;
+            w[3] = match (node.is_leaf(), self.links[OCTANTS * k as usize + o]) {
+                (true, _) => (-1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32)) as u32,
+                (false, END) => end,
+                (false, l) => record[l as usize],
             };
         }
+    }
+
+    /// The texel index of the root's record in octant `o`'s copy of the nodes
+    /// ([`Bvh::gpu_words`]).
+    pub fn root_texel(&self, o: usize) -> usize {
+        (HEADER_WORDS + o * self.nodes.len() * NODE_WORDS) / 4
+    }
+
+    /// The word address of the first leaf triangle in [`Bvh::gpu_words`].
+    pub fn triangle_base(&self) -> usize {
+        HEADER_WORDS + OCTANTS * NODE_WORDS * self.nodes.len()
     }
 
     /// The shadow feeler's walk, as intersect2's: whether it is blocked, its triangle tests and
@@ -279,11 +303,12 @@ impl Bvh {
     ) -> u64 {
         let inv = safe_inverse(rd);
         let octant = octant(inv);
+        let ray = self.grid.ray(ro, inv);
         let (mut node, mut visited) = (0i32, 0u64);
         while node != END {
             visited += 1;
             let n = &self.nodes[node as usize];
-            if self.enter(node as usize, ro, inv, t_min, limit) {
+            if self.enter(node as usize, &ray, octant, t_min, limit) {
                 if !n.is_leaf() {
                     // the near child first: the right one when the ray points down the axis
                     // (from the ray itself, not Node::near_child, which lays out the records
@@ -302,26 +327,40 @@ impl Bvh {
         visited
     }
 
-    /// Whether the ray enters node `n`'s box at some `t_min` ≤ t ≤ `limit` (the slab test of
-    /// Wagner 2018, Listing 4.5), bit for bit as `boxEntered` in the kernels: each slab's near
-    /// plane is its low bound, or its high bound where the ray points down the axis (as the
-    /// records of [`Bvh::gpu_words`] store them), and the largest entry and the smallest exit
-    /// distance are taken by integer max and min of the floats' bits. For t ≥ +0 the order of
-    /// the bits is the order of the floats; the entry distance is at least `t_min` ≥ +0, and
-    /// where an exit distance is negative so is the smallest of the bits — the box is missed
-    /// either way (an exit at exactly −0.0 too, a box the ray leaves at its origin). No
-    /// distance is NaN: 1/rd is finite ([`safe_inverse`]).
-    fn enter(&self, n: usize, ro: Vec3, inv: Vec3, t_min: f32, limit: f32) -> bool {
-        let node = &self.nodes[n];
-        let down = inv.cmplt(Vec3::ZERO);
-        let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
-        let bits = |v: Vec3| v.to_array().map(|f| f.to_bits() as i32);
-        let near = bits((Vec3::select(down, hi, lo) - ro) * inv);
-        let far = bits((Vec3::select(down, lo, hi) - ro) * inv);
-        let t_near = near.iter().fold(t_min.to_bits() as i32, |m, &t| m.max(t));
-        let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
+    /// Whether the ray (of `octant`, with the grid factors `ray`) enters node `n`'s box at some
+    /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5), bit for bit as
+    /// `boxEntered` in the kernels: the box on the grid ([`Bvh::planes`]), each slab's near
+    /// plane its low bound, or its high bound where the ray points down the axis (as the records
+    /// of [`Bvh::gpu_words`] store them), its distance `fma(q, a, b)` ([`RayGrid::t`]), and the
+    /// largest entry and the smallest exit distance taken by integer max and min of the floats'
+    /// bits. For t ≥ +0 the order of the bits is the order of the floats; the entry distance is
+    /// at least `t_min` ≥ +0, and where an exit distance is negative so is the smallest of the
+    /// bits — the box is missed either way (an exit at exactly −0.0 too, a box the ray leaves at
+    /// its origin). No distance is NaN: 1/rd is finite ([`safe_inverse`]).
+    fn enter(&self, n: usize, ray: &RayGrid, octant: usize, t_min: f32, limit: f32) -> bool {
+        let [near, far] = octant_planes(&self.planes[n], octant);
+        let t_near = ray
+            .t(near)
+            .iter()
+            .fold(t_min.to_bits() as i32, |m, &t| m.max(t));
+        let t_far = ray
+            .t(far)
+            .iter()
+            .fold(limit.to_bits() as i32, |m, &t| m.min(t));
         t_near <= t_far
     }
+}
+
+/// A box's near and far planes (step counts x, y, z) for rays of `octant`: per axis the low
+/// plane is the near one, unless the rays point down the axis.
+fn octant_planes(q: &Planes, octant: usize) -> [[u16; 3]; 2] {
+    let (mut near, mut far) = ([q[0], q[1], q[2]], [q[3], q[4], q[5]]);
+    for a in 0..3 {
+        if (octant >> a) & 1 == 1 {
+            std::mem::swap(&mut near[a], &mut far[a]);
+        }
+    }
+    [near, far]
 }
 
 /// The ray's octant: bit a set when it points down axis a (by the sign of 1/rd, as the kernels).
@@ -473,18 +512,21 @@ mod tests {
         let words = bvh.gpu_words();
         let n = bvh.nodes.len();
         let base = HEADER_WORDS + OCTANTS * NODE_WORDS * n;
+        assert_eq!(bvh.triangle_base(), base);
         assert_eq!(words.len(), base + TRIANGLE_WORDS * bvh.tris.len());
         assert_eq!(4 * words.len(), bvh.stats.bytes);
-        assert_eq!(words[..HEADER_WORDS], [n as u32, base as u32, 0, 0]);
         let f = |w: &[u32]| Vec3::from_array([0, 1, 2].map(|k| f32::from_bits(w[k])));
+        assert_eq!((words[0], f(&words[1..4])), (n as u32, bvh.grid.origin));
+        assert_eq!((f(&words[4..7]), words[7]), (bvh.grid.step, 0));
         for octant in 0..OCTANTS {
-            // the octant's records, near child right after its parent: where each node is
+            // the octant's records, near child right after its parent: each node's texel
             let mut at = vec![usize::MAX; n];
-            let mut next = HEADER_WORDS + octant * NODE_WORDS * n;
+            let root = HEADER_WORDS / 4 + octant * n;
+            let mut next = root;
             let mut todo = vec![0usize];
             while let Some(k) = todo.pop() {
                 at[k] = next;
-                next += NODE_WORDS;
+                next += 1;
                 let node = &bvh.nodes[k];
                 if !node.is_leaf() {
                     let near = node.first as usize + ((octant >> node.axis()) & 1);
@@ -492,26 +534,34 @@ mod tests {
                     todo.push(near);
                 }
             }
-            assert_eq!(next, HEADER_WORDS + (octant + 1) * NODE_WORDS * n);
+            assert_eq!(next, root + n);
+            assert_eq!(bvh.root_texel(octant), root);
             for (k, node) in bvh.nodes.iter().enumerate() {
-                let w = &words[at[k]..at[k] + NODE_WORDS];
-                // the planes where rays of the octant enter and leave the slabs
-                let down = [0, 1, 2].map(|a| (octant >> a) & 1 == 1);
-                let (lo, hi) = (Vec3::from(node.lo), Vec3::from(node.hi));
-                let down = glam::BVec3::from(down);
-                assert_eq!(f(&w[0..3]), Vec3::select(down, hi, lo));
-                assert_eq!(f(&w[4..7]), Vec3::select(down, lo, hi));
-                let link = bvh.links[OCTANTS * k + octant];
-                let want = if link == END {
-                    END as u32
-                } else {
-                    at[link as usize] as u32
-                };
-                assert_eq!(w[7], want, "miss link of node {k}, octant {octant}");
+                let w = &words[4 * at[k]..4 * at[k] + NODE_WORDS];
+                // the planes where rays of the octant enter and leave the slabs, 16 bits each
+                let q = bvh.planes[k];
+                let (lo, hi) = ([q[0], q[1], q[2]], [q[3], q[4], q[5]]);
+                let down = |a: usize| (octant >> a) & 1 == 1;
+                let near = [0, 1, 2].map(|a| if down(a) { hi[a] } else { lo[a] } as u32);
+                let far = [0, 1, 2].map(|a| if down(a) { lo[a] } else { hi[a] } as u32);
+                let halves = w[..3].iter().flat_map(|&x| [x & 0xffff, x >> 16]);
+                assert_eq!(halves.collect::<Vec<_>>(), [near, far].concat());
                 if !node.is_leaf() {
-                    assert_eq!(w[3], 0);
+                    // the miss link: the texel of the octant's next record after the subtree
+                    let want = match bvh.links[OCTANTS * k + octant] {
+                        END => root + n,
+                        link => at[link as usize],
+                    };
+                    assert_eq!(w[3], want as u32, "miss link of node {k}, octant {octant}");
                     continue;
                 }
+                // a leaf's miss link is the next record
+                assert_eq!(
+                    bvh.links[OCTANTS * k + octant],
+                    at.iter()
+                        .position(|&t| t == at[k] + 1)
+                        .map_or(END, |l| l as i32)
+                );
                 // the leaf's triangles: v0, id, edge1, 0, edge2, 0 each
                 let reference = -1 - w[3] as i32;
                 let count = reference & ((1 << LEAF_COUNT_BITS) - 1);
