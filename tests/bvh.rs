@@ -102,15 +102,64 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
 /// rays' node visits equal the twin's over the very same rays (the AOVs), and every pixel traced
 /// one primary ray, and so do the shadow feelers from their first hits (those that found an
 /// occluder included). Odd image sides leave a partial last block of `pixel_counts.comp`.
+///
+/// Three views: the bunny from its scene's camera; the bunny from a camera that looks down all
+/// three axes, whose rays are all of the last octant (the one whose records end where the leaf
+/// triangles begin); and eight small triangles at a cube's corners seen so, whose walks end at
+/// that octant's last record (a node pass must not step past it, `nodePass`).
 #[test]
 fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
+    let ctx = context();
+    let mut scene = load("bunny.toml");
+    walks_match_the_twin(&ctx, &scene, (47, 33), true);
+    // aimed at the scene's low corner, where the last octant's walks end
+    let corner = scene
+        .world_triangles()
+        .iter()
+        .flatten()
+        .fold(Vec3::INFINITY, |m, &p| m.min(p));
+    let c = &mut scene.camera;
+    let distance = (Vec3::from(c.position) - Vec3::from(c.look_at)).length();
+    c.look_at = corner.into();
+    c.position = (corner + Vec3::ONE.normalize() * distance).into();
+    c.up = [0.0, 1.0, 0.0];
+    // (the light lies above too: no feeler finds an occluder)
+    walks_match_the_twin(&ctx, &scene, (40, 40), false);
+    // eight small triangles at the corners of a cube, seen down all three axes: two leaves, and
+    // the rays that enter the near one and leave the cube before the far one — the octant's
+    // last record — end their walk there
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::new();
+    for k in 0..8 {
+        let c = Vec3::new((k & 1) as f32, (k >> 1 & 1) as f32, (k >> 2 & 1) as f32);
+        for v in [
+            c,
+            c + Vec3::new(0.1, 0.0, 0.0),
+            c + Vec3::new(0.0, 0.1, 0.1),
+        ] {
+            obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+        }
+        obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    std::fs::write(dir.path().join("corners.obj"), obj).unwrap();
+    let toml = "[camera]\nposition = [2.6, 2.7, 2.8]\nlook_at = [0.5, 0.5, 0.5]\nfov_y = 40.0\n\
+                [render]\nambient = [0.2, 0.2, 0.2]\n[[light]]\nposition = [3.0, 4.0, 2.0]\n\
+                [[object]]\ntype = \"obj\"\npath = \"corners.obj\"\ncolor = [0.8, 0.8, 0.8]\n";
+    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
+    let corners = gpgpu_rt::scene::Scene::load(&dir.path().join("scene.toml")).unwrap();
+    walks_match_the_twin(&ctx, &corners, (32, 32), false);
+}
+
+fn walks_match_the_twin(
+    ctx: &gpgpu_rt::gl::GlContext,
+    scene: &gpgpu_rt::scene::Scene,
+    (w, h): (u32, u32),
+    some_blocked: bool,
+) {
     use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
     use gpgpu_rt::reference::{closest_among, Feeler};
     use std::ops::ControlFlow;
-    let ctx = context();
-    let scene = load("bunny.toml");
-    let (w, h) = (47, 33);
-    let frame = render_gpu(&ctx, &scene, bvh_options(w, h, 0));
+    let frame = render_gpu(ctx, scene, bvh_options(w, h, 0));
     let primary = &frame.stats.ray_kinds["primary"];
     assert_eq!(primary.count("rays"), (w * h) as u64, "a ray per pixel");
     let twin = CpuBvh::new(scene.world_triangles());
@@ -150,16 +199,69 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     }
     let shadow = &frame.stats.ray_kinds["shadow_first_light"];
     assert_eq!(shadow.count("rays"), feelers, "feelers traced");
-    assert!(
-        blocked > 0 && blocked < feelers,
-        "{blocked} of {feelers} feelers blocked"
-    );
+    match some_blocked {
+        true => assert!(
+            blocked > 0 && blocked < feelers,
+            "{blocked} of {feelers} blocked"
+        ),
+        false => assert_eq!(blocked, 0, "{feelers} feelers"),
+    }
     assert_eq!(shadow.count("intersect2"), tests, "feelers' triangle tests");
     assert_eq!(
         shadow.count("nodes_visited"),
         nodes,
         "feelers' nodes visited"
     );
+}
+
+/// The boxes the kernels test — each node's planes on the 16-bit grid of its records
+/// (`Bvh::planes`) — hold every triangle of the node's subtree, and lie within a grid step of
+/// its float box: a walk on the grid misses no hit that the float boxes find.
+#[test]
+fn the_grid_boxes_hold_every_triangle_of_their_subtree() {
+    use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
+    let scene = load("bunny.toml");
+    let bvh = CpuBvh::new(scene.world_triangles());
+    let g = bvh.grid;
+    let plane = |a: usize, q: u16| g.origin[a] as f64 + q as f64 * g.step[a] as f64;
+    // the triangles of every node's subtree: its leaves' entries of Bvh::tris, a range
+    // (children come after their parent)
+    let mut ranges = vec![(u32::MAX, 0u32); bvh.nodes.len()];
+    for (n, node) in bvh.nodes.iter().enumerate().rev() {
+        ranges[n] = match node.is_leaf() {
+            true => (node.first, node.first + node.count()),
+            false => {
+                let (l, r) = (ranges[node.first as usize], ranges[node.first as usize + 1]);
+                (l.0.min(r.0), l.1.max(r.1))
+            }
+        };
+    }
+    let mut checked = 0;
+    for n in (0..bvh.nodes.len()).step_by(97).chain([0]) {
+        let (q, node) = (bvh.planes[n], &bvh.nodes[n]);
+        let (first, end) = ranges[n];
+        for &t in &bvh.tris[first as usize..end as usize] {
+            for v in bvh.triangles()[t as usize] {
+                for a in 0..3 {
+                    let p = v[a] as f64;
+                    assert!(
+                        plane(a, q[a]) <= p && p <= plane(a, q[3 + a]),
+                        "node {n} axis {a}"
+                    );
+                }
+            }
+        }
+        for a in 0..3 {
+            assert!(plane(a, q[a]) <= node.lo[a] as f64 && plane(a, q[3 + a]) >= node.hi[a] as f64);
+            assert!(
+                node.lo[a] as f64 - plane(a, q[a]) <= g.step[a] as f64,
+                "a step at most"
+            );
+            assert!(plane(a, q[3 + a]) - node.hi[a] as f64 <= g.step[a] as f64);
+        }
+        checked += 1;
+    }
+    assert!(checked > 100, "{checked} nodes");
 }
 
 /// The paths for other GL implementations: without `GL_ARB_gpu_shader_int64` the records are

@@ -152,7 +152,10 @@ impl Bvh {
             lo: nodes[0].lo.into(),
             hi: nodes[0].hi.into(),
         });
-        let planes = nodes.iter().map(|n| grid.planes(n)).collect();
+        let planes = {
+            use rayon::prelude::*;
+            nodes.par_iter().map(|n| grid.planes(n)).collect()
+        };
         let mut stats = BvhStats {
             nodes: nodes.len(),
             leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
@@ -339,14 +342,9 @@ impl Bvh {
     /// its origin). No distance is NaN: 1/rd is finite ([`safe_inverse`]).
     fn enter(&self, n: usize, ray: &RayGrid, octant: usize, t_min: f32, limit: f32) -> bool {
         let [near, far] = octant_planes(&self.planes[n], octant);
-        let t_near = ray
-            .t(near)
-            .iter()
-            .fold(t_min.to_bits() as i32, |m, &t| m.max(t));
-        let t_far = ray
-            .t(far)
-            .iter()
-            .fold(limit.to_bits() as i32, |m, &t| m.min(t));
+        let (near, far) = (ray.t(near), ray.t(far));
+        let t_near = near.iter().fold(t_min.to_bits() as i32, |m, &t| m.max(t));
+        let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
         t_near <= t_far
     }
 }
