@@ -44,7 +44,7 @@
 // mask, so each inner loop runs until its last lane leaves it, the others waiting: a lane that
 // entered a leaf waits for the group's other lanes to enter theirs. Until step 16 a single
 // loop whose every iteration took a node step or a triangle, then a second node step, paid
-// less (a lane tested its triangles while the others walked on); since a node step reads only
+// less (a lane tested its triangles while the others walked on); since a node step then read only
 // two texels (the octant's records), the node loop is a third of that iteration — Algorithm 1
 // and the triangle's third texel no longer paid in every step — and the waiting costs less
 // than it (docs/results/bvh_steps.md, step 17). The walk's order and counts are the same
@@ -84,19 +84,21 @@ float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 // t >= 0; ours: a shadow feeler from tMin = SHADOW_OFFSET on, since intersect2 takes no hit
 // before the offset, skips the boxes around its origin that it leaves before the offset.)
 //
-// Ours: the distance to plane q of axis a, (bvhGridOrigin[a] + q·bvhGridStep[a] − ro[a])/rd[a],
-// as q·gridA[a] + gridB[a] (a multiply and an add on llvmpipe, whose Mesa lowers fma so; a GL
-// implementation may fuse them, which moves a distance by a rounding). Its rounding error is
-// that of (plane − ro)·inv for rays that start within the scene's box and grows with the
-// origin's distance from the grid as the latter's does with its distance from the plane; the
-// boxes are padded by 1e-5 of the scene's extent (src/reference/bvh/build.rs).
+// Ours: the distance to plane q of axis a, (origin[a] + q·step[a] − ro[a])/rd[a], as
+// q·gridA[a] + gridB[a], rounded after the product and after the sum (on llvmpipe, whose Mesa
+// lowers fma so; a GL implementation that fuses them moves a distance by a rounding, and the
+// twin's node counts with it, not the hits). In world units its rounding error is about 2^-23
+// of the root's extent plus the ray origin's distance from the grid — where (plane − ro)·inv
+// errs by 2^-24 of the distance to the plane — and the boxes' padding of 1e-5 of the scene's
+// extent (src/reference/bvh/build.rs) covers it for origins within some 80 extents of the scene
+// (docs/results/bvh_steps.md, step 23).
 //
 // Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
 // bits — llvmpipe's float min and max are NaN-aware, three instructions each, the integer ones
 // one. For t >= +0 the bits are in the order of the floats; the entry distance is at least
 // tMin >= +0, and where an exit distance is negative so is the smallest of the bits: the box is
 // missed either way (an exit at exactly −0.0 too: a box the ray leaves at its origin). No
-// distance is NaN (safeInverse: gridA and gridB are finite). The CPU twin (Bvh::enter,
+// distance is NaN (safeInverse, and gridA and gridB clamped finite). The CPU twin (Bvh::enter,
 // RayGrid::t) computes the same bits.
 bool boxEntered(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit)
 {
@@ -127,7 +129,9 @@ void nodeStep(bool entered, int reference, inout int node, inout int leaf)
 // take to issue on llvmpipe, so the second record's independent load and test cost less than a
 // pass of their own: the bunny's node passes per SIMD group 17.9 → 12.1 at 210 instructions
 // instead of 122, 0.95 of the time (docs/results/bvh_steps.md, step 24). `steps`: 1 or 2, the
-// nodes visited; the walk's order and counts are those of single steps.
+// nodes visited; the walk's order and counts are those of single steps. (At the octant's last
+// record the second texel is the next octant's root or the first leaf triangle, or for an
+// empty last octant past the buffer, which imageLoad reads as 0: loaded, never used.)
 void nodePass(vec3 gridA, vec3 gridB, float tMin, float limit, int end,
               inout int node, inout int leaf, out int steps)
 {
@@ -167,8 +171,11 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhTexel(4).xyz);
     int nodes = int(header.x);
     triangleBase = BVH_HEADER_WORDS + 8 * BVH_NODE_WORDS * nodes;
-    // a slab's distances: q·gridA + gridB for its planes q (boxEntered)
-    vec3 gridA = gridStep * inv, gridB = (gridOrigin - ro) * inv;
+    // a slab's distances: q·gridA + gridB for its planes q (boxEntered), the factors clamped to
+    // the finite floats (an overflow to ±inf could make 0·inf or inf − inf; Grid::ray)
+    const float finite = 3.40282347e38;
+    vec3 gridA = clamp(gridStep * inv, -finite, finite);
+    vec3 gridB = clamp((gridOrigin - ro) * inv, -finite, finite);
     // the root: the first record of the octant's copy; end: the texel after its last
     int node = BVH_HEADER_WORDS / 4 + octant * nodes;
     int end = node + nodes;

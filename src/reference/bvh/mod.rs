@@ -7,7 +7,7 @@
 //! [`PARALLEL_BUILD`] triangles.
 //!
 //! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
-//! words addressed by word ([`Bvh::gpu_words`]):
+//! words read as texels of four ([`Bvh::gpu_words`]):
 //! - a header: the node count and the grid of the records' planes ([`Grid`], over the root's
 //!   box);
 //! - for each of the 8 ray octants a copy of the nodes in that octant's depth-first order (the
@@ -334,12 +334,12 @@ impl Bvh {
     /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5), bit for bit as
     /// `boxEntered` in the kernels: the box on the grid ([`Bvh::planes`]), each slab's near
     /// plane its low bound, or its high bound where the ray points down the axis (as the records
-    /// of [`Bvh::gpu_words`] store them), its distance `fma(q, a, b)` ([`RayGrid::t`]), and the
+    /// of [`Bvh::gpu_words`] store them), its distance q·a + b rounded twice ([`RayGrid::t`]), and the
     /// largest entry and the smallest exit distance taken by integer max and min of the floats'
     /// bits. For t ≥ +0 the order of the bits is the order of the floats; the entry distance is
     /// at least `t_min` ≥ +0, and where an exit distance is negative so is the smallest of the
     /// bits — the box is missed either way (an exit at exactly −0.0 too, a box the ray leaves at
-    /// its origin). No distance is NaN: 1/rd is finite ([`safe_inverse`]).
+    /// its origin). No distance is NaN: 1/rd is finite ([`safe_inverse`]) and so are a and b.
     fn enter(&self, n: usize, ray: &RayGrid, octant: usize, t_min: f32, limit: f32) -> bool {
         let [near, far] = octant_planes(&self.planes[n], octant);
         let (near, far) = (ray.t(near), ray.t(far));

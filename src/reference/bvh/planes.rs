@@ -1,7 +1,7 @@
 //! The boxes of the kernels' node records as 16-bit planes on a grid over the root's box (ours;
 //! `docs/results/bvh_steps.md`, step 23): a record is one texel, where the box as floats took
-//! two, and a slab's distance is one `fma` of the plane's grid step count with two per-ray
-//! factors. The CPU twin tests the same boxes with the same arithmetic ([`RayGrid::t`]).
+//! two, and a slab's distance is the plane's grid step count times one per-ray factor plus
+//! another. The CPU twin tests the same boxes with the same arithmetic ([`RayGrid::t`]).
 
 use glam::Vec3;
 
@@ -23,8 +23,9 @@ pub type Planes = [u16; 6];
 
 impl Grid {
     /// The grid over `root` (the root node's box): its low corner and, per axis, the smallest
-    /// float step whose [`GRID_STEPS`] steps reach the high side. A root that is no box (no
-    /// triangles) gets the unit grid at 0.
+    /// float step whose [`GRID_STEPS`] steps reach the high side, and no smaller than 2^-40 of
+    /// the axis's coordinates, so that the planes `origin + q·step` are distinct in f64 on a
+    /// flat axis too. A root that is no box (no triangles) gets the unit grid at 0.
     pub fn over(root: &Aabb) -> Grid {
         if !(root.lo.is_finite() && root.hi.is_finite() && root.lo.cmple(root.hi).all()) {
             return Grid {
@@ -34,7 +35,8 @@ impl Grid {
         }
         let step = |a: usize| {
             let extent = root.hi[a] as f64 - root.lo[a] as f64;
-            let mut s = ((extent / GRID_STEPS as f64) as f32).max(f32::MIN_POSITIVE);
+            let spacing = root.lo[a].abs().max(root.hi[a].abs()) * (-40f32).exp2();
+            let mut s = ((extent / GRID_STEPS as f64) as f32).max(spacing.max(f32::MIN_POSITIVE));
             while (s as f64) * (GRID_STEPS as f64) < extent {
                 s = s.next_up();
             }
@@ -46,14 +48,19 @@ impl Grid {
         }
     }
 
-    /// The node's box on the grid: the tightest planes that hold its float box (in exact
-    /// arithmetic).
+    /// Plane q of axis a, in f64 (exact but for a rounding of some 2^-53 of the coordinates,
+    /// far below the boxes' padding).
+    pub fn plane(&self, a: usize, q: u16) -> f64 {
+        self.origin[a] as f64 + q as f64 * self.step[a] as f64
+    }
+
+    /// The node's box on the grid: the tightest planes that hold its float box ([`Grid::plane`]).
     pub fn planes(&self, node: &Node) -> Planes {
         let max = GRID_STEPS as f64;
         let mut q = [0u16; 6];
         for a in 0..3 {
             let (o, s) = (self.origin[a] as f64, self.step[a] as f64);
-            let at = |q: f64| o + q * s;
+            let at = |q: f64| self.plane(a, q as u16);
             let (lo, hi) = (node.lo[a] as f64, node.hi[a] as f64);
             // the quotients' rounding may leave them a step off the tightest planes
             let mut l = ((lo - o) / s).floor().clamp(0.0, max);
@@ -70,16 +77,20 @@ impl Grid {
             while h > 0.0 && at(h - 1.0) >= hi {
                 h -= 1.0;
             }
+            debug_assert!(l <= h, "axis {a}: planes {l} > {h}");
             (q[a], q[3 + a]) = (l as u16, h as u16);
         }
         q
     }
 
-    /// The per-ray factors of the slab distances of a ray with origin `ro` and 1/direction `inv`.
+    /// The per-ray factors of the slab distances of a ray with origin `ro` and 1/direction `inv`,
+    /// clamped to the finite floats (as the kernels do): an overflow to ±∞ could otherwise make
+    /// 0·∞ or ∞ − ∞, where the distance is only far.
     pub fn ray(&self, ro: Vec3, inv: Vec3) -> RayGrid {
+        let finite = |v: Vec3| v.clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
         RayGrid {
-            a: self.step * inv,
-            b: (self.origin - ro) * inv,
+            a: finite(self.step * inv),
+            b: finite((self.origin - ro) * inv),
         }
     }
 }
@@ -113,9 +124,8 @@ mod tests {
         }
     }
 
-    /// The plane of step count q on axis a, exactly.
     fn at(g: &Grid, a: usize, q: u16) -> f64 {
-        g.origin[a] as f64 + q as f64 * g.step[a] as f64
+        g.plane(a, q)
     }
 
     #[test]
@@ -134,7 +144,7 @@ mod tests {
             );
             assert!(
                 at(&g, a, u16::MAX - 1) < root.hi[a] as f64,
-                "axis {a}: the smallest step"
+                "{a}: the smallest step"
             );
             assert_eq!((full[a], full[3 + a]), (0, u16::MAX));
         }
@@ -175,8 +185,9 @@ mod tests {
         let g = Grid::over(&flat);
         assert!(g.step.y > 0.0);
         let q = g.planes(&node(flat.lo.into(), flat.hi.into()));
-        assert_eq!(at(&g, 1, q[1]), 2.0);
-        assert!(at(&g, 1, q[4]) >= 2.0);
+        assert_eq!((q[1], q[4]), (0, 0), "the flat axis: one plane");
+        assert!(at(&g, 1, 1) > 2.0, "distinct planes");
+        assert_eq!((q[0], q[3], q[2], q[5]), (0, u16::MAX, 0, u16::MAX));
         let empty = Grid::over(&Aabb::EMPTY);
         assert_eq!((empty.origin, empty.step), (Vec3::ZERO, Vec3::ONE));
     }
@@ -192,5 +203,18 @@ mod tests {
         // planes x = 2, y = −1, z = 6.5: (plane − ro)·inv, exact in floats here
         let want = [4.0f32, 8.0, 3.75].map(|t| t.to_bits() as i32);
         assert_eq!(t, want);
+        // factors beyond the floats are clamped: far planes, never NaN
+        let huge = Grid {
+            origin: Vec3::splat(1e30),
+            step: Vec3::splat(1e30),
+        };
+        let r = huge.ray(Vec3::splat(-1e30), Vec3::new(1e20, -1e20, 1.0));
+        assert!(r.a.is_finite() && r.b.is_finite());
+        for q in [0, 1, u16::MAX] {
+            assert!(r
+                .t([q; 3])
+                .iter()
+                .all(|&t| !f32::from_bits(t as u32).is_nan()));
+        }
     }
 }
