@@ -129,24 +129,18 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     // the rays that enter the near one and leave the cube before the far one — the octant's
     // last record — end their walk there
     let dir = tempfile::tempdir().unwrap();
-    let mut obj = String::new();
-    for k in 0..8 {
+    let triangles = (0..8).map(|k| {
         let c = Vec3::new((k & 1) as f32, (k >> 1 & 1) as f32, (k >> 2 & 1) as f32);
-        for v in [
+        let t = [
             c,
             c + Vec3::new(0.1, 0.0, 0.0),
             c + Vec3::new(0.0, 0.1, 0.1),
-        ] {
-            obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
-        }
-        obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
-    }
-    std::fs::write(dir.path().join("corners.obj"), obj).unwrap();
-    let toml = "[camera]\nposition = [2.6, 2.7, 2.8]\nlook_at = [0.5, 0.5, 0.5]\nfov_y = 40.0\n\
-                [render]\nambient = [0.2, 0.2, 0.2]\n[[light]]\nposition = [3.0, 4.0, 2.0]\n\
-                [[object]]\ntype = \"obj\"\npath = \"corners.obj\"\ncolor = [0.8, 0.8, 0.8]\n";
-    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
-    let corners = gpgpu_rt::scene::Scene::load(&dir.path().join("scene.toml")).unwrap();
+        ];
+        (tri_obj(t), [0.8, 0.8, 0.8])
+    });
+    let head = "[camera]\nposition = [2.6, 2.7, 2.8]\nlook_at = [0.5, 0.5, 0.5]\nfov_y = 40.0\n\
+                [render]\nambient = [0.2, 0.2, 0.2]\n[[light]]\nposition = [3.0, 4.0, 2.0]\n";
+    let corners = scene_of(dir.path(), head, &triangles.collect::<Vec<_>>());
     let tree = gpgpu_rt::reference::bvh::Bvh::new(corners.world_triangles());
     assert_eq!(tree.nodes.len(), 3, "a root and two leaves");
     walks_match_the_twin(&ctx, &corners, (32, 32), false, true);

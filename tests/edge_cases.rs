@@ -22,29 +22,6 @@ use gpgpu_rt::reference::wagner_bvh::WagnerBvh;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
-/// A scene file in `dir`: `head` (camera, render, lights) and one object per (OBJ text, colour).
-fn scene_of(dir: &Path, head: &str, objects: &[(String, [f32; 3])]) -> Scene {
-    let mut toml = head.to_string();
-    for (k, (obj, c)) in objects.iter().enumerate() {
-        std::fs::write(dir.join(format!("o{k}.obj")), obj).unwrap();
-        toml += &format!(
-            "[[object]]\ntype = \"obj\"\npath = \"o{k}.obj\"\ncolor = [{:?}, {:?}, {:?}]\nspecular = 0.0\n",
-            c[0], c[1], c[2]
-        );
-    }
-    std::fs::write(dir.join("scene.toml"), toml).unwrap();
-    Scene::load(&dir.join("scene.toml")).unwrap()
-}
-
-/// An OBJ of one triangle.
-fn tri_obj(t: [Vec3; 3]) -> String {
-    let mut s = String::new();
-    for v in t {
-        s += &format!("v {:?} {:?} {:?}\n", v.x, v.y, v.z);
-    }
-    s + "f 1 2 3\n"
-}
-
 /// Every tracer: each registry entry (the grids at `grid_resolution`) and Wagner's megakernel,
 /// with a name for messages.
 fn every_tracer(grid_resolution: u32) -> Vec<(String, RenderOptions)> {

@@ -38,8 +38,9 @@ pub const ENTRY: Entry = Entry {
 
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the node records of every octant and
 /// the leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), the records
-/// addressed by texel and the triangles by word in the kernels' ints — which cannot overflow: `TextureBuffer::new` refuses a buffer of
-/// 2^31 bytes or more (or beyond `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it.
+/// addressed by texel and the triangles by word in the kernels' ints — which cannot overflow:
+/// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more (or beyond
+/// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it.
 fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
     let words = bvh.gpu_words();
     let data = TexelData::new;

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
@@ -238,4 +239,27 @@ pub fn run(args: &[&str]) -> std::process::Output {
 /// The standard error of a run, as text.
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A scene file in `dir`: `head` (camera, render, lights) and one object per (OBJ text, colour).
+pub fn scene_of(dir: &Path, head: &str, objects: &[(String, [f32; 3])]) -> Scene {
+    let mut toml = head.to_string();
+    for (k, (obj, c)) in objects.iter().enumerate() {
+        std::fs::write(dir.join(format!("o{k}.obj")), obj).unwrap();
+        toml += &format!(
+            "[[object]]\ntype = \"obj\"\npath = \"o{k}.obj\"\ncolor = [{:?}, {:?}, {:?}]\nspecular = 0.0\n",
+            c[0], c[1], c[2]
+        );
+    }
+    std::fs::write(dir.join("scene.toml"), toml).unwrap();
+    Scene::load(&dir.join("scene.toml")).unwrap()
+}
+
+/// An OBJ of one triangle.
+pub fn tri_obj(t: [Vec3; 3]) -> String {
+    let mut s = String::new();
+    for v in t {
+        s += &format!("v {:?} {:?} {:?}\n", v.x, v.y, v.z);
+    }
+    s + "f 1 2 3\n"
 }

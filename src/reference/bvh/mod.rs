@@ -159,8 +159,7 @@ impl Bvh {
         let mut stats = BvhStats {
             nodes: nodes.len(),
             leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
-            bytes: 4
-                * (HEADER_WORDS + OCTANTS * NODE_WORDS * nodes.len() + TRIANGLE_WORDS * ids.len()),
+            bytes: 4 * (triangle_base(nodes.len()) + TRIANGLE_WORDS * ids.len()),
             ..BvhStats::default()
         };
         build::measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
@@ -200,7 +199,7 @@ impl Bvh {
         use rayon::prelude::*;
         let n = self.nodes.len();
         let records = OCTANTS * NODE_WORDS * n;
-        let mut out = vec![0u32; HEADER_WORDS + records + TRIANGLE_WORDS * self.tris.len()];
+        let mut out = vec![0u32; self.stats.bytes / 4];
         let (head, rest) = out.split_at_mut(HEADER_WORDS);
         let bits = |v: Vec3| v.to_array().map(f32::to_bits);
         head[0] = n as u32;
@@ -267,7 +266,7 @@ impl Bvh {
 
     /// The word address of the first leaf triangle in [`Bvh::gpu_words`].
     pub fn triangle_base(&self) -> usize {
-        HEADER_WORDS + OCTANTS * NODE_WORDS * self.nodes.len()
+        triangle_base(self.nodes.len())
     }
 
     /// The shadow feeler's walk, as intersect2's: whether it is blocked, its triangle tests and
@@ -334,9 +333,9 @@ impl Bvh {
     /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5), bit for bit as
     /// `boxEntered` in the kernels: the box on the grid ([`Bvh::planes`]), each slab's near
     /// plane its low bound, or its high bound where the ray points down the axis (as the records
-    /// of [`Bvh::gpu_words`] store them), its distance q·a + b rounded twice ([`RayGrid::t`]), and the
-    /// largest entry and the smallest exit distance taken by integer max and min of the floats'
-    /// bits. For t ≥ +0 the order of the bits is the order of the floats; the entry distance is
+    /// of [`Bvh::gpu_words`] store them), its distance q·a + b rounded twice ([`RayGrid::t`]),
+    /// and the largest entry and the smallest exit distance taken by integer max and min of the
+    /// floats' bits. For t ≥ +0 the order of the bits is the order of the floats; the entry distance is
     /// at least `t_min` ≥ +0, and where an exit distance is negative so is the smallest of the
     /// bits — the box is missed either way (an exit at exactly −0.0 too, a box the ray leaves at
     /// its origin). No distance is NaN: 1/rd is finite ([`safe_inverse`]) and so are a and b.
@@ -347,6 +346,12 @@ impl Bvh {
         let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
         t_near <= t_far
     }
+}
+
+/// The word address of the first leaf triangle in [`Bvh::gpu_words`] of `n` nodes: after the
+/// header and the octants' records.
+fn triangle_base(n: usize) -> usize {
+    HEADER_WORDS + OCTANTS * NODE_WORDS * n
 }
 
 /// A box's near and far planes (step counts x, y, z) for rays of `octant`: per axis the low
