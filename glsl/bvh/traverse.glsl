@@ -124,11 +124,11 @@ void nodeStep(bool entered, int reference, inout int node, inout int leaf)
 
 // One pass of the node loop: the step of the record at texel `node`, and where that step goes
 // on to the next record — after an inner node entered or a leaf missed — the step of that record
-// too, whose texel is loaded and tested beside the first (ours). A node step's chain — the
-// texel load, the planes, the slab test, the next address — is longer than its instructions
-// take to issue on llvmpipe, so the second record's independent load and test cost less than a
-// pass of their own: the bunny's node passes per SIMD group 17.9 → 12.1 at 210 instructions
-// instead of 122, 0.95 of the time (docs/results/bvh_steps.md, step 24). `steps`: 1 or 2, the
+// too, whose texel is loaded and tested beside the first (ours). On llvmpipe the second
+// record's independent load and test cost less than a pass of their own: the bunny's node
+// passes per SIMD group 17.9 → 12.1 at 210 instructions instead of 122, 0.95 of the time
+// (docs/results/bvh_steps.md, step 24; not for the overlap of two chains of latencies alone:
+// a second walk's chain in the same loop did not pay, sixth session). `steps`: 1 or 2, the
 // nodes visited; the walk's order and counts are those of single steps. (At the octant's last
 // record the second texel is the next octant's root or the first leaf triangle, or for an
 // empty last octant past the buffer, which imageLoad reads as 0: loaded, never used.)
