@@ -1,0 +1,427 @@
+//! The lock step of the SAH BVH's walk on llvmpipe, simulated on the CPU (no GPU needed):
+//!
+//! ```sh
+//! gpgpu-rt render scenes/dragon.toml --tracer bvh --refl-depth 0 --frames 1 \
+//!     --width 512 --height 512 --aov-dir /tmp/aov -o /tmp/dragon.png
+//! cargo run --release --example walk_schedule -- scenes/dragon.toml /tmp/aov
+//! ```
+//!
+//! llvmpipe runs the 8 invocations of a SIMD group — a 4×2 block of pixels
+//! (`pixelPosition` in `glsl/common/images.glsl`) — in lock step, a loop until its last lane
+//! leaves it, and a loop entered by no lane once under an empty mask
+//! (`glsl/bvh/traverse.glsl`). This program walks each primary ray of the AOV directory through
+//! the records of [`Bvh::gpu_words`] as `traverse` does — node passes of one record, or of two
+//! where the walk goes on at the next record (step 24 of `docs/results/bvh_steps.md`), the
+//! triangle loop over each entered leaf — and counts per SIMD group the passes of the node
+//! loop and of the triangle loop, which are the trip counts callgrind measures per JIT block,
+//! beside what the lanes would need alone. It then counts two schedules that Mesa 22.3's
+//! llvmpipe makes costly, for what they could save: a speculative walk (Aila and Laine 2009) whose
+//! lanes walk on past a leaf until every lane of the group has one, which needs a group vote
+//! in each node pass, and a walk cut after a few passes of the outer loop whose unfinished rays
+//! a second dispatch walks on, 8 to a SIMD group.
+//!
+//! Every ray's node visits and triangle tests are checked against the CPU twin
+//! ([`Bvh::traverse`]); the program fails if one differs.
+
+use std::collections::VecDeque;
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use anyhow::{bail, ensure, Context, Result};
+use glam::Vec3;
+use gpgpu_rt::reference::bvh::{Bvh, LEAF_COUNT_BITS, TRIANGLE_WORDS};
+use gpgpu_rt::reference::intersect_triangle;
+use gpgpu_rt::scene::Scene;
+
+/// The SIMD group: 4×2 pixels.
+const BLOCK: (usize, usize) = (4, 2);
+
+/// An f32 `.npy` of shape [H, W, 3].
+fn read_rays(path: &Path) -> Result<(usize, usize, Vec<f32>)> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}", path.display()))?;
+    let npy = npyz::NpyFile::new(&bytes[..]).with_context(|| format!("{}", path.display()))?;
+    let shape = npy.shape().to_vec();
+    ensure!(
+        shape.len() == 3 && shape[2] == 3,
+        "{}: shape {shape:?}, not [H, W, 3]",
+        path.display()
+    );
+    let data = npy.into_vec::<f32>()?;
+    Ok((shape[0] as usize, shape[1] as usize, data))
+}
+
+/// The words of the hierarchy as the kernels read them.
+struct Records<'a> {
+    bvh: &'a Bvh,
+    words: Vec<u32>,
+}
+
+impl Records<'_> {
+    /// The texel of index `texel` (zeros past the buffer, as imageLoad reads them).
+    fn texel(&self, texel: i32) -> [u32; 4] {
+        let at = 4 * texel as usize;
+        match self.words.get(at..at + 4) {
+            Some(w) => [w[0], w[1], w[2], w[3]],
+            None => [0; 4],
+        }
+    }
+}
+
+/// One invocation: its ray, where its walk stands and what it has done.
+struct Lane {
+    ro: Vec3,
+    rd: Vec3,
+    grid_a: Vec3,
+    grid_b: Vec3,
+    node: i32,
+    end: i32,
+    limit: f32,
+    best: u32,
+    /// leaf references entered and not yet tested
+    pending: VecDeque<i32>,
+    nodes: u64,
+    tests: u64,
+    /// node passes this lane took part in
+    passes: u64,
+}
+
+impl Lane {
+    fn new(records: &Records, ro: Vec3, rd: Vec3) -> Lane {
+        let safe = |d: f32| if d.abs() < 1e-20 { 1e-20 } else { d };
+        let inv = Vec3::new(1.0 / safe(rd.x), 1.0 / safe(rd.y), 1.0 / safe(rd.z));
+        let octant = (0..3)
+            .map(|a| ((inv[a] < 0.0) as usize) << a)
+            .sum::<usize>();
+        let grid = records.bvh.grid.ray(ro, inv);
+        let node = records.bvh.root_texel(octant) as i32;
+        Lane {
+            ro,
+            rd,
+            grid_a: grid.a,
+            grid_b: grid.b,
+            node,
+            end: node + records.bvh.nodes.len() as i32,
+            limit: f32::INFINITY,
+            best: u32::MAX,
+            pending: VecDeque::new(),
+            nodes: 0,
+            tests: 0,
+            passes: 0,
+        }
+    }
+
+    fn walking(&self) -> bool {
+        self.node < self.end
+    }
+
+    /// `boxEntered` of traverse.glsl.
+    fn entered(&self, r: [u32; 4]) -> bool {
+        let q = |v: u32| (v & 0xffff) as f32;
+        let near = Vec3::new(q(r[0]), q(r[0] >> 16), q(r[1]));
+        let far = Vec3::new(q(r[1] >> 16), q(r[2]), q(r[2] >> 16));
+        let (tn, tf) = (
+            near * self.grid_a + self.grid_b,
+            far * self.grid_a + self.grid_b,
+        );
+        let bits = |t: f32| t.to_bits() as i32;
+        let t_near = bits(tn.x).max(bits(tn.y)).max(bits(tn.z)).max(0);
+        let t_far = bits(tf.x)
+            .min(bits(tf.y))
+            .min(bits(tf.z))
+            .min(bits(self.limit));
+        t_near <= t_far
+    }
+
+    /// `nodePass` of traverse.glsl (`pair`: step 24's second record), an entered leaf queued.
+    fn node_pass(&mut self, records: &Records, pair: bool) {
+        self.passes += 1;
+        let r0 = records.texel(self.node);
+        let e0 = self.entered(r0);
+        let second = pair && (r0[3] as i32 >= 0) == e0 && self.node + 1 < self.end;
+        let (entered, reference) = if second {
+            self.nodes += 1;
+            self.node += 1;
+            let r1 = records.texel(self.node);
+            (self.entered(r1), r1[3] as i32)
+        } else {
+            (e0, r0[3] as i32)
+        };
+        self.nodes += 1;
+        let inner = reference >= 0;
+        if entered && !inner {
+            self.pending.push_back(reference);
+        }
+        self.node = if !entered && inner {
+            reference
+        } else {
+            self.node + 1
+        };
+    }
+
+    /// Test the triangle of leaf entry `slot` (intersect1's triangleHit: the closest hit, ties
+    /// to the lower id).
+    fn test(&mut self, records: &Records, slot: usize) {
+        let at = records.bvh.triangle_base() + TRIANGLE_WORDS * slot;
+        self.hit(records.bvh, records.words[at + 3]);
+    }
+
+    fn hit(&mut self, bvh: &Bvh, id: u32) {
+        self.tests += 1;
+        let [v0, v1, v2] = bvh.triangles()[id as usize];
+        if let Some((t, _, _)) = intersect_triangle(self.ro, self.rd, v0, v1, v2) {
+            if t < self.limit || (t == self.limit && id < self.best) {
+                (self.limit, self.best) = (t, id);
+            }
+        }
+    }
+}
+
+/// A leaf reference's entries of `Bvh::tris`.
+fn leaf_slots(reference: i32) -> std::ops::Range<usize> {
+    let code = (-1 - reference) as usize;
+    let first = code >> LEAF_COUNT_BITS;
+    first..first + (code & ((1 << LEAF_COUNT_BITS) - 1))
+}
+
+/// Passes of a SIMD group's loops, summed over the groups.
+#[derive(Default)]
+struct Counts {
+    groups: u64,
+    node_passes: u64,
+    triangle_passes: u64,
+    empty_triangle_passes: u64,
+    outer_passes: u64,
+    /// per entry k of the node loop (k ≥ 3 together): passes, lane passes, lanes entering
+    loops: [[u64; 3]; 4],
+    /// the longest lane's node passes
+    longest: u64,
+}
+
+/// The node loop of today's walk: until every lane has entered a leaf or ended its walk (at
+/// least one pass).
+fn node_loop(group: &mut [Lane], records: &Records, pair: bool, k: usize, c: &mut Counts) {
+    let mut active: Vec<bool> = group.iter().map(Lane::walking).collect();
+    let entry = &mut c.loops[k.min(3)];
+    entry[2] += active.iter().filter(|&&a| a).count() as u64;
+    loop {
+        c.node_passes += 1;
+        entry[0] += 1;
+        for (lane, a) in group.iter_mut().zip(active.iter_mut()).filter(|(_, a)| **a) {
+            entry[1] += 1;
+            lane.node_pass(records, pair);
+            *a = lane.walking() && lane.pending.is_empty();
+        }
+        if !active.contains(&true) {
+            return;
+        }
+    }
+}
+
+/// The triangle loop: each lane tests its first pending leaf (at least one pass).
+fn triangle_loop(group: &mut [Lane], records: &Records, c: &mut Counts) {
+    let leaves: Vec<_> = group
+        .iter_mut()
+        .map(|l| l.pending.pop_front().map_or(0..0, leaf_slots))
+        .collect();
+    let passes = leaves.iter().map(|s| s.len() as u64).max().unwrap_or(0);
+    for (lane, slots) in group.iter_mut().zip(leaves) {
+        slots.for_each(|s| lane.test(records, s));
+    }
+    c.triangle_passes += passes.max(1);
+    c.empty_triangle_passes += (passes == 0) as u64;
+}
+
+/// Today's walk (glsl/bvh/traverse.glsl), at most `outer` passes of its outer loop.
+fn walk(group: &mut [Lane], records: &Records, pair: bool, outer: usize, c: &mut Counts) {
+    for k in 0..outer {
+        c.outer_passes += 1;
+        node_loop(group, records, pair, k, c);
+        triangle_loop(group, records, c);
+        if !group.iter().any(Lane::walking) {
+            return;
+        }
+    }
+}
+
+/// The speculative walk: a node pass while a walking lane has no pending leaf (a vote), each
+/// walking lane with fewer than `cap` pending leaves stepping on; then each lane's first
+/// pending leaf is tested.
+fn speculative(group: &mut [Lane], records: &Records, cap: usize, c: &mut Counts) {
+    while group.iter().any(|l| l.walking() || !l.pending.is_empty()) {
+        c.outer_passes += 1;
+        while group.iter().any(|l| l.walking() && l.pending.is_empty()) {
+            c.node_passes += 1;
+            for lane in group.iter_mut() {
+                if lane.walking() && lane.pending.len() < cap {
+                    lane.node_pass(records, true);
+                }
+            }
+        }
+        triangle_loop(group, records, c);
+    }
+}
+
+/// Each SIMD group of the image's primary rays.
+fn groups(records: &Records, width: usize, height: usize, o: &[f32], d: &[f32]) -> Vec<Vec<Lane>> {
+    let ray = |x: usize, y: usize| {
+        let i = 3 * (y * width + x);
+        let v = |a: &[f32]| Vec3::new(a[i], a[i + 1], a[i + 2]);
+        Lane::new(records, v(o), v(d))
+    };
+    let mut out = Vec::new();
+    for by in (0..height).step_by(BLOCK.1) {
+        for bx in (0..width).step_by(BLOCK.0) {
+            let lanes = (by..(by + BLOCK.1).min(height))
+                .flat_map(|y| (bx..(bx + BLOCK.0).min(width)).map(move |x| (x, y)))
+                .map(|(x, y)| ray(x, y));
+            out.push(lanes.collect());
+        }
+    }
+    out
+}
+
+/// Every ray's node visits and tests against the CPU twin's: the number that differ.
+fn check_twin(bvh: &Bvh, groups: &[Vec<Lane>]) -> usize {
+    let mut differ = 0;
+    for lane in groups.iter().flatten() {
+        let mut twin = Lane {
+            pending: VecDeque::new(),
+            limit: f32::INFINITY,
+            best: u32::MAX,
+            tests: 0,
+            ..*lane
+        };
+        let nodes = bvh.traverse(lane.ro, lane.rd, 0.0, f32::INFINITY, |ids| {
+            ids.iter().for_each(|&id| twin.hit(bvh, id));
+            ControlFlow::Continue(twin.limit)
+        });
+        differ +=
+            (nodes != lane.nodes || twin.tests != lane.tests || twin.best != lane.best) as usize;
+    }
+    differ
+}
+
+fn per_group(n: u64, c: &Counts) -> f64 {
+    n as f64 / c.groups as f64
+}
+
+fn report_walk(name: &str, all: &[Vec<Lane>], c: &Counts) {
+    let rays = all.iter().map(Vec::len).sum::<usize>() as f64;
+    let lane_passes: u64 = all.iter().flatten().map(|l| l.passes).sum();
+    let nodes: u64 = all.iter().flatten().map(|l| l.nodes).sum();
+    let tests: u64 = all.iter().flatten().map(|l| l.tests).sum();
+    println!(
+        "{name}: node loop {:.2} passes per SIMD group (its longest lane alone {:.2}, lanes' mean {:.2}; {:.2} nodes per ray, {:.2} per lane pass); triangle loop {:.2} passes ({:.2} with no lane testing; {:.3} tests per ray); outer loop {:.2}",
+        per_group(c.node_passes, c),
+        per_group(c.longest, c),
+        lane_passes as f64 / rays,
+        nodes as f64 / rays,
+        nodes as f64 / lane_passes as f64,
+        per_group(c.triangle_passes, c),
+        per_group(c.empty_triangle_passes, c),
+        tests as f64 / rays,
+        per_group(c.outer_passes, c),
+    );
+}
+
+/// Every SIMD group through `schedule`; the lanes after it and the counts.
+fn run(
+    mut all: Vec<Vec<Lane>>,
+    mut schedule: impl FnMut(&mut [Lane], &mut Counts),
+) -> (Vec<Vec<Lane>>, Counts) {
+    let mut c = Counts {
+        groups: all.len() as u64,
+        ..Counts::default()
+    };
+    for group in &mut all {
+        schedule(group, &mut c);
+        c.longest += group.iter().map(|l| l.passes).max().unwrap_or(0);
+    }
+    (all, c)
+}
+
+/// Today's walk with one and with two records per node pass, each ray checked against the twin.
+fn report_today(records: &Records, fresh: impl Fn() -> Vec<Vec<Lane>>) -> Result<()> {
+    for (name, pair) in [
+        ("one record per node pass (step 23)", false),
+        ("two records per node pass (step 24)", true),
+    ] {
+        let (all, c) = run(fresh(), |g, c| walk(g, records, pair, usize::MAX, c));
+        report_walk(name, &all, &c);
+        for (k, [passes, lane_passes, entering]) in c.loops.iter().enumerate().filter(|_| pair) {
+            println!(
+                "  node loop {k}{}: {:.2} passes per group, {:.2} lanes entering, lane utilisation {:.2}",
+                if k == 3 { " and later" } else { "" },
+                per_group(*passes, &c),
+                per_group(*entering, &c),
+                *lane_passes as f64 / (8.0 * *passes as f64)
+            );
+        }
+        let differ = check_twin(records.bvh, &all);
+        ensure!(
+            differ == 0,
+            "{differ} rays' node visits, tests or hits differ from the CPU twin's"
+        );
+    }
+    println!("checked: every ray's node visits, triangle tests and hit equal the CPU twin's");
+    Ok(())
+}
+
+/// The walk cut after `outer` passes of the outer loop, the unfinished rays walked on 8 to a
+/// SIMD group.
+fn report_cut(records: &Records, all: Vec<Vec<Lane>>, outer: usize) {
+    let rays = all.iter().map(Vec::len).sum::<usize>();
+    let (all, mut c) = run(all, |g, c| walk(g, records, true, outer, c));
+    let mut rest: Vec<Lane> = all.into_iter().flatten().filter(Lane::walking).collect();
+    let (first_nodes, first_triangles) = (c.node_passes, c.triangle_passes);
+    rest.chunks_mut(8)
+        .for_each(|g| walk(g, records, true, usize::MAX, &mut c));
+    println!(
+        "cut after {outer} outer passes: {:.2} node and {:.2} triangle passes per SIMD group, then {} rays ({:.1} %) walk on in {} SIMD groups: {:.2} and {:.2} more per first group",
+        per_group(first_nodes, &c),
+        per_group(first_triangles, &c),
+        rest.len(),
+        100.0 * rest.len() as f64 / rays as f64,
+        rest.len().div_ceil(8),
+        per_group(c.node_passes - first_nodes, &c),
+        per_group(c.triangle_passes - first_triangles, &c),
+    );
+}
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [scene, aov] = &args[..] else {
+        bail!("usage: walk_schedule SCENE.toml AOV_DIR (the primary rays of `render --aov-dir`)");
+    };
+    let scene = Scene::load(Path::new(scene))?;
+    let (height, width, origin) = read_rays(&Path::new(aov).join("ray_origin.npy"))?;
+    let (h2, w2, direction) = read_rays(&Path::new(aov).join("ray_direction.npy"))?;
+    ensure!(
+        (h2, w2) == (height, width),
+        "{aov}: ray_origin and ray_direction differ in shape"
+    );
+    let bvh = Bvh::new(scene.world_triangles());
+    let records = Records {
+        bvh: &bvh,
+        words: bvh.gpu_words(),
+    };
+    let fresh = || groups(&records, width, height, &origin, &direction);
+    println!(
+        "{} primary rays ({width}×{height}) in SIMD groups of {}×{}, {} triangles, {} nodes",
+        width * height,
+        BLOCK.0,
+        BLOCK.1,
+        bvh.triangles().len(),
+        bvh.nodes.len()
+    );
+    report_today(&records, fresh)?;
+    for cap in [2, 3] {
+        let (all, c) = run(fresh(), |g, c| speculative(g, &records, cap, c));
+        let name = format!("speculative, up to {cap} pending leaves, a vote per node pass");
+        report_walk(&name, &all, &c);
+    }
+    for outer in [2, 3] {
+        report_cut(&records, fresh(), outer);
+    }
+    Ok(())
+}
