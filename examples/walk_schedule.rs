@@ -20,6 +20,11 @@
 //! in each node pass, and a walk cut after a few passes of the outer loop whose unfinished rays
 //! a second dispatch walks on, 8 to a SIMD group.
 //!
+//! It also weighs how evenly llvmpipe's threads share each tile's dispatch — each takes one
+//! contiguous share of the work groups — with the tile's rows in the order of step 9 and in
+//! that of `PixelGrid::row_stride` (step 25), a SIMD group costed by the instructions
+//! callgrind counts per pass.
+//!
 //! Every ray's node visits and triangle tests are checked against the CPU twin
 //! ([`Bvh::traverse`]); the program fails if one differs.
 
@@ -29,12 +34,24 @@ use std::path::Path;
 
 use anyhow::{bail, ensure, Context, Result};
 use glam::Vec3;
+use gpgpu_rt::gl::PixelGrid;
 use gpgpu_rt::reference::bvh::{Bvh, LEAF_COUNT_BITS, TRIANGLE_WORDS};
 use gpgpu_rt::reference::intersect_triangle;
 use gpgpu_rt::scene::Scene;
 
 /// The SIMD group: 4×2 pixels.
 const BLOCK: (usize, usize) = (4, 2);
+
+/// The pixel kernels' work groups (8×8 pixels) and the default tile (`--tile 256`).
+const GROUP: usize = 8;
+const TILE: usize = 256;
+
+/// A SIMD group's instructions (callgrind, the dragon's intersect1 at step 24): a node pass
+/// 212, a triangle pass 249, the rest of the kernel about 1,420 (its straight-line code and
+/// the record store, docs/results/bvh_steps.md, sixth session).
+fn group_cost(c: &Counts) -> f64 {
+    212.0 * c.node_passes as f64 + 249.0 * c.triangle_passes as f64 + 1420.0
+}
 
 /// An f32 `.npy` of shape [H, W, 3].
 fn read_rays(path: &Path) -> Result<(usize, usize, Vec<f32>)> {
@@ -388,6 +405,70 @@ fn report_cut(records: &Records, all: Vec<Vec<Lane>>, outer: usize) {
     );
 }
 
+/// How evenly llvmpipe's `threads` threads share each tile's dispatch (each takes one
+/// contiguous share of its work groups in the order x, then y), the tile's rows taken in the
+/// order `row(y, rows)` (`pixelPosition`): the work over `threads` times the slowest share,
+/// summed over the tiles. Costs per SIMD group by [`group_cost`], in the order of [`groups`].
+fn share_efficiency(
+    costs: &[f64],
+    (width, height): (usize, usize),
+    threads: usize,
+    row: impl Fn(u32, u32) -> u32,
+) -> f64 {
+    let block_cols = width.div_ceil(BLOCK.0);
+    let mut shares = std::collections::HashMap::<(usize, usize), Vec<f64>>::new();
+    for (i, cost) in costs.iter().enumerate() {
+        let (px, py) = ((i % block_cols) * BLOCK.0, (i / block_cols) * BLOCK.1);
+        let (tx, ty) = (px / TILE, py / TILE);
+        let cols = TILE.min(width - tx * TILE).div_ceil(GROUP);
+        let rows = TILE.min(height - ty * TILE).div_ceil(GROUP) as u32;
+        let tile_row = ((py % TILE) / GROUP) as u32;
+        let y = (0..rows).find(|&y| row(y, rows) == tile_row);
+        let linear = y.expect("a row map is one-to-one") as usize * cols + (px % TILE) / GROUP;
+        let share = (linear / (cols * rows as usize / threads).max(1)).min(threads - 1);
+        shares.entry((tx, ty)).or_insert_with(|| vec![0.0; threads])[share] += cost;
+    }
+    let slowest: f64 = shares
+        .values()
+        .map(|s| s.iter().copied().fold(0.0, f64::max))
+        .sum();
+    costs.iter().sum::<f64>() / (threads as f64 * slowest)
+}
+
+/// The threads' shares of the step-24 walk with the rows in the order of step 9 and of step 25.
+fn report_shares(records: &Records, fresh: impl Fn() -> Vec<Vec<Lane>>, size: (usize, usize)) {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if threads < 2 {
+        return;
+    }
+    let costs: Vec<f64> = fresh()
+        .into_iter()
+        .map(|mut group| {
+            let mut c = Counts::default();
+            walk(&mut group, records, true, usize::MAX, &mut c);
+            group_cost(&c)
+        })
+        .collect();
+    // step 9: y·s mod rows, s the integer nearest rows/φ that is coprime to the rows
+    let step9 = |y: u32, rows: u32| {
+        let coprime =
+            |s: u32| (2..=s.min(rows)).all(|d| !s.is_multiple_of(d) || !rows.is_multiple_of(d));
+        let start = (rows as f64 * 0.618_033_988_75).round().max(1.0) as u32;
+        y * (start..)
+            .find(|&s| coprime(s))
+            .expect("rows + 1 is coprime")
+            % rows
+    };
+    let step25 = |y: u32, rows: u32| {
+        PixelGrid::tile_row(y, rows, PixelGrid::row_stride(rows, threads as u32))
+    };
+    println!(
+        "{threads} threads' shares of each {TILE}² tile (a SIMD group's instructions: 212 a node pass, 249 a triangle pass, 1,420 the rest): {:.3} of the even split with the rows of step 9, {:.3} with those of step 25",
+        share_efficiency(&costs, size, threads, step9),
+        share_efficiency(&costs, size, threads, step25)
+    );
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [scene, aov] = &args[..] else {
@@ -415,6 +496,7 @@ fn main() -> Result<()> {
         bvh.nodes.len()
     );
     report_today(&records, fresh)?;
+    report_shares(&records, fresh, (width, height));
     for cap in [2, 3] {
         let (all, c) = run(fresh(), |g, c| speculative(g, &records, cap, c));
         let name = format!("speculative, up to {cap} pending leaves, a vote per node pass");

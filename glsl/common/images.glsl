@@ -29,9 +29,15 @@ uniform ivec2 tileOffset;
 // - Mesa's llvmpipe hands each of its N threads one contiguous 1/N of a dispatch's work groups,
 //   row after row, so with an object in the middle of the image one thread got the busy rows
 //   and the others waited (the bunny's BVH intersect1: 34 ms on two threads, 26 ms with
-//   LP_NUM_THREADS=3 on the same two cores). Work-group row y therefore covers the tile's row
-//   y·tileRowStride mod rows, the stride coprime to the rows (the host's choice, near rows/φ:
-//   PixelGrid::row_stride), so that every contiguous share of a dispatch spreads over the tile.
+//   LP_NUM_THREADS=3 on the same two cores). Work-group row y < rows − 1 therefore covers the
+//   tile's row y·tileRowStride mod (rows − 1), and the last row itself: where the N threads
+//   divide the rows the stride is N, which gives thread t the rows t, t + N, t + 2N, … —
+//   neighbours of the other threads' rows, so every share costs about the same; else a stride
+//   coprime to rows − 1 near (rows − 1)/φ, which spreads every contiguous share over the tile
+//   (PixelGrid::row_stride, GlInfo::dispatch_threads). The earlier order, y·s mod rows with s
+//   near rows/φ for any thread count, left two threads' shares 0.91 of an even split (the
+//   bunny's and the dragon's BVH intersect1, examples/walk_schedule.rs), the shuffle 0.98–0.99:
+//   0.92 of the time in alternating pairs (docs/results/bvh_steps.md, step 25).
 // - llvmpipe runs 8 invocations of consecutive x as one SIMD group; they take a 4×2 block of
 //   pixels instead of a row of 8, whose rays diverge less (BVH intersect1 ~5 % faster).
 uniform int tileRowStride;
@@ -39,8 +45,8 @@ uniform int tileRowStride;
 // The pixel this invocation works on (storePos in the thesis, ch. 4).
 ivec2 pixelPosition()
 {
-    int rows = int(gl_NumWorkGroups.y);
-    int row = int(gl_WorkGroupID.y) * max(tileRowStride, 1) % rows;
+    int rows = int(gl_NumWorkGroups.y), y = int(gl_WorkGroupID.y);
+    int row = y == rows - 1 ? y : y * max(tileRowStride, 1) % max(rows - 1, 1);
     ivec2 l = ivec2(gl_LocalInvocationID.xy);
     // SIMD group l.y: block (l.y & 1, l.y >> 1) of 4×2 pixels; lane l.x within it
     ivec2 inGroup = ivec2((l.y & 1) * 4 + (l.x & 3), (l.y >> 1) * 2 + (l.x >> 2));

@@ -50,6 +50,26 @@ impl GlInfo {
     pub fn is_llvmpipe(&self) -> bool {
         self.renderer.contains("llvmpipe")
     }
+
+    /// The threads among which the implementation splits a dispatch's work groups, each taking
+    /// one contiguous share of them in the order x, then y ([`PixelGrid::row_stride`] spreads
+    /// the tile's rows over the shares): for llvmpipe its compute threads as Mesa 22.3 counts
+    /// them (`lp_screen.c`: `LP_NUM_THREADS`, else the CPUs where there are more than one — we
+    /// take those of `std::thread::available_parallelism` — and at most 16, `LP_MAX_THREADS`;
+    /// with 0 the calling thread runs them all), 1 elsewhere: a GPU hands its work groups out
+    /// as they finish. A count that misses Mesa's changes only how evenly the shares are
+    /// loaded.
+    pub fn dispatch_threads(&self) -> u32 {
+        if !self.is_llvmpipe() {
+            return 1;
+        }
+        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
+        let threads = std::env::var("LP_NUM_THREADS")
+            .ok()
+            .and_then(|v| v.trim().parse::<u32>().ok())
+            .unwrap_or(if cpus > 1 { cpus } else { 0 });
+        threads.clamp(1, 16)
+    }
 }
 
 /// A current GL context. Dropping it releases the context.

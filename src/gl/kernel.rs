@@ -31,11 +31,14 @@ pub struct PixelGrid {
     pub height: u32,
     /// Dispatches cover at most tile×tile pixels (0: the whole image in one dispatch).
     pub tile: u32,
+    /// The threads that split a dispatch's work groups in contiguous shares
+    /// ([`super::GlInfo::dispatch_threads`]).
+    pub threads: u32,
 }
 
 impl PixelGrid {
     /// Check the tile size: a multiple of the work group size, or 0.
-    pub fn new(width: u32, height: u32, tile: u32) -> Result<PixelGrid> {
+    pub fn new(width: u32, height: u32, tile: u32, threads: u32) -> Result<PixelGrid> {
         if !tile.is_multiple_of(PIXEL_GROUP) {
             bail!(
                 "--tile {tile} must be a multiple of {PIXEL_GROUP} (the kernels' work group size)"
@@ -45,17 +48,36 @@ impl PixelGrid {
             width,
             height,
             tile,
+            threads: threads.max(1),
         })
     }
 
-    /// The stride through `rows` work-group rows of a tile (`tileRowStride` in
-    /// `glsl/common/images.glsl`): the integer nearest rows/φ that is coprime to `rows`, so that
-    /// y·stride mod rows visits every row once and consecutive rows land far apart.
-    pub fn row_stride(rows: u32) -> u32 {
-        let start = ((rows as f64) * 0.618_033_988_75).round().max(1.0) as u32;
+    /// The stride s through the `rows` work-group rows of a tile (`tileRowStride` in
+    /// `glsl/common/images.glsl`): dispatch row y < rows − 1 covers the tile's row
+    /// y·s mod (rows − 1), the last row itself — one row each, as s is coprime to rows − 1.
+    /// Where `threads` (> 1) divide the rows, s is their number: the shuffle that gives the
+    /// share of thread t (dispatch rows t·rows/threads and on) the tile's rows t, t + threads,
+    /// t + 2·threads, …, neighbours of the other threads' rows, so the shares cost the same
+    /// wherever the image is busy. Otherwise the integer nearest (rows − 1)/φ coprime to
+    /// rows − 1, which spreads every contiguous share over the tile.
+    pub fn row_stride(rows: u32, threads: u32) -> u32 {
+        if threads > 1 && rows.is_multiple_of(threads) {
+            return threads;
+        }
+        let m = rows.saturating_sub(1).max(1);
+        let start = ((m as f64) * 0.618_033_988_75).round().max(1.0) as u32;
         (start..)
-            .find(|&s| gcd(s, rows) == 1)
-            .expect("rows + 1 is coprime to rows")
+            .find(|&s| gcd(s, m) == 1)
+            .expect("m + 1 is coprime to m")
+    }
+
+    /// The tile's row that dispatch row `y` of `rows` covers (as `pixelPosition` computes it).
+    pub fn tile_row(y: u32, rows: u32, stride: u32) -> u32 {
+        if y + 1 == rows {
+            y
+        } else {
+            y * stride % rows.saturating_sub(1).max(1)
+        }
     }
 
     /// The tiles as (x, y, width, height), row by row.
@@ -185,7 +207,8 @@ impl Kernel {
         for (tx, ty, tw, th) in grid.tiles() {
             self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
             let rows = th.div_ceil(group);
-            self.set_i32("tileRowStride", PixelGrid::row_stride(rows) as i32);
+            let stride = PixelGrid::row_stride(rows, grid.threads);
+            self.set_i32("tileRowStride", stride as i32);
             timers.time(gl, self.timer, || {
                 // SAFETY: dispatch of the program in use.
                 unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
@@ -241,41 +264,44 @@ mod tests {
     use super::*;
 
     #[test]
-    fn row_strides_visit_every_row_once_and_spread_each_half() {
-        for rows in 1..=300u32 {
-            let s = PixelGrid::row_stride(rows);
-            let mut seen: Vec<u32> = (0..rows).map(|y| y * s % rows).collect();
-            // each half of the dispatch's rows (two threads' shares) covers rows of both
-            // halves of the tile about equally
-            let top = seen[..(rows / 2) as usize]
-                .iter()
-                .filter(|&&r| r < rows / 2)
-                .count() as f64;
-            seen.sort_unstable();
-            assert_eq!(
-                seen,
-                (0..rows).collect::<Vec<_>>(),
-                "{rows} rows, stride {s}"
-            );
-            if rows >= 16 {
-                let share = top / (rows / 2) as f64;
-                assert!((0.3..=0.7).contains(&share), "{rows} rows: {share}");
+    fn tile_rows_visit_every_row_once_and_load_each_share_alike() {
+        for threads in 1..=8u32 {
+            for rows in 1..=300u32 {
+                let s = PixelGrid::row_stride(rows, threads);
+                let map: Vec<u32> = (0..rows).map(|y| PixelGrid::tile_row(y, rows, s)).collect();
+                let mut seen = map.clone();
+                seen.sort_unstable();
+                let all: Vec<u32> = (0..rows).collect();
+                assert_eq!(seen, all, "{rows} rows, {threads} threads, stride {s}");
+                if threads > 1 && rows % threads == 0 {
+                    // thread t's contiguous share of the dispatch rows: the tile's rows t,
+                    // t + threads, ...
+                    for (y, &row) in map.iter().enumerate() {
+                        let t = y as u32 / (rows / threads);
+                        assert_eq!(row % threads, t, "{rows} rows, {threads} threads, y {y}");
+                    }
+                } else if rows >= 16 {
+                    // each half of the dispatch rows covers both halves of the tile about equally
+                    let top = map[..(rows / 2) as usize].iter().filter(|&&r| r < rows / 2);
+                    let share = top.count() as f64 / (rows / 2) as f64;
+                    assert!((0.3..=0.7).contains(&share), "{rows} rows: {share}");
+                }
             }
         }
     }
 
     #[test]
     fn tiles_cover_the_image_once() {
-        let g = PixelGrid::new(100, 37, 32).unwrap();
+        let g = PixelGrid::new(100, 37, 32, 2).unwrap();
         let tiles = g.tiles();
         let area: u32 = tiles.iter().map(|t| t.2 * t.3).sum();
         assert_eq!(area, 100 * 37);
         assert_eq!(tiles.len(), 4 * 2);
         assert_eq!(tiles.last(), Some(&(96, 32, 4, 5)));
         assert_eq!(
-            PixelGrid::new(100, 37, 0).unwrap().tiles(),
+            PixelGrid::new(100, 37, 0, 1).unwrap().tiles(),
             vec![(0, 0, 100, 37)]
         );
-        assert!(PixelGrid::new(8, 8, 12).is_err());
+        assert!(PixelGrid::new(8, 8, 12, 1).is_err());
     }
 }

@@ -174,7 +174,7 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
     if w == 0 || h == 0 || w > max_tex || h > max_tex {
         bail!("image size {w}x{h} outside 1..={max_tex} (GL_MAX_TEXTURE_SIZE)");
     }
-    PixelGrid::new(w, h, options.tile)
+    PixelGrid::new(w, h, options.tile, info.dispatch_threads())
 }
 
 /// The error for more lights than `flags` holds: it suggests the bitwise layout only where

@@ -185,7 +185,12 @@ impl SoftShadowRenderer {
         if options.width == 0 || options.height == 0 {
             bail!("width and height must be positive");
         }
-        let pixels = PixelGrid::new(options.width, options.height, options.tile)?;
+        let pixels = PixelGrid::new(
+            options.width,
+            options.height,
+            options.tile,
+            info.dispatch_threads(),
+        )?;
         let packed = pack(info, &tree)?;
         let samples = (options.samples_u, options.samples_v);
         let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples)?;

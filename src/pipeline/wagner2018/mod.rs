@@ -194,7 +194,7 @@ fn check(info: &GlInfo, scene: &Scene, o: &WagnerOptions) -> Result<PixelGrid> {
             o.tile
         );
     }
-    PixelGrid::new(w, h, o.tile)
+    PixelGrid::new(w, h, o.tile, info.dispatch_threads())
 }
 
 impl WagnerRenderer {
