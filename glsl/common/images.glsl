@@ -36,8 +36,9 @@ uniform ivec2 tileOffset;
 //   coprime to rows − 1 near (rows − 1)/φ, which spreads every contiguous share over the tile
 //   (PixelGrid::row_stride, GlInfo::dispatch_threads). The earlier order, y·s mod rows with s
 //   near rows/φ for any thread count, left two threads' shares 0.91 of an even split (the
-//   bunny's and the dragon's BVH intersect1, examples/walk_schedule.rs), the shuffle 0.98–0.99:
-//   0.92 of the time in alternating pairs (docs/results/bvh_steps.md, step 25).
+//   bunny's and the dragon's BVH intersect1, examples/walk_schedule.rs), the shuffle 0.98–0.99;
+//   24 alternating pairs gave 0.92 of the time, later runs on a slower machine did not confirm
+//   it (docs/results/bvh_steps.md, step 25).
 // - llvmpipe runs 8 invocations of consecutive x as one SIMD group; they take a 4×2 block of
 //   pixels instead of a row of 8, whose rays diverge less (BVH intersect1 ~5 % faster).
 uniform int tileRowStride;

@@ -55,7 +55,8 @@ impl GlInfo {
     /// one contiguous share of them in the order x, then y ([`PixelGrid::row_stride`] spreads
     /// the tile's rows over the shares): for llvmpipe its compute threads as Mesa 22.3 counts
     /// them (`lp_screen.c`: `LP_NUM_THREADS`, else the CPUs where there are more than one — we
-    /// take those of `std::thread::available_parallelism` — and at most 16, `LP_MAX_THREADS`;
+    /// take those of `std::thread::available_parallelism` — and at most `LP_MAX_THREADS`: we
+    /// cap at 16, the bound of older releases, where later ones allow 32;
     /// with 0 the calling thread runs them all), 1 elsewhere: a GPU hands its work groups out
     /// as they finish. A count that misses Mesa's changes only how evenly the shares are
     /// loaded.

@@ -64,7 +64,7 @@ impl PixelGrid {
         if threads > 1 && rows.is_multiple_of(threads) {
             return threads;
         }
-        let m = rows.saturating_sub(1).max(1);
+        let m = Self::row_modulus(rows);
         let start = ((m as f64) * 0.618_033_988_75).round().max(1.0) as u32;
         (start..)
             .find(|&s| gcd(s, m) == 1)
@@ -76,8 +76,13 @@ impl PixelGrid {
         if y + 1 == rows {
             y
         } else {
-            y * stride % rows.saturating_sub(1).max(1)
+            y * stride % Self::row_modulus(rows)
         }
+    }
+
+    /// The modulus of the rows' order: rows − 1 (at least 1; the last row stays in place).
+    fn row_modulus(rows: u32) -> u32 {
+        rows.saturating_sub(1).max(1)
     }
 
     /// The tiles as (x, y, width, height), row by row.
