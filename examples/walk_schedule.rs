@@ -35,7 +35,7 @@ use std::path::Path;
 use anyhow::{bail, ensure, Context, Result};
 use glam::Vec3;
 use gpgpu_rt::gl::PixelGrid;
-use gpgpu_rt::reference::bvh::{Bvh, LEAF_COUNT_BITS, TRIANGLE_WORDS};
+use gpgpu_rt::reference::bvh::{BlockEntry, Bvh, END, LEAF_COUNT_BITS, TRIANGLE_WORDS};
 use gpgpu_rt::reference::intersect_triangle;
 use gpgpu_rt::scene::Scene;
 
@@ -44,6 +44,10 @@ const BLOCK: (usize, usize) = (4, 2);
 
 /// The pixel kernels' work groups (8×8 pixels) and the default tile (`--tile 256`).
 const GROUP: usize = 8;
+const _: () = assert!(
+    GROUP == gpgpu_rt::reference::bvh::BLOCK as usize,
+    "a block of entry.comp"
+);
 const TILE: usize = 256;
 
 /// A SIMD group's instructions (callgrind, the dragon's intersect1 at step 24): a node pass
@@ -71,6 +75,37 @@ fn read_rays(path: &Path) -> Result<(usize, usize, Vec<f32>)> {
 struct Records<'a> {
     bvh: &'a Bvh,
     words: Vec<u32>,
+    /// per octant, the texel of every node's record ([`Bvh::record_texels`])
+    texels: Vec<Vec<u32>>,
+}
+
+/// The entry point of every 8×8 block of the image (`glsl/bvh/entry.comp`, step 26 of
+/// `docs/results/bvh_steps.md`), the blocks in GL's order (rows from the bottom).
+struct Entries {
+    blocks: Vec<Option<BlockEntry>>,
+    width: usize,
+    height: usize,
+}
+
+impl Entries {
+    fn new(bvh: &Bvh, (width, height): (usize, usize), o: &[f32], d: &[f32]) -> Entries {
+        let blocks = bvh.block_entries((width as u32, height as u32), |x, y| {
+            let i = 3 * ((height - 1 - y as usize) * width + x as usize);
+            let v = |a: &[f32]| Vec3::new(a[i], a[i + 1], a[i + 2]);
+            Some((v(o), v(d)))
+        });
+        Entries {
+            blocks,
+            width,
+            height,
+        }
+    }
+
+    /// The entry of the pixel in column x, row `row` of the AOVs (from the top).
+    fn at(&self, x: usize, row: usize) -> Option<BlockEntry> {
+        let (b, y) = (GROUP, self.height - 1 - row);
+        self.blocks[y / b * self.width.div_ceil(b) + x / b]
+    }
 }
 
 impl Records<'_> {
@@ -100,30 +135,43 @@ struct Lane {
     tests: u64,
     /// node passes this lane took part in
     passes: u64,
+    /// its block's entry point (`None`: it walks from its root)
+    entry: Option<BlockEntry>,
 }
 
 impl Lane {
-    fn new(records: &Records, ro: Vec3, rd: Vec3) -> Lane {
+    fn new(records: &Records, ro: Vec3, rd: Vec3, entry: Option<BlockEntry>) -> Lane {
         let safe = |d: f32| if d.abs() < 1e-20 { 1e-20 } else { d };
         let inv = Vec3::new(1.0 / safe(rd.x), 1.0 / safe(rd.y), 1.0 / safe(rd.z));
         let octant = (0..3)
             .map(|a| ((inv[a] < 0.0) as usize) << a)
             .sum::<usize>();
         let grid = records.bvh.grid.ray(ro, inv);
-        let node = records.bvh.root_texel(octant) as i32;
+        let (root, n) = (
+            records.bvh.root_texel(octant) as i32,
+            records.bvh.nodes.len(),
+        );
+        // the walk of traverse.glsl: from the entry's record to the texel after its subtree if
+        // the ray is of the entry's octant, else the whole octant's copy
+        let texel = |k: i32| records.texels[octant][if k == END { n } else { k as usize }] as i32;
+        let (node, end) = match entry {
+            Some(e) if e.octant == octant => (texel(e.node), texel(e.stop)),
+            _ => (root, root + n as i32),
+        };
         Lane {
             ro,
             rd,
             grid_a: grid.a,
             grid_b: grid.b,
             node,
-            end: node + records.bvh.nodes.len() as i32,
+            end,
             limit: f32::INFINITY,
             best: u32::MAX,
             pending: VecDeque::new(),
             nodes: 0,
             tests: 0,
             passes: 0,
+            entry,
         }
     }
 
@@ -278,12 +326,18 @@ fn speculative(group: &mut [Lane], records: &Records, cap: usize, c: &mut Counts
     }
 }
 
-/// Each SIMD group of the image's primary rays.
-fn groups(records: &Records, width: usize, height: usize, o: &[f32], d: &[f32]) -> Vec<Vec<Lane>> {
+/// Each SIMD group of the image's primary rays, walking from their blocks' entries or (`None`)
+/// from the root.
+fn groups(
+    records: &Records,
+    (width, height): (usize, usize),
+    (o, d): (&[f32], &[f32]),
+    entries: Option<&Entries>,
+) -> Vec<Vec<Lane>> {
     let ray = |x: usize, y: usize| {
         let i = 3 * (y * width + x);
         let v = |a: &[f32]| Vec3::new(a[i], a[i + 1], a[i + 2]);
-        Lane::new(records, v(o), v(d))
+        Lane::new(records, v(o), v(d), entries.and_then(|e| e.at(x, y)))
     };
     let mut out = Vec::new();
     for by in (0..height).step_by(BLOCK.1) {
@@ -308,7 +362,8 @@ fn check_twin(bvh: &Bvh, groups: &[Vec<Lane>]) -> usize {
             tests: 0,
             ..*lane
         };
-        let nodes = bvh.traverse(lane.ro, lane.rd, 0.0, f32::INFINITY, |ids| {
+        let (entry, ro, rd) = (lane.entry.as_ref(), lane.ro, lane.rd);
+        let nodes = bvh.traverse_from(entry, ro, rd, 0.0, f32::INFINITY, |ids| {
             ids.iter().for_each(|&id| twin.hit(bvh, id));
             ControlFlow::Continue(twin.limit)
         });
@@ -357,15 +412,34 @@ fn run(
     (all, c)
 }
 
-/// Today's walk with one and with two records per node pass, each ray checked against the twin.
-fn report_today(records: &Records, fresh: impl Fn() -> Vec<Vec<Lane>>) -> Result<()> {
-    for (name, pair) in [
-        ("one record per node pass (step 23)", false),
-        ("two records per node pass (step 24)", true),
+/// The walk from the root with one and with two records per node pass, and today's, from the
+/// blocks' entries; each ray checked against the twin.
+fn report_today(
+    records: &Records,
+    from_root: impl Fn() -> Vec<Vec<Lane>>,
+    fresh: impl Fn() -> Vec<Vec<Lane>>,
+) -> Result<()> {
+    for (name, pair, today) in [
+        (
+            "from the root, one record per node pass (step 23)",
+            false,
+            false,
+        ),
+        (
+            "from the root, two records per node pass (step 24)",
+            true,
+            false,
+        ),
+        (
+            "from the blocks' entries, two records per node pass (step 26)",
+            true,
+            true,
+        ),
     ] {
-        let (all, c) = run(fresh(), |g, c| walk(g, records, pair, usize::MAX, c));
+        let lanes = if today { fresh() } else { from_root() };
+        let (all, c) = run(lanes, |g, c| walk(g, records, pair, usize::MAX, c));
         report_walk(name, &all, &c);
-        for (k, [passes, lane_passes, entering]) in c.loops.iter().enumerate().filter(|_| pair) {
+        for (k, [passes, lane_passes, entering]) in c.loops.iter().enumerate().filter(|_| today) {
             println!(
                 "  node loop {k}{}: {:.2} passes per group, {:.2} lanes entering, lane utilisation {:.2}",
                 if k == 3 { " and later" } else { "" },
@@ -485,8 +559,12 @@ fn main() -> Result<()> {
     let records = Records {
         bvh: &bvh,
         words: bvh.gpu_words(),
+        texels: (0..8).map(|o| bvh.record_texels(o)).collect(),
     };
-    let fresh = || groups(&records, width, height, &origin, &direction);
+    let rays = (&origin[..], &direction[..]);
+    let entries = Entries::new(&bvh, (width, height), &origin, &direction);
+    let from_root = || groups(&records, (width, height), rays, None);
+    let fresh = || groups(&records, (width, height), rays, Some(&entries));
     println!(
         "{} primary rays ({width}×{height}) in SIMD groups of {}×{}, {} triangles, {} nodes",
         width * height,
@@ -495,7 +573,7 @@ fn main() -> Result<()> {
         bvh.triangles().len(),
         bvh.nodes.len()
     );
-    report_today(&records, fresh)?;
+    report_today(&records, from_root, fresh)?;
     report_shares(&records, fresh, (width, height));
     for cap in [2, 3] {
         let (all, c) = run(fresh(), |g, c| speculative(g, &records, cap, c));

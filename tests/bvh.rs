@@ -168,11 +168,24 @@ fn walks_match_the_twin(
             "every ray down all three axes"
         );
     }
+    // the primary rays walk from their 8×8 block's entry point (glsl/bvh/entry.comp); the AOVs'
+    // rows run from the top, GL's (and the blocks') from the bottom
+    let aov_index = |x: u32, y: u32| ((h - 1 - y) * w + x) as usize;
+    let ray = |x, y| {
+        let i = aov_index(x, y);
+        Some((
+            Vec3::from(aovs.ray_origin[i]),
+            Vec3::from(aovs.ray_direction[i]),
+        ))
+    };
+    let entries = twin.block_entries((w, h), ray);
     let (mut nodes, mut tests) = (0u64, 0u64);
-    for (o, d) in aovs.ray_origin.iter().zip(&aovs.ray_direction) {
-        let (ro, rd) = (Vec3::from(*o), Vec3::from(*d));
+    for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+        let (ro, rd) = ray(x, y).unwrap();
+        let b = gpgpu_rt::reference::bvh::BLOCK;
+        let entry = entries[((y / b) * w.div_ceil(b) + x / b) as usize];
         let mut best = None;
-        nodes += twin.traverse(ro, rd, 0.0, f32::INFINITY, |ids| {
+        nodes += twin.traverse_from(entry.as_ref(), ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
             closest_among(&mut best, twin.triangles(), ids, (ro, rd, -1), &mut tests);
             ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))

@@ -1,6 +1,7 @@
 // intersect1 kernel of the BVH — ours, after Wagner 2018 ch. 3.2 (SAH BVH, eq. 4.1) and 4.2
 // (traversal, Möller–Trumbore Listing 4.2 = Müller's Algorithm 1): the closest hit of each ray
-// by an ordered traversal of the CPU-built BVH (bvh/traverse.glsl). Deviations: see there;
+// by an ordered traversal of the CPU-built BVH (bvh/traverse.glsl), from its block's entry
+// point (bvh/entry.comp, ours: Reshetov et al. 2005). Deviations: see there;
 // equal distances go to the lower triangle id, as in the base tracer's loop, so the image
 // equals the base tracer's. Listings 13, 14 of Müller 2015: common/intersect1_main.glsl.
 #if RECORD_STORE_64
@@ -8,6 +9,9 @@
 #endif
 #include "../common/intersect_head.glsl"
 #include "traverse.glsl"
+
+// the entry point of each 8×8 block of rays (bvh/entry.comp, run before this kernel)
+layout(rgba32ui, binding = IMAGE_BVH_ENTRIES) readonly uniform uimage2D bvhEntries;
 
 #if !HIT_RECORDS
 #error "the BVH's intersect1 stores hit records (bvh/hit_record.glsl): it keeps no u, v"
@@ -41,7 +45,7 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
 {
     rayO = ro; rayD = rd; rayLast = lastTriID;
     bestT = t_min; bestID = triID;
-    traverse(ro, rd, 0.0, bestT);
+    traverse(ro, rd, 0.0, bestT, imageLoad(bvhEntries, storePos >> 3).xyz);
     t_min = bestT; triID = bestID;
     closestHitRecord = bestAt;
 }

@@ -63,21 +63,21 @@
 // next leaf search), the triangle loop behind the lanes that entered a leaf — each loop's exit
 // test is its back edge, and what is left is one triangle pass per SIMD group (the last outer
 // pass, whose lanes all end their walk without a leaf) (docs/results/bvh_steps.md, step 18).
-// The first passes need no test: a walk starts at its octant's root (node < end, guard = 0 <
-// bound), and the outer loop goes on only with node < end and guard < bound.
+// The outer loop's first pass needs no test of its own: the test inside it holds (node < end,
+// guard = 0 < bound) unless the walk's block entry is empty (node == end, bvh/entry.comp: every
+// ray of the block misses the root), and the outer loop goes on only with node < end and
+// guard < bound.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
 
 #include "words.glsl"
+#include "octant.glsl"
 
 bool triangleHit(int at, int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
 
 // the word address of the first leaf triangle (after the records)
 int triangleBase = 0;
-
-// 1/rd with zero (and tiny) components replaced by 1e-20: the slab test never computes 0·inf.
-float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 
 // Listing 4.5: does the ray enter the box of `record` (its planes where the ray enters and
 // leaves the slabs, 16-bit step counts on the grid) at some tMin <= t <= limit? (Wagner tests
@@ -102,8 +102,8 @@ float safeInverse(float d) { return 1.0 / (abs(d) < 1e-20 ? 1e-20 : d); }
 // RayGrid::t) computes the same bits.
 bool boxEntered(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit)
 {
-    vec3 near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));
-    vec3 far = vec3(ivec3(record.y >> 16u, record.z & 0xffffu, record.z >> 16u));
+    vec3 near, far;
+    recordPlanes(record, near, far);
     ivec3 tNears = floatBitsToInt(near * gridA + gridB);
     ivec3 tFars = floatBitsToInt(far * gridA + gridB);
     int tNear = max(max(tNears.x, tNears.y), max(tNears.z, floatBitsToInt(tMin)));
@@ -161,11 +161,14 @@ bool leafTriangles(inout int slot, int slotEnd, inout float limit)
     return false;
 }
 
-// The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it.
-bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
+// The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it. `entry`: the
+// entry point of the ray's block (bvh/entry.comp: its octant, first record and the texel after
+// its subtree) — a ray of that octant walks that subtree only, the others (and every ray where
+// entry.x is no octant, as in intersect2) the whole tree.
+bool traverse(vec3 ro, vec3 rd, float tMin, float limit, uvec3 entry)
 {
-    vec3 inv = vec3(safeInverse(rd.x), safeInverse(rd.y), safeInverse(rd.z));
-    int octant = (inv.x < 0.0 ? 1 : 0) | (inv.y < 0.0 ? 2 : 0) | (inv.z < 0.0 ? 4 : 0);
+    vec3 inv = safeInverses(rd);
+    int octant = rayOctant(inv);
     // the header: the node count N and the grid (plane q of axis a at origin[a] + q·step[a])
     uvec4 header = bvhTexel(0);
     vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhTexel(4).xyz);
@@ -179,6 +182,10 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit)
     // the root: the first record of the octant's copy; end: the texel after its last
     int node = BVH_HEADER_WORDS / 4 + octant * nodes;
     int end = node + nodes;
+    if (int(entry.x) == octant) {
+        node = int(entry.y);
+        end = int(entry.z);
+    }
     // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
     // below slotEnd
     int slot = 0, slotEnd = 0;

@@ -17,11 +17,12 @@ use super::{
     Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind, MAX_PIXEL_EVENTS,
 };
 use crate::frame::FrameStats;
-use crate::gl::resources::{TexelData, TextureBuffers};
+use crate::gl::kernel::PIXEL_GROUP;
+use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::reference::bvh::{
-    Bvh as CpuBvh, BvhStats, HEADER_WORDS, LEAF_COUNT_BITS, NODE_WORDS, TRIANGLE_WORDS,
+    Bvh as CpuBvh, BvhStats, BLOCK, HEADER_WORDS, LEAF_COUNT_BITS, NODE_WORDS, TRIANGLE_WORDS,
 };
 use crate::reference::CpuAccelerator;
 use crate::scene::{transform_triangles, Scene};
@@ -91,8 +92,19 @@ fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 9] {
     ]
 }
 
+/// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
+const ENTRY_GROUP: u32 = 64;
+const _: () = assert!(
+    BLOCK == PIXEL_GROUP,
+    "a block is one work group of intersect1"
+);
+
 pub struct Bvh {
     gl: Arc<Gl>,
+    /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into
+    /// `entries`: one texel per 8×8 pixels
+    entry: Kernel,
+    entries: Image2d,
     intersect1: Kernel,
     intersect2: Kernel,
     /// object-space vertex positions of every object (triangle soup, scene order)
@@ -112,8 +124,16 @@ pub struct Bvh {
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         let defs = kernel_defines(b.info);
+        let blocks = |n: u32| n.div_ceil(BLOCK);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
+            // timed as a part of intersect1: the closest-hit search of the passes
+            entry: b.kernel(
+                "bvh/entry.comp",
+                &[&defs[..], &[("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string())]].concat(),
+                "intersect1",
+            )?,
+            entries: Image2d::new(b.gl, blocks(b.width), blocks(b.height), glow::RGBA32UI)?,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             objects: scene
@@ -188,6 +208,11 @@ impl Accelerator for Bvh {
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
         self.bind(f.gl);
+        self.entries.bind_image(f.gl, image::BVH_ENTRIES);
+        self.entry.use_program();
+        let blocks = self.entries.width * self.entries.height;
+        self.entry
+            .dispatch_1d(f.timers, blocks.div_ceil(ENTRY_GROUP));
         self.intersect1.use_program();
         &self.intersect1
     }
@@ -222,6 +247,7 @@ impl Accelerator for Bvh {
 
 impl Drop for Bvh {
     fn drop(&mut self) {
+        self.entries.delete(&self.gl);
         if let Some(b) = &self.buffers {
             b.delete(&self.gl);
         }

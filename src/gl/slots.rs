@@ -89,6 +89,8 @@ slot_table! {
         /// the SAH BVH's texture buffer, read as an image buffer (glsl/bvh/words.glsl): the
         /// node records of every ray octant, then the leaf triangles
         BVH = 8,
+        /// the SAH BVH's entry point per 8×8 block of intersect1's rays (glsl/bvh/entry.comp)
+        BVH_ENTRIES = 9,
     }
 }
 

@@ -39,7 +39,9 @@ pub use super::aabb::Aabb;
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 
 mod build;
+mod entry;
 mod planes;
+pub use entry::{BlockEntry, RayBounds, BLOCK};
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 
 /// Bins per axis of the binned SAH.
@@ -223,10 +225,10 @@ impl Bvh {
         out
     }
 
-    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`.
-    fn octant_records(&self, o: usize, out: &mut [u32]) {
-        // the octant's depth-first order, from its miss links: after an inner node its near
-        // child, after a leaf (a subtree of one) its miss link
+    /// The nodes in the depth-first order of octant `o` (its records' order in
+    /// [`Bvh::gpu_words`]), from its miss links: after an inner node its near child, after a
+    /// leaf (a subtree of one) its miss link.
+    fn octant_order(&self, o: usize) -> Vec<u32> {
         let mut order = Vec::with_capacity(self.nodes.len());
         let mut k = 0i32;
         while k != END {
@@ -237,12 +239,31 @@ impl Bvh {
                 false => node.near_child(o) as i32,
             };
         }
+        order
+    }
+
+    /// The texel of every node's record in octant `o`'s copy ([`Bvh::gpu_words`]), and after
+    /// them the texel after the copy (where [`END`] points).
+    pub fn record_texels(&self, o: usize) -> Vec<u32> {
+        self.texels_in_order(o, &self.octant_order(o))
+    }
+
+    /// [`Bvh::record_texels`] of octant `o`, whose order is `order`.
+    fn texels_in_order(&self, o: usize, order: &[u32]) -> Vec<u32> {
         let base = self.root_texel(o);
-        let mut record = vec![0u32; self.nodes.len()];
+        let mut record = vec![0u32; self.nodes.len() + 1];
         for (i, &k) in order.iter().enumerate() {
             record[k as usize] = (base + i) as u32;
         }
-        let end = (base + self.nodes.len()) as u32;
+        record[self.nodes.len()] = (base + self.nodes.len()) as u32;
+        record
+    }
+
+    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`.
+    fn octant_records(&self, o: usize, out: &mut [u32]) {
+        let order = self.octant_order(o);
+        let record = self.texels_in_order(o, &order);
+        let end = record[self.nodes.len()];
         for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
             let node = &self.nodes[k as usize];
             debug_assert!(node.first < 1 << (31 - LEAF_COUNT_BITS), "see gpu_words");
@@ -300,14 +321,29 @@ impl Bvh {
         ro: Vec3,
         rd: Vec3,
         t_min: f32,
+        limit: f32,
+        leaf: impl FnMut(&[u32]) -> ControlFlow<(), f32>,
+    ) -> u64 {
+        self.traverse_from(None, ro, rd, t_min, limit, leaf)
+    }
+
+    /// [`Bvh::traverse`] from a block's entry point ([`Bvh::block_entry`], intersect1's walk):
+    /// a ray of the entry's octant walks the entry node's subtree only, others the whole tree.
+    pub fn traverse_from(
+        &self,
+        entry: Option<&BlockEntry>,
+        ro: Vec3,
+        rd: Vec3,
+        t_min: f32,
         mut limit: f32,
         mut leaf: impl FnMut(&[u32]) -> ControlFlow<(), f32>,
     ) -> u64 {
         let inv = safe_inverse(rd);
         let octant = octant(inv);
         let ray = self.grid.ray(ro, inv);
-        let (mut node, mut visited) = (0i32, 0u64);
-        while node != END {
+        let (mut node, stop) = entry::walk_range(entry, octant);
+        let mut visited = 0u64;
+        while node != stop {
             visited += 1;
             let n = &self.nodes[node as usize];
             if self.enter(node as usize, &ray, octant, t_min, limit) {
@@ -374,8 +410,13 @@ fn octant(inv: Vec3) -> usize {
 /// 1/rd with zero (and tiny) components replaced by 1e-20, so the slab test never computes
 /// 0·∞ (the kernels do the same).
 fn safe_inverse(rd: Vec3) -> Vec3 {
+    safe_divisor(rd).recip()
+}
+
+/// The divisors of [`safe_inverse`]: rd with zero (and tiny) components replaced by 1e-20.
+fn safe_divisor(rd: Vec3) -> Vec3 {
     let s = |d: f32| if d.abs() < 1e-20 { 1e-20 } else { d };
-    Vec3::new(1.0 / s(rd.x), 1.0 / s(rd.y), 1.0 / s(rd.z))
+    Vec3::new(s(rd.x), s(rd.y), s(rd.z))
 }
 
 /// The miss links of every node for every octant: the depth-first order of that octant (the
@@ -435,7 +476,7 @@ mod tests {
 
     /// A small deterministic triangle soup: a jittered grid of triangles, a few duplicates
     /// (equal centroids) and a long sliver.
-    fn soup() -> Vec<[Vec3; 3]> {
+    pub(super) fn soup() -> Vec<[Vec3; 3]> {
         let mut out = Vec::new();
         let mut s = 12345u32;
         let mut rnd = || {

@@ -1,0 +1,128 @@
+// The entry point of each block of intersect1's rays — ours, not in Wagner 2018, whose kernel
+// walks every ray from the root (ch. 4.2): the entry points of Reshetov, Soupikov and Hurley's
+// multi-level ray tracing (MLRTA, SIGGRAPH 2005), found for the 8×8 pixels of each work group
+// of bvh/intersect1.comp before it runs. CPU twin: src/reference/bvh/entry.rs
+// (RayBounds::may_enter, Bvh::block_entry), bit for bit.
+//
+// One invocation per block (pixels 8bx .. 8bx + 7, 8by .. 8by + 7 of the image; 8: the pixel
+// kernels' work groups, PIXEL_GROUP on the host, as in common/images.glsl): it bounds the
+// block's active rays by the smallest and largest origin coordinate and 1/direction per axis
+// (where they all share one octant; else the block has no entry), then goes down the octant's
+// records from the root while the bounds can enter only one child of the node (mayEnter):
+// every ray of the block misses the other child, whose subtree its own walk would enter
+// nowhere. Where both children may be entered, or at a leaf, it stops and stores (octant, the
+// node's record, the texel after its subtree: its miss link); where the bounds miss the root,
+// or both children of a node, an empty walk (record = end). The block's rays walk that subtree
+// only (bvh/traverse.glsl) and find the hits of a walk from the root, visiting fewer nodes. A
+// block without an entry stores octant 8, no ray's: its rays walk from their roots.
+//
+// On llvmpipe (docs/results/bvh_steps.md, step 26): the primary rays of the dragon at 512²
+// walk from nodes ~4 levels down (their nodes visited 31.0 -> 22.6 per ray), for some 1-2 %
+// of intersect1's instructions here; the kernel is timed as part of intersect1.
+#include "../common/images.glsl"
+#include "words.glsl"
+#include "octant.glsl"
+
+layout(local_size_x = BVH_ENTRY_GROUP) in;
+
+layout(rgba32ui, binding = IMAGE_BVH_ENTRIES) writeonly uniform uimage2D bvhEntries;
+
+// the rays of the block's octant: per axis the smallest and largest 1/direction and origin
+vec3 invLo = vec3(0.0), invHi = vec3(0.0), roLo = vec3(0.0), roHi = vec3(0.0);
+// the grid of the records' planes (plane q of axis a at gridOrigin[a] + q·gridStep[a])
+vec3 gridOrigin = vec3(0.0), gridStep = vec3(0.0);
+
+// The bounds of the block's active rays; false if it has none, or if they point up and down
+// one axis (two octants or more: no entry, every ray walks from its root). Ours, for llvmpipe:
+// per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose inverses are
+// the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding keeps the order —
+// so that a ray costs no division; inactive rays, and pixels out of the image (which imageLoad
+// reads as zeros: rayState 0), count for nothing.
+bool bound(ivec2 block, out int octant)
+{
+    const float inf = 1.0 / 0.0;
+    vec3 dLo = vec3(inf), dHi = vec3(-inf);
+    roLo = vec3(inf); roHi = vec3(-inf);
+    for (int k = 0; k < 64; k++) {
+        ivec2 p = block * 8 + ivec2(k & 7, k >> 3);
+        vec4 originState = imageLoad(rayOriginTexture, p);
+        vec3 d = safeDivisors(imageLoad(rayDirTexture, p).xyz);
+        if (originState.w > 0.0) { // active, as intersect1 traces it
+            dLo = min(dLo, d); dHi = max(dHi, d);
+            roLo = min(roLo, originState.xyz); roHi = max(roHi, originState.xyz);
+        }
+    }
+    invLo = 1.0 / dHi; invHi = 1.0 / dLo;
+    octant = rayOctant(dLo);
+    return dLo.x <= dHi.x && !any(lessThan(dLo * sign(dHi), vec3(0.0)));
+}
+
+// The distances from the rays' origins to the planes at world coordinates w, bounded over the
+// rays: the interval products of w − origin and 1/direction, per axis.
+void distanceBounds(vec3 w, out vec3 lo, out vec3 hi)
+{
+    vec3 p0 = w - roHi, p1 = w - roLo;
+    vec3 c0 = p0 * invLo, c1 = p0 * invHi, c2 = p1 * invLo, c3 = p1 * invHi;
+    lo = min(min(c0, c1), min(c2, c3));
+    hi = max(max(c0, c1), max(c2, c3));
+}
+
+// May a ray of the bounds enter the box of `record` (from t = 0 on)? false only where the
+// bounds' latest slab entry comes after their earliest exit (or the exit before 0), widened by
+// a margin: per axis 4 grid steps and 2^-18 of the magnitudes of the grid's extent, its origin
+// and the rays' origins, as a distance at the bounds' largest |1/d|. A ray's own boxEntered and
+// these bounds err by a few roundings of those magnitudes, so a box refused here is one that
+// every ray of the bounds misses by more than a step (RayBounds::may_enter).
+bool mayEnter(uvec4 record)
+{
+    vec3 near, far;
+    recordPlanes(record, near, far);
+    vec3 scale = abs(gridOrigin) + gridStep * 65535.0 + max(abs(roLo), abs(roHi));
+    vec3 margin = (gridStep * 4.0 + scale * 3.814697265625e-6) * max(abs(invLo), abs(invHi));
+    vec3 nearLo, nearHi, farLo, farHi;
+    distanceBounds(gridOrigin + near * gridStep, nearLo, nearHi);
+    distanceBounds(gridOrigin + far * gridStep, farLo, farHi);
+    vec3 tNears = nearLo - margin, tFars = farHi + margin;
+    float tNear = max(max(max(tNears.x, tNears.y), tNears.z), 0.0);
+    float tFar = min(min(tFars.x, tFars.y), tFars.z);
+    return !(tFar < 0.0 || tNear > tFar);
+}
+
+// The entry of the bounds' rays in the records of `octant`: (octant, first record, end).
+uvec4 entryPoint(int octant)
+{
+    uvec4 header = bvhTexel(0);
+    gridOrigin = uintBitsToFloat(header.yzw);
+    gridStep = uintBitsToFloat(bvhTexel(4).xyz);
+    int nodes = int(header.x);
+    int n = BVH_HEADER_WORDS / 4 + octant * nodes;
+    bool empty = !mayEnter(bvhRecord(n));
+    // down one level a step (the tree's depth is below the node count)
+    for (int d = 0; !empty && d < nodes; d++) {
+        if (int(bvhRecord(n).w) < 0) break; // a leaf
+        // an inner node's near child is the next record, its far child the near child's miss
+        // link (a leaf's: the record after it)
+        int near = n + 1;
+        uvec4 nearRecord = bvhRecord(near);
+        int far = int(nearRecord.w) < 0 ? near + 1 : int(nearRecord.w);
+        bool nearEntered = mayEnter(nearRecord), farEntered = mayEnter(bvhRecord(far));
+        if (nearEntered && farEntered) break;
+        empty = !nearEntered && !farEntered;
+        if (!empty) n = nearEntered ? near : far;
+    }
+    // the texel after n's subtree: its miss link (a leaf's: the next record)
+    int reference = int(bvhRecord(n).w);
+    int end = reference < 0 ? n + 1 : reference;
+    return uvec4(uint(octant), uint(empty ? end : n), uint(end), 0u);
+}
+
+void main()
+{
+    ivec2 blocks = imageSize(bvhEntries);
+    int b = int(gl_GlobalInvocationID.x);
+    if (b >= blocks.x * blocks.y) return;
+    ivec2 block = ivec2(b % blocks.x, b / blocks.x);
+    int octant;
+    uvec4 entry = bound(block, octant) ? entryPoint(octant) : uvec4(8u, 0u, 0u, 0u);
+    imageStore(bvhEntries, block, entry);
+}
