@@ -3,16 +3,17 @@
 //! below the root, at the deepest node whose siblings on the way down the beam misses. The
 //! CPU twin of `glsl/bvh/entry.comp`, bit for bit.
 //!
-//! A block is the 8×8 pixels of one work group of intersect1 ([`BLOCK`]). Its rays, where they
-//! share one octant, are bounded per axis by the smallest and largest origin coordinate and
-//! 1/direction ([`RayBounds`]; a block whose rays point up and down an axis has no entry). From the root of that octant's walk the search goes down while the bounds
-//! can enter only one child of the node ([`RayBounds::may_enter`]): every ray of the bounds
-//! misses the other child's box, so its walk would visit that subtree's root, skip it and find
-//! nothing there. Where both children may be entered (or at a leaf) the search stops: the
-//! block's rays of its octant walk that node's subtree only — its records from the node on, up
-//! to its miss link — and the hits are those of a walk from the root, as each ray's own tests
-//! would have skipped every box the search left out. Only the nodes visited are fewer. Rays of
-//! other octants walk from their root.
+//! A block is the 8×8 pixels of one work group of intersect1 ([`BLOCK`]). Its active rays,
+//! where they share one octant, are bounded per axis by the smallest and largest origin
+//! coordinate and 1/direction ([`RayBounds`]; a block whose rays point up and down an axis has
+//! no entry). From the root of that octant's walk the search goes down while the bounds can
+//! enter only one child of the node ([`RayBounds::may_enter`]): every ray of the bounds misses
+//! the other child's box, so its walk would visit that subtree's root, skip it and find nothing
+//! there. Where both children may be entered (or at a leaf) the search stops: the block's rays
+//! walk that node's subtree only — its records from the node on, up to its miss link — and the
+//! hits are those of a walk from the root, as each ray's own tests would have skipped every box
+//! the search left out. Only the nodes visited are fewer. (A walk checks the entry's octant
+//! against its ray's, as the kernel does; a ray of another octant walks from its root.)
 
 use glam::Vec3;
 
@@ -21,7 +22,7 @@ use super::{octant, octant_planes, safe_divisor, Bvh, END, OCTANTS};
 /// Pixels per side of a block: intersect1's work groups (`PIXEL_GROUP`).
 pub const BLOCK: u32 = 8;
 
-/// The rays of a block in the block's octant, bounded per axis.
+/// The rays of a block (all of one octant), bounded per axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RayBounds {
     pub octant: usize,
@@ -34,7 +35,7 @@ pub struct RayBounds {
 impl RayBounds {
     /// The bounds of the rays (origin, direction); `None` without a ray, or if they point up
     /// and down one axis (more than one octant). As the kernel: per axis the smallest and
-    /// largest divisor of [`safe_inverse`], whose inverses bound the rays' 1/rd exactly (1/x
+    /// largest divisor of `safe_inverse`, whose inverses bound the rays' 1/rd exactly (1/x
     /// falls on either side of 0, and rounding keeps the order).
     pub fn of(rays: impl IntoIterator<Item = (Vec3, Vec3)>) -> Option<RayBounds> {
         let (mut d_lo, mut d_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
