@@ -419,35 +419,21 @@ fn safe_divisor(rd: Vec3) -> Vec3 {
     Vec3::new(s(rd.x), s(rd.y), s(rd.z))
 }
 
-/// The miss links of every node for every octant: the depth-first order of that octant (the
-/// near child of every split first) continues after a node's subtree at its miss link.
+/// The miss links of every node for every octant (`links[OCTANTS·n + o]`): the depth-first
+/// order of octant o (every node before its subtree, the near child's subtree before the far
+/// child's) continues after a node's subtree at its miss link, [`END`] after the last. The
+/// near child's miss link is the far child, the far child's its parent's — in one pass down
+/// the nodes, as [`build::layout`] places every node's children after it.
 fn miss_links(nodes: &[Node]) -> Vec<i32> {
-    use rayon::prelude::*;
-    let per_octant: Vec<Vec<i32>> = (0..OCTANTS)
-        .into_par_iter()
-        .map(|octant| octant_links(nodes, octant))
-        .collect();
-    (0..OCTANTS * nodes.len())
-        .map(|k| per_octant[k % OCTANTS][k / OCTANTS])
-        .collect()
-}
-
-/// Every node's miss link in the depth-first order of one octant — every node before its
-/// subtree, the near child's subtree before the far child's: the node after its subtree
-/// ([`END`] after the last).
-fn octant_links(nodes: &[Node], octant: usize) -> Vec<i32> {
-    let mut links = vec![END; nodes.len()];
-    // (node, its miss link): the far child's miss link is its parent's, the near child's is
-    // the far child
-    let mut todo = vec![(0u32, END)];
-    while let Some((n, miss)) = todo.pop() {
-        links[n as usize] = miss;
-        let node = &nodes[n as usize];
-        if !node.is_leaf() {
-            let near = node.near_child(octant);
-            let far = 2 * node.first + 1 - near;
-            todo.push((far, miss));
-            todo.push((near, far as i32));
+    let mut links = vec![END; OCTANTS * nodes.len()];
+    for (k, node) in nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
+        debug_assert!(node.first as usize > k, "children after their parent");
+        let (left, right) = (node.first as usize, node.first as usize + 1);
+        for o in 0..OCTANTS {
+            let near = node.near_child(o) as usize;
+            let far = left + right - near;
+            links[OCTANTS * near + o] = far as i32;
+            links[OCTANTS * far + o] = links[OCTANTS * k + o];
         }
     }
     links
