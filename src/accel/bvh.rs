@@ -99,6 +99,21 @@ const _: () = assert!(
     "a block is one work group of intersect1"
 );
 
+/// The BVH binds its word buffer and its blocks' entries at image units [`image::BVH`] and
+/// [`image::BVH_ENTRIES`], after the pipeline's ray-state images: a GL implementation with fewer
+/// units (`GL_MAX_IMAGE_UNITS`; GL 4.5 asks for 8) gets a clear error here, not a failed link.
+fn image_units_suffice(max_image_units: i32) -> Result<()> {
+    let needed = image::BVH.max(image::BVH_ENTRIES) as i32 + 1;
+    if max_image_units < needed {
+        bail!(
+            "--tracer bvh binds image units up to {}, and this GL implementation has {max_image_units} \
+             (GL_MAX_IMAGE_UNITS); use --tracer base or grid",
+            needed - 1
+        );
+    }
+    Ok(())
+}
+
 pub struct Bvh {
     gl: Arc<Gl>,
     /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into
@@ -123,6 +138,7 @@ pub struct Bvh {
 
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        image_units_suffice(b.info.max_image_units)?;
         let defs = kernel_defines(b.info);
         let blocks = |n: u32| n.div_ceil(BLOCK);
         Ok(Box::new(Bvh {
@@ -251,5 +267,18 @@ impl Drop for Bvh {
         if let Some(b) = &self.buffers {
             b.delete(&self.gl);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn too_few_image_units_are_refused_by_name() {
+        let err = super::image_units_suffice(8).unwrap_err().to_string();
+        assert!(
+            err.contains("GL_MAX_IMAGE_UNITS") && err.contains("up to 9"),
+            "{err}"
+        );
+        assert!(super::image_units_suffice(10).is_ok());
     }
 }
