@@ -13,8 +13,9 @@
 // nowhere. Where both children may be entered, or at a leaf, it stops and stores (octant, the
 // node's record, the texel after its subtree: its miss link); where the bounds miss the root,
 // or both children of a node, an empty walk (record = end). The block's rays walk that subtree
-// only (bvh/traverse.glsl) and find the hits of a walk from the root, visiting fewer nodes. A
-// block without an entry stores octant 8, no ray's: its rays walk from their roots.
+// only (bvh/traverse.glsl) and find the hits of a walk from the root, visiting fewer nodes. The
+// octant is stored plus one: a block without an entry stores 0, as do texels never written or
+// read out of the image (imageLoad reads zeros), and its rays walk from their roots.
 //
 // On llvmpipe (docs/results/bvh_steps.md, step 26): the primary rays of the dragon at 512²
 // visit 22.8 nodes each instead of 31.0, for 8.8 M instructions in this kernel (some 3 % of
@@ -89,7 +90,7 @@ bool mayEnter(uvec4 record)
     return !(tFar < 0.0 || tNear > tFar);
 }
 
-// The entry of the bounds' rays in the records of `octant`: (octant, first record, end).
+// The entry of the bounds' rays in the records of `octant`: (octant + 1, first record, end).
 uvec4 entryPoint(int octant)
 {
     uvec4 header = bvhTexel(0);
@@ -114,7 +115,7 @@ uvec4 entryPoint(int octant)
     // the texel after n's subtree: its miss link (a leaf's: the next record)
     int reference = int(bvhRecord(n).w);
     int end = reference < 0 ? n + 1 : reference;
-    return uvec4(uint(octant), uint(empty ? end : n), uint(end), 0u);
+    return uvec4(uint(octant + 1), uint(empty ? end : n), uint(end), 0u);
 }
 
 void main()
@@ -124,6 +125,6 @@ void main()
     if (b >= blocks.x * blocks.y) return;
     ivec2 block = ivec2(b % blocks.x, b / blocks.x);
     int octant;
-    uvec4 entry = bound(block, octant) ? entryPoint(octant) : uvec4(8u, 0u, 0u, 0u);
+    uvec4 entry = bound(block, octant) ? entryPoint(octant) : uvec4(0u);
     imageStore(bvhEntries, block, entry);
 }

@@ -27,7 +27,7 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
     rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
-    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(8u, 0u, 0u)); // from the root
+    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
 }
 
 #include "../common/intersect2_main.glsl"

@@ -162,9 +162,9 @@ bool leafTriangles(inout int slot, int slotEnd, inout float limit)
 }
 
 // The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it. `entry`: the
-// entry point of the ray's block (bvh/entry.comp: its octant, first record and the texel after
-// its subtree) — a ray of that octant walks that subtree only, the others (and every ray where
-// entry.x is no octant, as in intersect2) the whole tree.
+// entry point of the ray's block (bvh/entry.comp: its octant + 1, first record and the texel
+// after its subtree) — a ray of that octant walks that subtree only, the others (and every ray
+// where entry.x is 0, no entry, as in intersect2) the whole tree.
 bool traverse(vec3 ro, vec3 rd, float tMin, float limit, uvec3 entry)
 {
     vec3 inv = safeInverses(rd);
@@ -182,7 +182,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit, uvec3 entry)
     // the root: the first record of the octant's copy; end: the texel after its last
     int node = BVH_HEADER_WORDS / 4 + octant * nodes;
     int end = node + nodes;
-    if (int(entry.x) == octant) {
+    if (int(entry.x) == octant + 1) {
         node = int(entry.y);
         end = int(entry.z);
     }
