@@ -35,7 +35,7 @@ use std::path::Path;
 use anyhow::{bail, ensure, Context, Result};
 use glam::Vec3;
 use gpgpu_rt::gl::PixelGrid;
-use gpgpu_rt::reference::bvh::{BlockEntry, Bvh, END, LEAF_COUNT_BITS, TRIANGLE_WORDS};
+use gpgpu_rt::reference::bvh::{block_of, BlockEntry, Bvh, END, LEAF_COUNT_BITS, TRIANGLE_WORDS};
 use gpgpu_rt::reference::intersect_triangle;
 use gpgpu_rt::scene::Scene;
 
@@ -44,10 +44,6 @@ const BLOCK: (usize, usize) = (4, 2);
 
 /// The pixel kernels' work groups (8×8 pixels) and the default tile (`--tile 256`).
 const GROUP: usize = 8;
-const _: () = assert!(
-    GROUP == gpgpu_rt::reference::bvh::BLOCK as usize,
-    "a block of entry.comp"
-);
 const TILE: usize = 256;
 
 /// A SIMD group's instructions (callgrind, the dragon's intersect1 at step 24): a node pass
@@ -103,8 +99,8 @@ impl Entries {
 
     /// The entry of the pixel in column x, row `row` of the AOVs (from the top).
     fn at(&self, x: usize, row: usize) -> Option<BlockEntry> {
-        let (b, y) = (GROUP, self.height - 1 - row);
-        self.blocks[y / b * self.width.div_ceil(b) + x / b]
+        let y = (self.height - 1 - row) as u32;
+        self.blocks[block_of(self.width as u32, x as u32, y)]
     }
 }
 

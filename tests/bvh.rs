@@ -182,8 +182,7 @@ fn walks_match_the_twin(
     let (mut nodes, mut tests) = (0u64, 0u64);
     for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
         let (ro, rd) = ray(x, y).unwrap();
-        let b = gpgpu_rt::reference::bvh::BLOCK;
-        let entry = entries[((y / b) * w.div_ceil(b) + x / b) as usize];
+        let entry = entries[gpgpu_rt::reference::bvh::block_of(w, x, y)];
         let mut best = None;
         nodes += twin.traverse_from(entry.as_ref(), ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);

@@ -98,22 +98,26 @@ uvec4 entryPoint(int octant)
     gridStep = uintBitsToFloat(bvhTexel(4).xyz);
     int nodes = int(header.x);
     int n = BVH_HEADER_WORDS / 4 + octant * nodes;
-    bool empty = !mayEnter(bvhRecord(n));
-    // down one level a step (the tree's depth is below the node count)
-    for (int d = 0; !empty && d < nodes; d++) {
-        if (int(bvhRecord(n).w) < 0) break; // a leaf
+    uvec4 record = bvhRecord(n); // n's
+    bool empty = !mayEnter(record);
+    // down one level a step, while n is an inner node (the tree's depth is below the node count)
+    for (int d = 0; !empty && int(record.w) >= 0 && d < nodes; d++) {
         // an inner node's near child is the next record, its far child the near child's miss
         // link (a leaf's: the record after it)
         int near = n + 1;
         uvec4 nearRecord = bvhRecord(near);
         int far = int(nearRecord.w) < 0 ? near + 1 : int(nearRecord.w);
-        bool nearEntered = mayEnter(nearRecord), farEntered = mayEnter(bvhRecord(far));
+        uvec4 farRecord = bvhRecord(far);
+        bool nearEntered = mayEnter(nearRecord), farEntered = mayEnter(farRecord);
         if (nearEntered && farEntered) break;
         empty = !nearEntered && !farEntered;
-        if (!empty) n = nearEntered ? near : far;
+        if (!empty) {
+            n = nearEntered ? near : far;
+            record = nearEntered ? nearRecord : farRecord;
+        }
     }
     // the texel after n's subtree: its miss link (a leaf's: the next record)
-    int reference = int(bvhRecord(n).w);
+    int reference = int(record.w);
     int end = reference < 0 ? n + 1 : reference;
     return uvec4(uint(octant + 1), uint(empty ? end : n), uint(end), 0u);
 }

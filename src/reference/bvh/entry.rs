@@ -120,8 +120,8 @@ impl Bvh {
             return empty(n);
         }
         while !self.nodes[n as usize].is_leaf() {
-            let near = self.nodes[n as usize].near_child(o);
-            let far = 2 * self.nodes[n as usize].first + 1 - near;
+            let node = &self.nodes[n as usize];
+            let (near, far) = (node.near_child(o), node.far_child(o));
             n = match (enters(near), enters(far)) {
                 (true, true) => break,
                 (true, false) => near,
@@ -137,7 +137,7 @@ impl Bvh {
     }
 
     /// The entry point of every block of a `width`×`height` image, blocks row by row from the
-    /// low corner (GL's order), each from the rays `ray(x, y)` of its active pixels (`None`:
+    /// low corner (GL's order: [`block_of`]), each from the rays `ray(x, y)` of its active pixels (`None`:
     /// no ray); `None` for a block without a ray or with rays of more than one octant.
     pub fn block_entries(
         &self,
@@ -156,6 +156,13 @@ impl Bvh {
             })
             .collect()
     }
+}
+
+/// The index of the block of pixel (x, y) (GL's order, rows from the bottom) among the blocks
+/// of an image `width` pixels wide, as [`Bvh::block_entries`] lists them and intersect1 reads
+/// them (`storePos >> 3`).
+pub fn block_of(width: u32, x: u32, y: u32) -> usize {
+    ((y / BLOCK) * width.div_ceil(BLOCK) + x / BLOCK) as usize
 }
 
 /// Where a ray of `octant` walks from, and where it stops: `entry`'s node and stop if it is of

@@ -41,7 +41,7 @@ use super::{closest_among, CpuAccelerator, Feeler, Hit};
 mod build;
 mod entry;
 mod planes;
-pub use entry::{BlockEntry, RayBounds, BLOCK};
+pub use entry::{block_of, BlockEntry, RayBounds, BLOCK};
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 
 /// Bins per axis of the binned SAH.
@@ -94,6 +94,11 @@ impl Node {
     /// a): the left one, on the low side of the split, unless the ray points down the axis.
     pub fn near_child(&self, octant: usize) -> u32 {
         self.first + ((octant >> self.axis()) & 1) as u32
+    }
+
+    /// The other child of an inner node for rays of `octant`.
+    pub fn far_child(&self, octant: usize) -> u32 {
+        2 * self.first + 1 - self.near_child(octant)
     }
 }
 
@@ -428,10 +433,8 @@ fn miss_links(nodes: &[Node]) -> Vec<i32> {
     let mut links = vec![END; OCTANTS * nodes.len()];
     for (k, node) in nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
         debug_assert!(node.first as usize > k, "children after their parent");
-        let (left, right) = (node.first as usize, node.first as usize + 1);
         for o in 0..OCTANTS {
-            let near = node.near_child(o) as usize;
-            let far = left + right - near;
+            let (near, far) = (node.near_child(o) as usize, node.far_child(o) as usize);
             links[OCTANTS * near + o] = far as i32;
             links[OCTANTS * far + o] = links[OCTANTS * k + o];
         }
