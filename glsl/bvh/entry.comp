@@ -14,20 +14,22 @@
 // node's record, the texel after its subtree: its miss link); where the bounds miss the root,
 // or both children of a node, an empty walk (record = end). The block's rays walk that subtree
 // only (bvh/traverse.glsl) and find the hits of a walk from the root, visiting fewer nodes. The
-// octant is stored plus one: a block without an entry stores 0, as do texels never written or
-// read out of the image (imageLoad reads zeros), and its rays walk from their roots.
+// octant is stored plus one: a block without an entry stores 0, as do the entry texels before
+// the first dispatch (the host uploads zeros; bvh/entries.glsl), and its rays walk from their
+// roots.
 //
 // On llvmpipe (docs/results/bvh_steps.md, step 26): the primary rays of the dragon at 512²
 // visit 22.8 nodes each instead of 31.0, for 8.8 M instructions in this kernel (some 3 % of
 // the dragon's intersect1, 6 % of the bunny's: mostly the loads of the blocks' rays); the
 // kernel is timed as part of intersect1.
 #include "../common/images.glsl"
+#define BVH_WORDS_WRITABLE
 #include "words.glsl"
 #include "octant.glsl"
 
 layout(local_size_x = BVH_ENTRY_GROUP) in;
 
-layout(rgba32ui, binding = IMAGE_BVH_ENTRIES) writeonly uniform uimage2D bvhEntries;
+#include "entries.glsl"
 
 // the block's rays: per axis the smallest and largest 1/direction and origin
 vec3 invLo = vec3(0.0), invHi = vec3(0.0), roLo = vec3(0.0), roHi = vec3(0.0);
@@ -124,11 +126,10 @@ uvec4 entryPoint(int octant)
 
 void main()
 {
-    ivec2 blocks = imageSize(bvhEntries);
     int b = int(gl_GlobalInvocationID.x);
-    if (b >= blocks.x * blocks.y) return;
-    ivec2 block = ivec2(b % blocks.x, b / blocks.x);
+    if (b >= BVH_ENTRY_TEXELS) return;
+    ivec2 block = ivec2(b % BVH_BLOCKS_X, b / BVH_BLOCKS_X);
     int octant;
     uvec4 entry = bound(block, octant) ? entryPoint(octant) : uvec4(0u);
-    imageStore(bvhEntries, block, entry);
+    imageStore(bvh, entryTexel(block), entry);
 }

@@ -11,7 +11,7 @@
 #include "traverse.glsl"
 
 // the entry point of each 8×8 block of rays (bvh/entry.comp, run before this kernel)
-layout(rgba32ui, binding = IMAGE_BVH_ENTRIES) readonly uniform uimage2D bvhEntries;
+#include "entries.glsl"
 
 #if !HIT_RECORDS
 #error "the BVH's intersect1 stores hit records (bvh/hit_record.glsl): it keeps no u, v"
@@ -45,7 +45,7 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
 {
     rayO = ro; rayD = rd; rayLast = lastTriID;
     bestT = t_min; bestID = triID;
-    traverse(ro, rd, 0.0, bestT, imageLoad(bvhEntries, storePos >> 3).xyz);
+    traverse(ro, rd, 0.0, bestT, bvhRecord(entryTexel(storePos >> 3)).xyz);
     t_min = bestT; triID = bestID;
     closestHitRecord = bestAt;
 }

@@ -1,7 +1,12 @@
 // The SAH BVH's word buffer — ours, after Wagner 2018's three textures of Fig. 4.3 (ch. 4.2)
 // in one buffer (Bvh::gpu_words in src/reference/bvh/mod.rs; its layout: bvh/traverse.glsl),
 // read as RGBA32UI texels of 4 words, for bvh/traverse.glsl and bvh/hit_record.glsl.
+// (bvh/entry.comp defines BVH_WORDS_WRITABLE: it writes the blocks' entries, bvh/entries.glsl)
+#ifdef BVH_WORDS_WRITABLE
+layout(rgba32ui, binding = IMAGE_BVH) uniform uimageBuffer bvh;
+#else
 layout(rgba32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
+#endif
 
 // The texel of index `texel` (a node record). Its index masked to BVH_TEXEL_INDEX_MASK (the
 // host's: the buffer has fewer texels, so no valid index changes): llvmpipe's LLVM then knows

@@ -18,7 +18,7 @@ use super::{
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
-use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
+use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::reference::bvh::{
@@ -41,9 +41,12 @@ pub const ENTRY: Entry = Entry {
 /// the leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), the records
 /// addressed by texel and the triangles by word in the kernels' ints — which cannot overflow:
 /// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more (or beyond
-/// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it.
-fn upload(gl: &Gl, bvh: &CpuBvh) -> Result<TextureBuffers> {
-    let words = bvh.gpu_words();
+/// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
+/// `glsl/bvh/entry.comp` to write its entry point into (`glsl/bvh/entries.glsl`), 0 (no entry)
+/// until it does: the same image unit, so the BVH binds no more than GL 4.5's 8.
+fn upload(gl: &Gl, bvh: &CpuBvh, blocks: u32) -> Result<TextureBuffers> {
+    let mut words = bvh.gpu_words();
+    words.resize(words.len() + 4 * blocks as usize, 0);
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
@@ -73,13 +76,15 @@ pub fn texel_index_mask() -> (&'static str, String) {
 }
 
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
-/// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]) and texel indices
-/// ([`TEXEL_INDEX_BITS`]), and they store hit records and per-pixel counts
+/// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]), texel indices
+/// ([`TEXEL_INDEX_BITS`]) and its last `blocks` texels, the blocks' entries
+/// (`BVH_ENTRY_TEXELS`), and they store hit records and per-pixel counts
 /// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
 /// 64-bit integers (`RECORD_STORE_64`); on llvmpipe intersect1 loads the next work group's rays
 /// ahead (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
-fn kernel_defines(info: &GlInfo) -> [(&'static str, String); 9] {
+fn kernel_defines(info: &GlInfo, blocks: u32) -> [(&'static str, String); 10] {
     [
+        ("BVH_ENTRY_TEXELS", blocks.to_string()),
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
         ("PREFETCH_RAYS", (info.is_llvmpipe() as i32).to_string()),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
@@ -99,11 +104,11 @@ const _: () = assert!(
     "a block is one work group of intersect1"
 );
 
-/// The BVH binds its word buffer and its blocks' entries at image units [`image::BVH`] and
-/// [`image::BVH_ENTRIES`], after the pipeline's ray-state images: a GL implementation with fewer
-/// units (`GL_MAX_IMAGE_UNITS`; GL 4.5 asks for 8) gets a clear error here, not a failed link.
+/// The BVH binds its word buffer (with its blocks' entries) at image unit [`image::BVH`], after
+/// the pipeline's ray-state images: a GL implementation with fewer units (`GL_MAX_IMAGE_UNITS`;
+/// GL 4.5 asks for 8, as many as the BVH binds) gets a clear error here, not a failed link.
 fn image_units_suffice(max_image_units: i32) -> Result<()> {
-    let needed = image::BVH.max(image::BVH_ENTRIES) as i32 + 1;
+    let needed = image::BVH as i32 + 1;
     if max_image_units < needed {
         bail!(
             "--tracer bvh binds image units up to {}, and this GL implementation has {max_image_units} \
@@ -116,10 +121,11 @@ fn image_units_suffice(max_image_units: i32) -> Result<()> {
 
 pub struct Bvh {
     gl: Arc<Gl>,
-    /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into
-    /// `entries`: one texel per 8×8 pixels
+    /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into the
+    /// last texels of the word buffer: one per 8×8 pixels, row by row (`glsl/bvh/entries.glsl`)
     entry: Kernel,
-    entries: Image2d,
+    /// the blocks of the image
+    blocks: u32,
     intersect1: Kernel,
     intersect2: Kernel,
     /// object-space vertex positions of every object (triangle soup, scene order)
@@ -139,8 +145,8 @@ pub struct Bvh {
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
-        let defs = kernel_defines(b.info);
-        let blocks = |n: u32| n.div_ceil(BLOCK);
+        let blocks = b.width.div_ceil(BLOCK) * b.height.div_ceil(BLOCK);
+        let defs = kernel_defines(b.info, blocks);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             // timed as a part of intersect1: the closest-hit search of the passes
@@ -149,7 +155,7 @@ impl Bvh {
                 &[&defs[..], &[("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string())]].concat(),
                 "intersect1",
             )?,
-            entries: Image2d::new(b.gl, blocks(b.width), blocks(b.height), glow::RGBA32UI)?,
+            blocks,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             objects: scene
@@ -184,7 +190,7 @@ impl Bvh {
                 bvh.tris.len()
             );
         }
-        let buffers = upload(&self.gl, &bvh)?;
+        let buffers = upload(&self.gl, &bvh, self.blocks)?;
         if let Some(old) = self.buffers.replace(buffers) {
             old.delete(&self.gl);
         }
@@ -206,9 +212,10 @@ impl Bvh {
         self.builds
     }
 
+    /// Bind the word buffer; the entry kernel writes its last texels, the others read it.
     fn bind(&self, gl: &Gl) {
         if let Some(b) = &self.buffers {
-            b.bind_images(gl);
+            b.bind_images(gl, glow::READ_WRITE);
         }
     }
 }
@@ -224,11 +231,9 @@ impl Accelerator for Bvh {
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
         self.bind(f.gl);
-        self.entries.bind_image(f.gl, image::BVH_ENTRIES);
         self.entry.use_program();
-        let blocks = self.entries.width * self.entries.height;
         self.entry
-            .dispatch_1d(f.timers, blocks.div_ceil(ENTRY_GROUP));
+            .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
         self.intersect1.use_program();
         &self.intersect1
     }
@@ -263,7 +268,6 @@ impl Accelerator for Bvh {
 
 impl Drop for Bvh {
     fn drop(&mut self) {
-        self.entries.delete(&self.gl);
         if let Some(b) = &self.buffers {
             b.delete(&self.gl);
         }
@@ -274,11 +278,12 @@ impl Drop for Bvh {
 mod tests {
     #[test]
     fn too_few_image_units_are_refused_by_name() {
-        let err = super::image_units_suffice(8).unwrap_err().to_string();
+        let err = super::image_units_suffice(7).unwrap_err().to_string();
         assert!(
-            err.contains("GL_MAX_IMAGE_UNITS") && err.contains("up to 9"),
+            err.contains("GL_MAX_IMAGE_UNITS") && err.contains("up to 7"),
             "{err}"
         );
-        assert!(super::image_units_suffice(10).is_ok());
+        // GL 4.5's minimum suffices
+        assert!(super::image_units_suffice(8).is_ok());
     }
 }

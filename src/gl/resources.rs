@@ -301,11 +301,12 @@ impl TextureBuffer {
         }
     }
 
-    /// Bind to image unit `unit`, read-only (an `imageBuffer` with `layout(format, binding =
-    /// unit) readonly`). llvmpipe generates image loads inline, where it calls a function for
-    /// every `texelFetch` of a format other than 8-bit RGBA (docs/results/bvh_steps.md).
-    pub fn bind_image(&self, gl: &Gl, unit: u32) {
-        bind_image_unit(gl, unit, self.texture, glow::READ_ONLY, self.format);
+    /// Bind to image unit `unit` with `access` (`glow::READ_ONLY`: an `imageBuffer` with
+    /// `layout(format, binding = unit) readonly`). llvmpipe generates image loads inline, where
+    /// it calls a function for every `texelFetch` of a format other than 8-bit RGBA
+    /// (docs/results/bvh_steps.md).
+    pub fn bind_image(&self, gl: &Gl, unit: u32, access: u32) {
+        bind_image_unit(gl, unit, self.texture, access, self.format);
     }
 
     pub fn delete(&self, gl: &Gl) {
@@ -387,10 +388,10 @@ impl TextureBuffers {
         }
     }
 
-    /// Bind every one to its unit as a read-only image (the units are image units).
-    pub fn bind_images(&self, gl: &Gl) {
+    /// Bind every one to its unit as an image with `access` (the units are image units).
+    pub fn bind_images(&self, gl: &Gl, access: u32) {
         for (t, unit) in &self.0 {
-            t.bind_image(gl, *unit);
+            t.bind_image(gl, *unit, access);
         }
     }
 

@@ -87,10 +87,11 @@ slot_table! {
         WAGNER_RAY = 2,
         WAGNER_NORMAL = 3,
         /// the SAH BVH's texture buffer, read as an image buffer (glsl/bvh/words.glsl): the
-        /// node records of every ray octant, then the leaf triangles
-        BVH = 8,
-        /// the SAH BVH's entry point per 8×8 block of intersect1's rays (glsl/bvh/entry.comp)
-        BVH_ENTRIES = 9,
+        /// node records of every ray octant, the leaf triangles, and the entry point of each
+        /// 8×8 block of intersect1's rays (glsl/bvh/entries.glsl). Unit 7, the last of the 8
+        /// that GL 4.5 guarantees (`GL_MAX_IMAGE_UNITS`), beside the ray-state images 0–6 that
+        /// its kernels bind too
+        BVH = 7,
     }
 }
 
@@ -158,6 +159,21 @@ mod tests {
             let n = names.len();
             names.dedup();
             assert_eq!(names.len(), n);
+        }
+    }
+
+    /// Every image unit and texture unit is one that GL 4.5 guarantees to a compute shader
+    /// (`GL_MAX_IMAGE_UNITS` ≥ 8, `GL_MAX_COMPUTE_TEXTURE_IMAGE_UNITS` ≥ 16): the designs run
+    /// on any GL 4.5 implementation, not only on llvmpipe's 192 units.
+    #[test]
+    fn units_are_within_gl_4_5_minimums() {
+        for (table, units) in [(image::TABLE, 8), (sampler::TABLE, 16)] {
+            for (name, slot) in table {
+                assert!(
+                    *slot < units,
+                    "{name} = {slot}: GL 4.5 guarantees {units} units"
+                );
+            }
         }
     }
 }

@@ -1,0 +1,21 @@
+// The entry point of each 8×8 block of intersect1's rays — ours (Reshetov, Soupikov and Hurley
+// 2005; bvh/entry.comp finds and writes them, bvh/intersect1.comp reads them): a texel per
+// block, (octant + 1, first record, end, 0), in the last BVH_ENTRY_TEXELS texels of the word
+// buffer (bvh/words.glsl; the host appends them, zeros, to Bvh::gpu_words), the blocks of the
+// image row by row as the CPU twin's Bvh::block_entries and block_of number them
+// (src/reference/bvh/entry.rs).
+//
+// In the word buffer rather than an image of their own (ours): the BVH's kernels bind the
+// pipeline's ray-state images at units 0–6 and the word buffer at 7, the 8 image units GL 4.5
+// guarantees (GL_MAX_IMAGE_UNITS), and intersect1 reads its entry as it reads a node record.
+// (A storage buffer instead took 1.08 of the dragon's intersect1 time on llvmpipe, 12 pairs:
+// its load per invocation is not the image's one texel load; docs/results/bvh_steps.md.)
+
+// the blocks per row of the image (IMAGE_WIDTH: a #define of the pipeline)
+const int BVH_BLOCKS_X = (IMAGE_WIDTH + 7) / 8;
+
+// the texel of the entry of the block of pixels 8·block .. 8·block + 7
+int entryTexel(ivec2 block)
+{
+    return imageSize(bvh) - BVH_ENTRY_TEXELS + block.y * BVH_BLOCKS_X + block.x;
+}
