@@ -35,6 +35,18 @@ void trace(ivec2 storePos)
     if (originState.w <= 0.0) return;
     int lastTriID = int(imageLoad(rayDirTexture, storePos).w);
     vec3 n = imageLoad(normalTexture, storePos).xyz;
+    // Ours: the pixel's shadow flags are loaded here, before the search, where Listing 15
+    // loads them after it to set the flag — no other invocation writes this texel in the
+    // dispatch, so the value is the same, and its load's latency hides behind the search. On
+    // llvmpipe the load after the walk waited for memory at the end of every invocation (in a
+    // sampling profile of the dragon's intersect2, about 5 % of the kernel); loaded here, the
+    // BVH's intersect2 took 0.94 of the time on the dragon, 0.98 on the bunny (12 alternating
+    // pairs each, docs/results/bvh_steps.md, ninth session).
+#if SHADOW_BITS
+    uvec4 flags = imageLoad(shadowTexture, storePos);
+#else
+    vec4 shadows = imageLoad(shadowTexture, storePos);
+#endif
     vec3 ro = originState.xyz;
     vec3 toLight = lightPos[lightSource].xyz - ro;
     float lightDistance = length(toLight);
@@ -50,11 +62,9 @@ void trace(ivec2 storePos)
     // set the shadow flag if needed
     if (shadow) {
 #if SHADOW_BITS
-        uvec4 flags = imageLoad(shadowTexture, storePos);
         flags[lightSource >> 5] |= 1u << uint(lightSource & 31);
         imageStore(shadowTexture, storePos, flags);
 #else
-        vec4 shadows = imageLoad(shadowTexture, storePos);
         switch (lightSource) {
             case 0: shadows.x = 1.0; break;
             case 1: shadows.y = 1.0; break;
