@@ -212,10 +212,11 @@ impl Bvh {
         self.builds
     }
 
-    /// Bind the word buffer; the entry kernel writes its last texels, the others read it.
-    fn bind(&self, gl: &Gl) {
+    /// Bind the word buffer with `access`: the entry kernel writes its last texels
+    /// (`glow::READ_WRITE`), the others only read it (`glow::READ_ONLY`).
+    fn bind(&self, gl: &Gl, access: u32) {
         if let Some(b) = &self.buffers {
-            b.bind_images(gl, glow::READ_WRITE);
+            b.bind_images(gl, access);
         }
     }
 }
@@ -230,16 +231,17 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
-        self.bind(f.gl);
+        self.bind(f.gl, glow::READ_WRITE);
         self.entry.use_program();
         self.entry
             .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+        self.bind(f.gl, glow::READ_ONLY);
         self.intersect1.use_program();
         &self.intersect1
     }
 
     fn any_hit(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
-        self.bind(f.gl);
+        self.bind(f.gl, glow::READ_ONLY);
         self.intersect2.use_program();
         &self.intersect2
     }
