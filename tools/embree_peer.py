@@ -115,7 +115,8 @@ def worker(conn, barrier, tris, robust):
             q = queries[msg[1]]
             barrier.wait()
             t0, c0 = time.perf_counter(), time.process_time()
-            trace(scene, *q)
+            if len(q[0]):  # (a share can be empty: fewer rays than chunks)
+                trace(scene, *q)
             conn.send((t0, time.perf_counter(), time.process_time() - c0))
 
 
@@ -135,7 +136,9 @@ class Embree:
             barrier = ctx.Barrier(threads)
             for _ in range(threads):
                 mine, theirs = ctx.Pipe()
-                proc = ctx.Process(target=worker, args=(theirs, barrier, tris, robust))
+                # daemons: an error that ends this script ends them too
+                proc = ctx.Process(target=worker, args=(theirs, barrier, tris, robust),
+                                   daemon=True)
                 proc.start()
                 self.pool.append((proc, mine))
             for _, conn in self.pool:

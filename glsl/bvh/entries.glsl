@@ -11,9 +11,7 @@
 // (A storage buffer instead took 1.08 of the dragon's intersect1 time on llvmpipe, 12 pairs:
 // its load per invocation is not the image's one texel load; docs/results/bvh_steps.md.)
 
-// the blocks per row of the image (IMAGE_WIDTH: a #define of the pipeline)
-const int BVH_BLOCKS_X = (IMAGE_WIDTH + 7) / 8;
-
+// (BVH_ENTRY_TEXELS: the image's blocks, BVH_BLOCKS_X of them a row; #defines of the host)
 // the texel of the entry of the block of pixels 8·block .. 8·block + 7
 int entryTexel(ivec2 block)
 {

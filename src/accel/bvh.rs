@@ -77,14 +77,15 @@ pub fn texel_index_mask() -> (&'static str, String) {
 
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]), texel indices
-/// ([`TEXEL_INDEX_BITS`]) and its last `blocks` texels, the blocks' entries
-/// (`BVH_ENTRY_TEXELS`), and they store hit records and per-pixel counts
+/// ([`TEXEL_INDEX_BITS`]) and its last texels, the entries of the image's blocks (columns ×
+/// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`), and they store hit records and per-pixel counts
 /// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
 /// 64-bit integers (`RECORD_STORE_64`); on llvmpipe intersect1 loads the next work group's rays
 /// ahead (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
-fn kernel_defines(info: &GlInfo, blocks: u32) -> [(&'static str, String); 10] {
+fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 11] {
     [
-        ("BVH_ENTRY_TEXELS", blocks.to_string()),
+        ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
+        ("BVH_BLOCKS_X", blocks.0.to_string()),
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
         ("PREFETCH_RAYS", (info.is_llvmpipe() as i32).to_string()),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
@@ -145,7 +146,7 @@ pub struct Bvh {
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
-        let blocks = b.width.div_ceil(BLOCK) * b.height.div_ceil(BLOCK);
+        let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
         let defs = kernel_defines(b.info, blocks);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
@@ -155,7 +156,7 @@ impl Bvh {
                 &[&defs[..], &[("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string())]].concat(),
                 "intersect1",
             )?,
-            blocks,
+            blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             objects: scene
