@@ -421,7 +421,7 @@ def report(results, a, command, load):
         f"(load average {load[0]} before, {load[1]} after); ours on "
         f"`{results[0]['gl_renderer']}` (all cores)",
         f"- Embree: embreex {embreex_version()}, {flags}; rtcIntersect1/rtcOccluded1 per ray "
-        f"(embreex binds no packet calls), 1 thread per call: the {th}-thread column splits "
+        f"(embreex binds no packet calls), 1 thread per call: the {th}-process column splits "
         f"the rays over {th} worker processes, each with its own Embree scene, timed from a "
         "common barrier to the last one's end; build = rtcCommitScene (multi-threaded, TBB)",
         f"- Mrays/s: rays / seconds, medians of {a.repeats} Embree runs; ours medians of "
@@ -437,7 +437,7 @@ def report(results, a, command, load):
         "of their own; intersect2 with its counts", "",
         "## Primary rays (closest hit)", "",
         f"| scene | size | triangles | Embree build ms | our build ms (BVH or grid) | Embree Mrays/s "
-        f"(1 thread) | Embree Mrays/s ({th} threads) | ours Mrays/s | ours/Embree | "
+        f"(1 thread) | Embree Mrays/s ({th} processes) | ours Mrays/s | ours/Embree | "
         "ours/Embree per round: median (range) | "
         "ours Mrays/s, whole kind | first-hit agreement % (ids / with ties) |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
@@ -449,7 +449,7 @@ def report(results, a, command, load):
             str(r["triangles"]), fmt(r["embree_build_ms"], 1), fmt(r["bvh_build_ms"], 1),
             *rate_cells(m, th), f"{m['agree_pct']:.4f} / {m['agree_ties_pct']:.4f}"]) + " |")
     lines += ["", "## Shadow feelers (any hit, intersect2)", "",
-              f"| scene | feelers | Embree Mrays/s (1 thread) | Embree Mrays/s ({th} threads) "
+              f"| scene | feelers | Embree Mrays/s (1 thread) | Embree Mrays/s ({th} processes) "
               "| ours Mrays/s | ours/Embree | ours/Embree per round: median (range) "
               "| ours Mrays/s, whole kind | shadow agreement % (hit pixels) |",
               "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -460,7 +460,7 @@ def report(results, a, command, load):
                                             *rate_cells(m, th), f"{m['agree_pct']:.4f}"]) + " |")
     lines += ["", "## Details", "",
               "| scene | Embree upload ms (embreex copy) | cores Embree got: build, "
-              f"{th}-thread rays (CPU / wall time) | Embree best Mrays/s ({th} threads) | ties "
+              f"{th}-process rays (CPU / wall time) | Embree best Mrays/s ({th} processes) | ties "
               "| other disagreements (on a shared edge) | max relative t difference, same id |",
               "|---|---:|---:|---:|---:|---:|---:|"]
     for r in results:
