@@ -15,5 +15,14 @@ layout(std430, binding = SSBO_MATERIAL) readonly buffer MaterialBuffer { vec4 ma
 layout(std430, binding = SSBO_LIGHT_POS) SCENE_QUALIFIER buffer LightPosBuffer { vec4 lightPos[]; };
 layout(std430, binding = SSBO_LIGHT_COLOR) SCENE_QUALIFIER buffer LightColorBuffer { vec4 lightColor[]; };
 
-// Number of triangles in the scene (vertex.length() / 3).
-int triangleCount() { return vertex.length() / 3; }
+// Number of triangles in the scene: SCENE_TRIANGLES, a #define of the host
+// (pipeline::raytrace::kernel_defines). Deviation: Listings 12 and 15 loop to vertex.length() - 2;
+// GLSL 4.60 §4.1.9 and GL 4.6 §7.8 make length() of a runtime-sized array the size of the buffer
+// bound to that block's binding, but Mesa 22.3's zink returns the size of another bound buffer
+// when the program declares a shader storage block it does not use (every kernel that includes
+// this file does), so the grids' build kernels registered 278 of 22,146 references
+// (docs/drivers.md). The host knows the count; no kernel asks a buffer for it.
+#ifndef SCENE_TRIANGLES
+#error "SCENE_TRIANGLES (the scene's triangle count) must be #defined by the host"
+#endif
+int triangleCount() { return SCENE_TRIANGLES; }

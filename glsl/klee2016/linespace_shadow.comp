@@ -21,17 +21,21 @@
 // it every surface would shadow itself); so is a node within NEAR_MARGIN child cells of it.
 // The shadow value (fraction of unblocked rays) goes to shadowTexture and, multiplied into
 // the diffuse colour, back into the diffuse texture.
-// loopLimit: llvmpipe ends all loops of an invocation after 65535 iterations in total — and it
-// runs 8 invocations as one SIMD vector whose loops iterate while any lane is active, so the
-// budget is spent by the vector, not by one pixel. Two guards: every loop iteration here is
-// counted and an invocation past LOOP_BUDGET stops; and after the work a sentinel loop of
-// loopSentinel (= 2, a uniform so that it is not unrolled) iterations must run completely —
-// if llvmpipe's limit was reached it ends after one. Either way the pixel is counted as
-// truncated. The host then renders the frame again with the pixel's rays split into batches
-// (rayBegin..rayEnd, one dispatch each, the lit counts summed in shadowTexture.g), halving
-// the batch until no pixel is truncated; a frame truncated with one ray per batch is refused.
-// A ray's result does not depend on the other rays of its packet, so batches give the same
-// image (ours; the thesis' GPU had no such limit).
+// loopLimit: Mesa's llvmpipe (and lavapipe, under zink) silently ends the loops of a SIMD vector
+// of invocations (8 on a 256-bit CPU) after 65535 iterations, and the vector iterates while
+// any of its lanes does, so nested loops that diverge cost the vector the sum of its lanes'
+// iterations. The kernel stays below the limit instead of detecting it: every loop iteration
+// is counted (WITHIN_BUDGET; initShaft's NUM_RAYS by the host) and an invocation stops past
+// LOOP_BUDGET, which the host sets to the limit's share of one lane (GlInfo::loop_limit; no
+// bound elsewhere), so no vector reaches the limit. (A sentinel loop after the work, which
+// ended early if the limit had been reached, proved no guard: on zink the traversal's loops
+// were cut while the sentinel still ran whole, and 174 of 2,294 pixels of the bunny at 10x10
+// rays came out too light, unreported — docs/drivers.md.) A pixel past its budget is counted
+// as truncated, and the host renders the frame again with the pixel's rays split into
+// batches (rayBegin..rayEnd, one dispatch each, the lit counts summed in shadowTexture.g),
+// halving the batch until no pixel is truncated; a frame truncated with one ray per batch is
+// refused. A ray's result does not depend on the other rays of its packet, so batches give
+// the same image (ours; the thesis' GPU had no such limit).
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
@@ -40,7 +44,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 #define GEOMETRY_BIT 1u
 #define CHILDREN_BIT 2u
-#define LOOP_BUDGET 60000u
 #define INF uintBitsToFloat(0x7F800000u)
 
 // the G-buffer: position (xyz, w: 1 = geometry), normal (xyz, facing the camera), diffuse (rgb)
@@ -71,7 +74,6 @@ uniform int tex_x_res;
 uniform int tex_y_res;
 uniform int ls_y_size;
 uniform ivec2 tileOffset;
-uniform int loopSentinel;
 uniform int rayBegin;        // this dispatch's rays: rayBegin <= r < rayEnd (0, NUM_RAYS: all)
 uniform int rayEnd;
 uniform bool accumulate;     // add to the lit count of the batches before
@@ -98,13 +100,18 @@ bool loopStep()
 // the algorithm's loops below read as printed.
 #define WITHIN_BUDGET loopStep()
 
+// Listings 1 and 2 declare traverse_chilids and active_rays[] as bool; here they are uints
+// (0u false, 1u true). GLSL allows bool members and arrays in private memory, but lavapipe (Mesa
+// 22.3), under zink, fails to create any compute pipeline that indexes an array of them with a
+// dynamic index (vkCreateComputePipelines: VK_ERROR_UNKNOWN; docs/drivers.md has the
+// three-line reproduction), and stack[depth] and active_rays[r] are such indices.
 struct Stack
 {
     uvec2 parent_node;
     uvec2 nodelist[N * N];
     ivec2 offset[N * N];
     int nodelist_index;
-    bool traverse_chilids;
+    uint traverse_chilids;
     int current_slice;
     int last_slice;
     float u_min, u_max, v_min, v_max;
@@ -119,7 +126,7 @@ struct Shaft {
     vec3 origin;
     vec3 destination;
     vec3 corner_dir[4];
-    bool active_rays[NUM_RAYS];
+    uint active_rays[NUM_RAYS];
     vec3 ray_start[NUM_MAX_DEPTH + 1];
     vec3 ray_direction[NUM_RAYS];
 } shaft;
@@ -147,8 +154,9 @@ void initShaft(vec3 pos, vec3 normal)
     for (int r = 0; r < NUM_RAYS; r++) {
         // samples behind the surface are blocked by it (N·L <= 0)
         vec3 l = samplePoint(r);
-        shaft.active_rays[r] = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
-        if (shaft.active_rays[r]) active_rays++;
+        bool front = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
+        shaft.active_rays[r] = uint(front);
+        if (front) active_rays++;
         shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
     }
     // initialise the shaft: transform into the N-tree coordinate system
@@ -263,13 +271,13 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
 // the last depth with line spaces (deactivate) the ray is then deactivated.
 bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
 {
-    if (r >= rayEnd || !shaft.active_rays[r]) return false;
+    if (r >= rayEnd || shaft.active_rays[r] == 0u) return false;
     int sf, ef;
     ivec2 sd, ed;
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
     if (!getEntry(node, sf, sd, ef, ed)) return false;
     if (deactivate) {
-        shaft.active_rays[r] = false;
+        shaft.active_rays[r] = 0u;
         active_rays--;
     }
     return true;
@@ -312,7 +320,7 @@ bool occludes(uint t, vec3 ro, vec3 rd)
 // the exact triangle tests of a leaf for ray r
 void leafRay(int r, uvec2 node, vec3 childStart, float te)
 {
-    if (r >= rayEnd || !shaft.active_rays[r]) return;
+    if (r >= rayEnd || shaft.active_rays[r] == 0u) return;
     int sf, ef;
     ivec2 sd, ed;
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return;
@@ -321,7 +329,7 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     uint count = node.g;
     for (uint i = 0u; i < count && WITHIN_BUDGET; i++) {
         if (occludes(leafTriangles[off + i], originWorld, rd)) {
-            shaft.active_rays[r] = false;
+            shaft.active_rays[r] = 0u;
             active_rays--;
             return;
         }
@@ -395,7 +403,7 @@ bool initLevel(int d, uvec2 parent)
     if (!sliceRange(d, first, last)) return false;
     stack[d].parent_node = parent;
     stack[d].nodelist_index = 0;
-    stack[d].traverse_chilids = false;
+    stack[d].traverse_chilids = 0u;
     stack[d].current_slice = first;
     stack[d].last_slice = last;
     return true;
@@ -412,14 +420,14 @@ int traverse()
         // for all slices of the node, from current_slice on (the loop ends at last_slice or
         // when a child is to be traversed: next_depth)
         for (int slice = stack[depth].current_slice; WITHIN_BUDGET; slice += dir) {
-            if (!stack[depth].traverse_chilids) {
+            if (stack[depth].traverse_chilids == 0u) {
                 sliceUV(depth, slice);
                 int cu0 = max(int(floor(stack[depth].u_min)), 0);
                 int cu1 = min(int(floor(stack[depth].u_max)), N - 1);
                 int cv0 = max(int(floor(stack[depth].v_min)), 0);
                 int cv1 = min(int(floor(stack[depth].v_max)), N - 1);
                 stack[depth].nodelist_index = 0;
-                for (int cu = cu0; cu <= cu1; cu++) {
+                for (int cu = cu0; cu <= cu1 && WITHIN_BUDGET; cu++) {
                     for (int cv = cv0; cv <= cv1 && WITHIN_BUDGET; cv++) {
                         ivec3 c;
                         c[k] = slice; c[u] = cu; c[v] = cv;
@@ -466,7 +474,7 @@ int traverse()
                     if (descend && depth + 1 < NUM_MAX_DEPTH) {
                         shaft.ray_start[depth + 1] = childStart;
                         if (initLevel(depth + 1, node)) {
-                            stack[depth].traverse_chilids = true;
+                            stack[depth].traverse_chilids = 1u;
                             stack[depth].current_slice = slice;
                             next_depth = true;
                         }
@@ -476,7 +484,7 @@ int traverse()
                 if (next_depth) break;
             }
             if (next_depth) break;
-            stack[depth].traverse_chilids = false;
+            stack[depth].traverse_chilids = 0u;
             if (slice == stack[depth].last_slice) break;
         }
         // the thesis adds 2 and subtracts 1 at the end of the while loop
@@ -583,7 +591,7 @@ int litRays(vec3 pos, vec3 normal)
     if (SHADOW_MODE == 2) {
         int lit = 0;
         for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
-            if (shaft.active_rays[r] && !ddaBlocked(r)) lit++;
+            if (shaft.active_rays[r] != 0u && !ddaBlocked(r)) lit++;
         }
         return lit;
     }
@@ -618,14 +626,6 @@ int litRays(vec3 pos, vec3 normal)
     return traverse();
 }
 
-// false if the GL implementation's loop limit ended loops early (see loopLimit above)
-bool loopsComplete()
-{
-    int c = 0;
-    for (int i = 0; i < loopSentinel; i++) c++;
-    return c == loopSentinel;
-}
-
 void main()
 {
     countersBegin();
@@ -635,7 +635,6 @@ void main()
         if (pos.w > 0.0) {
             vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
             float lit = float(litRays(pos.xyz, n));
-            if (!loopsComplete()) truncated = 1u;
             if (accumulate) lit += imageLoad(shadowTexture, storePos).g;
             float s = lit / float(NUM_RAYS);
             imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));

@@ -44,7 +44,38 @@ pub struct GlInfo {
     pub int64: bool,
 }
 
+/// How Mesa's llvmpipe — and lavapipe, which zink runs on in software — treat long shader
+/// loops: a SIMD vector of `lanes` invocations stops every loop after `iterations` iterations
+/// in total (gallivm's guard against endless loops), silently. A vector iterates while any of
+/// its lanes does, so divergent nested loops cost it the sum of its lanes' iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LoopLimit {
+    pub iterations: u32,
+    pub lanes: u32,
+}
+
+impl LoopLimit {
+    /// The iterations one invocation may run, every loop counted, so that no vector reaches
+    /// the limit whatever its lanes do.
+    pub fn per_invocation(&self) -> u32 {
+        self.iterations / self.lanes.max(1)
+    }
+}
+
 impl GlInfo {
+    /// The loop limit of a GL implementation that has one: llvmpipe, alone or under zink
+    /// (GL_RENDERER names it, with the width of its vectors: "llvmpipe (LLVM 15.0.6, 256 bits)",
+    /// 8 lanes of 32 bits; 16 lanes where the width cannot be read). `None` elsewhere.
+    pub fn loop_limit(&self) -> Option<LoopLimit> {
+        if !self.is_llvmpipe() {
+            return None;
+        }
+        Some(LoopLimit {
+            iterations: 65535,
+            lanes: vector_bits(&self.renderer).map_or(16, |b| b / 32),
+        })
+    }
+
     /// Whether this is Mesa's llvmpipe (GL_RENDERER names it): the CPU rasteriser whose loop
     /// limit and code generation some kernels adapt to.
     pub fn is_llvmpipe(&self) -> bool {
@@ -71,6 +102,16 @@ impl GlInfo {
             .unwrap_or(if cpus > 1 { cpus } else { 0 });
         threads.clamp(1, 16)
     }
+}
+
+/// The vector width llvmpipe names in its GL_RENDERER ("… 256 bits)").
+fn vector_bits(renderer: &str) -> Option<u32> {
+    let head = renderer
+        .split(" bits")
+        .next()
+        .filter(|h| h.len() < renderer.len())?;
+    let n = head.rsplit([' ', ',', '(']).next()?;
+    n.parse::<u32>().ok().filter(|&b| b >= 32)
 }
 
 /// A current GL context. Dropping it releases the context.
@@ -440,5 +481,21 @@ pub fn alloc_error(err: u32, what: &str, bytes: u64) -> String {
         )
     } else {
         format!("{name} (0x{err:04x}) while allocating {what} of {size} ({bytes} bytes)")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::vector_bits;
+
+    #[test]
+    fn llvmpipe_vector_width_is_read_from_the_renderer() {
+        assert_eq!(vector_bits("llvmpipe (LLVM 15.0.6, 256 bits)"), Some(256));
+        assert_eq!(
+            vector_bits("zink (llvmpipe (LLVM 15.0.6, 512 bits))"),
+            Some(512)
+        );
+        assert_eq!(vector_bits("llvmpipe (LLVM 15.0.6)"), None);
+        assert_eq!(vector_bits("NVIDIA H200/PCIe/SSE2"), None);
     }
 }

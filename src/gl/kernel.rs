@@ -4,11 +4,13 @@
 //! numbers.
 
 use std::collections::HashMap;
+use std::ffi::CStr;
 use std::sync::Arc;
 
 use anyhow::{bail, Result};
 use glow::HasContext;
 
+use super::crash;
 use super::resources::GpuTimers;
 use super::{compile_program, Defines, Gl, ShaderSource};
 
@@ -22,6 +24,8 @@ pub struct Kernel {
     /// The name its dispatches are timed under (the key of `gpu_ms`).
     timer: &'static str,
     uniforms: HashMap<String, glow::UniformLocation>,
+    /// What the crash handler says if the driver faults while this program is in use.
+    crash_note: &'static CStr,
 }
 
 /// The image size and tiling of a per-pixel dispatch.
@@ -120,6 +124,14 @@ impl Kernel {
         timer: &'static str,
     ) -> Result<Kernel> {
         let program = compile_program(gl, shaders, stages, defines)?;
+        let files: Vec<String> = stages
+            .iter()
+            .map(|(_, f)| shaders.display_name(f))
+            .collect();
+        let files: Vec<&str> = files.iter().map(String::as_str).collect();
+        // SAFETY: a plain query on the current context.
+        let renderer = unsafe { gl.get_parameter_string(glow::RENDERER) };
+        let crash_note = crash::keep(&crash::message(timer, &files, &renderer));
         // SAFETY: queries of the program we just linked.
         let uniforms = unsafe {
             (0..gl.get_active_uniforms(program))
@@ -135,6 +147,7 @@ impl Kernel {
             program,
             timer,
             uniforms,
+            crash_note,
         })
     }
 
@@ -142,8 +155,9 @@ impl Kernel {
         self.timer
     }
 
-    /// Make this program current.
+    /// Make this program current (and the one a driver crash is reported against).
     pub fn use_program(&self) {
+        crash::note_program(self.crash_note);
         // SAFETY: binding our own program.
         unsafe { self.gl.use_program(Some(self.program)) };
     }
@@ -162,6 +176,10 @@ impl Kernel {
     pub fn set_f32(&self, name: &str, v: f32) {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_1_f32(self.loc(name), v) };
+    }
+    pub fn set_i32_slice(&self, name: &str, v: &[i32]) {
+        // SAFETY: a uniform array of the program in use, of at least v.len() elements.
+        unsafe { self.gl.uniform_1_i32_slice(self.loc(name), v) };
     }
     pub fn set_ivec2(&self, name: &str, v: [i32; 2]) {
         // SAFETY: a uniform of the program in use.

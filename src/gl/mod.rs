@@ -1,6 +1,7 @@
 //! OpenGL plumbing: the headless context, program loading, and small resource helpers.
 
 pub mod context;
+pub mod crash;
 pub mod kernel;
 pub mod program;
 pub mod resources;

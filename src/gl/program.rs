@@ -67,7 +67,8 @@ impl ShaderSource {
         }
     }
 
-    fn display_name(&self, name: &str) -> String {
+    /// How `name` is shown in messages: its path below `--glsl-dir`, or `glsl/NAME` when embedded.
+    pub fn display_name(&self, name: &str) -> String {
         match &self.effective_dir() {
             Some(dir) => dir.join(name).display().to_string(),
             None => format!("glsl/{name}"),

@@ -244,7 +244,7 @@ impl GpuScene {
             gl,
             shaders,
             &[(glow::VERTEX_SHADER, "mueller2015/transform.vert")],
-            &Defines::new(),
+            &Defines::new().set("SCENE_TRIANGLES", scene.triangle_count()),
             "transform",
         )?;
         let (vao, light_vao, vbos) = vertex_arrays(gl, scene, &data)?;

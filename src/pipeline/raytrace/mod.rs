@@ -97,7 +97,8 @@ pub const COUNTERS: &[&str] = &[
 /// The counters that count ray–triangle tests (the rest count events).
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
-/// `#define`s every kernel gets: counter slots and the shadow-flag layout; the SAH BVH's kernels
+/// `#define`s every kernel gets: counter slots, the shadow-flag layout, the scene's triangle
+/// count (`glsl/common/scene.glsl`'s `triangleCount()`); the SAH BVH's kernels
 /// override the last three (`accel::bvh`: hit records, 64-bit record stores, the next work
 /// group's rays loaded ahead on llvmpipe).
 pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
@@ -116,7 +117,8 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         .set("HIT_RECORDS", 0)
         .set("PIXEL_COUNTS", 0)
         .set("RECORD_STORE_64", 0)
-        .set("PREFETCH_RAYS", 0);
+        .set("PREFETCH_RAYS", 0)
+        .set("SCENE_TRIANGLES", scene.triangle_count());
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }

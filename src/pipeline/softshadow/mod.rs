@@ -31,6 +31,7 @@ use self::present::Present;
 use self::shadow_pass::{shadow_kernel, ShadowPass, ShadowUniforms};
 use super::Renderer;
 use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
+use crate::gl::context::LoopLimit;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
 use crate::reference::ntree::{self, NTree, PackedLinespaces};
@@ -128,6 +129,8 @@ pub struct SoftShadowRenderer {
     /// Doubled when a frame hits llvmpipe's loop limit, kept for the next frames, back to 1
     /// when the mode or the samples change.
     ray_batches: u32,
+    /// The GL implementation's loop limit (the shadow kernel's budget follows from it).
+    loop_limit: Option<LoopLimit>,
     /// The camera and the statistics of the last frame drawn.
     last: Option<(Camera, FrameStats)>,
 }
@@ -193,7 +196,8 @@ impl SoftShadowRenderer {
         )?;
         let packed = pack(info, &tree)?;
         let samples = (options.samples_u, options.samples_v);
-        let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples)?;
+        let limit = info.loop_limit();
+        let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples, limit)?;
         let (w, h) = (options.width, options.height);
         let triangles = scene.world_triangles();
         let shadow = ShadowPass::new(&gl, info, kernel, &tree, &packed, &triangles, &options)?;
@@ -219,6 +223,7 @@ impl SoftShadowRenderer {
             timers: GpuTimers::default(),
             pixels,
             ray_batches: 1,
+            loop_limit: limit,
             last: None,
             gl,
         })
@@ -233,7 +238,8 @@ impl SoftShadowRenderer {
         su: u32,
         sv: u32,
     ) -> Result<()> {
-        self.shadow.kernel = shadow_kernel(&self.gl, shaders, &self.scene.tree, mode, (su, sv))?;
+        let (tree, limit) = (&self.scene.tree, self.loop_limit);
+        self.shadow.kernel = shadow_kernel(&self.gl, shaders, tree, mode, (su, sv), limit)?;
         self.options.mode = mode;
         self.options.samples_u = su;
         self.options.samples_v = sv;

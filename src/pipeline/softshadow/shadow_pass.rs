@@ -12,6 +12,7 @@ use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
 use super::{KleeShading, SoftShadowOptions};
+use crate::gl::context::LoopLimit;
 use crate::gl::resources::{GpuTimers, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
@@ -34,6 +35,7 @@ pub fn shadow_kernel(
     tree: &NTree,
     mode: ShadowMode,
     (su, sv): (u32, u32),
+    limit: Option<LoopLimit>,
 ) -> Result<Kernel> {
     if !(1..=10).contains(&su) || !(1..=10).contains(&sv) {
         bail!("{su}x{sv} light samples: 1x1 to 10x10");
@@ -47,7 +49,8 @@ pub fn shadow_kernel(
         .set("NUM_RAYS", su * sv)
         .set("SHADOW_MODE", mode.kernel_mode())
         .set("NEAR_ORIGIN_RULE", mode.near_origin_rule() as u32)
-        .set("BIT_IS_HIT", mode.bit_is_hit() as u32);
+        .set("BIT_IS_HIT", mode.bit_is_hit() as u32)
+        .set("LOOP_BUDGET", format!("{}u", loop_budget(limit, su * sv)));
     for (i, c) in COUNTERS.iter().enumerate() {
         defines = defines.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -65,6 +68,13 @@ pub fn shadow_kernel(
         &defines,
         timer,
     )
+}
+
+/// The iterations one invocation of the shadow kernel may run (`LOOP_BUDGET`, the kernel's
+/// loopLimit): where the GL implementation ends loops, the limit's share of one SIMD lane less
+/// initShaft's loop over the rays, which the kernel does not count; no bound elsewhere.
+pub fn loop_budget(limit: Option<LoopLimit>, rays: u32) -> u32 {
+    limit.map_or(u32::MAX, |l| l.per_invocation().saturating_sub(rays).max(1))
 }
 
 /// The counts of one shadow pass.
@@ -195,7 +205,6 @@ impl ShadowPass {
         k.set_i32("tex_x_res", x as i32);
         k.set_i32("tex_y_res", y as i32);
         k.set_i32("ls_y_size", ls_y as i32);
-        k.set_i32("loopSentinel", 2);
         let (rw, ro, f) = (glow::READ_WRITE, glow::READ_ONLY, glow::RGBA32F);
         // SAFETY: binding our textures to their units.
         unsafe {
