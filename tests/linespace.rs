@@ -250,6 +250,7 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
         let cpu = r.cpu();
+        let batches = f.stats.facts["ray_batches"].as_u64().unwrap() as usize;
         let (mut hits, mut off, mut cpu_tests) = (0usize, 0usize, 0u64);
         for (i, p) in f.gbuffer_position.iter().enumerate() {
             if p[3] <= 0.0 {
@@ -259,10 +260,11 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             }
             hits += 1;
             let nrm = f.gbuffer_normal[i];
-            let (s, c) = cpu.shadow(
+            let (s, c) = cpu.shadow_in_batches(
                 mode,
                 Vec3::new(p[0], p[1], p[2]),
                 Vec3::new(nrm[0], nrm[1], nrm[2]).normalize(),
+                batches,
             );
             cpu_tests += c.triangle_tests;
             if (s - f.shadow[i]).abs() > 1e-6 {
@@ -701,15 +703,18 @@ fn cpu_frame(
     hit: &[usize],
 ) -> (Vec<f32>, ShadowCounts) {
     let cpu = r.cpu();
+    // the rays in as many packets as the GPU split them into (its loop budget)
+    let batches = f.stats.facts["ray_batches"].as_u64().unwrap() as usize;
     let mut counts = ShadowCounts::default();
     let values = hit
         .iter()
         .map(|&i| {
             let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
-            let (s, c) = cpu.shadow(
+            let (s, c) = cpu.shadow_in_batches(
                 mode,
                 Vec3::new(p[0], p[1], p[2]),
                 Vec3::new(n[0], n[1], n[2]).normalize(),
+                batches,
             );
             counts += c;
             s

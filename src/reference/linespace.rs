@@ -314,6 +314,40 @@ impl<'a> LinespaceShadows<'a> {
     /// The pixel's shadow value (fraction of unblocked samples) for a surface point `p` with
     /// normal `normal` (facing the viewer), and the counts.
     pub fn shadow(&self, mode: ShadowMode, p: Vec3, normal: Vec3) -> (f32, ShadowCounts) {
+        self.shadow_in_batches(mode, p, normal, 1)
+    }
+
+    /// [`Self::shadow`] with the rays split into `batches` packets as the GPU's shadow pass
+    /// splits them (`rayBegin..rayEnd`, `shadow_pass::ShadowPass::run`): the same value, and
+    /// the counts of the smaller packets' traversals.
+    pub fn shadow_in_batches(
+        &self,
+        mode: ShadowMode,
+        p: Vec3,
+        normal: Vec3,
+        batches: usize,
+    ) -> (f32, ShadowCounts) {
+        let rays = (self.samples_u * self.samples_v) as usize;
+        let per_batch = rays.div_ceil(batches.clamp(1, rays));
+        let mut counts = ShadowCounts::default();
+        let mut lit = 0;
+        for begin in (0..rays).step_by(per_batch) {
+            let (l, c) = self.lit_rays(mode, p, normal, begin..(begin + per_batch).min(rays));
+            lit += l;
+            counts += c;
+        }
+        (lit as f32 / rays as f32, counts)
+    }
+
+    /// How many of the rays `batch` (of the light samples, in order) reach the light: one
+    /// packet, as one dispatch of the GPU's shadow pass traces it.
+    fn lit_rays(
+        &self,
+        mode: ShadowMode,
+        p: Vec3,
+        normal: Vec3,
+        batch: std::ops::Range<usize>,
+    ) -> (usize, ShadowCounts) {
         let mut counts = ShadowCounts::default();
         let origin = p + normal * self.offset;
         let light_points = light_samples(&self.light, self.samples_u, self.samples_v);
@@ -321,11 +355,12 @@ impl<'a> LinespaceShadows<'a> {
         // samples behind the surface are blocked by it (N·L <= 0, as Listing 15)
         let active_rays: Vec<bool> = light_points
             .iter()
-            .map(|l| normal.dot(*l - p) > 0.0)
+            .enumerate()
+            .map(|(r, l)| batch.contains(&r) && normal.dot(*l - p) > 0.0)
             .collect();
         let active_count = active_rays.iter().filter(|a| **a).count();
         if active_count == 0 {
-            return (0.0, counts);
+            return (0, counts);
         }
         let inv = self.tree.inv_node_size();
         let o = self.tree.to_ntree(origin);
@@ -378,8 +413,9 @@ impl<'a> LinespaceShadows<'a> {
                     })
                 };
                 let Some(k) = k else {
-                    counts.packet_failures += 1;
-                    return (1.0, counts);
+                    // no packet: lit, counted once per pixel
+                    counts.packet_failures += (batch.start == 0) as u64;
+                    return (batch.len(), counts);
                 };
                 let (u, v) = face_axes(k);
                 let mut shaft = Shaft {
@@ -399,7 +435,7 @@ impl<'a> LinespaceShadows<'a> {
                 self.cgt(mode, &mut shaft, &mut counts)
             }
         };
-        (lit as f32 / num_rays as f32, counts)
+        (lit, counts)
     }
 
     /// The slices [first, last] (in traversal order) the packet crosses in a node at stack
