@@ -11,6 +11,7 @@ layout(local_size_x = 128, local_size_y = 1, local_size_z = 1) in;
 #include "../common/grid.glsl"
 #include "tribox.glsl"
 
+layout(std430, binding = SSBO_VOXEL_COUNT) readonly buffer VoxelCount { uint voxelCount[]; };
 layout(std430, binding = SSBO_VOXEL_START) readonly buffer VoxelStart { uint voxelStart[]; };
 layout(std430, binding = SSBO_VOXEL_FILL) coherent buffer VoxelFill { uint voxelFill[]; };
 layout(std430, binding = SSBO_VOXEL_TRIS_FILLED) writeonly buffer VoxelTris { int voxelTris[]; };
@@ -18,10 +19,16 @@ layout(std430, binding = SSBO_VOXEL_TRIS_FILLED) writeonly buffer VoxelTris { in
 uint truncated = 0u;
 int currentTriangle = -1;
 
+// Ours: a claim past the voxel's count is not written. count.comp made the same test, but in
+// another program: GLSL lets a compiler fuse a·b + c into one rounding in one of them and not
+// in the other, so on a GPU the two may disagree on a triangle that touches a voxel's face.
+// Such a claim would write into the next voxel's list (or past the buffer); it is counted as
+// truncated instead, and the host refuses the frame.
 void registerInVoxel(int voxID)
 {
-    uint slot = voxelStart[voxID] + atomicAdd(voxelFill[voxID], 1u);
-    voxelTris[slot] = currentTriangle;
+    uint k = atomicAdd(voxelFill[voxID], 1u);
+    if (k < voxelCount[voxID]) voxelTris[voxelStart[voxID] + k] = currentTriangle;
+    else truncated = 1u;
 }
 
 #include "grid_overlap.glsl"

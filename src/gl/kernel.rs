@@ -10,9 +10,9 @@ use std::sync::Arc;
 use anyhow::{bail, Result};
 use glow::HasContext;
 
-use super::crash;
 use super::resources::GpuTimers;
 use super::{compile_program, Defines, Gl, ShaderSource};
+use super::{crash, sync};
 
 /// The work group size of the per-pixel kernels (`local_size_x = local_size_y = 8`).
 pub const PIXEL_GROUP: u32 = 8;
@@ -218,7 +218,8 @@ impl Kernel {
     }
 
     /// Dispatch this kernel (in use) over the image in tiles of `grid`, each dispatch timed,
-    /// the tile's origin in the uniform `tileOffset`, followed by a barrier.
+    /// the tile's origin in the uniform `tileOffset`, the tiles between two barriers ([`sync`]:
+    /// the tiles write disjoint pixels).
     pub fn dispatch_pixels(&self, timers: &mut GpuTimers, grid: PixelGrid) {
         self.dispatch_pixel_groups(timers, grid, PIXEL_GROUP);
     }
@@ -227,6 +228,7 @@ impl Kernel {
     /// 16×16); the tiles should be multiples of `group`.
     pub fn dispatch_pixel_groups(&self, timers: &mut GpuTimers, grid: PixelGrid, group: u32) {
         let gl = &self.gl;
+        sync::barrier(gl);
         for (tx, ty, tw, th) in grid.tiles() {
             self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
             let rows = th.div_ceil(group);
@@ -237,20 +239,21 @@ impl Kernel {
                 unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
             });
         }
-        barrier(gl);
+        sync::barrier(gl);
     }
 
-    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, followed
-    /// by a barrier.
+    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, between
+    /// two barriers ([`sync`]).
     pub fn dispatch_1d(&self, timers: &mut GpuTimers, groups: u32) {
         let gl = &self.gl;
+        sync::barrier(gl);
         if groups > 0 {
             // SAFETY: dispatch of the program in use.
             timers.time(gl, self.timer, || unsafe {
                 gl.dispatch_compute(groups, 1, 1)
             });
         }
-        barrier(gl);
+        sync::barrier(gl);
     }
 }
 
@@ -259,19 +262,6 @@ impl Drop for Kernel {
         // SAFETY: deleting our own program.
         unsafe { self.gl.delete_program(self.program) };
     }
-}
-
-/// A barrier so the next kernel or draw sees this kernel's image and buffer writes.
-pub fn barrier(gl: &Gl) {
-    // SAFETY: glMemoryBarrier on a current context.
-    unsafe {
-        gl.memory_barrier(
-            glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
-                | glow::SHADER_STORAGE_BARRIER_BIT
-                | glow::BUFFER_UPDATE_BARRIER_BIT
-                | glow::TEXTURE_FETCH_BARRIER_BIT,
-        )
-    };
 }
 
 fn gcd(a: u32, b: u32) -> u32 {

@@ -6,6 +6,7 @@ pub mod kernel;
 pub mod program;
 pub mod resources;
 pub mod slots;
+pub mod sync;
 
 pub use context::{alloc_error, check_alloc, check_error, gl_error_name, Gl, GlContext, GlInfo};
 pub use kernel::{Kernel, PixelGrid};

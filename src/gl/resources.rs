@@ -98,7 +98,6 @@ impl Ssbo {
         let mut bytes = vec![0u8; self.bytes];
         // SAFETY: the slice is the buffer's size.
         unsafe {
-            gl.memory_barrier(glow::BUFFER_UPDATE_BARRIER_BIT);
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer));
             gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
@@ -205,7 +204,6 @@ impl Image2d {
         let mut data = vec![[0u32; 4]; (self.width * self.height) as usize];
         // SAFETY: the slice holds w·h RGBA uints.
         unsafe {
-            gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT);
             gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             gl.get_tex_image(
@@ -406,7 +404,6 @@ pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> 
     let mut data = vec![[0f32; 4]; (w * h) as usize];
     // SAFETY: the slice holds w·h RGBA floats.
     unsafe {
-        gl.memory_barrier(glow::TEXTURE_UPDATE_BARRIER_BIT | glow::FRAMEBUFFER_BARRIER_BIT);
         gl.bind_texture(glow::TEXTURE_2D, Some(texture));
         gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
         gl.get_tex_image(

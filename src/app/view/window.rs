@@ -321,8 +321,6 @@ impl ScreenQuad {
         let gl = &self.gl;
         // SAFETY: drawing with our own objects on the current context.
         unsafe {
-            // the tracer's kernels wrote the texture through image stores
-            gl.memory_barrier(glow::TEXTURE_FETCH_BARRIER_BIT);
             gl.viewport(0, 0, size.0 as i32, size.1 as i32);
             gl.clear_color(0.08, 0.08, 0.08, 1.0);
             gl.clear(glow::COLOR_BUFFER_BIT);

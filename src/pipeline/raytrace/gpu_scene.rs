@@ -289,6 +289,11 @@ impl GpuScene {
         self.bind(gl);
         let k = &self.transform;
         k.use_program();
+        // a pass whose vertex shader stores into the scene's buffers, which the last frame's
+        // kernels read: between two barriers (gl::sync). GL 4.6 §7.12 leaves open how often a
+        // vertex shader runs for a vertex; the stores are idempotent, so any count gives the
+        // same buffers
+        crate::gl::sync::barrier(gl);
         timers.time(gl, k.timer(), || {
             // SAFETY: draws with our program and VAOs; rasterization is discarded.
             unsafe {
@@ -311,9 +316,9 @@ impl GpuScene {
                 gl.bind_vertex_array(None);
                 gl.disable(glow::RASTERIZER_DISCARD);
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-                gl.memory_barrier(glow::SHADER_STORAGE_BARRIER_BIT);
             }
         });
+        crate::gl::sync::barrier(gl);
     }
 
     pub fn delete(&self, gl: &Gl) {

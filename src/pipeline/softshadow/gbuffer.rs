@@ -183,9 +183,6 @@ impl GBuffer {
                 gl.bind_vertex_array(None);
                 gl.disable(glow::DEPTH_TEST);
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-                gl.memory_barrier(
-                    glow::SHADER_IMAGE_ACCESS_BARRIER_BIT | glow::TEXTURE_FETCH_BARRIER_BIT,
-                );
             }
         });
     }
