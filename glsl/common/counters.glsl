@@ -11,6 +11,9 @@ void countersBegin()
 {
     if (gl_LocalInvocationIndex < uint(COUNTER_SLOTS_PER_KERNEL))
         groupCount[gl_LocalInvocationIndex] = 0u;
+    // GLSL 4.60 §8.16: barrier() orders shared-memory accesses in a compute shader;
+    // memoryBarrierShared() first says so to compilers of earlier versions too
+    memoryBarrierShared();
     barrier();
 }
 
@@ -22,6 +25,7 @@ void countAdd(int local, uint n)
 // local: the kernel's own counter 0..COUNTER_SLOTS_PER_KERNEL-1; slot: the global counter.
 void countersEnd(int local, int slot)
 {
+    memoryBarrierShared();
     barrier();
     if (gl_LocalInvocationIndex == 0u) {
         uint n = groupCount[local];

@@ -29,7 +29,7 @@ void main()
         // Blelloch scan: up-sweep
         uint offset = 1u;
         for (uint d = 512u; d > 0u; d >>= 1u) {
-            barrier();
+            memoryBarrierShared(); barrier();
             if (local < d) {
                 uint ai = offset * (2u * local + 1u) - 1u;
                 uint bi = offset * (2u * local + 2u) - 1u;
@@ -37,7 +37,7 @@ void main()
             }
             offset <<= 1u;
         }
-        barrier();
+        memoryBarrierShared(); barrier();
         if (local == 0u) {
             blockSums[block] = temp[1023];
             temp[1023] = 0u;
@@ -45,7 +45,7 @@ void main()
         // down-sweep
         for (uint d = 1u; d < 1024u; d <<= 1u) {
             offset >>= 1u;
-            barrier();
+            memoryBarrierShared(); barrier();
             if (local < d) {
                 uint ai = offset * (2u * local + 1u) - 1u;
                 uint bi = offset * (2u * local + 2u) - 1u;
@@ -54,7 +54,7 @@ void main()
                 temp[bi] += t;
             }
         }
-        barrier();
+        memoryBarrierShared(); barrier();
         if (a < uint(voxelTotal)) voxelStart[a] = temp[2u * local];
         if (b < uint(voxelTotal)) voxelStart[b] = temp[2u * local + 1u];
     } else if (scanPhase == 1) {

@@ -185,11 +185,23 @@ fn ssbo_sizes(scene: &Scene) -> [(u32, &'static str, usize); 8] {
     ]
 }
 
+/// The most triangles Müller 2015's pipeline renders: their ids travel in float channels.
+pub const MAX_TRIANGLES: usize = 1 << 24;
+
 /// Every buffer the upload will make, estimated before any is made: each SSBO within
 /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, the vertex arrays (host copy and VBOs) within the host's
 /// memory.
 pub fn check_sizes(info: &GlInfo, scene: &Scene) -> Result<()> {
     let triangles = scene.triangle_count();
+    // the kernels carry a triangle id in a float channel of the ray state (rayDir.w, the
+    // colour buffer's carried hit): exact up to 2^24
+    if triangles > MAX_TRIANGLES {
+        bail!(
+            "{}: {triangles} triangles, more than the {MAX_TRIANGLES} whose ids the ray-state \
+             images carry exactly (a float channel: 2^24)",
+            scene.path.display()
+        );
+    }
     for (_, name, bytes) in ssbo_sizes(scene) {
         if bytes as i64 > info.max_ssbo_block_size {
             bail!(
