@@ -3,6 +3,7 @@
 
 mod args;
 mod bench;
+mod parity;
 mod render;
 mod view;
 
@@ -25,6 +26,11 @@ use gpgpu_rt::scene::Scene;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The OpenGL driver: the first device that gives a 4.5 core context (auto), Mesa's
+    /// llvmpipe, or Mesa's zink (OpenGL on Vulkan; Debian: mesa-vulkan-drivers). The same as
+    /// GPGPU_RT_DRIVER=NAME in the environment (docs/drivers.md).
+    #[arg(long, global = true, value_enum, value_name = "NAME")]
+    driver: Option<gpgpu_rt::gl::driver::Driver>,
 }
 
 #[derive(Subcommand)]
@@ -45,6 +51,10 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts
     /// (with its point lights' positions and shadow offset).
+    /// Render every design and accelerator on a few scenes and write their first hits, shadows
+    /// and exact counts to --out; with --against, compare them with another driver's
+    /// (docs/drivers.md, "Parity").
+    Parity(parity::ParityArgs),
     Info {
         scene: Option<PathBuf>,
         /// Print JSON.
@@ -63,6 +73,10 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => e.exit(),
     };
+    if let Some(d) = cli.driver {
+        // before any thread or GL call: Mesa reads its variables when it loads the driver
+        std::env::set_var(gpgpu_rt::gl::driver::DRIVER_ENV, d.name());
+    }
     match run(cli, &matches) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -79,6 +93,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
         Command::Bench(args) => bench::run(args),
         Command::ExportTriangles { scene, output } => render::export_triangles(&scene, &output),
         Command::Info { scene, json, gpu } => info(scene, json, gpu),
+        Command::Parity(args) => parity::run(args),
     }
 }
 

@@ -124,8 +124,10 @@ pub struct GlContext {
 
 impl GlContext {
     /// Open a headless GL 4.5 core context. `device`: the index of the EGL device to use; `None`
-    /// picks the first device that gives a 4.5 core context.
+    /// picks the first device that gives a 4.5 core context — of the driver `GPGPU_RT_DRIVER`
+    /// names, where it names one ([`super::driver`]).
     pub fn headless(device: Option<usize>) -> Result<GlContext> {
+        let driver = super::driver::apply_from_env()?;
         let devices: Vec<Device> = Device::query_devices()
             .map_err(|e| {
                 anyhow!(
@@ -160,14 +162,27 @@ impl GlContext {
         let mut failures = Vec::new();
         for i in candidates {
             match Self::open(&devices[i], i) {
-                Ok(ctx) => return Ok(ctx),
+                Ok(ctx) if driver.matches(&ctx.info.renderer) => return Ok(ctx),
+                Ok(ctx) => failures.push(format!(
+                    "{}: {}, not {}",
+                    describe(i, &devices[i]),
+                    ctx.info.renderer,
+                    driver.name()
+                )),
                 Err(e) => failures.push(format!("{}: {e:#}", describe(i, &devices[i]))),
             }
         }
-        bail!(
-            "no EGL device gives an OpenGL 4.5 core context:\n  {}",
-            failures.join("\n  ")
-        )
+        let what = match driver {
+            super::driver::Driver::Auto => "an OpenGL 4.5 core context".to_string(),
+            d => format!(
+                "an OpenGL 4.5 core context of {} ({}={}; for zink install \
+                 mesa-vulkan-drivers)",
+                d.name(),
+                super::driver::DRIVER_ENV,
+                d.name()
+            ),
+        };
+        bail!("no EGL device gives {what}:\n  {}", failures.join("\n  "))
     }
 
     fn open(device: &Device, index: usize) -> Result<GlContext> {

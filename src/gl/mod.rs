@@ -2,6 +2,7 @@
 
 pub mod context;
 pub mod crash;
+pub mod driver;
 pub mod kernel;
 pub mod program;
 pub mod resources;
