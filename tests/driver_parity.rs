@@ -75,3 +75,34 @@ fn llvmpipe_and_zink_render_every_design_alike() {
     );
     assert!(report.contains("Every case agrees."), "{report}");
 }
+
+/// `--driver` and `GPGPU_RT_DRIVER` pick the driver `info` reports; a name that is no driver
+/// is refused with the variable named.
+#[test]
+fn the_driver_is_picked_by_flag_or_environment() {
+    let info = |args: &[&str], env: Option<&str>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"));
+        c.args(["info", "--json"]).args(args);
+        match env {
+            Some(v) => c.env("GPGPU_RT_DRIVER", v),
+            None => c.env_remove("GPGPU_RT_DRIVER"),
+        };
+        c.output().expect("the binary runs")
+    };
+    let renderer = |o: &std::process::Output| {
+        let doc: serde_json::Value = serde_json::from_slice(&o.stdout).expect("info --json");
+        doc["renderer"].as_str().unwrap().to_string()
+    };
+    let o = info(&["--driver", "llvmpipe"], None);
+    assert!(renderer(&o).starts_with("llvmpipe"), "{}", renderer(&o));
+    if zink_installed() {
+        let o = info(&["--driver", "zink"], None);
+        assert!(renderer(&o).starts_with("zink"), "{}", renderer(&o));
+        let o = info(&[], Some("zink"));
+        assert!(renderer(&o).starts_with("zink"), "{}", renderer(&o));
+    }
+    let o = info(&[], Some("nouveau"));
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("GPGPU_RT_DRIVER=nouveau") && err.contains("zink"), "{err}");
+}

@@ -105,6 +105,7 @@ fn info(scene: Option<PathBuf>, json: bool, gpu: args::GpuArgs) -> Result<()> {
     }
     let ctx = GlContext::headless(gpu.device)?;
     let mut doc = serde_json::to_value(&ctx.info)?;
+    doc["egl_devices"] = json!(gpgpu_rt::gl::context::egl_devices());
     if let Some(s) = &scene {
         doc["scene"] = json!(s.path);
         doc["triangles"] = json!(s.triangle_count());

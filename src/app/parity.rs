@@ -46,8 +46,9 @@ pub struct ParityArgs {
     /// Relative difference two drivers' counts may have. The counts of traversals that step by
     /// float comparisons (ray–box slabs, cell boundaries) follow the rounding, and GLSL lets a
     /// compiler contract a·b + c into one fma: on llvmpipe and zink Wagner's node visits differ
-    /// by 0.3 %, the stream's cells by one in 92,000, the proximity clouds' jumps by one.
-    #[arg(long, default_value_t = 0.01)]
+    /// by up to 0.3 % and its shadow tests by up to 1.3 % (the turning teapots at 48²), the
+    /// stream's cells by one in 92,000, the proximity clouds' jumps by one.
+    #[arg(long, default_value_t = 0.02)]
     pub count_tolerance: f64,
     #[command(flatten)]
     pub gpu: GpuArgs,

@@ -114,6 +114,22 @@ fn vector_bits(renderer: &str) -> Option<u32> {
     n.parse::<u32>().ok().filter(|&b| b >= 32)
 }
 
+/// The EGL devices as `info` lists them: index and name (or vendor; Mesa's software device has
+/// neither).
+pub fn egl_devices() -> Vec<String> {
+    Device::query_devices()
+        .map(|devices| {
+            devices
+                .enumerate()
+                .map(|(i, d)| {
+                    let name = d.name().or(d.vendor()).unwrap_or("unnamed EGL device");
+                    format!("{i}: {name}")
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
 /// A current GL context. Dropping it releases the context.
 pub struct GlContext {
     pub gl: Arc<Gl>,
