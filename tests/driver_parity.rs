@@ -104,5 +104,8 @@ fn the_driver_is_picked_by_flag_or_environment() {
     let o = info(&[], Some("nouveau"));
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("GPGPU_RT_DRIVER=nouveau") && err.contains("zink"), "{err}");
+    assert!(
+        err.contains("GPGPU_RT_DRIVER=nouveau") && err.contains("zink"),
+        "{err}"
+    );
 }
