@@ -56,7 +56,9 @@ if [ -n "$record_reference" ]; then
 fi
 
 # 2. the device: an NVIDIA GPU unless --dry-run
-info_json=$("$bin" info --json 2>&1) || { say "no GL context: $info_json"; exit 1; }
+if ! info_json=$("$bin" info --json 2>/dev/null); then
+    say "no GL context:"; "$bin" info --json; exit 1
+fi
 renderer=$(printf '%s' "$info_json" | sed -n 's/.*"renderer": *"\([^"]*\)".*/\1/p' | head -1)
 if [ "$dry_run" = 0 ] && ! printf '%s' "$renderer" | grep -qi nvidia; then
     say "the first EGL device is \"$renderer\", not an NVIDIA GPU (use --dry-run to check the script)"

@@ -37,11 +37,8 @@ pub const TRIANGLES_PER_DISPATCH: u32 = 60_000;
 /// The triangles one dispatch tests on this GL implementation: [`TRIANGLES_PER_DISPATCH`] on
 /// Mesa's llvmpipe (GL_RENDERER names it), else all of them (`u32::MAX`).
 pub fn triangles_per_dispatch(info: &GlInfo) -> u32 {
-    if info.is_llvmpipe() {
-        TRIANGLES_PER_DISPATCH
-    } else {
-        u32::MAX
-    }
+    info.loop_limit()
+        .map_or(u32::MAX, |_| TRIANGLES_PER_DISPATCH)
 }
 
 /// The triangle ranges `first..end` of the dispatches over `count` triangles, at most `per`

@@ -159,17 +159,8 @@ struct CaseRecord {
     skipped: String,
 }
 
-/// The scenes shipped beside the binary: `scenes/` of the source tree or of the working
-/// folder.
-fn scene_dir() -> PathBuf {
-    let here = Path::new("scenes");
-    if here.is_dir() {
-        return here.to_path_buf();
-    }
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-fn renderer(
+/// The point-light ray tracer of `design` (a `Design::Ray`).
+fn ray_tracer(
     ctx: &GlContext,
     scene: &Scene,
     shaders: &ShaderSource,
@@ -200,7 +191,24 @@ fn renderer(
             };
             pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, shaders, options)
         }
-        Design::Soft(mode) => {
+        Design::Soft(_) => unreachable!("the soft shadows are made by soft_renderer"),
+    }
+}
+
+/// The soft-shadow renderer in `mode` (3×3 rays): the one of the case before, switched to the
+/// mode, where it has the scene — its N-tree and line spaces are built once for the three
+/// modes.
+fn soft_renderer<'a>(
+    kept: &'a mut Option<(&'static str, SoftShadowRenderer)>,
+    ctx: &GlContext,
+    (file, scene): (&'static str, &Scene),
+    shaders: &ShaderSource,
+    mode: ShadowMode,
+    size: u32,
+) -> Result<&'a mut SoftShadowRenderer> {
+    match kept {
+        Some((f, r)) if *f == file => r.reconfigure(shaders, mode, 3, 3)?,
+        _ => {
             let options = SoftShadowOptions {
                 mode,
                 samples_u: 3,
@@ -213,9 +221,10 @@ fn renderer(
                 tile: 0,
             };
             let r = SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, scene, shaders, options)?;
-            Ok(Box::new(r))
+            *kept = Some((file, r));
         }
     }
+    Ok(&mut kept.as_mut().expect("made above").1)
 }
 
 /// Render the case's frames (three where an object turns) and return the last.
@@ -261,9 +270,10 @@ fn counts_of(design: Design, frame: &Frame) -> (BTreeMap<String, u64>, String) {
     (counts, why.to_string())
 }
 
-fn write_case(dir: &Path, frame: &Frame, record: &CaseRecord) -> Result<()> {
+/// A case's folder: its record and, where it ran, the frame's first hits and shadows.
+fn write_case(dir: &Path, frame: Option<&Frame>, record: &CaseRecord) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot make {}", dir.display()))?;
-    if let Some(a) = &frame.aovs {
+    if let Some((frame, a)) = frame.and_then(|f| f.aovs.as_ref().map(|a| (f, a))) {
         let shape = [frame.height as u64, frame.width as u64];
         write_npy(
             &dir.join("triangle_id.npy"),
@@ -301,17 +311,28 @@ fn cases(only: Option<&str>) -> Vec<(String, Design, &'static SceneCase)> {
 /// Render every case on this driver into `args.out`.
 fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
     let shaders = ShaderSource::from_dir(args.gpu.glsl_dir.clone())?;
-    let dir = scene_dir();
+    let dir = crate::bench::runner::find_scenes_dir(None)?;
     let mut scenes: BTreeMap<&str, Scene> = BTreeMap::new();
+    let mut soft = None;
     for (case, design, s) in cases(args.only.as_deref()) {
         if !scenes.contains_key(s.file) {
             scenes.insert(s.file, Scene::load(&dir.join(s.file))?);
         }
         let scene = &scenes[s.file];
         let t0 = std::time::Instant::now();
-        let mut r = renderer(ctx, scene, &shaders, design, args.size)
-            .with_context(|| format!("parity case {case}"))?;
-        let frame = match render_case(r.as_mut(), scene, s.turning) {
+        let mut ray;
+        let r: &mut dyn Renderer = match design {
+            Design::Soft(mode) => {
+                soft_renderer(&mut soft, ctx, (s.file, scene), &shaders, mode, args.size)
+                    .with_context(|| format!("parity case {case}"))?
+            }
+            Design::Ray { .. } => {
+                ray = ray_tracer(ctx, scene, &shaders, design, args.size)
+                    .with_context(|| format!("parity case {case}"))?;
+                ray.as_mut()
+            }
+        };
+        let frame = match render_case(r, scene, s.turning) {
             Ok(f) => f,
             // a static design (seed 004's grid, Klee's N-tree) refuses moving objects: skipped
             Err(e) if s.turning.is_some() => {
@@ -323,7 +344,7 @@ fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
                     counts_depend_on_order: String::new(),
                     skipped: format!("{e:#}"),
                 };
-                write_case(&args.out.join(&case), &empty_frame(args.size), &record)?;
+                write_case(&args.out.join(&case), None, &record)?;
                 eprintln!("{case}: skipped ({e:#})");
                 continue;
             }
@@ -338,20 +359,10 @@ fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
             counts_depend_on_order: why,
             skipped: String::new(),
         };
-        write_case(&args.out.join(&case), &frame, &record)?;
+        write_case(&args.out.join(&case), Some(&frame), &record)?;
         eprintln!("{case}: rendered ({:.1} s)", t0.elapsed().as_secs_f64());
     }
     Ok(())
-}
-
-fn empty_frame(size: u32) -> Frame {
-    Frame {
-        width: size,
-        height: size,
-        color: Vec::new(),
-        aovs: None,
-        stats: Default::default(),
-    }
 }
 
 /// One case's folder read back.
@@ -382,14 +393,39 @@ fn load(dir: &Path) -> Result<Recorded> {
             shadow: None,
         });
     }
-    let shadow_file = dir.join("shadow.npy");
+    // every array of the case holds one value per pixel of its record's size
+    let pixels = record.width as usize * record.height as usize;
+    let sized = |path: PathBuf, len: usize| -> Result<()> {
+        if len != pixels {
+            bail!(
+                "{}: {len} values, but the case is {}x{} pixels",
+                path.display(),
+                record.width,
+                record.height
+            );
+        }
+        Ok(())
+    };
+    let (ids, t, shadow) = (
+        dir.join("triangle_id.npy"),
+        dir.join("hit_t.npy"),
+        dir.join("shadow.npy"),
+    );
+    let triangle_id: Vec<i32> = read_npy(&ids)?;
+    sized(ids, triangle_id.len())?;
+    let hit_t: Vec<f32> = read_npy(&t)?;
+    sized(t, hit_t.len())?;
+    let shadow = if shadow.exists() {
+        let v: Vec<f32> = read_npy(&shadow)?;
+        sized(shadow, v.len())?;
+        Some(v)
+    } else {
+        None
+    };
     Ok(Recorded {
-        triangle_id: read_npy(&dir.join("triangle_id.npy"))?,
-        hit_t: read_npy(&dir.join("hit_t.npy"))?,
-        shadow: shadow_file
-            .exists()
-            .then(|| read_npy(&shadow_file))
-            .transpose()?,
+        triangle_id,
+        hit_t,
+        shadow,
         record,
     })
 }
@@ -620,5 +656,33 @@ mod tests {
         e.record.counts.insert("ray_batches".into(), 2);
         let d = compare(&a, &e).unwrap();
         assert!(d.counts.is_empty() && d.note.contains("batches"), "{d:?}");
+    }
+
+    #[test]
+    fn a_case_folder_whose_arrays_miss_pixels_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let r = recorded(&[1, 2, 3, 4], &[1.0; 4], &[1.0; 4], &[]);
+        let frame = Frame {
+            width: 4,
+            height: 1,
+            color: vec![[0.0; 4]; 4],
+            aovs: Some(gpgpu_rt::frame::Aovs {
+                triangle_id: vec![1, 2, 3, 4],
+                hit_t: vec![1.0; 4],
+                ..Default::default()
+            }),
+            stats: Default::default(),
+        };
+        write_case(dir.path(), Some(&frame), &r.record).unwrap();
+        // a folder cut short: three ids for the record's four pixels
+        write_npy(&dir.path().join("triangle_id.npy"), &[3], [1, 2, 3]).unwrap();
+        let e = load(dir.path())
+            .err()
+            .expect("3 values for 4 pixels")
+            .to_string();
+        assert!(
+            e.contains("triangle_id.npy") && e.contains("3 values"),
+            "{e}"
+        );
     }
 }

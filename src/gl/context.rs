@@ -114,6 +114,11 @@ fn vector_bits(renderer: &str) -> Option<u32> {
     n.parse::<u32>().ok().filter(|&b| b >= 32)
 }
 
+/// An EGL device's name, else its vendor.
+fn device_name(d: &Device) -> &str {
+    d.name().or(d.vendor()).unwrap_or("unnamed EGL device")
+}
+
 /// The EGL devices as `info` lists them: index and name (or vendor; Mesa's software device has
 /// neither).
 pub fn egl_devices() -> Vec<String> {
@@ -121,10 +126,7 @@ pub fn egl_devices() -> Vec<String> {
         .map(|devices| {
             devices
                 .enumerate()
-                .map(|(i, d)| {
-                    let name = d.name().or(d.vendor()).unwrap_or("unnamed EGL device");
-                    format!("{i}: {name}")
-                })
+                .map(|(i, d)| format!("{i}: {}", device_name(&d)))
                 .collect()
         })
         .unwrap_or_default()
@@ -155,12 +157,7 @@ impl GlContext {
         if devices.is_empty() {
             bail!("EGL reports no devices; install libegl-mesa0 (llvmpipe) or a GPU driver");
         }
-        let describe = |i: usize, d: &Device| {
-            format!(
-                "device {i} ({})",
-                d.name().or(d.vendor()).unwrap_or("unnamed EGL device")
-            )
-        };
+        let describe = |i: usize, d: &Device| format!("device {i} ({})", device_name(d));
         let candidates: Vec<usize> = match device {
             Some(i) if i < devices.len() => vec![i],
             Some(i) => bail!(

@@ -551,7 +551,7 @@ fn rotation_center(scene: &Scene) -> Vec3 {
 }
 
 /// `--scenes DIR`, else `./scenes`, else the source tree's `scenes/`.
-fn find_scenes_dir(given: Option<&Path>) -> Result<PathBuf> {
+pub(crate) fn find_scenes_dir(given: Option<&Path>) -> Result<PathBuf> {
     if let Some(d) = given {
         if !d.is_dir() {
             bail!("--scenes {}: not a folder", d.display());
