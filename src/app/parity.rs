@@ -374,15 +374,16 @@ struct Recorded {
 }
 
 fn read_npy<T: npyz::Deserialize>(path: &Path) -> Result<Vec<T>> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes = gpgpu_rt::scene::file::read(path)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
     let npy = npyz::NpyFile::new(&bytes[..]).with_context(|| format!("{}", path.display()))?;
     npy.into_vec::<T>()
         .with_context(|| format!("{}", path.display()))
 }
 
 fn load(dir: &Path) -> Result<Recorded> {
-    let json = std::fs::read_to_string(dir.join("stats.json"))
-        .with_context(|| format!("cannot read {}", dir.join("stats.json").display()))?;
+    let json = gpgpu_rt::scene::file::read_text(&dir.join("stats.json"))
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", dir.join("stats.json").display()))?;
     let record: CaseRecord = serde_json::from_str(&json)
         .with_context(|| format!("{}: not a parity record", dir.display()))?;
     if !record.skipped.is_empty() {

@@ -56,8 +56,8 @@ impl ShaderSource {
         match &self.effective_dir() {
             Some(dir) => {
                 let path = dir.join(name);
-                std::fs::read_to_string(&path)
-                    .with_context(|| format!("cannot read GLSL file {}", path.display()))
+                crate::scene::file::read_text(&path)
+                    .map_err(|e| anyhow!("cannot read GLSL file {}: {e}", path.display()))
             }
             None => EMBEDDED
                 .iter()
@@ -235,7 +235,7 @@ fn dump_source(name: &str, text: &str) {
     let mut path = dir.join(&file);
     let mut k = 2;
     while path.exists() {
-        if std::fs::read_to_string(&path).is_ok_and(|t| t == text) {
+        if crate::scene::file::read_text(&path).is_ok_and(|t| t == text) {
             return;
         }
         path = dir.join(format!("{file}.{k}"));

@@ -1,8 +1,6 @@
 //! The files a scene was read from, which no output may replace: the scene file, its objects'
 //! models (with an OBJ's material libraries) and its textures.
 
-use std::fs;
-use std::io::{BufRead as _, BufReader};
 use std::path::{Path, PathBuf};
 
 use super::check::{parent_of, Input};
@@ -29,7 +27,7 @@ pub fn scene_inputs(scene: &Scene) -> Vec<Input> {
 
 /// The `path` of every `[[object]]` of the scene file, relative to its folder.
 fn model_paths(scene_file: &Path) -> Vec<PathBuf> {
-    let Ok(text) = fs::read_to_string(scene_file) else {
+    let Ok(text) = crate::scene::file::read_text(scene_file) else {
         return Vec::new();
     };
     let Ok(doc) = text.parse::<toml::Table>() else {
@@ -49,13 +47,13 @@ fn material_libraries(model: &Path) -> Vec<PathBuf> {
     let is_obj = model
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-    let file = fs::File::open(model).ok().filter(|_| is_obj);
-    let lines = file
-        .into_iter()
-        .flat_map(|f| BufReader::new(f).lines().map_while(Result::ok));
+    let text = is_obj
+        .then(|| crate::scene::file::read_text(model).ok())
+        .flatten()
+        .unwrap_or_default();
     let dir = parent_of(model);
     let mut libs = Vec::new();
-    for line in lines {
+    for line in text.lines() {
         if let Some(names) = line.trim_start().strip_prefix("mtllib ") {
             libs.extend(names.split_whitespace().map(|n| dir.join(n)));
         }

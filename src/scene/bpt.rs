@@ -39,12 +39,8 @@ pub fn teapot(path: &Path, n: u32) -> Result<Mesh, SceneError> {
 
 /// A model file as text, its length checked against the host's memory first.
 pub(super) fn read_model_text(path: &Path, what: &str) -> Result<String, SceneError> {
-    let err = |e: String| SceneError::at(path, None, format!("cannot read {what}: {e}"));
-    let len = std::fs::metadata(path)
-        .map_err(|e| err(e.to_string()))?
-        .len();
-    budget::check_file(len).map_err(|m| SceneError::at(path, None, m))?;
-    std::fs::read_to_string(path).map_err(|e| err(e.to_string()))
+    super::file::read_text(path)
+        .map_err(|e| SceneError::at(path, None, format!("cannot read {what}: {e}")))
 }
 
 /// One patch as `n`×`n` quads of two triangles each, y-up.

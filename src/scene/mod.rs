@@ -5,6 +5,7 @@
 pub mod bpt;
 pub mod budget;
 pub mod camera;
+pub mod file;
 pub mod magnitudes;
 pub mod mesh;
 pub mod obj;
@@ -107,8 +108,9 @@ impl Object {
 /// [`crate::limits::TEXTURE_BYTES`] bytes of memory (a small file can claim a huge image).
 fn decode_texture(path: &Path) -> Result<image::RgbaImage, String> {
     use crate::limits::{TEXTURE_BYTES, TEXTURE_SIDE};
-    let mut reader = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
+    let bytes = file::read(path)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
         .map_err(|e| e.to_string())?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(TEXTURE_SIDE);
@@ -243,7 +245,7 @@ impl Scene {
 
     /// Load a scene file with some of its procedural sizes replaced by `overrides`.
     pub fn load_with(path: &Path, overrides: &Overrides) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path)
+        let text = file::read_text(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
         Self::parse(path, &text, overrides)
     }

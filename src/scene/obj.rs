@@ -47,7 +47,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
     for model in &models {
         has_vertex_colors |= append_obj_model(&mut mesh, &model.mesh, &materials);
     }
-    check_obj_finite(path, &mesh)?;
+    check_obj_finite(path, &text, &mesh)?;
     Ok(LoadedObj {
         mesh,
         materials,
@@ -297,7 +297,7 @@ fn vec3_at(v: &[f32], i: usize) -> Vec3 {
 }
 
 /// tobj reads `nan` and `inf`; a vertex with one is an error naming its line.
-fn check_obj_finite(path: &Path, mesh: &Mesh) -> Result<(), SceneError> {
+fn check_obj_finite(path: &Path, text: &str, mesh: &Mesh) -> Result<(), SceneError> {
     let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
     if finite(bytemuck::cast_slice(&mesh.positions))
         && finite(bytemuck::cast_slice(&mesh.normals))
@@ -306,8 +306,7 @@ fn check_obj_finite(path: &Path, mesh: &Mesh) -> Result<(), SceneError> {
     {
         return Ok(());
     }
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    let (line, what) = locate_obj_error(&text);
+    let (line, what) = locate_obj_error(text);
     Err(SceneError::at(
         path,
         line,

@@ -58,18 +58,13 @@ fn read_ply(path: &Path) -> Result<Ply<DefaultElement>, SceneError> {
 /// they come).
 fn read_ply_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
     let err = |m: String| SceneError::at(path, None, m);
-    let open = |e: std::io::Error| err(format!("cannot open PLY file: {e}"));
-    let len = std::fs::metadata(path).map_err(open)?.len();
-    budget::check_file(len).map_err(err)?;
-    let file = std::fs::File::open(path).map_err(open)?;
     let gz = path.extension().is_some_and(|e| e == "gz");
     if !gz {
-        let mut bytes = Vec::with_capacity(len as usize);
-        std::io::BufReader::new(file)
-            .read_to_end(&mut bytes)
-            .map_err(|e| err(format!("cannot read PLY file: {e}")))?;
-        return Ok(bytes);
+        return super::file::read(path).map_err(|e| err(format!("cannot read PLY file: {e}")));
     }
+    let (file, len) =
+        super::file::open_regular(path).map_err(|e| err(format!("cannot open PLY file: {e}")))?;
+    budget::check_file(len).map_err(err)?;
     let cap = budget::host_limit().map_or(u64::MAX, |(b, _)| b / budget::FILE_FACTOR);
     let mut bytes = Vec::new();
     flate2::read::GzDecoder::new(std::io::BufReader::new(file))

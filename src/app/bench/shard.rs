@@ -187,9 +187,9 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<(Manifest, PathBuf)>> {
     let mut shards = Vec::new();
     for d in dirs {
         let path = d.join(MANIFEST);
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!(
-                "{}: cannot read (is it the --out of `bench --shard K/N`?)",
+        let text = gpgpu_rt::scene::file::read_text(&path).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: cannot read (is it the --out of `bench --shard K/N`?): {e}",
                 path.display()
             )
         })?;
@@ -284,7 +284,8 @@ pub fn copy_file(from_dir: &Path, rel: &Path, out: &Path) -> Result<()> {
         std::fs::create_dir_all(parent)
             .with_context(|| format!("cannot create {}", parent.display()))?;
     }
-    let bytes = std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
+    let bytes = gpgpu_rt::scene::file::read(&from)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", from.display()))?;
     gpgpu_rt::output::write_file(&to, |w| Ok(w.write_all(&bytes)?))
 }
 

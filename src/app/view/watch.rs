@@ -109,7 +109,7 @@ fn walk(root: &Path, dir: &Path, depth: usize, out: &mut BTreeMap<PathBuf, u64>)
             let mut h = DefaultHasher::new();
             meta.len().hash(&mut h);
             if meta.len() <= MAX_HASHED_BYTES {
-                if let Ok(bytes) = std::fs::read(&path) {
+                if let Ok(bytes) = gpgpu_rt::scene::file::read(&path) {
                     bytes.hash(&mut h);
                 }
             } else if let Ok(m) = meta.modified() {
