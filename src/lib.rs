@@ -7,5 +7,6 @@ pub mod gl;
 pub mod limits;
 pub mod output;
 pub mod pipeline;
+pub mod progress;
 pub mod reference;
 pub mod scene;

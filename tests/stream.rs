@@ -372,7 +372,7 @@ fn proximity_clouds_change_no_pixel() {
 fn distance_field_equals_brute_force() {
     let scene = load("cow.toml");
     let dims = UVec3::new(9, 6, 11);
-    let grid = StreamGrid::build(scene.world_triangles(), scene.bounds(), dims);
+    let grid = StreamGrid::build(scene.world_triangles(), scene.bounds(), dims).unwrap();
     let d = dims.as_ivec3();
     let pos = |i: usize| {
         let i = i as i32;

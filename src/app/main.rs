@@ -77,6 +77,10 @@ fn main() -> ExitCode {
         // before any thread or GL call: Mesa reads its variables when it loads the driver
         std::env::set_var(gpgpu_rt::gl::driver::DRIVER_ENV, d.name());
     }
+    if let Err(e) = gpgpu_rt::scene::budget::check_limit_var() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     match run(cli, &matches) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -76,7 +76,16 @@ pub fn ray_tracer(
     if let Some(n) = options.grid.resolution {
         check("the grid resolution", n, &crate::limits::GRID_RES).map_err(anyhow::Error::msg)?;
     }
-    if options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner {
+    check_grid_options(&options)?;
+    let per_triangle = host_bytes_per_triangle(&options);
+    let triangles = scene.triangle_count() as u64;
+    crate::scene::budget::reserve(
+        &format!("building and uploading the scene's {triangles} triangles"),
+        "the scene with --tracer",
+        triangles.saturating_mul(per_triangle),
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", scene.path.display()))?;
+    if is_wagner(&options) {
         let o = wagner2018::WagnerOptions::of(&options);
         let r = wagner2018::WagnerRenderer::new(gl, info, scene, shaders, o)?;
         return Ok(Box::new(r));
@@ -87,21 +96,62 @@ pub fn ray_tracer(
             gl, info, scene, shaders, o,
         )?));
     }
-    if options.grid.stream_naive_shadows {
+    let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;
+    Ok(Box::new(r))
+}
+
+fn is_wagner(options: &raytrace::RenderOptions) -> bool {
+    options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner
+}
+
+/// The grid options that only some designs take, refused for the others (before any design
+/// is built, so that none of them ignores one).
+fn check_grid_options(options: &raytrace::RenderOptions) -> Result<()> {
+    let stream = options.tracer == TracerKind::Stream;
+    if options.grid.stream_naive_shadows && !stream {
         anyhow::bail!("--stream-naive-shadows applies to --tracer stream only");
     }
-    if options.grid.axes.is_some() {
+    if options.grid.axes.is_some() && !stream {
         anyhow::bail!(
             "--grid GXxGYxGZ applies to --tracer stream only (the compute grids are cubic)"
         );
     }
     let exact = options.tracer == TracerKind::Grid && options.grid.variant == GridVariant::Exact;
-    if options.grid.proximity_clouds && !exact {
+    if options.grid.proximity_clouds && !(exact || stream) {
         anyhow::bail!(
             "--proximity-clouds applies to --tracer stream and to --tracer grid with \
-             --grid-variant exact only (the thesis grid's per-ray voxel lists cannot skip cells)"
+             --grid-variant exact only (the thesis grid's per-ray voxel lists cannot skip cells; \
+             the BVHs have no cells)"
         );
     }
-    let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;
-    Ok(Box::new(r))
+    Ok(())
+}
+
+/// Host bytes per triangle a point-light design takes while it is built and uploaded, beyond
+/// the loaded mesh (checked before it is built; `tests/memory_estimates.rs` holds each against
+/// the peak of the allocations). Every design makes the world-space triangles (36) and
+/// attributes (136), and the driver keeps a copy of what is uploaded (a software driver's GPU
+/// memory is the host's).
+pub fn host_bytes_per_triangle(options: &raytrace::RenderOptions) -> u64 {
+    const WORLD: u64 = 36 + 136;
+    // vertex arrays on the GPU: positions, normals, colours, texture coordinates, material
+    const UPLOAD: u64 = 136;
+    // the SAH BVH: builder boxes, centres and ids (24 + 12 + 4), at most 2n nodes of 32 bytes
+    // and their GPU copy, the wide layout built from them
+    const SAH_BVH: u64 = 40 + 2 * 32 * 2 + 2 * 64;
+    // Wagner's BVH: builder (24 + 12 + 4 + 4), 2n nodes of 48; its six textures (node bounds
+    // and integers 2·48, ids 4, vertices, normals, colours 3·48) staged, owned and copied by
+    // the driver
+    const WAGNER: u64 = 44 + 2 * 48 + 3 * (2 * 48 + 4 + 3 * 48);
+    // seed 004's textures: two of four RGB32F slices per triangle, staged and in the driver
+    // (padded to four channels), and the copy of the scene the renderer keeps
+    const STREAM: u64 = 2 * 4 * (12 + 16) + 136;
+    if is_wagner(options) {
+        return WORLD + WAGNER;
+    }
+    match options.tracer {
+        TracerKind::Stream => WORLD + STREAM,
+        TracerKind::Bvh => WORLD + UPLOAD + SAH_BVH,
+        _ => WORLD + UPLOAD,
+    }
 }

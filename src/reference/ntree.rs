@@ -24,6 +24,8 @@
 //!   words along x, continued on the next y row, line spaces one after the other along y,
 //!   continued along z, at most 2048 (GL_MAX_3D_TEXTURE_SIZE) per axis.
 
+use crate::progress::Progress;
+use crate::scene::budget;
 use anyhow::{bail, Result};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -407,6 +409,8 @@ pub struct NTree {
     pub leaf_count: usize,
     pub build_ms: f64,
     pub linespace_build_ms: f64,
+    /// The host bytes the build estimated, step by step, before allocating them.
+    pub estimated_bytes: u64,
 }
 
 impl NTree {
@@ -458,6 +462,12 @@ impl NTree {
             bail!("the scene has no triangles to build an N-tree over");
         }
         let t0 = std::time::Instant::now();
+        let what = format!("the N-tree of N = {n}, depth {depth}");
+        let mut budget = budget::Tracker::new(&what, "--ntree-n with --ntree-depth");
+        let tri_bytes = std::mem::size_of::<[DVec3; 3]>() + 2 * 4; // the f64 copy, the id lists
+        budget
+            .add(triangles.len() as u64 * tri_bytes as u64)
+            .map_err(anyhow::Error::msg)?;
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for t in triangles {
             for p in t {
@@ -482,11 +492,18 @@ impl NTree {
             leaf_count: 0,
             build_ms: 0.0,
             linespace_build_ms: 0.0,
+            estimated_bytes: 0,
         };
         let tris: Vec<[DVec3; 3]> = triangles.iter().map(|t| t.map(|p| p.as_dvec3())).collect();
         let all: Vec<u32> = (0..triangles.len() as u32).collect();
         // inner nodes in line-space order: (group of its children); the root first
         let mut inner_groups = vec![0u32];
+        // per inner node: its children's group, and its line space three times over (the
+        // line spaces, their concatenation and the packed texels of the upload with the
+        // driver's copy; a software driver's GPU memory is the host's), added before either
+        // is allocated so that a tree too large is refused while its geometry is sorted
+        let group_bytes = 8 * (n as u64).pow(3) + 3 * 4 * linespace_words(n) as u64;
+        budget.add(group_bytes).map_err(anyhow::Error::msg)?;
         tree.nodes.resize((n as usize).pow(3), [0, 0]);
         let mut work = vec![(0u32, 1u32, min_bound.as_dvec3(), edge as f64, all)];
         while let Some((group, level, origin, size, ids)) = work.pop() {
@@ -523,6 +540,7 @@ impl NTree {
                 }
                 let slot = group as usize * nn * nn * nn + i;
                 if level < depth - 1 {
+                    budget.add(group_bytes).map_err(anyhow::Error::msg)?;
                     let child_group = (tree.nodes.len() / (nn * nn * nn)) as u32;
                     tree.nodes.resize(tree.nodes.len() + nn * nn * nn, [0, 0]);
                     let ls = inner_groups.len() as u32;
@@ -536,6 +554,7 @@ impl NTree {
                     if off >= 1 << 30 {
                         bail!("more than 2^30 leaf triangle references");
                     }
+                    budget.add(4 * b.len() as u64).map_err(anyhow::Error::msg)?;
                     tree.nodes[slot] = [GEOMETRY_BIT | (off << 2), b.len() as u32];
                     tree.leaf_triangles.extend_from_slice(&b);
                     tree.leaf_count += 1;
@@ -547,13 +566,17 @@ impl NTree {
         }
         tree.build_ms = t0.elapsed().as_secs_f64() * 1e3;
         let t1 = std::time::Instant::now();
+        let progress = Progress::new("line spaces", inner_groups.len() as u64, 1000);
         let spaces: Vec<Vec<u32>> = inner_groups
             .par_iter()
             .map(|&g| build_linespace(n, &tree.group_filled(g)))
+            .inspect(|_| progress.inc(1))
             .collect();
+        drop(progress);
         tree.linespace_count = spaces.len();
         tree.linespaces = spaces.concat();
         tree.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
+        tree.estimated_bytes = budget.total();
         Ok(tree)
     }
 

@@ -38,9 +38,12 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
     let idx = |c: IVec3| ((c.z * d.y + c.y) * d.x + c.x) as usize;
     let inside = |c: IVec3| c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
     let back = causal_neighbours();
-    let cells: Vec<IVec3> = (0..d.z)
-        .flat_map(|z| (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z))))
-        .collect();
+    // the scan order, without a list of the cells (a 512³ grid would need 1.6 GB for it)
+    let cells = || {
+        (0..d.z).flat_map(move |z| {
+            (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z)))
+        })
+    };
     let mut relax = |c: IVec3, offsets: &mut dyn Iterator<Item = IVec3>| {
         let mut best = dist[idx(c)];
         for o in offsets {
@@ -50,10 +53,15 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
         }
         dist[idx(c)] = best;
     };
-    for &c in &cells {
+    for c in cells() {
         relax(c, &mut back.iter().copied());
     }
-    for &c in cells.iter().rev() {
+    let reverse = (0..d.z).rev().flat_map(move |z| {
+        (0..d.y)
+            .rev()
+            .flat_map(move |y| (0..d.x).rev().map(move |x| IVec3::new(x, y, z)))
+    });
+    for c in reverse {
         relax(c, &mut back.iter().map(|o| -*o));
     }
     dist.into_iter().map(|v| v.min(far)).collect()

@@ -15,6 +15,7 @@ use super::grid::tri_box_overlap;
 use super::proximity::cloud_jump;
 pub use super::proximity::{cells_between, chebyshev_distances};
 use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
+use crate::scene::budget;
 
 /// Ray state of the traversal (Fig. 2, `tMax`'s w channel): still walking.
 pub const ACTIVE: f32 = 1.0;
@@ -124,6 +125,28 @@ pub struct StreamGrid {
     pub triangles: Vec<[Vec3; 3]>,
 }
 
+/// Per cell (first, count), and the triangle ids of `pairs` (cell, id) packed by cell — a
+/// counting sort, stable, so each cell's ids stay ascending as the pairs came in id order.
+fn pack_by_cell(cells: usize, pairs: &[(u32, u32)]) -> (Vec<(u32, u32)>, Vec<u32>) {
+    let mut packed = vec![(0u32, 0u32); cells];
+    for &(c, _) in pairs {
+        packed[c as usize].1 += 1;
+    }
+    let mut first = 0u32;
+    for cell in &mut packed {
+        let count = cell.1;
+        *cell = (first, 0);
+        first += count;
+    }
+    let mut refs = vec![0u32; pairs.len()];
+    for &(c, id) in pairs {
+        let cell = &mut packed[c as usize];
+        refs[(cell.0 + cell.1) as usize] = id;
+        cell.1 += 1;
+    }
+    (packed, refs)
+}
+
 /// The cells a triangle overlaps (triangle/box separating axes, boxes enlarged by 10⁻⁴ of a
 /// cell so that nothing on a cell face is lost), in index order.
 fn overlapped_cells(bx: &GridBox, t: &[Vec3; 3]) -> Vec<usize> {
@@ -146,31 +169,67 @@ fn overlapped_cells(bx: &GridBox, t: &[Vec3; 3]) -> Vec<usize> {
     out
 }
 
+/// References the grid may hold: Fig. 3 stores pointers and triangle ids as floats (RGB32F,
+/// R32F), exact below 2^24.
+pub const MAX_REFERENCES: usize = 1 << 24;
+
+/// Host bytes per cell while the grid is built: (pointer, count) 8, the filled flag 1, the
+/// proximity distance 4.
+pub const CELL_BUILD_BYTES: u64 = 8 + 1 + 4;
+/// Host bytes per cell while the grid is built and uploaded: [`CELL_BUILD_BYTES`], the cell's
+/// RGB32F texel for the upload 12 and the driver's copy of it, padded to four channels, 16 (a
+/// software driver's GPU memory is the host's).
+pub const CELL_BYTES: u64 = CELL_BUILD_BYTES + 12 + 16;
+
+/// Host bytes per reference while the grid is built: the (cell, triangle) pair of the first
+/// pass 8, the packed id 4.
+pub const REFERENCE_BUILD_BYTES: u64 = 8 + 4;
+/// Host bytes per reference, built and uploaded: its R32F texel 4 and the driver's copy 4 more.
+pub const REFERENCE_BYTES: u64 = REFERENCE_BUILD_BYTES + 4 + 4;
+
 impl StreamGrid {
     /// Register every triangle in the cells it overlaps, pack the lists, compute the
-    /// proximity distances.
-    pub fn build(triangles: Vec<[Vec3; 3]>, bounds: (Vec3, Vec3), dims: UVec3) -> StreamGrid {
+    /// proximity distances. The cells' memory is checked before it is allocated and the
+    /// references are counted as they are found: a grid past the host's memory or past
+    /// [`MAX_REFERENCES`] is refused before it is built, naming `--grid`.
+    pub fn build(
+        triangles: Vec<[Vec3; 3]>,
+        bounds: (Vec3, Vec3),
+        dims: UVec3,
+    ) -> Result<StreamGrid, String> {
         let bx = GridBox::new(bounds.0, bounds.1, dims);
-        let mut lists = vec![Vec::new(); bx.cell_count()];
+        let n = bx.cell_count();
+        let what = format!(
+            "the stream's grid of {}x{}x{} cells",
+            dims.x, dims.y, dims.z
+        );
+        budget::reserve(&what, "--grid", n as u64 * CELL_BYTES)?;
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
         for (id, t) in triangles.iter().enumerate() {
             for c in overlapped_cells(&bx, t) {
-                lists[c].push(id as u32);
+                if pairs.len() + 1 == MAX_REFERENCES {
+                    return Err(format!(
+                        "{what} would hold 2^24 or more references to the {} triangles (it \
+                         passed that at triangle {id}): the float textures of Fig. 3 address at \
+                         most 2^24; use a coarser --grid or a smaller scene",
+                        triangles.len()
+                    ));
+                }
+                pairs.push((c as u32, id as u32));
             }
         }
-        let mut cells = Vec::with_capacity(lists.len());
-        let mut refs = Vec::new();
-        for l in &lists {
-            cells.push((refs.len() as u32, l.len() as u32));
-            refs.extend_from_slice(l);
-        }
-        let filled: Vec<bool> = lists.iter().map(|l| !l.is_empty()).collect();
-        StreamGrid {
+        let refs_bytes = pairs.len() as u64 * REFERENCE_BYTES;
+        budget::reserve(&format!("{what}'s references"), "--grid", refs_bytes)?;
+        let (cells, refs) = pack_by_cell(n, &pairs);
+        drop(pairs);
+        let filled: Vec<bool> = cells.iter().map(|&(_, count)| count > 0).collect();
+        Ok(StreamGrid {
             proximity: chebyshev_distances(dims, &filled),
             bx,
             cells,
             refs,
             triangles,
-        }
+        })
     }
 
     /// The paper's storage estimate M = 96·n + 16·gx·gy·gz bytes (ch. 4).

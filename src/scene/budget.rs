@@ -34,16 +34,43 @@ pub fn host_limit() -> Option<(u64, &'static str)> {
     Some((kib.saturating_mul(1024), "the host's available memory"))
 }
 
-/// `"123"`, `"64K"`, `"512M"`, `"2G"` (powers of 1024) as bytes.
+/// `"123"`, `"64K"`, `"512M"`, `"2G"`, `"1T"` as bytes; `KB`/`KiB` and the like mean the same
+/// (powers of 1024, as `MemAvailable` counts).
 pub fn parse_bytes(s: &str) -> Option<u64> {
     let s = s.trim();
-    let (digits, shift) = match s.char_indices().last()? {
-        (i, 'k' | 'K') => (&s[..i], 10),
-        (i, 'm' | 'M') => (&s[..i], 20),
-        (i, 'g' | 'G') => (&s[..i], 30),
-        _ => (s, 0),
+    let lower = s.to_ascii_lowercase();
+    // "KiB" needs its K; a lone "B" means bytes
+    let (number, needs_unit) = match lower.strip_suffix("ib") {
+        Some(n) => (n, true),
+        None => (lower.strip_suffix('b').unwrap_or(&lower), false),
     };
-    digits.trim().parse::<u64>().ok()?.checked_mul(1 << shift)
+    let (digits, shift) = match number.char_indices().last()? {
+        (i, 'k') => (&number[..i], 10),
+        (i, 'm') => (&number[..i], 20),
+        (i, 'g') => (&number[..i], 30),
+        (i, 't') => (&number[..i], 40),
+        _ if !needs_unit => (number, 0),
+        _ => return None,
+    };
+    let digits = digits.trim();
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    digits.parse::<u64>().ok()?.checked_mul(1 << shift)
+}
+
+/// An error when `GPGPU_RT_MEMORY_LIMIT` is set but is not a size (checked once at the start
+/// of every command: a limit that does not parse must not silently mean no limit).
+pub fn check_limit_var() -> Result<(), String> {
+    match std::env::var(LIMIT_VAR) {
+        Err(std::env::VarError::NotPresent) => Ok(()),
+        Ok(v) if parse_bytes(&v).is_some_and(|b| b > 0) => Ok(()),
+        Ok(v) => Err(format!(
+            "{LIMIT_VAR}={v:?} is not a positive size (bytes, or with K, M, G or T for powers of \
+             1024, e.g. 512M)"
+        )),
+        Err(e) => Err(format!("{LIMIT_VAR}: {e}")),
+    }
 }
 
 /// `bytes` as "12.3 MiB".
@@ -79,6 +106,46 @@ pub fn check_against(what: &str, bytes: u64, limit: Option<(u64, &str)>) -> Resu
     }
 }
 
+/// `what`, whose size `decided_by` (an option, or the scene) sets, would take `bytes` of host
+/// memory: an error naming both when that is more than the limit. Every structure a scene or
+/// an option sizes is estimated through here before it is allocated.
+pub fn reserve(what: &str, decided_by: &str, bytes: u64) -> Result<(), String> {
+    check_host(what, bytes).map_err(|e| format!("{e} ({decided_by} decides its size)"))
+}
+
+/// A build that allocates as it goes (a tree whose size shows only while it is built): each
+/// step adds its bytes before it allocates them, and the running total is checked against
+/// the limit taken once at the start.
+pub struct Tracker {
+    what: String,
+    decided_by: String,
+    limit: Option<(u64, &'static str)>,
+    total: u64,
+}
+
+impl Tracker {
+    pub fn new(what: &str, decided_by: &str) -> Tracker {
+        Tracker {
+            what: what.to_string(),
+            decided_by: decided_by.to_string(),
+            limit: host_limit(),
+            total: 0,
+        }
+    }
+
+    /// Add `bytes` about to be allocated; an error when the total passes the limit.
+    pub fn add(&mut self, bytes: u64) -> Result<(), String> {
+        self.total = self.total.saturating_add(bytes);
+        check_against(&self.what, self.total, self.limit.map(|(b, s)| (b, s)))
+            .map_err(|e| format!("{e} ({} decides its size)", self.decided_by))
+    }
+
+    /// The bytes added so far.
+    pub fn total(&self) -> u64 {
+        self.total
+    }
+}
+
 /// `triangles` of `what`, with the copies made for the GPU, within the host's memory.
 pub fn check_triangles(what: &str, triangles: u64) -> Result<(), String> {
     let bytes = triangles.saturating_mul(MESH_TRIANGLE_BYTES * TRIANGLE_COPIES);
@@ -103,6 +170,12 @@ mod tests {
         assert_eq!(parse_bytes("64 k"), Some(64 << 10));
         assert_eq!(parse_bytes("100"), Some(100));
         assert_eq!(parse_bytes("x"), None);
+        assert_eq!(parse_bytes("1KB"), Some(1 << 10));
+        assert_eq!(parse_bytes("3 MiB"), Some(3 << 20));
+        assert_eq!(parse_bytes("7b"), Some(7));
+        for bad in ["-5", "abc", "", "K", "1.5G", "5iB", "+3"] {
+            assert_eq!(parse_bytes(bad), None, "{bad}");
+        }
         assert_eq!(parse_bytes("99999999999999G"), None);
         assert_eq!(human(3 << 29), "1.5 GiB");
     }

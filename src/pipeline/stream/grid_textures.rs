@@ -15,7 +15,7 @@ use crate::scene::Scene;
 
 /// Pointers and triangle ids are stored as floats (RGB32F, R32F, as the paper): exact below
 /// 2^24.
-const FLOAT_EXACT: usize = 1 << 24;
+const FLOAT_EXACT: usize = crate::reference::stream_grid::MAX_REFERENCES;
 
 pub struct GridTextures {
     cells: Texture3d,

@@ -213,7 +213,8 @@ impl StreamRenderer {
             .dims
             .map(UVec3::from)
             .unwrap_or_else(|| auto_dims(scene.triangle_count()));
-        let grid = StreamGrid::build(scene.world_triangles(), scene.bounds(), dims);
+        let grid = StreamGrid::build(scene.world_triangles(), scene.bounds(), dims)
+            .map_err(|e| anyhow!("{}: {e}", scene.path.display()))?;
         let grid_ms = start.elapsed().as_secs_f64() * 1e3;
         let textures = GridTextures::upload(&gl, &grid, &scene)?;
         let targets = Targets::new(&gl, options.width, options.height, options.aovs)?;

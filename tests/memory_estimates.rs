@@ -1,0 +1,136 @@
+//! What the host's memory checks estimate against what is allocated (issue 33, class 2): each
+//! structure a scene or an option sizes is built here under a counting allocator, and the peak
+//! of its allocations must stay within the estimate checked before it was built (and the
+//! estimate within a small factor of the peak, so that it does not refuse what would fit).
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+
+struct Counting;
+
+static NOW: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        let now = NOW.fetch_add(l.size(), Relaxed) + l.size();
+        PEAK.fetch_max(now, Relaxed);
+        System.alloc(l)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        NOW.fetch_sub(l.size(), Relaxed);
+        System.dealloc(p, l)
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+/// One test at a time: the tests of this file run on several threads, and each one's
+/// allocations would count in another's peak.
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    ONE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The peak of the bytes allocated by `f` beyond what was allocated when it began.
+fn peak_of<T>(f: impl FnOnce() -> T) -> (T, u64) {
+    let base = NOW.load(Relaxed);
+    PEAK.store(base, Relaxed);
+    let t = f();
+    (t, (PEAK.load(Relaxed) - base) as u64)
+}
+
+/// The estimate must hold the peak, and not be more than `slack` times it.
+fn within(what: &str, peak: u64, estimate: u64, slack: f64) {
+    eprintln!("{what}: peak {peak} bytes, estimate {estimate}");
+    assert!(
+        peak <= estimate,
+        "{what}: allocated {peak} bytes, estimated {estimate}"
+    );
+    assert!(
+        estimate as f64 <= slack * peak as f64,
+        "{what}: estimated {estimate} bytes for {peak} allocated"
+    );
+}
+
+/// Each point-light design, built and one frame drawn, within its per-triangle estimate (the
+/// stream's grid adds its cells and references, estimated by `StreamGrid::build`).
+#[test]
+fn each_design_allocates_within_its_estimate() {
+    let _s = serial();
+    use gpgpu_rt::accel::{BvhVariant, TracerKind};
+    use gpgpu_rt::reference::stream_grid::{CELL_BYTES, REFERENCE_BYTES};
+    use gpgpu_rt::scene::{Overrides, Scene};
+    let ctx = common::context();
+    let o = Overrides {
+        level: Some(7),
+        ..Default::default()
+    };
+    let scene = Scene::load_with(&common::scene_path("square.toml"), &o).unwrap();
+    let t = scene.triangle_count() as u64;
+    for (name, tracer, variant) in [
+        ("base", TracerKind::Base, BvhVariant::Sah),
+        ("grid", TracerKind::Grid, BvhVariant::Sah),
+        ("bvh", TracerKind::Bvh, BvhVariant::Sah),
+        ("wagner", TracerKind::Bvh, BvhVariant::Wagner),
+        ("stream", TracerKind::Stream, BvhVariant::Sah),
+    ] {
+        let opts = gpgpu_rt::pipeline::raytrace::RenderOptions {
+            tracer,
+            bvh_variant: variant,
+            ..common::options(8, 8, 0)
+        };
+        let shaders = Default::default();
+        let per_triangle = gpgpu_rt::pipeline::host_bytes_per_triangle(&opts);
+        let (stats, peak) = peak_of(|| {
+            let gl = ctx.gl.clone();
+            let mut r =
+                gpgpu_rt::pipeline::ray_tracer(gl, &ctx.info, &scene, &shaders, opts).unwrap();
+            r.render(&scene.camera).unwrap().stats
+        });
+        let mut estimate = t * per_triangle;
+        if tracer == TracerKind::Stream {
+            let fact = |k: &str| stats.facts[k].clone();
+            let dims: [u64; 3] = serde_json::from_value(fact("grid_dims")).unwrap();
+            let cells: u64 = dims.iter().product();
+            let refs = fact("grid_references").as_u64().unwrap();
+            estimate += cells * CELL_BYTES + refs * REFERENCE_BYTES;
+        }
+        within(name, peak, estimate, 3.0);
+    }
+}
+
+/// The stream's grid at a fine `--grid` over one triangle: the cells dominate.
+#[test]
+fn the_stream_grid_allocates_within_its_estimate() {
+    let _s = serial();
+    use glam::{UVec3, Vec3};
+    use gpgpu_rt::reference::stream_grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
+    let tri = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]];
+    let (grid, peak) =
+        peak_of(|| StreamGrid::build(tri, (Vec3::ZERO, Vec3::ONE), UVec3::splat(160)).unwrap());
+    let estimate =
+        grid.cells.len() as u64 * CELL_BUILD_BYTES + grid.refs.len() as u64 * REFERENCE_BUILD_BYTES;
+    within("stream grid 160³", peak, estimate, 3.0);
+}
+
+/// The N-tree, geometry and line spaces, within what its build added up before allocating.
+#[test]
+fn the_ntree_allocates_within_its_estimate() {
+    let _s = serial();
+    use gpgpu_rt::reference::ntree::NTree;
+    let scene = common::load("bunny_area.toml");
+    let tris = scene.world_triangles();
+    for (n, depth) in [(10, 3), (6, 4)] {
+        let (tree, peak) = peak_of(|| NTree::build(&tris, n, depth).unwrap());
+        within(
+            &format!("N-tree N = {n}, depth {depth}"),
+            peak,
+            tree.estimated_bytes,
+            4.0,
+        );
+    }
+}
