@@ -104,13 +104,17 @@ pub struct ExactGrid {
     refs: u64,
 }
 
+/// What decides the size of the grid's buffers, for a refusal.
+const SIZED_BY: &str = "--grid (N³ voxels) with the scene (its references)";
+
 impl ExactGrid {
     fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
         let frame = GridFrame::new(scene, resolution(scene, o, MAX_RESOLUTION)?);
         let n3 = frame.voxels();
         let defs = [frame.define()];
         let max_ssbo = b.info.max_ssbo_block_size;
-        let ssbo = |name, bytes| Ssbo::new(b.gl, name, bytes, None, max_ssbo);
+        // the voxel arrays are --grid's (N³), the reference lists the scene's with --grid
+        let ssbo = |name, bytes| Ssbo::sized(b.gl, name, bytes, None, max_ssbo, SIZED_BY);
         let dist_bytes = if o.proximity_clouds { 4 * n3 } else { 4 };
         let lists = Lists {
             voxel_count: ssbo("voxelCount", 4 * n3)?,
@@ -212,7 +216,7 @@ impl ExactGrid {
                 (&mut l.voxel_tris, "voxelTris"),
             ] {
                 b.delete(&self.gl);
-                *b = Ssbo::new(&self.gl, name, bytes, None, self.max_ssbo)?;
+                *b = Ssbo::sized(&self.gl, name, bytes, None, self.max_ssbo, SIZED_BY)?;
             }
         }
         Ok(())

@@ -80,7 +80,13 @@ impl ThesisGrid {
             ("ray_array_length", r.to_string()),
         ];
         let pixels = (b.width * b.height) as usize;
-        let ssbo = |name, bytes| Ssbo::new(b.gl, name, bytes, None, b.info.max_ssbo_block_size);
+        let max = b.info.max_ssbo_block_size;
+        let ssbo = |name, bytes, by: &str| Ssbo::sized(b.gl, name, bytes, None, max, by);
+        let (voxels, rays) = ("--grid", "the image size");
+        let (voxel_lists, ray_lists) = (
+            "--grid with --voxel-array-length",
+            "the image size with --ray-array-length",
+        );
         Ok(Box::new(ThesisGrid {
             gl: b.gl.clone(),
             triangles: scene.triangle_count(),
@@ -89,10 +95,10 @@ impl ThesisGrid {
             traversal: b.kernel("thesis_grid/traversal.comp", &defs, "traversal")?,
             intersect1: b.kernel("thesis_grid/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("thesis_grid/intersect2.comp", &defs, "intersect2")?,
-            voxelslist: ssbo("voxelslist", 4 * n3 * l as usize)?,
-            voxelcontains: ssbo("voxelcontains", 4 * n3)?,
-            rayslist: ssbo("rayslist", 4 * pixels * r as usize)?,
-            raycontains: ssbo("raycontains", 4 * pixels)?,
+            voxelslist: ssbo("voxelslist", 4 * n3 * l as usize, voxel_lists)?,
+            voxelcontains: ssbo("voxelcontains", 4 * n3, voxels)?,
+            rayslist: ssbo("rayslist", 4 * pixels * r as usize, ray_lists)?,
+            raycontains: ssbo("raycontains", 4 * pixels, rays)?,
             voxel_array_length: l,
             ray_array_length: r,
             frame,

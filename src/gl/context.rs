@@ -505,7 +505,7 @@ pub fn alloc_error(err: u32, what: &str, bytes: u64) -> String {
     if err == glow::OUT_OF_MEMORY {
         format!(
             "{name} (0x{err:04x}): the GL implementation has no memory for {what} of {size} \
-             ({bytes} bytes); use a smaller scene or image"
+             ({bytes} bytes)"
         )
     } else {
         format!("{name} (0x{err:04x}) while allocating {what} of {size} ({bytes} bytes)")

@@ -17,7 +17,8 @@ pub struct Ssbo {
 
 impl Ssbo {
     /// Allocate `bytes` (at least 16) of immutable storage, optionally filled with `data`,
-    /// after checking the size against `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`.
+    /// after checking the size against `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`; a buffer the scene
+    /// or the image size decides (see [`Ssbo::sized`]).
     pub fn new(
         gl: &Gl,
         name: &'static str,
@@ -25,11 +26,31 @@ impl Ssbo {
         data: Option<&[u8]>,
         max_block: i64,
     ) -> Result<Ssbo> {
+        Self::sized(
+            gl,
+            name,
+            bytes,
+            data,
+            max_block,
+            "the scene or the image size",
+        )
+    }
+
+    /// [`Ssbo::new`] for a buffer whose size `sized_by` decides (options such as `--grid
+    /// with --voxel-array-length`): the refusal names them.
+    pub fn sized(
+        gl: &Gl,
+        name: &'static str,
+        bytes: usize,
+        data: Option<&[u8]>,
+        max_block: i64,
+        sized_by: &str,
+    ) -> Result<Ssbo> {
         let bytes = bytes.max(16);
         if bytes as i64 > max_block {
             bail!(
                 "buffer `{name}` needs {bytes} bytes, more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {max_block} \
-                 of this GL implementation; use a smaller scene or image"
+                 of this GL implementation; {sized_by} decides its size"
             );
         }
         if bytes > i32::MAX as usize {
@@ -56,7 +77,7 @@ impl Ssbo {
                 glow::DYNAMIC_STORAGE_BIT,
             );
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
-            let what = format!("the shader storage buffer `{name}`");
+            let what = format!("the shader storage buffer `{name}` (sized by {sized_by})");
             super::check_alloc(gl, &what, bytes as u64)?;
             Ok(Ssbo {
                 buffer,
@@ -137,7 +158,7 @@ impl Image2d {
                 glow::RG32UI | glow::RG32F => 8,
                 _ => 16,
             };
-            let what = format!("a {width}x{height} image texture");
+            let what = format!("a {width}x{height} image texture (sized by the image size)");
             super::check_alloc(gl, &what, width as u64 * height as u64 * texel)?;
             gl.tex_parameter_i32(
                 glow::TEXTURE_2D,
@@ -264,7 +285,7 @@ impl TextureBuffer {
         if texels as i64 > max || padded.len() > i32::MAX as usize {
             bail!(
                 "texture `{name}` needs {texels} texels, more than GL_MAX_TEXTURE_BUFFER_SIZE = {max} \
-                 of this GL implementation; use a smaller scene"
+                 of this GL implementation; the scene decides its size"
             );
         }
         // SAFETY: buffer and texture creation on a current context.
@@ -273,7 +294,7 @@ impl TextureBuffer {
             gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
             gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, &padded, glow::STATIC_DRAW);
             gl.bind_buffer(glow::TEXTURE_BUFFER, None);
-            let what = format!("the texture buffer `{name}`");
+            let what = format!("the texture buffer `{name}` (sized by the scene)");
             super::check_alloc(gl, &what, padded.len() as u64)?;
             let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
             gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));

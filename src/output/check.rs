@@ -112,7 +112,22 @@ pub fn check(targets: &[Target]) -> Result<()> {
             );
         }
     }
+    for a in targets {
+        if let Some(b) = targets.iter().find(|b| folder_of(&a.path, &b.path)) {
+            bail!(
+                "{} would be a file, but {} puts a file inside it: it cannot be both",
+                a.name(),
+                b.name()
+            );
+        }
+    }
     Ok(())
+}
+
+/// `file` is a folder above `other` (an `-o x.png` where `--aov-dir x.png` writes files).
+fn folder_of(file: &Path, other: &Path) -> bool {
+    let file = canonical(file);
+    canonical(other).ancestors().skip(1).any(|d| d == file)
 }
 
 /// Refuse any target that is one of `inputs`.
@@ -133,6 +148,18 @@ pub fn refuse_inputs(targets: &[Target], inputs: &[Input]) -> Result<()> {
 fn check_one(t: &Target) -> Result<()> {
     if is_stream(&t.path) {
         return Ok(());
+    }
+    // `y.png/` names a folder: the path's own file name ignores the slash
+    if t.path
+        .as_os_str()
+        .to_string_lossy()
+        .ends_with(std::path::MAIN_SEPARATOR)
+    {
+        bail!(
+            "{}: ends in {}, so it names a folder, not a file",
+            t.name(),
+            std::path::MAIN_SEPARATOR
+        );
     }
     match fs::metadata(&t.path) {
         Ok(m) if m.is_dir() => bail!("{}: is a folder, not a file", t.name()),
@@ -162,8 +189,16 @@ fn check_extension(t: &Target) -> Result<()> {
             Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
             None => String::new(),
         };
+        let name = t.path.file_name().unwrap_or_default().to_string_lossy();
+        let got = if !ext.is_empty() {
+            format!("not `.{ext}`")
+        } else if name.starts_with('.') && !name[1..].contains('.') {
+            format!("`{name}` has no extension: a name that begins with its only dot is all name")
+        } else {
+            format!("`{name}` has no extension")
+        };
         bail!(
-            "{}: {} writes {}, so the file name must end in {list} (not `.{ext}`)",
+            "{}: {} writes {}, so the file name must end in {list} ({got})",
             t.name(),
             t.option,
             t.format.describe(),

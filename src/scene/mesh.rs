@@ -4,7 +4,7 @@
 //! A mesh is a triangle soup, as the kernels read it (Müller 2015, Listing 12): the vertices of
 //! triangle k are entries 3k, 3k+1, 3k+2 of every per-vertex array.
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// Per-vertex attributes of a triangle soup plus a local material index per triangle.
 #[derive(Debug, Clone, Default)]
@@ -49,19 +49,34 @@ impl Mesh {
 
 /// Area-weighted vertex normals of an indexed triangle list: unit length, or zero for a
 /// vertex of degenerate triangles only.
+/// Summed in f64: the cross product of f32 edges squares their length, which leaves f32 for
+/// a model in units of 1e-12 or 1e10 (a normal of zero length, NaN once normalised).
 pub(super) fn smooth_normals(pos: &[Vec3], triangles: &[[usize; 3]]) -> Vec<Vec3> {
-    let mut acc = vec![Vec3::ZERO; pos.len()];
+    let mut acc = vec![DVec3::ZERO; pos.len()];
     for t in triangles {
-        let n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
+        let n = face_cross([pos[t[0]], pos[t[1]], pos[t[2]]]);
         t.iter().for_each(|&k| acc[k] += n);
     }
-    acc.into_iter().map(Vec3::normalize_or_zero).collect()
+    acc.into_iter()
+        .map(|n| n.normalize_or_zero().as_vec3())
+        .collect()
+}
+
+/// The cross product of a triangle's edges, in f64 (area-weighted normal).
+fn face_cross(p: [Vec3; 3]) -> DVec3 {
+    let [a, b, c] = p.map(|v| v.as_dvec3());
+    (b - a).cross(c - a)
+}
+
+/// A triangle's unit geometric normal (zero for a degenerate one), computed in f64.
+pub fn face_normal(p: [Vec3; 3]) -> Vec3 {
+    face_cross(p).normalize_or_zero().as_vec3()
 }
 
 /// The normals at the corners `idx` (positions `p`) of a triangle; a zero vertex normal
 /// (degenerate geometry) gives way to the triangle's geometric normal.
 pub(super) fn corner_normals(p: [Vec3; 3], idx: [usize; 3], normals: &[Vec3]) -> [Vec3; 3] {
-    let geo = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+    let geo = face_normal(p);
     idx.map(|i| {
         if normals[i] == Vec3::ZERO {
             geo

@@ -98,9 +98,25 @@ pub struct Object {
 }
 
 impl Object {
-    /// The normal matrix: inverse transpose of the model matrix' upper 3×3.
+    /// The normal matrix: inverse transpose of the model matrix' upper 3×3. Normals are
+    /// normalised after it, so its scale is free: where the f32 inverse leaves a safe range
+    /// (a model matrix that scales by 1e-13 or 1e13 overflows it: NaN normals) it is computed
+    /// in f64 and divided by its largest element; ordinary transforms keep the f32 inverse.
     pub fn normal_matrix(&self) -> Mat3 {
-        Mat3::from_mat4(self.model).inverse().transpose()
+        let m = Mat3::from_mat4(self.model).inverse().transpose();
+        let largest = m.to_cols_array().iter().fold(0.0f32, |a, v| a.max(v.abs()));
+        if (1e-15..=1e15).contains(&largest) {
+            return m;
+        }
+        let m = glam::DMat3::from_mat4(self.model.as_dmat4())
+            .inverse()
+            .transpose();
+        let largest = m.to_cols_array().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if largest > 0.0 && largest.is_finite() {
+            (m * (1.0 / largest)).as_mat3()
+        } else {
+            m.as_mat3() // singular: refused by the scene's validation
+        }
     }
 }
 
@@ -668,10 +684,13 @@ impl ObjectDef {
             Quat::from_euler(glam::EulerRot::YXZ, r[1], r[0], r[2]),
             Vec3::from(self.translate),
         );
-        if Mat3::from_mat4(model).determinant().abs() < 1e-12 {
-            return Err(ObjectError::Here(
-                "the transform is singular (a zero scale)".into(),
-            ));
+        // the rotation is orthonormal: the matrix is singular exactly when a scale is zero (a
+        // small determinant is no test: a uniform scale of 1e-4 has 1e-12 and is fine)
+        let scale = self.scale.vector();
+        if scale.cmpeq(Vec3::ZERO).any() {
+            return Err(ObjectError::Here(format!(
+                "the transform is singular: scale = {scale} has a zero component"
+            )));
         }
         Ok(model)
     }

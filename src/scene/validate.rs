@@ -19,7 +19,21 @@ fn first_bad2(v: &[Vec2]) -> Option<usize> {
     v.iter().position(|x| !x.is_finite())
 }
 
-/// An object's uploaded arrays, world space, all finite; material ids below `materials`.
+/// The first vertex of a triangle with a world-space area whose world-space normal has no
+/// direction (a degenerate triangle is never hit, so its normals do not matter).
+fn first_zero_normal(o: &Object) -> Option<usize> {
+    let m = &o.mesh;
+    let nm = o.normal_matrix();
+    (0..m.positions.len()).find(|&i| {
+        let t = i - i % 3;
+        let world = [0, 1, 2].map(|k| o.model.transform_point3(m.positions[t + k]));
+        let has_area = super::mesh::face_normal(world) != Vec3::ZERO;
+        has_area && (nm * m.normals[i]).normalize_or_zero() == Vec3::ZERO
+    })
+}
+
+/// An object's uploaded arrays, world space, all finite, normals with a direction; material
+/// ids below `materials`.
 pub fn object(o: &Object, materials: usize) -> Result<(), String> {
     let m = &o.mesh;
     let nm = o.normal_matrix();
@@ -39,6 +53,14 @@ pub fn object(o: &Object, materials: usize) -> Result<(), String> {
                 o.name
             ));
         }
+    }
+    if let Some(i) = first_zero_normal(o) {
+        return Err(format!(
+            "object `{}`: vertex {i} of a triangle with an area has a normal of zero length \
+             after its transform (the numbers leave f32 on the way: a model in units near \
+             1e-20 or 1e20?); the kernels would normalise it to NaN",
+            o.name
+        ));
     }
     if let Some(t) = m
         .triangle_material
