@@ -939,3 +939,54 @@ fn klee_tables_2_3_and_fig12_tiny_report_the_same_error_against_exact() {
         }
     }
 }
+
+/// A run that measures nothing (every configuration fails: an empty `--glsl-dir`) leaves the
+/// previous run's report, CSVs and plots as they were, and no temporary file behind.
+#[test]
+fn a_run_that_measures_nothing_keeps_the_previous_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    let tiny = [
+        "thesis-5.1", "--width", "8", "--height", "8", "--angles", "1", "--warmup", "0",
+        "--quiet", "--out",
+    ];
+    let o = bench(&[&tiny[..], &[out.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let snapshot = |d: &Path| {
+        let mut files: Vec<(String, Vec<u8>)> = walk(d)
+            .into_iter()
+            .map(|p| {
+                let rel = p.strip_prefix(d).unwrap().display().to_string();
+                (rel, std::fs::read(&p).unwrap())
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let before = snapshot(&out);
+    assert!(before.iter().any(|(n, _)| n == "report.md"), "{before:?}");
+    let empty = dir.path().join("no-kernels");
+    std::fs::create_dir(&empty).unwrap();
+    let glsl = ["--glsl-dir", empty.to_str().unwrap()];
+    let o = bench(&[&tiny[..], &[out.to_str().unwrap()], &glsl[..]].concat());
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("nothing was measured"), "{}", stderr(&o));
+    let after = snapshot(&out);
+    let names = |v: &[(String, Vec<u8>)]| v.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&after), names(&before), "files added or removed");
+    assert!(after == before, "a file of the good run was replaced");
+}
+
+/// Every file below `d`.
+fn walk(d: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(d).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}

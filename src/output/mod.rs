@@ -28,7 +28,7 @@ use crate::frame::{Aovs, Frame};
 
 pub use check::{check, check_folder, parent_of, refuse_inputs, same_file, Format, Input, Target};
 pub use inputs::scene_inputs;
-pub use stage::{write_file, Staging, WriteSeek};
+pub use stage::{write_file, Batch, Staging, WriteSeek};
 
 /// The files of `--aov-dir` (`shadow.npy` only where the renderer has it).
 pub const AOV_FILES: [&str; 6] = [

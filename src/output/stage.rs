@@ -5,6 +5,7 @@
 use std::fs::{self, File};
 use std::io::{BufWriter, Cursor, Seek, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use anyhow::{anyhow, Context as _, Result};
 use tempfile::NamedTempFile;
@@ -190,11 +191,61 @@ fn write_stream(target: &Path, bytes: &[u8]) -> Result<()> {
     f.flush().with_context(named)
 }
 
-/// Write the single file `target` with `encode`: into a temporary file, then renamed over it.
+/// The staging of a [`Batch`] in progress, which [`write_file`] stages into.
+static BATCH: Mutex<Option<Staging>> = Mutex::new(None);
+
+fn batch() -> MutexGuard<'static, Option<Staging>> {
+    BATCH.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Every file [`write_file`] writes while a batch is open is staged, not put in place: a
+/// command that writes many files as it goes (the bench's CSVs, plots, frames and report)
+/// commits them together at its end, or, dropping the batch, leaves every old file as it was
+/// (a bench run that measured nothing must not replace one that did).
+pub struct Batch(());
+
+impl Batch {
+    pub fn begin() -> Batch {
+        *batch() = Some(Staging::new());
+        Batch(())
+    }
+
+    /// Put every staged file in place.
+    pub fn commit(self) -> Result<()> {
+        let staged = batch().take();
+        staged.map_or(Ok(()), Staging::commit)
+    }
+
+    /// Put in place only the staged files that replace nothing; the others are discarded.
+    pub fn commit_new_files(self) -> Result<()> {
+        let Some(mut s) = batch().take() else {
+            return Ok(());
+        };
+        s.staged.retain(|f| match f {
+            Staged::Temp { target, .. } => fs::symlink_metadata(target).is_err(),
+            Staged::Stream { .. } => false,
+        });
+        s.commit()
+    }
+}
+
+impl Drop for Batch {
+    fn drop(&mut self) {
+        // the staged files are removed as the staging drops
+        let staged = batch().take();
+        drop(staged);
+    }
+}
+
+/// Write the single file `target` with `encode`: into a temporary file, then renamed over it
+/// (or staged into the open [`Batch`]).
 pub fn write_file(
     target: &Path,
     encode: impl FnOnce(&mut dyn WriteSeek) -> Result<()>,
 ) -> Result<()> {
+    if let Some(s) = batch().as_mut() {
+        return s.file(target, encode);
+    }
     let mut s = Staging::new();
     s.file(target, encode)?;
     s.commit()

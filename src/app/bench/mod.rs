@@ -82,10 +82,12 @@ pub mod thesis_5_3;
 pub mod wagner;
 pub mod wagner_report;
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Result};
 use clap::Parser as _;
+use gpgpu_rt::output::Batch;
 
 pub use args::{BenchArgs, BenchCommand, MergeArgs, ProtocolId};
 pub use protocol::{Protocol, Section, Units};
@@ -132,6 +134,21 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
 }
 
+/// Put the files of a run that measured something in place; a run that measured nothing
+/// (every configuration failed) writes only files that replace none, so the previous run's
+/// report, CSVs and plots stay as they were.
+fn keep_if_measured(batch: Batch, measured: usize, failed: usize, out: &Path) -> Result<()> {
+    if measured > 0 {
+        return batch.commit();
+    }
+    batch.commit_new_files()?;
+    bail!(
+        "nothing was measured ({failed} failure(s), see above); files an earlier run wrote in \
+         {} are left as they were",
+        out.display()
+    );
+}
+
 /// The protocols of the command line, each once, in a fixed order (the units' order).
 fn protocols(bench: &Bench) -> Vec<&'static Protocol> {
     let mut ids = bench.args.protocols.clone();
@@ -149,14 +166,17 @@ fn report(bench: &mut Bench, start: Instant, earlier_s: f64) -> Result<()> {
         bench.machine.gl_version,
         bench.out.display()
     );
+    let batch = Batch::begin();
     let sections: Vec<Section> = protocols(bench)
         .into_iter()
         .map(|p| run_protocol(p, bench))
         .collect();
     let wall_s = earlier_s + start.elapsed().as_secs_f64();
     let path = report::write(bench, &sections, wall_s)?;
-    eprintln!("wrote {}", path.display());
     let failed: usize = sections.iter().map(|s| s.failures).sum();
+    let measured: usize = sections.iter().map(|s| s.measured).sum();
+    keep_if_measured(batch, measured, failed, &bench.out)?;
+    eprintln!("wrote {}", path.display());
     if failed > 0 {
         bail!("{failed} configuration(s) failed; see {}", path.display());
     }
@@ -190,10 +210,12 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         bench.machine.gl_renderer,
         bench.out.display()
     );
-    let mut failed = 0;
+    let batch = Batch::begin();
+    let (mut failed, mut measured) = (0, 0);
     for p in protocols(bench) {
         let section = run_protocol(p, bench);
         failed += section.failures;
+        measured += section.measured;
     }
     let failed_configs = bench
         .measured
@@ -211,6 +233,13 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         sections: std::mem::take(&mut bench.sections),
     };
     let path = shard::write_manifest(bench, &manifest)?;
+    // a shard that took no unit still writes its manifest: the merge needs every shard's
+    let ok_configs = manifest.configs.len() - failed_configs;
+    let (measured, all_failed) = (measured + ok_configs, failed + failed_configs);
+    match (measured, all_failed) {
+        (0, 0) => batch.commit()?,
+        _ => keep_if_measured(batch, measured, all_failed, &bench.out)?,
+    }
     let done = manifest.configs.len() + manifest.sections.len();
     eprintln!(
         "shard {shard}: {done} of {} units measured; wrote {} (merge all {} shards with `gpgpu-rt bench merge DIR… --out DIR`)",

@@ -33,6 +33,10 @@ pub struct Section {
     pub failures: usize,
     /// Files written, relative to the output folder.
     pub files: Vec<PathBuf>,
+    /// Configurations measured (a whole protocol: 1 when it reported): a run whose sections
+    /// measured nothing keeps the previous run's files.
+    #[serde(default)]
+    pub measured: usize,
 }
 
 impl Section {
@@ -41,6 +45,7 @@ impl Section {
         Section {
             protocol: p.name.into(),
             title: p.title.into(),
+            measured: usize::from(!markdown.trim().is_empty()),
             markdown,
             failures: 0,
             files,
@@ -51,6 +56,7 @@ impl Section {
     pub fn failed(p: &Protocol, e: &anyhow::Error) -> Section {
         Section {
             failures: 1,
+            measured: 0,
             ..Section::new(p, format!("**The protocol failed:** `{e:#}`\n"), vec![])
         }
     }
@@ -71,6 +77,7 @@ impl Section {
         s.files
             .extend(outcomes.iter().filter_map(|o| o.image.clone()));
         s.failures = outcomes.iter().filter(|o| o.error.is_some()).count();
+        s.measured = outcomes.len() - s.failures;
         Ok(s)
     }
 
