@@ -947,8 +947,17 @@ fn a_run_that_measures_nothing_keeps_the_previous_results() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b");
     let tiny = [
-        "thesis-5.1", "--width", "8", "--height", "8", "--angles", "1", "--warmup", "0",
-        "--quiet", "--out",
+        "thesis-5.1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--angles",
+        "1",
+        "--warmup",
+        "0",
+        "--quiet",
+        "--out",
     ];
     let o = bench(&[&tiny[..], &[out.to_str().unwrap()]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
@@ -970,7 +979,11 @@ fn a_run_that_measures_nothing_keeps_the_previous_results() {
     let glsl = ["--glsl-dir", empty.to_str().unwrap()];
     let o = bench(&[&tiny[..], &[out.to_str().unwrap()], &glsl[..]].concat());
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("nothing was measured"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nothing was measured"),
+        "{}",
+        stderr(&o)
+    );
     let after = snapshot(&out);
     let names = |v: &[(String, Vec<u8>)]| v.iter().map(|f| f.0.clone()).collect::<Vec<_>>();
     assert_eq!(names(&after), names(&before), "files added or removed");

@@ -17,6 +17,7 @@
 
 mod check;
 mod inputs;
+pub mod interrupt;
 mod stage;
 
 use std::path::Path;

@@ -11,6 +11,7 @@ use anyhow::{anyhow, Context as _, Result};
 use tempfile::NamedTempFile;
 
 use super::check::{is_stream, parent_of};
+use super::interrupt;
 
 /// Where an encoder writes: a file or a buffer (image encoders want to seek).
 pub trait WriteSeek: Write + Seek {}
@@ -29,6 +30,8 @@ pub struct Staging {
     staged: Vec<Staged>,
     /// Folders made for the outputs, outermost first; removed again unless committed.
     created: Vec<PathBuf>,
+    /// What it registered for removal on an interrupt ([`interrupt`]).
+    registered: Vec<u64>,
 }
 
 impl Staging {
@@ -44,8 +47,10 @@ impl Staging {
             if d.as_os_str().is_empty() {
                 continue;
             }
+            let mut r = interrupt::registry();
             fs::create_dir(d)
                 .with_context(|| format!("cannot create the folder {}", d.display()))?;
+            self.registered.push(r.add(d.to_path_buf(), true));
             self.created.push(d.to_path_buf());
         }
         Ok(())
@@ -68,7 +73,12 @@ impl Staging {
             return Ok(());
         }
         let target = through_link(target);
-        let tmp = temp_beside(&target).with_context(named)?;
+        let tmp = {
+            let mut r = interrupt::registry();
+            let tmp = temp_beside(&target).with_context(named)?;
+            self.registered.push(r.add(tmp.path().to_path_buf(), false));
+            tmp
+        };
         let mut w = BufWriter::new(tmp.as_file());
         encode(&mut w).with_context(named)?;
         w.flush().with_context(named)?;
@@ -86,18 +96,25 @@ impl Staging {
         let (streams, temps): (Vec<_>, Vec<_>) = staged
             .into_iter()
             .partition(|s| matches!(s, Staged::Stream { .. }));
+        // (a pipe may block: an interrupt must still find the registry free meanwhile)
         for s in streams {
             if let Staged::Stream { bytes, target } = s {
                 write_stream(&target, &bytes)?;
             }
         }
+        // held to the end: an interrupt waits for the renames, so it finds all or none done
+        let mut registry = interrupt::registry();
         let temps = temps.into_iter().filter_map(|t| match t {
             Staged::Temp { tmp, target } => Some((tmp, target)),
             Staged::Stream { .. } => None,
         });
-        rename_all(temps.collect())?;
-        self.created.clear();
-        Ok(())
+        let renamed = rename_all(temps.collect());
+        if renamed.is_ok() {
+            self.created.clear();
+        }
+        registry.forget(&std::mem::take(&mut self.registered));
+        drop(registry); // before `self` drops, which takes it again
+        renamed
     }
 }
 
@@ -142,11 +159,13 @@ fn roll_back(done: Vec<(PathBuf, Option<NamedTempFile<()>>)>) {
 
 impl Drop for Staging {
     fn drop(&mut self) {
+        let mut registry = interrupt::registry();
         // the temporary files first (removed as they drop), then the folders made for them
         self.staged.clear();
         for d in self.created.iter().rev() {
             let _ = fs::remove_dir(d);
         }
+        registry.forget(&self.registered);
     }
 }
 

@@ -77,6 +77,14 @@ pub fn ray_tracer(
         check("the grid resolution", n, &crate::limits::GRID_RES).map_err(anyhow::Error::msg)?;
     }
     check_grid_options(&options)?;
+    if !scene.area_lights.is_empty() {
+        anyhow::bail!(
+            "{}: the point-light ray tracers light with [[light]]s only; the scene's {} \
+             [[area_light]](s) would be ignored (render it with --shadows)",
+            scene.path.display(),
+            scene.area_lights.len()
+        );
+    }
     let per_triangle = host_bytes_per_triangle(&options);
     let triangles = scene.triangle_count() as u64;
     crate::scene::budget::reserve(

@@ -60,8 +60,8 @@ pub struct SoftShadowOptions {
 
 /// The scene's single area light (the thesis lights with one).
 pub fn scene_light(scene: &Scene) -> Result<AreaLight> {
-    match scene.area_lights.as_slice() {
-        [l] => Ok(*l),
+    let light = match scene.area_lights.as_slice() {
+        [l] => *l,
         [] => bail!(
             "{}: --shadows needs an [[area_light]] in the scene file",
             scene.path.display()
@@ -71,7 +71,17 @@ pub fn scene_light(scene: &Scene) -> Result<AreaLight> {
             scene.path.display(),
             scene.area_lights.len()
         ),
+    };
+    if !scene.lights.is_empty() {
+        bail!(
+            "{}: the soft-shadow pipeline (Klee 2016) lights with the [[area_light]] only; the \
+             scene's {} point [[light]](s) would be ignored (remove them, or render with the \
+             point-light ray tracer)",
+            scene.path.display(),
+            scene.lights.len()
+        );
     }
+    Ok(light)
 }
 
 /// The view-projection matrix matching `Camera::rays` (pixel centres, image plane at near).
