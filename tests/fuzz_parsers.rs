@@ -83,6 +83,11 @@ const HOSTILE: &[&str] = &[
     "end_header",
     "\u{0}",
     "é",
+    // inputs that are no regular files (`scene_models` makes the FIFOs): refused, never read
+    "\"models/pipe.obj\"",
+    "\"/dev/zero\"",
+    "\"models\"",
+    "pipe.mtl",
 ];
 
 /// One random change of `data`.
@@ -249,6 +254,52 @@ fn scene_models(dir: &Path) {
     ] {
         let path = format!("scenes/models/{name}");
         std::fs::write(m.join(name), read(&path)).unwrap();
+    }
+    fifos(&m);
+}
+
+/// FIFOs where a mutated path may point: read without a bound, they would block for ever.
+fn fifos(dir: &Path) {
+    for name in ["pipe.obj", "pipe.mtl"] {
+        let c = std::ffi::CString::new(dir.join(name).to_str().unwrap()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    }
+}
+
+/// Each kind of input file as a FIFO, a device and a folder: refused at once, naming it.
+#[test]
+fn inputs_that_are_no_regular_files() {
+    let d = tempfile::tempdir().unwrap();
+    let m = d.path().join("models");
+    std::fs::create_dir(&m).unwrap();
+    fifos(&m);
+    std::fs::write(
+        m.join("t.obj"),
+        "mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let head = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n[[object]]\n";
+    for (object, named) in [
+        ("type = \"obj\"\npath = \"models/pipe.obj\"", "pipe.obj"),
+        ("type = \"obj\"\npath = \"/dev/zero\"", "/dev/zero"),
+        ("type = \"obj\"\npath = \"models\"", "models"),
+        ("type = \"obj\"\npath = \"models/t.obj\"", "pipe.mtl"),
+        ("type = \"ply\"\npath = \"models/pipe.obj\"", "pipe.obj"),
+        ("type = \"teapot\"\npath = \"/dev/zero\"", "/dev/zero"),
+        (
+            "type = \"floor\"\ntexture = \"models/pipe.obj\"",
+            "pipe.obj",
+        ),
+    ] {
+        let s = d.path().join("s.toml");
+        std::fs::write(&s, format!("{head}{object}\n")).unwrap();
+        let t = Instant::now();
+        let e = Scene::load(&s).expect_err(object).to_string();
+        assert!(t.elapsed() < CASE_LIMIT, "{object}: {:?}", t.elapsed());
+        assert!(
+            e.contains(named) && e.contains("regular files"),
+            "{object}: {e}"
+        );
     }
 }
 

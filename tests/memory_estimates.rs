@@ -65,10 +65,7 @@ fn each_design_allocates_within_its_estimate() {
     use gpgpu_rt::reference::stream_grid::{CELL_BYTES, REFERENCE_BYTES};
     use gpgpu_rt::scene::{Overrides, Scene};
     let ctx = common::context();
-    let o = Overrides {
-        level: Some(7),
-        ..Default::default()
-    };
+    let o = Overrides { level: Some(7) };
     let scene = Scene::load_with(&common::scene_path("square.toml"), &o).unwrap();
     let t = scene.triangle_count() as u64;
     for (name, tracer, variant) in [
@@ -131,6 +128,50 @@ fn the_ntree_allocates_within_its_estimate() {
             peak,
             tree.estimated_bytes,
             4.0,
+        );
+    }
+}
+
+/// Seeded random grids and N-trees over random triangle soups (`FUZZ_SEED` replays): every
+/// build's peak within its estimate.
+#[test]
+fn random_builds_allocate_within_their_estimates() {
+    use glam::{UVec3, Vec3};
+    use gpgpu_rt::reference::ntree::NTree;
+    use gpgpu_rt::reference::stream_grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
+    let _s = serial();
+    let seed = std::env::var("FUZZ_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(33);
+    let mut rng = fastrand::Rng::with_seed(seed);
+    for case in 0..12 {
+        let n = rng.usize(1..200);
+        let spread = [0.05f32, 1.0, 20.0][rng.usize(0..3)];
+        let mut p = || Vec3::new(rng.f32(), rng.f32(), rng.f32()) * spread;
+        let tris: Vec<[Vec3; 3]> = (0..n).map(|_| [p(), p(), p()]).collect();
+        let (lo, hi) = tris.iter().flatten().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(a, b), v| (a.min(*v), b.max(*v)),
+        );
+        let dims = UVec3::new(rng.u32(1..96), rng.u32(1..96), rng.u32(1..96));
+        let at = format!("seed {seed}, case {case}: {n} triangles");
+        let (grid, peak) = peak_of(|| StreamGrid::build(tris.clone(), (lo, hi), dims).unwrap());
+        let estimate = grid.cells.len() as u64 * CELL_BUILD_BYTES
+            + grid.refs.len() as u64 * REFERENCE_BUILD_BYTES;
+        // a grid of few cells is dominated by fixed costs the per-cell estimate leaves out
+        assert!(
+            peak <= estimate.max(64 << 10),
+            "{at}: grid {dims}: {peak} > {estimate}"
+        );
+        // (depth 4 over large random triangles has tens of thousands of line spaces: kept small)
+        let depth = rng.u32(3..5);
+        let n = rng.u32(2..if depth == 3 { 9 } else { 5 });
+        let (tree, peak) = peak_of(|| NTree::build(&tris, n, depth).unwrap());
+        assert!(
+            peak <= tree.estimated_bytes,
+            "{at}: N-tree {n}, {depth}: {peak} > {}",
+            tree.estimated_bytes
         );
     }
 }

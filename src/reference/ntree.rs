@@ -465,8 +465,11 @@ impl NTree {
         let what = format!("the N-tree of N = {n}, depth {depth}");
         let mut budget = budget::Tracker::new(&what, "--ntree-n with --ntree-depth");
         let tri_bytes = std::mem::size_of::<[DVec3; 3]>() + 2 * 4; // the f64 copy, the id lists
+                                                                   // and what any build takes: the work lists, the thread pool, a line space in progress
+                                                                   // per thread
+        let fixed = 64 << 10;
         budget
-            .add(triangles.len() as u64 * tri_bytes as u64)
+            .add(fixed + triangles.len() as u64 * tri_bytes as u64)
             .map_err(anyhow::Error::msg)?;
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for t in triangles {
@@ -509,6 +512,9 @@ impl NTree {
         while let Some((group, level, origin, size, ids)) = work.pop() {
             let cell = size / n as f64;
             let nn = n as usize;
+            budget
+                .add(24 * (nn * nn * nn) as u64)
+                .map_err(anyhow::Error::msg)?;
             let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nn * nn * nn];
             for &id in &ids {
                 let t = &tris[id as usize];
@@ -534,6 +540,10 @@ impl NTree {
                     }
                 }
             }
+            // the children's id lists (grown by doubling: up to twice their length), counted
+            // as they are made; they are a group's references, never more than a level's
+            let refs: usize = buckets.iter().map(Vec::len).sum();
+            budget.add(8 * refs as u64).map_err(anyhow::Error::msg)?;
             for (i, b) in buckets.into_iter().enumerate() {
                 if b.is_empty() {
                     continue;

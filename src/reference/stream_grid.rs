@@ -149,24 +149,18 @@ fn pack_by_cell(cells: usize, pairs: &[(u32, u32)]) -> (Vec<(u32, u32)>, Vec<u32
 
 /// The cells a triangle overlaps (triangle/box separating axes, boxes enlarged by 10⁻⁴ of a
 /// cell so that nothing on a cell face is lost), in index order.
-fn overlapped_cells(bx: &GridBox, t: &[Vec3; 3]) -> Vec<usize> {
+/// (An iterator, not a list: a triangle across a fine grid overlaps millions of cells.)
+fn overlapped_cells<'a>(bx: &'a GridBox, t: &'a [Vec3; 3]) -> impl Iterator<Item = usize> + 'a {
     let margin = bx.cell * 1e-4;
     let lo = bx.cell_of(t[0].min(t[1]).min(t[2]) - margin);
     let hi = bx.cell_of(t[0].max(t[1]).max(t[2]) + margin);
     let half = bx.cell * 0.5 + margin;
-    let mut out = Vec::new();
-    for z in lo.z..=hi.z {
-        for y in lo.y..=hi.y {
-            for x in lo.x..=hi.x {
-                let c = IVec3::new(x, y, z);
-                let centre = bx.min + (c.as_vec3() + 0.5) * bx.cell;
-                if tri_box_overlap(centre, half, *t) {
-                    out.push(bx.index(c).expect("clamped"));
-                }
-            }
-        }
-    }
-    out
+    (lo.z..=hi.z)
+        .flat_map(move |z| {
+            (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| IVec3::new(x, y, z)))
+        })
+        .filter(move |&c| tri_box_overlap(bx.min + (c.as_vec3() + 0.5) * bx.cell, half, *t))
+        .map(|c| bx.index(c).expect("clamped"))
 }
 
 /// References the grid may hold: Fig. 3 stores pointers and triangle ids as floats (RGB32F,
@@ -181,9 +175,12 @@ pub const CELL_BUILD_BYTES: u64 = 8 + 1 + 4;
 /// software driver's GPU memory is the host's).
 pub const CELL_BYTES: u64 = CELL_BUILD_BYTES + 12 + 16;
 
+/// Host bytes of one (cell, triangle) pair of the first pass.
+const PAIR_BYTES: u64 = 8;
 /// Host bytes per reference while the grid is built: the (cell, triangle) pair of the first
-/// pass 8, the packed id 4.
-pub const REFERENCE_BUILD_BYTES: u64 = 8 + 4;
+/// pass, three times over while the pairs grow (the old block and the new, twice as large, are
+/// both held while they move), and the packed id 4.
+pub const REFERENCE_BUILD_BYTES: u64 = 3 * PAIR_BYTES + 4;
 /// Host bytes per reference, built and uploaded: its R32F texel 4 and the driver's copy 4 more.
 pub const REFERENCE_BYTES: u64 = REFERENCE_BUILD_BYTES + 4 + 4;
 
@@ -203,10 +200,18 @@ impl StreamGrid {
             "the stream's grid of {}x{}x{} cells",
             dims.x, dims.y, dims.z
         );
-        budget::reserve(&what, "--grid", n as u64 * CELL_BYTES)?;
+        let mut budget = budget::Tracker::new(&what, "--grid");
+        budget.add(n as u64 * CELL_BYTES)?;
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         for (id, t) in triangles.iter().enumerate() {
             for c in overlapped_cells(&bx, t) {
+                if pairs.len() == pairs.capacity() {
+                    // the pairs grow by doubling, and while they move the old block and the
+                    // new one (twice as large) are both held: checked before it is taken
+                    let more = pairs.capacity().max(4);
+                    budget.add(2 * more as u64 * PAIR_BYTES)?;
+                    pairs.reserve_exact(more);
+                }
                 if pairs.len() + 1 == MAX_REFERENCES {
                     return Err(format!(
                         "{what} would hold 2^24 or more references to the {} triangles (it \
@@ -218,8 +223,8 @@ impl StreamGrid {
                 pairs.push((c as u32, id as u32));
             }
         }
-        let refs_bytes = pairs.len() as u64 * REFERENCE_BYTES;
-        budget::reserve(&format!("{what}'s references"), "--grid", refs_bytes)?;
+        // (the pairs were added as they grew)
+        budget.add(pairs.len() as u64 * (REFERENCE_BYTES - 3 * PAIR_BYTES))?;
         let (cells, refs) = pack_by_cell(n, &pairs);
         drop(pairs);
         let filled: Vec<bool> = cells.iter().map(|&(_, count)| count > 0).collect();

@@ -136,7 +136,7 @@ impl Tracker {
     /// Add `bytes` about to be allocated; an error when the total passes the limit.
     pub fn add(&mut self, bytes: u64) -> Result<(), String> {
         self.total = self.total.saturating_add(bytes);
-        check_against(&self.what, self.total, self.limit.map(|(b, s)| (b, s)))
+        check_against(&self.what, self.total, self.limit)
             .map_err(|e| format!("{e} ({} decides its size)", self.decided_by))
     }
 
