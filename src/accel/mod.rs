@@ -186,7 +186,7 @@ pub struct GridOptions {
     pub voxel_array_length: u32,
     pub ray_array_length: Option<u32>,
     /// The streaming tracer's grid, gx×gy×gz cells (`--grid 14x16x14`); `None`: `resolution`
-    /// on every axis, or the paper's 3·∛n with neither.
+    /// on every axis, or the paper's ∛n with neither.
     pub axes: Option<[u32; 3]>,
     /// The streaming tracer: skip empty cells by their proximity-cloud distances
     /// (`--proximity-clouds`).

@@ -60,7 +60,7 @@ impl std::str::FromStr for GridResolution {
 #[derive(Debug, Clone, clap::Args)]
 pub struct GridArgs {
     /// Grid resolution N (N³ voxels, N from 1 to 1024), or `auto`: N = cbrt(triangles / 5),
-    /// within 4..=64 (--tracer stream: 3·∛triangles per axis, as seed 004). --tracer stream
+    /// within 4..=64 (--tracer stream: ∛triangles per axis, as seed 004). --tracer stream
     /// also takes GXxGYxGZ cells, e.g. 14x16x14.
     #[arg(long, default_value = "auto", value_name = "N|GXxGYxGZ|auto")]
     pub grid: GridResolution,

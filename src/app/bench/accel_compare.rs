@@ -123,7 +123,7 @@ fn stream(proximity_clouds: bool) -> impl Fn(usize) -> TracerSpec {
     }
 }
 
-/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's 3·∛T
+/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's ∛T
 /// per axis).
 pub const ACCELERATORS: [Accelerator; 8] = [
     Accelerator {

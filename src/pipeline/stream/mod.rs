@@ -59,7 +59,7 @@ pub struct StreamOptions {
     pub height: u32,
     /// reflection bounces after the primary rays (the paper's Table 3: 2)
     pub refl_depth: u32,
-    /// gx, gy, gz (`None`: the paper's 3·∛n per axis)
+    /// gx, gy, gz (`None`: the paper's ∛n per axis)
     pub dims: Option<[u32; 3]>,
     pub proximity_clouds: bool,
     /// steps (triangle tests or cell moves) per traverse call
