@@ -523,7 +523,8 @@ impl StreamRenderer {
     }
 
     /// The AOVs of the last frame, row 0 = the top row; the normal from the hit record and
-    /// the triangles' normals, as shading.frag interpolates it (no shadow AOV).
+    /// the triangles' normals, as shading.frag interpolates it; the shadow AOV from the
+    /// shadow rays' results (`shadow_shares`).
     fn aovs(&self) -> Option<Aovs> {
         let AovTargets { rays, hit, .. } = self.targets.primary.as_ref()?;
         let (w, h) = (self.options.width, self.options.height);
