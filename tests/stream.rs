@@ -91,7 +91,7 @@ const T_REL: f32 = 1e-5;
 
 /// Relative difference allowed between the GPU's counts and the CPU twin's: a hit distance a
 /// few ulps off (above) can fall on the other side of a cell's exit and end a walk one cell
-/// later or earlier (measured: one ray of 4096 on the cow's 54³ grid, 4 of 10673 triangle
+/// later or earlier (measured: one ray of 4096 on the cow on a 54³ grid, 4 of 10673 triangle
 /// tests and 1 of 80898 cells; every other configuration here exact).
 const COUNT_REL: f64 = 1e-3;
 
