@@ -592,7 +592,7 @@ fn wagner_a1_and_a2_tiny_rows_published_values_and_ratios() {
         .is_file());
 }
 
-/// The published milliseconds of `purcell-table<n>`'s paper CSV row of `scene` in `column`.
+/// The published milliseconds of `proximity-clouds-table<n>`'s paper CSV row of `scene` in `column`.
 fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> String {
     let row = rows
         .iter()
@@ -605,13 +605,14 @@ fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> Stri
 /// only in Table 1 (no lights, no shadow tests), shadows in 2 and 3, two reflection bounces in 3;
 /// the published milliseconds beside ours; the best GPU time the frames' sum.
 #[test]
-fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
+fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bp");
     let o = bench(&[
+        // the old name stays an alias
         "purcell-table1",
-        "purcell-table2",
-        "purcell-table3",
+        "proximity-clouds-table2",
+        "proximity-clouds-table3",
         "--sizes",
         "16x16",
         "--angles",
@@ -659,7 +660,7 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
     ];
     let stanford = ["142", "235", "482"];
     for n in 1..=3u32 {
-        let p = format!("purcell-table{n}");
+        let p = format!("proximity-clouds-table{n}");
         let frames = read_csv(&out.join(format!("{p}.csv")));
         // 3 scenes × (g, pc, grid g, grid pc) + the Stanford bunny × (g, grid g) + the sparse
         // room × 4, and in Table 2 the 4 scenes' g with naive shadow rays
@@ -765,6 +766,11 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     check_report_links(&out, &report);
+    let title = report.lines().next().unwrap();
+    assert!(title.starts_with("# Seed 004, Tables 1–3"), "{title}");
+    // the paper's test machine, as its ch. 4 names it
+    assert!(report.contains("GeForce 6800GT 400 MHz with 256 MB at 1100 MHz"));
+    assert!(report.contains("NVIDIA driver 1.0-9746"));
     assert!(report.contains("almost always worse than not using proximity clouds"));
     // Table 2's shadow-ray saving, for every dense scene
     let shadows = report

@@ -2,21 +2,21 @@
 //! tracer, with (pc) and without (g) proximity clouds, on the four scenes of Fig. 4–7 at
 //! 256², 512², 768², best of several runs.
 //!
-//! - `purcell-table1`: ray casting, eye rays only (the scenes' lights removed);
-//! - `purcell-table2`: shadow casting, eye and shadow rays;
-//! - `purcell-table3`: ray tracing, eye, shadow and reflection rays, two levels of recursion.
+//! - `proximity-clouds-table1`: ray casting, eye rays only (the scenes' lights removed);
+//! - `proximity-clouds-table2`: shadow casting, eye and shadow rays;
+//! - `proximity-clouds-table3`: ray tracing, eye, shadow and reflection rays, two levels of recursion.
 //!
 //! Every scene is measured with `--tracer stream` at the paper's grid (g, and pc where the
 //! paper has it) and with the compute exact grid (`--tracer grid`, cubic: the paper's largest
 //! axis) on the same frames; a sparse scene (`sparse_room.toml`) is added, where skipping empty
-//! cells should pay. The report is in [`super::purcell_report`].
+//! cells should pay. The report is in [`super::proximity_clouds_report`].
 
 use anyhow::Result;
 
 use super::config::{Config, GridVariant, Sizing, TracerSpec};
 use super::protocol::{Protocol, Section, Units};
-use super::published_purcell::{self as pp, PaperScene};
-use super::purcell_report as report;
+use super::proximity_clouds_report as report;
+use super::published_proximity_clouds::{self as pp, PaperScene};
 use super::runner::Bench;
 
 /// The sparse scene (not in the paper): a small detailed object in a large empty room.
@@ -38,31 +38,31 @@ pub const FULL_SIDES: &[u32] = &pp::SIZES;
 /// Table 1 at every scale.
 pub const BUNNY_SIDE: u32 = 512;
 
-pub const PURCELL_TABLE1: Protocol = Protocol {
-    name: "purcell-table1",
+pub const PROXIMITY_CLOUDS_TABLE1: Protocol = Protocol {
+    name: "proximity-clouds-table1",
     title: "Ray casting, eye rays only: streaming grid g and pc vs compute grid (seed 004, \
             Table 1)",
     run: |p, bench| run(p, bench, 1),
     units: Units::Configs,
 };
 
-pub const PURCELL_TABLE2: Protocol = Protocol {
-    name: "purcell-table2",
+pub const PROXIMITY_CLOUDS_TABLE2: Protocol = Protocol {
+    name: "proximity-clouds-table2",
     title: "Shadow casting, eye and shadow rays: streaming grid g and pc vs compute grid (seed \
             004, Table 2)",
     run: |p, bench| run(p, bench, 2),
     units: Units::Configs,
 };
 
-pub const PURCELL_TABLE3: Protocol = Protocol {
-    name: "purcell-table3",
+pub const PROXIMITY_CLOUDS_TABLE3: Protocol = Protocol {
+    name: "proximity-clouds-table3",
     title: "Ray tracing, eye, shadow and reflection rays (two levels of recursion): streaming \
             grid g and pc vs compute grid (seed 004, Table 3)",
     run: |p, bench| run(p, bench, 3),
     units: Units::Configs,
 };
 
-/// What a run of `purcell-table<n>` measures.
+/// What a run of `proximity-clouds-table<n>` measures.
 pub struct Plan {
     pub table: u32,
     /// Image sides (square images), ascending.

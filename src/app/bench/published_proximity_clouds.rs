@@ -6,11 +6,11 @@
 //! conclusion's findings. Values are milliseconds per frame, the best of several runs ("all the
 //! presented measurement results are best values of multiple test runs").
 
-/// The paper's hardware (a GeForce 6800GT-era GPU, fragment programs with instruction and loop
-/// limits); the paper's text in the seed does not name the card beyond its references to the
-/// NVIDIA GPU Programming Guide of 2005.
-pub const GPU: &str = "an NVIDIA GPU of 2005–2006 (GeForce 6800GT era; the seed's text does not \
-                       name the card)";
+/// The paper's test machine, as its ch. 4 lists it ("Parameters of the machine used for
+/// testing"): the GPU whose fragment programs had the instruction and loop limits of ch. 3.
+pub const GPU: &str = "GeForce 6800GT 400 MHz with 256 MB at 1100 MHz, AthlonXP 3200+ \
+                       (2200 MHz) with 512 MB at 400 MHz, GNU/Linux 2.6.16.29, NVIDIA driver \
+                       1.0-9746 (the paper's ch. 4)";
 
 /// The three image sizes of Tables 1–3, in their order.
 pub const SIZES: [u32; 3] = [256, 512, 768];
@@ -127,7 +127,7 @@ pub const TABLE_3: [Row; 4] = [
     },
 ];
 
-/// The table of protocol `purcell-table<n>` (1, 2 or 3).
+/// The table of protocol `proximity-clouds-table<n>` (1, 2 or 3).
 pub fn table(n: u32) -> &'static [Row; 4] {
     match n {
         1 => &TABLE_1,

@@ -1,4 +1,4 @@
-//! The report of `purcell-table1…3` (seed 004, Tables 1–3): our best GPU milliseconds beside
+//! The report of `proximity-clouds-table1…3` (seed 004, Tables 1–3): our best GPU milliseconds beside
 //! the published ones, the pc/g ratios, the streaming tracer beside the compute grid on the
 //! same frames, the work counts, and the paper's findings beside what we measured.
 
@@ -12,8 +12,8 @@ use super::csv_files::write_rows;
 use super::format::{int, num, ratio, table};
 use super::outcome::Outcome;
 use super::plots::{Chart, Figure, Series, Style};
-use super::published_purcell::{self as pp, PaperScene};
-use super::purcell::{Plan, SPARSE};
+use super::proximity_clouds::{Plan, SPARSE};
+use super::published_proximity_clouds::{self as pp, PaperScene};
 
 /// The paper's columns and ours.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -388,7 +388,7 @@ fn findings(plan: &Plan, outcomes: &[Outcome]) -> String {
 /// dense scene and side.
 fn shadow_line(plan: &Plan, outcomes: &[Outcome]) -> String {
     if plan.table != 2 {
-        return "Measured in Table 2 (`purcell-table2`: stream g with `--stream-naive-shadows` \
+        return "Measured in Table 2 (`proximity-clouds-table2`: stream g with `--stream-naive-shadows` \
                 beside it)."
             .into();
     }
@@ -440,7 +440,7 @@ fn sparse_line(plan: &Plan, outcomes: &[Outcome]) -> String {
 
 fn bunny_line(outcomes: &[Outcome]) -> String {
     let file = pp::STANFORD_BUNNY.file;
-    let side = super::purcell::BUNNY_SIDE;
+    let side = super::proximity_clouds::BUNNY_SIDE;
     let at = |c| ours(outcomes, file, side, c);
     match (at(Column::StreamG), at(Column::GridG)) {
         (Some(g), Some(gg)) => format!(
