@@ -216,6 +216,7 @@ fn stream(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, dims: [u32; 3], pc: bool
         steps_per_call: 64,
         max_calls: 10_000,
         naive_shadows: false,
+        no_mask: false,
         aovs: true,
     };
     // the kernels built in, or with `STREAM_TEST_GLSL_DIR=DIR` those of DIR (a planted bug)

@@ -28,6 +28,7 @@ fn options(size: u32, dims: [u32; 3], proximity_clouds: bool) -> StreamOptions {
         steps_per_call: 64,
         max_calls: 10_000,
         naive_shadows: false,
+        no_mask: false,
         aovs: true,
     }
 }
@@ -225,10 +226,19 @@ fn light_scene(dir: &std::path::Path) -> Scene {
 /// the ambient term alone, checked where the light's cosine exceeds 0.01), and the shadow-ray
 /// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`]; the
 /// shadow AOV is 1 where lit or missed, 0 where blocked or the light is behind. With
-/// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`).
-fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) -> Frame {
+/// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`); with
+/// `no_mask`, the masking is off (`--stream-no-mask`): the twin then also traces the shadow
+/// rays of surfaces facing away from the light, as the GPU does, and counts their tests.
+fn check_shadows(
+    ctx: &GlContext,
+    scene: &Scene,
+    dims: [u32; 3],
+    naive: bool,
+    no_mask: bool,
+) -> Frame {
     let mut o = options(64, dims, false);
     o.naive_shadows = naive;
+    o.no_mask = no_mask;
     let (f, grid) = render(ctx, scene, o);
     let offset = scene.settings.shadow_offset;
     let rule = match naive {
@@ -255,6 +265,12 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
         let to_light = light - p;
         let distance = to_light.length();
         let l = to_light / distance;
+        let feeler = StreamRay {
+            o: p,
+            d: l,
+            skip: id,
+            limit: distance,
+        };
         if n.dot(l) <= 0.0 {
             if n.dot(l) < -0.01 {
                 assert_eq!(
@@ -262,14 +278,14 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
                     "pixel {i}: a light behind counts as blocked"
                 );
             }
+            if no_mask {
+                // traced without the masking, its verdict unused
+                let c = grid.trace(&feeler, rule, false).1;
+                shadow_tests += c.tests;
+                add(&mut counts, c);
+            }
             continue;
         }
-        let feeler = StreamRay {
-            o: p,
-            d: l,
-            skip: id,
-            limit: distance,
-        };
         let (blocker, c) = grid.trace(&feeler, rule, false);
         shadow_tests += c.tests;
         add(&mut counts, c);
@@ -304,7 +320,8 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
 }
 
 /// The shadow rays, optimised (any hit before the light) and naive (the closest hit anywhere),
-/// against the twin; both give the same image, the naive ones with more triangle tests.
+/// masked and not, against the twin; all give the same image, the naive ones and the unmasked
+/// ones (on the cow, where surfaces face away from the light) more triangle tests.
 #[test]
 fn shadows_equal_the_cpu_twin() {
     let ctx = context();
@@ -314,10 +331,35 @@ fn shadows_equal_the_cpu_twin() {
         (light_scene(dir.path()), [3, 3, 3]),
     ];
     for (scene, dims) in &scenes {
-        let fast = check_shadows(&ctx, scene, *dims, false);
-        let naive = check_shadows(&ctx, scene, *dims, true);
+        let fast = check_shadows(&ctx, scene, *dims, false, false);
+        let naive = check_shadows(&ctx, scene, *dims, true, false);
         assert_eq!(fast.color, naive.color, "the naive shadow rays' image");
         let tests = |f: &Frame| f.stats.triangle_tests["shadow"];
+        for naive_too in [false, true] {
+            let unmasked = check_shadows(&ctx, scene, *dims, naive_too, true);
+            assert_eq!(
+                fast.color, unmasked.color,
+                "the unmasked shadow rays' image"
+            );
+            assert_eq!(
+                fast.aovs.as_ref().unwrap().shadow,
+                unmasked.aovs.as_ref().unwrap().shadow,
+                "the unmasked shadow AOV"
+            );
+            let masked = if naive_too { &naive } else { &fast };
+            eprintln!(
+                "shadow tests: masked {}, unmasked {}",
+                tests(masked),
+                tests(&unmasked)
+            );
+            assert!(tests(&unmasked) >= tests(masked));
+            if scene.triangle_count() > 100 {
+                assert!(
+                    tests(&unmasked) > tests(masked),
+                    "the cow has back faces lit"
+                );
+            }
+        }
         eprintln!(
             "shadow tests: any hit {}, naive {}",
             tests(&fast),

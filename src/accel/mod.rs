@@ -199,6 +199,10 @@ pub struct GridOptions {
     /// The streaming tracer: shadow rays as the naive closest-hit search the paper's shadow
     /// optimisation improves on (`--stream-naive-shadows`).
     pub stream_naive_shadows: bool,
+    /// The streaming tracer without its masking kernel's optimisation (`--stream-no-mask`):
+    /// rays that need no work are found by the traverse kernel's first call instead, and the
+    /// shadow rays of surfaces facing away from the light are traced.
+    pub stream_no_mask: bool,
     /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
     /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
     /// split only where the GL implementation ends long loops.
@@ -217,6 +221,7 @@ impl Default for GridOptions {
             stream_steps: 64,
             stream_max_calls: 10_000,
             stream_naive_shadows: false,
+            stream_no_mask: false,
             triangles_per_dispatch: None,
         }
     }

@@ -83,6 +83,13 @@ pub struct GridArgs {
     /// saves.
     #[arg(long)]
     pub stream_naive_shadows: bool,
+    /// --tracer stream: switch off the masking of rays that need no work (seed 004, ch. 3:
+    /// "rays missed the scene AABB, shadow rays for rays not intersecting any objects") —
+    /// the traverse kernel's first call finds them instead, and the shadow rays of surfaces
+    /// facing away from the light are traced (their verdict unused): the same image, for
+    /// measuring what the masking saves.
+    #[arg(long)]
+    pub stream_no_mask: bool,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
@@ -113,6 +120,7 @@ impl GridArgs {
             stream_steps: self.stream_steps,
             stream_max_calls: self.stream_max_calls,
             stream_naive_shadows: self.stream_naive_shadows,
+            stream_no_mask: self.stream_no_mask,
             triangles_per_dispatch: None,
         }
     }

@@ -120,6 +120,7 @@ fn stream(proximity_clouds: bool) -> impl Fn(usize) -> TracerSpec {
         axes: auto_dims(t).to_array(),
         proximity_clouds,
         naive_shadows: false,
+        no_mask: false,
     }
 }
 

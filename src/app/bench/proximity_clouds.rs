@@ -108,6 +108,7 @@ impl Plan {
             axes: scene.grid,
             proximity_clouds: pc,
             naive_shadows: false,
+            no_mask: false,
         };
         let resolution = scene.grid.into_iter().max().unwrap_or(1);
         let mut v = vec![stream(false)];
@@ -124,16 +125,23 @@ impl Plan {
         v
     }
 
-    /// Table 2 measures the paper's shadow-ray optimisation ("roughly 20 % speedup compared
-    /// to the naive implementation of shadow rays") on its dense scenes: stream g with the
-    /// naive shadow rays (`--stream-naive-shadows`) beside stream g.
-    fn naive(&self, scene: &PaperScene) -> Option<TracerSpec> {
+    /// Table 2 measures the paper's shadow-ray optimisations ("roughly 20 % speedup compared
+    /// to the naive implementation of shadow rays") on its dense scenes, each switched off
+    /// beside stream g: the any-hit search (`--stream-naive-shadows`), the masking
+    /// (`--stream-no-mask`), and both.
+    fn naive(&self, scene: &PaperScene) -> Vec<TracerSpec> {
         let dense = pp::SCENES.iter().any(|s| s.file == scene.file);
-        (self.table == 2 && dense).then_some(TracerSpec::Stream {
-            axes: scene.grid,
-            proximity_clouds: false,
-            naive_shadows: true,
-        })
+        if self.table != 2 || !dense {
+            return Vec::new();
+        }
+        [(true, false), (false, true), (true, true)]
+            .map(|(naive_shadows, no_mask)| TracerSpec::Stream {
+                axes: scene.grid,
+                proximity_clouds: false,
+                naive_shadows,
+                no_mask,
+            })
+            .to_vec()
     }
 
     /// Every scene of the table and the sparse room, every tracer, every side; and the

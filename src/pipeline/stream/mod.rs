@@ -68,6 +68,8 @@ pub struct StreamOptions {
     pub max_calls: u32,
     /// shadow rays as a naive closest-hit search (`--stream-naive-shadows`)
     pub naive_shadows: bool,
+    /// without the masking kernel's optimisation (`--stream-no-mask`)
+    pub no_mask: bool,
     pub aovs: bool,
 }
 
@@ -84,6 +86,7 @@ impl StreamOptions {
             steps_per_call: g.stream_steps,
             max_calls: g.stream_max_calls,
             naive_shadows: g.stream_naive_shadows,
+            no_mask: g.stream_no_mask,
             aovs: o.aovs,
         }
     }
@@ -263,6 +266,7 @@ impl StreamRenderer {
         t.bind_rays(gl, &t.rays[from]);
         let cam = camera.rays(t.width, t.height);
         k.set_i32("generate", generate);
+        k.set_i32("masking", !self.options.no_mask as i32);
         k.set_vec3("camImgPosition", cam.cam_img_position.to_array());
         k.set_vec3("camImgOffset", cam.cam_img_offset.to_array());
         k.set_vec3("camWidth", cam.cam_width.to_array());
@@ -288,6 +292,7 @@ impl StreamRenderer {
         self.use_kernel(k);
         t.bind_rays(gl, t.ray_set(rays));
         k.set_i32("shadowRays", shadow as i32);
+        k.set_i32("masking", !self.options.no_mask as i32);
         t.draw(gl, &mut self.timers, k, t.fbo.state[0]);
         t.unbind(gl);
         t.state[1].tmax.clear(gl);
@@ -515,6 +520,7 @@ impl StreamRenderer {
             ("grid_build_ms", json!(self.grid_ms)),
             ("proximity_clouds", json!(self.options.proximity_clouds)),
             ("naive_shadows", json!(self.options.naive_shadows)),
+            ("masking", json!(!self.options.no_mask)),
             ("steps_per_call", json!(self.options.steps_per_call)),
         ] {
             stats.facts.insert(k.into(), v);
@@ -641,6 +647,7 @@ impl Renderer for StreamRenderer {
             ("steps_per_call", json!(o.steps_per_call)),
             ("max_calls", json!(o.max_calls)),
             ("naive_shadows", json!(o.naive_shadows)),
+            ("masking", json!(!o.no_mask)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
