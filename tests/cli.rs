@@ -440,7 +440,11 @@ fn options_of_the_other_pipeline_are_refused() {
     a.extend_from_slice(&small);
     assert_fails(&run(&a), &["--light-samples does not apply", "--shadows"]);
     // the streaming tracer's switches, with another tracer
-    for flag in ["--stream-no-mask", "--stream-naive-shadows"] {
+    for flag in [
+        "--stream-no-mask",
+        "--stream-naive-shadows",
+        "--stream-single-sided",
+    ] {
         let mut a = vec!["render", cow.as_str(), "--tracer", "grid", flag];
         a.extend_from_slice(&small);
         assert_fails(&run(&a), &[flag, "applies to --tracer stream only"]);

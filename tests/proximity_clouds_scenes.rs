@@ -217,6 +217,7 @@ fn stream(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, dims: [u32; 3], pc: bool
         max_calls: 10_000,
         naive_shadows: false,
         no_mask: false,
+        single_sided: false,
         aovs: true,
     };
     // the kernels built in, or with `STREAM_TEST_GLSL_DIR=DIR` those of DIR (a planted bug)

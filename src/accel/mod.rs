@@ -203,6 +203,9 @@ pub struct GridOptions {
     /// rays that need no work are found by the traverse kernel's first call instead, and the
     /// shadow rays of surfaces facing away from the light are traced.
     pub stream_no_mask: bool,
+    /// The streaming tracer with the paper's single-sided Möller–Trumbore test
+    /// (`--stream-single-sided`): back faces are no hits.
+    pub stream_single_sided: bool,
     /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
     /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
     /// split only where the GL implementation ends long loops.
@@ -222,6 +225,7 @@ impl Default for GridOptions {
             stream_max_calls: 10_000,
             stream_naive_shadows: false,
             stream_no_mask: false,
+            stream_single_sided: false,
             triangles_per_dispatch: None,
         }
     }

@@ -90,6 +90,11 @@ pub struct GridArgs {
     /// measuring what the masking saves.
     #[arg(long)]
     pub stream_no_mask: bool,
+    /// --tracer stream: the paper's single-sided Möller–Trumbore test ("the fastest known
+    /// single sided algorithm", seed 004 ch. 3): a triangle seen from its back is no hit.
+    /// Default: two-sided, as every tracer here.
+    #[arg(long)]
+    pub stream_single_sided: bool,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
@@ -121,6 +126,7 @@ impl GridArgs {
             stream_max_calls: self.stream_max_calls,
             stream_naive_shadows: self.stream_naive_shadows,
             stream_no_mask: self.stream_no_mask,
+            stream_single_sided: self.stream_single_sided,
             triangles_per_dispatch: None,
         }
     }

@@ -93,6 +93,9 @@ pub fn ray_tracer(
     if options.grid.stream_no_mask {
         anyhow::bail!("--stream-no-mask applies to --tracer stream only");
     }
+    if options.grid.stream_single_sided {
+        anyhow::bail!("--stream-single-sided applies to --tracer stream only");
+    }
     if options.grid.axes.is_some() {
         anyhow::bail!(
             "--grid GXxGYxGZ applies to --tracer stream only (the compute grids are cubic)"

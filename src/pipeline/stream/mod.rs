@@ -70,6 +70,8 @@ pub struct StreamOptions {
     pub naive_shadows: bool,
     /// without the masking kernel's optimisation (`--stream-no-mask`)
     pub no_mask: bool,
+    /// the paper's single-sided ray–triangle test (`--stream-single-sided`)
+    pub single_sided: bool,
     pub aovs: bool,
 }
 
@@ -87,6 +89,7 @@ impl StreamOptions {
             max_calls: g.stream_max_calls,
             naive_shadows: g.stream_naive_shadows,
             no_mask: g.stream_no_mask,
+            single_sided: g.stream_single_sided,
             aovs: o.aovs,
         }
     }
@@ -186,10 +189,13 @@ fn check(info: &GlInfo, scene: &Scene, o: &StreamOptions) -> Result<()> {
 }
 
 fn defines(scene: &Scene, o: &StreamOptions) -> Defines {
-    let mut d = Defines::new().set("STEPS_PER_CALL", o.steps_per_call).set(
-        "SHADOW_OFFSET",
-        format!("{:?}", scene.settings.shadow_offset),
-    );
+    let mut d = Defines::new()
+        .set("STEPS_PER_CALL", o.steps_per_call)
+        .set(
+            "SHADOW_OFFSET",
+            format!("{:?}", scene.settings.shadow_offset),
+        )
+        .set("SINGLE_SIDED", o.single_sided as u32);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -521,6 +527,7 @@ impl StreamRenderer {
             ("proximity_clouds", json!(self.options.proximity_clouds)),
             ("naive_shadows", json!(self.options.naive_shadows)),
             ("masking", json!(!self.options.no_mask)),
+            ("single_sided", json!(self.options.single_sided)),
             ("steps_per_call", json!(self.options.steps_per_call)),
         ] {
             stats.facts.insert(k.into(), v);
@@ -648,6 +655,7 @@ impl Renderer for StreamRenderer {
             ("max_calls", json!(o.max_calls)),
             ("naive_shadows", json!(o.naive_shadows)),
             ("masking", json!(!o.no_mask)),
+            ("single_sided", json!(o.single_sided)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
