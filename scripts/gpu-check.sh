@@ -98,7 +98,7 @@ if [ "$dry_run" = 1 ]; then
     protocols=(thesis-5.3 wagner-a2)
     extra=(--width 16 --height 16 --angles 1)
 else
-    protocols=(thesis-5.1 thesis-5.3 klee-fig13 wagner-a2 purcell-table1)
+    protocols=(thesis-5.1 thesis-5.3 klee-fig13 wagner-a2 proximity-clouds-table1)
     extra=()
 fi
 n=${#protocols[@]}

@@ -592,7 +592,7 @@ fn wagner_a1_and_a2_tiny_rows_published_values_and_ratios() {
         .is_file());
 }
 
-/// The published milliseconds of `purcell-table<n>`'s paper CSV row of `scene` in `column`.
+/// The published milliseconds of `proximity-clouds-table<n>`'s paper CSV row of `scene` in `column`.
 fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> String {
     let row = rows
         .iter()
@@ -605,13 +605,14 @@ fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> Stri
 /// only in Table 1 (no lights, no shadow tests), shadows in 2 and 3, two reflection bounces in 3;
 /// the published milliseconds beside ours; the best GPU time the frames' sum.
 #[test]
-fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
+fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bp");
     let o = bench(&[
+        // the old name stays an alias
         "purcell-table1",
-        "purcell-table2",
-        "purcell-table3",
+        "proximity-clouds-table2",
+        "proximity-clouds-table3",
         "--sizes",
         "16x16",
         "--angles",
@@ -659,11 +660,12 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
     ];
     let stanford = ["142", "235", "482"];
     for n in 1..=3u32 {
-        let p = format!("purcell-table{n}");
+        let p = format!("proximity-clouds-table{n}");
         let frames = read_csv(&out.join(format!("{p}.csv")));
         // 3 scenes × (g, pc, grid g, grid pc) + the Stanford bunny × (g, grid g) + the sparse
-        // room × 4, and in Table 2 the 4 scenes' g with naive shadow rays
-        let configs = if n == 2 { 22 } else { 18 };
+        // room × 4, and in Table 2 the 4 scenes' g with naive shadow rays, without masking,
+        // and with neither optimisation
+        let configs = if n == 2 { 30 } else { 18 };
         assert_eq!(frames.len(), configs, "{p}");
         for r in &frames {
             let scene = r["scene"].as_str();
@@ -680,11 +682,13 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
             );
             if stream {
                 assert_eq!(r["grid_resolution"], grids[scene], "{p} {scene}");
-                assert!(["g", "pc", "g-naive"].contains(&r["variant"].as_str()));
+                let variant = r["variant"].as_str();
+                assert!(["g", "pc", "g-naive", "g-nomask", "g-naive-nomask"].contains(&variant));
                 assert_eq!(
                     r["fact_naive_shadows"],
-                    (r["variant"] == "g-naive").to_string()
+                    variant.contains("naive").to_string()
                 );
+                assert_eq!(r["fact_masking"], (!variant.contains("nomask")).to_string());
                 assert_eq!(
                     r["fact_proximity_clouds"],
                     (r["variant"] == "pc").to_string()
@@ -700,20 +704,18 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
             4,
             "no pc for bunny"
         );
-        let naive = rows_with(&frames, "variant", "g-naive");
-        assert_eq!(
-            naive.len(),
-            if n == 2 { 4 } else { 0 },
-            "{p}: naive shadows"
-        );
-        for r in naive {
-            // the same shadows, found the naive way: at least as many tests
-            let g = frames
-                .iter()
-                .find(|g| g["scene"] == r["scene"] && g["variant"] == "g")
-                .unwrap();
-            assert!(u(r, "tests_shadow") >= u(g, "tests_shadow"), "{r:?}");
-            assert_eq!(u(r, "tests_closest"), u(g, "tests_closest"), "{r:?}");
+        for variant in ["g-naive", "g-nomask", "g-naive-nomask"] {
+            let rows = rows_with(&frames, "variant", variant);
+            assert_eq!(rows.len(), if n == 2 { 4 } else { 0 }, "{p}: {variant}");
+            for r in rows {
+                // the same shadows, found with an optimisation off: at least as many tests
+                let g = frames
+                    .iter()
+                    .find(|g| g["scene"] == r["scene"] && g["variant"] == "g")
+                    .unwrap();
+                assert!(u(r, "tests_shadow") >= u(g, "tests_shadow"), "{r:?}");
+                assert_eq!(u(r, "tests_closest"), u(g, "tests_closest"), "{r:?}");
+            }
         }
         let summary = read_csv(&out.join(format!("{p}_summary.csv")));
         check_summary_against_frames(&frames, &summary);
@@ -765,14 +767,26 @@ fn purcell_tables_tiny_rows_grids_and_published_milliseconds() {
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     check_report_links(&out, &report);
+    let title = report.lines().next().unwrap();
+    assert!(title.starts_with("# Seed 004, Tables 1–3"), "{title}");
+    // the paper's test machine, as its ch. 4 names it
+    assert!(report.contains("GeForce 6800GT 400 MHz with 256 MB at 1100 MHz"));
+    assert!(report.contains("NVIDIA driver 1.0-9746"));
     assert!(report.contains("almost always worse than not using proximity clouds"));
-    // Table 2's shadow-ray saving, for every dense scene
+    // Table 2's shadow-ray savings, each optimisation for every dense scene
     let shadows = report
         .lines()
-        .find(|l| l.contains("time saved per frame (1 − g / g-naive)"))
+        .find(|l| l.contains("shadow-ray optimisations each switched off"))
         .expect("Table 2's shadow-ray finding");
-    for scene in ["Knight", "Torus knot", "Bunny", "Stanford Bunny"] {
-        assert!(shadows.contains(&format!("{scene} ")), "{scene}: {shadows}");
+    for col in [
+        "1 − g / g-naive)",
+        "1 − g / g-nomask)",
+        "1 − g / g-naive-nomask)",
+    ] {
+        let part = &shadows[shadows.find(col).expect(col)..];
+        for scene in ["Knight", "Torus knot", "Bunny", "Stanford Bunny"] {
+            assert!(part.contains(&format!("{scene} ")), "{scene}: {part}");
+        }
     }
     assert!(!shadows.contains('–'), "every saving measured: {shadows}");
 }

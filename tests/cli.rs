@@ -439,6 +439,16 @@ fn options_of_the_other_pipeline_are_refused() {
     let mut a = vec!["render", cow.as_str(), "--light-samples", "3x3"];
     a.extend_from_slice(&small);
     assert_fails(&run(&a), &["--light-samples does not apply", "--shadows"]);
+    // the streaming tracer's switches, with another tracer
+    for flag in [
+        "--stream-no-mask",
+        "--stream-naive-shadows",
+        "--stream-single-sided",
+    ] {
+        let mut a = vec!["render", cow.as_str(), "--tracer", "grid", flag];
+        a.extend_from_slice(&small);
+        assert_fails(&run(&a), &[flag, "applies to --tracer stream only"]);
+    }
     // the defaults of both pipelines' options are not "given": these render
     let o = with(&["--tile", "64", "--frames", "2", "--light-samples", "2x2"]);
     assert!(o.status.success(), "{}", stderr(&o));

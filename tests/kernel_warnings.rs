@@ -69,6 +69,8 @@ fn every_kernel_compiles_without_warnings() {
         steps_per_call: 16,
         max_calls: 10_000,
         naive_shadows: true,
+        no_mask: true,
+        single_sided: false,
         aovs: true,
     };
     let mut r = StreamRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)

@@ -28,6 +28,8 @@ fn options(size: u32, dims: [u32; 3], proximity_clouds: bool) -> StreamOptions {
         steps_per_call: 64,
         max_calls: 10_000,
         naive_shadows: false,
+        no_mask: false,
+        single_sided: false,
         aovs: true,
     }
 }
@@ -91,7 +93,7 @@ const T_REL: f32 = 1e-5;
 
 /// Relative difference allowed between the GPU's counts and the CPU twin's: a hit distance a
 /// few ulps off (above) can fall on the other side of a cell's exit and end a walk one cell
-/// later or earlier (measured: one ray of 4096 on the cow's 54³ grid, 4 of 10673 triangle
+/// later or earlier (measured: one ray of 4096 on the cow on a 54³ grid, 4 of 10673 triangle
 /// tests and 1 of 80898 cells; every other configuration here exact).
 const COUNT_REL: f64 = 1e-3;
 
@@ -162,9 +164,9 @@ fn check_against_twin(ctx: &GlContext, scene: &Scene, o: StreamOptions) -> Frame
 fn first_hits_and_counts_equal_the_cpu_twin_on_cubic_and_non_cubic_grids() {
     let ctx = context();
     let cow = unlit(load("cow.toml"));
-    // the paper's auto grid (3·∛5804 = 54 per axis) and a non-cubic one
+    // the paper's auto grid (∛5804 ≈ 17.97: 18 per axis) and a non-cubic one
     let auto = gpgpu_rt::reference::stream_grid::auto_dims(cow.triangle_count());
-    assert_eq!(auto, UVec3::splat(54));
+    assert_eq!(auto, UVec3::splat(18));
     for dims in [auto.to_array(), [7, 13, 4]] {
         for pc in [false, true] {
             check_against_twin(&ctx, &cow, options(64, dims, pc));
@@ -225,10 +227,19 @@ fn light_scene(dir: &std::path::Path) -> Scene {
 /// the ambient term alone, checked where the light's cosine exceeds 0.01), and the shadow-ray
 /// test count and the cells entered by both kinds of rays agree within [`COUNT_REL`]; the
 /// shadow AOV is 1 where lit or missed, 0 where blocked or the light is behind. With
-/// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`).
-fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) -> Frame {
+/// `naive`, the shadow rays are the naive closest-hit search (`--stream-naive-shadows`); with
+/// `no_mask`, the masking is off (`--stream-no-mask`): the twin then also traces the shadow
+/// rays of surfaces facing away from the light, as the GPU does, and counts their tests.
+fn check_shadows(
+    ctx: &GlContext,
+    scene: &Scene,
+    dims: [u32; 3],
+    naive: bool,
+    no_mask: bool,
+) -> Frame {
     let mut o = options(64, dims, false);
     o.naive_shadows = naive;
+    o.no_mask = no_mask;
     let (f, grid) = render(ctx, scene, o);
     let offset = scene.settings.shadow_offset;
     let rule = match naive {
@@ -255,6 +266,12 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
         let to_light = light - p;
         let distance = to_light.length();
         let l = to_light / distance;
+        let feeler = StreamRay {
+            o: p,
+            d: l,
+            skip: id,
+            limit: distance,
+        };
         if n.dot(l) <= 0.0 {
             if n.dot(l) < -0.01 {
                 assert_eq!(
@@ -262,14 +279,14 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
                     "pixel {i}: a light behind counts as blocked"
                 );
             }
+            if no_mask {
+                // traced without the masking, its verdict unused
+                let c = grid.trace(&feeler, rule, false).1;
+                shadow_tests += c.tests;
+                add(&mut counts, c);
+            }
             continue;
         }
-        let feeler = StreamRay {
-            o: p,
-            d: l,
-            skip: id,
-            limit: distance,
-        };
         let (blocker, c) = grid.trace(&feeler, rule, false);
         shadow_tests += c.tests;
         add(&mut counts, c);
@@ -304,7 +321,8 @@ fn check_shadows(ctx: &GlContext, scene: &Scene, dims: [u32; 3], naive: bool) ->
 }
 
 /// The shadow rays, optimised (any hit before the light) and naive (the closest hit anywhere),
-/// against the twin; both give the same image, the naive ones with more triangle tests.
+/// masked and not, against the twin; all give the same image, the naive ones and the unmasked
+/// ones (on the cow, where surfaces face away from the light) more triangle tests.
 #[test]
 fn shadows_equal_the_cpu_twin() {
     let ctx = context();
@@ -314,10 +332,35 @@ fn shadows_equal_the_cpu_twin() {
         (light_scene(dir.path()), [3, 3, 3]),
     ];
     for (scene, dims) in &scenes {
-        let fast = check_shadows(&ctx, scene, *dims, false);
-        let naive = check_shadows(&ctx, scene, *dims, true);
+        let fast = check_shadows(&ctx, scene, *dims, false, false);
+        let naive = check_shadows(&ctx, scene, *dims, true, false);
         assert_eq!(fast.color, naive.color, "the naive shadow rays' image");
         let tests = |f: &Frame| f.stats.triangle_tests["shadow"];
+        for naive_too in [false, true] {
+            let unmasked = check_shadows(&ctx, scene, *dims, naive_too, true);
+            assert_eq!(
+                fast.color, unmasked.color,
+                "the unmasked shadow rays' image"
+            );
+            assert_eq!(
+                fast.aovs.as_ref().unwrap().shadow,
+                unmasked.aovs.as_ref().unwrap().shadow,
+                "the unmasked shadow AOV"
+            );
+            let masked = if naive_too { &naive } else { &fast };
+            eprintln!(
+                "shadow tests: masked {}, unmasked {}",
+                tests(masked),
+                tests(&unmasked)
+            );
+            assert!(tests(&unmasked) >= tests(masked));
+            if scene.triangle_count() > 100 {
+                assert!(
+                    tests(&unmasked) > tests(masked),
+                    "the cow has back faces lit"
+                );
+            }
+        }
         eprintln!(
             "shadow tests: any hit {}, naive {}",
             tests(&fast),
@@ -574,4 +617,55 @@ fn a_jump_never_passes_the_nearest_non_empty_cell() {
         differ, 0,
         "{differ} first hits differ with proximity clouds"
     );
+}
+
+/// The paper's single-sided test (`--stream-single-sided`) drops back faces and nothing else:
+/// on seed 004's scenes (no eye ray meets a back face first) the first hits and the eye rays'
+/// triangle tests are those of the two-sided test; on the teapot (patches not consistently
+/// wound) the pixels that change are exactly those whose two-sided first hit is a back face,
+/// and where the single-sided test hits, it hits a front face.
+#[test]
+fn single_sided_test_drops_back_faces_only() {
+    let ctx = context();
+    let back = |tri: &[Vec3; 3], d: Vec3| (tri[1] - tri[0]).cross(tri[2] - tri[0]).dot(d) > 0.0;
+    for (file, dims) in [
+        ("knight.toml", [14, 16, 14]),
+        ("torus_knot.toml", [16, 16, 16]),
+        ("teapot1.toml", [24, 24, 24]),
+    ] {
+        let scene = unlit(load(file));
+        let tris = scene.world_triangles();
+        let two = render(&ctx, &scene, options(64, dims, false)).0;
+        let mut o = options(64, dims, false);
+        o.single_sided = true;
+        let one = render(&ctx, &scene, o).0;
+        let (a2, a1) = (two.aovs.as_ref().unwrap(), one.aovs.as_ref().unwrap());
+        let mut changed = 0;
+        for (i, d) in a2.ray_direction.iter().enumerate() {
+            let d = Vec3::from(*d);
+            let (id2, id1) = (a2.triangle_id[i], a1.triangle_id[i]);
+            if id1 >= 0 {
+                assert!(
+                    !back(&tris[id1 as usize], d),
+                    "{file} pixel {i}: a back face"
+                );
+            }
+            if id2 != id1 {
+                changed += 1;
+                assert!(id2 >= 0 && back(&tris[id2 as usize], d), "{file} pixel {i}");
+            }
+        }
+        let tests = |f: &Frame| f.stats.triangle_tests["closest"];
+        eprintln!(
+            "{file}: {changed} pixels changed; tests two-sided {}, single-sided {}",
+            tests(&two),
+            tests(&one)
+        );
+        if file == "teapot1.toml" {
+            assert!(changed > 100, "{file}: {changed} back-face first hits");
+        } else {
+            assert_eq!(changed, 0, "{file}");
+            assert_eq!(tests(&two), tests(&one), "{file}: the same walks");
+        }
+    }
 }

@@ -245,13 +245,17 @@ def primary(res, aov, tris):
     }
 
 
-def feeler_query(aov, info):
+def feeler_query(aov, info, first_light_only=False):
     """intersect2's feelers: per light, from the hit point towards it where N·L > 0; the
-    query and which hit pixels each light's feelers start from."""
+    query and which hit pixels each light's feelers start from. `first_light_only`: the
+    scene's first light alone, as Wagner 2018's kernel shades (one point light; the others are
+    left out), so that its shadow AOV (0 or 1 per pixel) is compared with the same feelers."""
     o, d = aov["ray_origin"].reshape(-1, 3), aov["ray_direction"].reshape(-1, 3)
     t, n = aov["hit_t"].reshape(-1), aov["normal"].reshape(-1, 3)
     hit = aov["triangle_id"].reshape(-1) >= 0
     lights = np.asarray(info["light_positions"], np.float32).reshape(-1, 3)
+    if first_light_only:
+        lights = lights[:1]
     off = np.float32(info["shadow_offset"])
     p = (o[hit] + t[hit, None] * d[hit]).astype(np.float32)
     rays, traced = [], []
@@ -313,7 +317,8 @@ def measure(scene, a, work):
     emb = Embree(tris, a.robust, a.threads)
     queries = {"primary": primary_query(aov)}
     if ray_tracer and info["lights"] > 0:
-        queries["feelers"], traced = feeler_query(aov, info)
+        wagner = a.tracer == "bvh" and a.bvh_variant == "wagner"
+        queries["feelers"], traced = feeler_query(aov, info, first_light_only=wagner)
     # the megakernel times primary rays and feelers together: agreement only
     timed = ray_tracer and a.bvh_variant == "sah"
     rerender = (lambda k: rerun(a, scene, pipeline_args, d, k)) if timed else None
@@ -412,6 +417,7 @@ def report(results, a, command, load):
     flags = "robust (RTC_SCENE_FLAG_ROBUST)" if a.robust else "default flags (not robust)"
     cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text()
                 .splitlines() if line.startswith("model name")), platform.processor())
+    wagner = a.tracer == "bvh" and a.bvh_variant == "wagner"
     lines = [
         f"# Embree as the peer of `{tracer_label(a)}`: the same rays on "
         "the same machine", "",
@@ -424,17 +430,7 @@ def report(results, a, command, load):
         f"(embreex binds no packet calls), 1 thread per call: the {th}-process column splits "
         f"the rays over {th} worker processes, each with its own Embree scene, timed from a "
         "common barrier to the last one's end; build = rtcCommitScene (multi-threaded, TBB)",
-        f"- Mrays/s: rays / seconds, medians of {a.repeats} Embree runs; ours medians of "
-        f"{a.repeats} renders, each timed in the last of its {a.frames} frames (W·H / "
-        "gpu_ms.intersect1; feelers / gpu_ms.intersect2); ours/Embree: the ratio of the "
-        f"medians. In {a.repeats} rounds each of our renders is followed by Embree's runs of the "
-        "same rays (1 thread, then all), so both sides are timed over the same seconds; per "
-        "round: ours over Embree's of that round. "
-        "Agreement: same triangle id / with ties (ids differ, t within 1e-5 relative)",
-        "- ours, whole kind: the rays over the GPU time of their ray kind (`ray_kinds`): for "
-        "`--tracer bvh` intersect1 with the hit evaluation (`evaluate_hit`, Listings 13–14) and "
-        "the addition of its per-pixel counts (`pixel_counts`), which the BVH runs as kernels "
-        "of their own; intersect2 with its counts", "",
+        *(timing_bullets(a) if not wagner else wagner_bullets(a)), "",
         "## Primary rays (closest hit)", "",
         f"| scene | size | triangles | Embree build ms | our build ms (BVH or grid) | Embree Mrays/s "
         f"(1 thread) | Embree Mrays/s ({th} processes) | ours Mrays/s | ours/Embree | "
@@ -448,7 +444,9 @@ def report(results, a, command, load):
             f"`{r['scene']}`" + label(r), r["size"],
             str(r["triangles"]), fmt(r["embree_build_ms"], 1), fmt(r["bvh_build_ms"], 1),
             *rate_cells(m, th), f"{m['agree_pct']:.4f} / {m['agree_ties_pct']:.4f}"]) + " |")
-    lines += ["", "## Shadow feelers (any hit, intersect2)", "",
+    feelers_title = ("Shadow feelers (any hit, towards the scene's first light only)" if wagner
+                     else "Shadow feelers (any hit, intersect2)")
+    lines += ["", f"## {feelers_title}", "",
               f"| scene | feelers | Embree Mrays/s (1 thread) | Embree Mrays/s ({th} processes) "
               "| ours Mrays/s | ours/Embree | ours/Embree per round: median (range) "
               "| ours Mrays/s, whole kind | shadow agreement % (hit pixels) |",
@@ -469,12 +467,47 @@ def report(results, a, command, load):
                      f"{r['embree_build_cores']:.2f}, {m['embree_s'][th][2]:.2f} | "
                      f"{mrays(m['rays'], m['embree_s'][th][1]):.2f} | {m['ties']} | "
                      f"{m['disagree']} ({m['disagree_on_edge']}) | {m['max_t_rel_same_id']:.1e} |")
+    ours_test = ("Listing 4.2 (Wagner's Möller–Trumbore, with its ε)" if wagner else
+                 "Algorithm 1 (Möller–Trumbore without an epsilon, the thesis' test)")
     lines += ["", "On a shared edge: one tracer's first hit lies on an edge of its triangle "
               "(within 1e-3, barycentric), and the other's ray slipped between the two triangles "
               "of that edge by a rounding error and went on to a farther one. Neither test is "
-              "watertight: Algorithm 1 (Möller–Trumbore without an epsilon, the thesis' test) "
-              "and Embree without its robust mode.", ""]
+              f"watertight: {ours_test} and Embree without its robust mode.", ""]
     return "\n".join(lines)
+
+
+def timing_bullets(a):
+    """How Müller's pipeline (`--tracer bvh --bvh-variant sah`, or a grid) is timed."""
+    return [
+        f"- Mrays/s: rays / seconds, medians of {a.repeats} Embree runs; ours medians of "
+        f"{a.repeats} renders, each timed in the last of its {a.frames} frames (W·H / "
+        "gpu_ms.intersect1; feelers / gpu_ms.intersect2); ours/Embree: the ratio of the "
+        f"medians. In {a.repeats} rounds each of our renders is followed by Embree's runs of the "
+        "same rays (1 thread, then all), so both sides are timed over the same seconds; per "
+        "round: ours over Embree's of that round. "
+        "Agreement: same triangle id / with ties (ids differ, t within 1e-5 relative)",
+        "- ours, whole kind: the rays over the GPU time of their ray kind (`ray_kinds`): for "
+        "`--tracer bvh` intersect1 with the hit evaluation (`evaluate_hit`, Listings 13–14) and "
+        "the addition of its per-pixel counts (`pixel_counts`), which the BVH runs as kernels "
+        "of their own; intersect2 with its counts",
+    ]
+
+
+def wagner_bullets(a):
+    """Wagner's megakernel: one dispatch traces a pixel's primary ray and its one feeler, so
+    there is no time of ours per kind of ray to set beside Embree's."""
+    return [
+        f"- Mrays/s: Embree's only, rays / seconds, medians of {a.repeats} runs. Ours: none — "
+        "Wagner 2018's kernel (`glsl/wagner2018/raytrace.comp`) traces a pixel's primary ray "
+        "and its shadow feeler in one dispatch, so there is no time of ours per kind of ray "
+        "(the build column is the CPU build of Listings 4.3–4.4)",
+        "- feelers: from each primary hit towards the scene's **first** light only, where "
+        "N·L > 0, from the shadow offset to the light — Wagner's kernel shades with one point "
+        "light (the others are left out, as the thesis' one light), and its shadow AOV is 0 or 1 "
+        "per pixel; agreement: that AOV against Embree's occlusion of the same feelers",
+        "- agreement of first hits: same triangle id / with ties (ids differ, t within 1e-5 "
+        "relative)",
+    ]
 
 
 def embreex_version():

@@ -6,7 +6,11 @@
 //               plane relative to the camera, as mueller2015/eye_ray_generation.comp); weight 1
 // generate = 1: shadow rays from the eye or reflection ray's hit towards lightPosition, with
 //               the light's distance as their limit; none where the ray hit nothing or the
-//               light lies behind the surface (it is then in shadow: shading.frag)
+//               light lies behind the surface (it is then in shadow: shading.frag). Without
+//               masking (masking = 0, --stream-no-mask), the paper's optimisation switched off
+//               for measuring it: the rays towards a light behind the surface are made too,
+//               their limit negated (-distance) so that the shadow AOV still leaves them out;
+//               the shading ignores their verdict (the cosine is not positive)
 // generate = 2: reflection rays (mirror direction) from hits on reflective surfaces, weight
 //               times reflectivity; none elsewhere
 #include "grid.glsl"
@@ -20,6 +24,7 @@ uniform vec3 camWidth;
 uniform vec3 camHeight;
 uniform vec2 imageSize2;
 uniform vec3 lightPosition;
+uniform int masking;
 
 layout(location = 0) out vec4 outOrigin;
 layout(location = 1) out vec4 outDirection;
@@ -46,10 +51,11 @@ void secondaryRay(ivec2 px)
         float distance = length(toLight);
         vec3 l = toLight / distance;
         if (dot(s.normal, l) > 0.0) outDirection = vec4(l, distance);
+        else if (masking == 0) outDirection = vec4(l, -distance);
     } else if (s.reflectivity > 0.0) {
         outDirection = vec4(reflect(d.xyz, s.normal), d.w * s.reflectivity);
     }
-    if (outDirection.w > 0.0) countAdd(COUNTER_RAYS, 1u);
+    if (outDirection.w != 0.0) countAdd(COUNTER_RAYS, 1u);
 }
 
 void main()

@@ -19,6 +19,9 @@
 // naiveShadow (--stream-naive-shadows, for measuring that optimisation): a shadow ray searched
 // like an eye ray — the closest hit beyond shadowOffset, the walk not stopped at the light —
 // and a blocker only when that hit lies before the light (the same verdicts, more work).
+// Without masking (--stream-no-mask), a ray the masking kernel would have masked arrives with
+// -1 triangles processed: this call finishes it with no hit, and the shadow rays' limit is
+// |rayDirection.w| (negative for a light behind the surface).
 // Proximity clouds (ch. 3, Fig. 3's B channel): in an empty cell at distance dist >= 2 from the
 // nearest non-empty one, the ray jumps out of the cube of cells within dist - 1 of it, all empty.
 layout(early_fragment_tests) in;
@@ -111,9 +114,10 @@ void main()
     vec4 hit = texelFetch(stateHit, px, 0);
     ivec3 cell = ivec3(cellK.xyz);
     int k = int(cellK.w);
-    float limit = anyHit != 0 ? d.w : INF;
+    float limit = anyHit != 0 ? abs(d.w) : INF;
     uint tests = 0u, entered = 0u, jumps = 0u, skipped = 0u;
-    bool done = false;
+    // a ray the masking kernel would have masked (masking off): finished, no hit
+    bool done = k < 0;
     for (int i = 0; i < STEPS_PER_CALL && !done; ++i) {
         vec3 c = texelFetch(cells, cell, 0).rgb;
         if (k < int(c.g)) {
@@ -146,7 +150,7 @@ void main()
         entered += 1u;
     }
     // the naive shadow ray's verdict: a blocker only before the light
-    if (done && naiveShadow != 0 && hit.z >= d.w) hit = vec4(0.0, 0.0, INF, -1.0);
+    if (done && naiveShadow != 0 && hit.z >= abs(d.w)) hit = vec4(0.0, 0.0, INF, -1.0);
     outTMax = vec4(tMax, done ? RAY_DONE : RAY_ACTIVE);
     outCell = vec4(vec3(cell), float(k));
     outHit = hit;

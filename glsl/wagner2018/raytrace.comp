@@ -56,7 +56,9 @@ layout(rgba32f, binding = IMAGE_WAGNER_RAY) uniform writeonly image2D rayImage;
 layout(rgba32f, binding = IMAGE_WAGNER_NORMAL) uniform writeonly image2D normalImage;
 
 // Listing 4.1's camera, computed on the CPU: direction to the image's upper-left corner, unit
-// vectors right and down, the image's extent along them
+// vectors right and down, the image's extent along them. A reading (docs/listings.md): the
+// listing adds α·xDirection·xScale + β·yDirection·yScale with α, β in [0, 1] to
+// camera.direction, so that points at the corner where α = β = 0, not along the view.
 struct Camera {
     vec3 position;
     vec3 direction;

@@ -186,7 +186,7 @@ pub struct GridOptions {
     pub voxel_array_length: u32,
     pub ray_array_length: Option<u32>,
     /// The streaming tracer's grid, gx×gy×gz cells (`--grid 14x16x14`); `None`: `resolution`
-    /// on every axis, or the paper's 3·∛n with neither.
+    /// on every axis, or the paper's ∛n with neither.
     pub axes: Option<[u32; 3]>,
     /// The streaming tracer: skip empty cells by their proximity-cloud distances
     /// (`--proximity-clouds`).
@@ -199,6 +199,13 @@ pub struct GridOptions {
     /// The streaming tracer: shadow rays as the naive closest-hit search the paper's shadow
     /// optimisation improves on (`--stream-naive-shadows`).
     pub stream_naive_shadows: bool,
+    /// The streaming tracer without its masking kernel's optimisation (`--stream-no-mask`):
+    /// rays that need no work are found by the traverse kernel's first call instead, and the
+    /// shadow rays of surfaces facing away from the light are traced.
+    pub stream_no_mask: bool,
+    /// The streaming tracer with the paper's single-sided Möller–Trumbore test
+    /// (`--stream-single-sided`): back faces are no hits.
+    pub stream_single_sided: bool,
     /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
     /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
     /// split only where the GL implementation ends long loops.
@@ -217,6 +224,8 @@ impl Default for GridOptions {
             stream_steps: 64,
             stream_max_calls: 10_000,
             stream_naive_shadows: false,
+            stream_no_mask: false,
+            stream_single_sided: false,
             triangles_per_dispatch: None,
         }
     }

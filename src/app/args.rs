@@ -60,7 +60,7 @@ impl std::str::FromStr for GridResolution {
 #[derive(Debug, Clone, clap::Args)]
 pub struct GridArgs {
     /// Grid resolution N (N³ voxels, N from 1 to 1024), or `auto`: N = cbrt(triangles / 5),
-    /// within 4..=64 (--tracer stream: 3·∛triangles per axis, as seed 004). --tracer stream
+    /// within 4..=64 (--tracer stream: ∛triangles per axis, as seed 004). --tracer stream
     /// also takes GXxGYxGZ cells, e.g. 14x16x14.
     #[arg(long, default_value = "auto", value_name = "N|GXxGYxGZ|auto")]
     pub grid: GridResolution,
@@ -83,6 +83,18 @@ pub struct GridArgs {
     /// saves.
     #[arg(long)]
     pub stream_naive_shadows: bool,
+    /// --tracer stream: switch off the masking of rays that need no work (seed 004, ch. 3:
+    /// "rays missed the scene AABB, shadow rays for rays not intersecting any objects") —
+    /// the traverse kernel's first call finds them instead, and the shadow rays of surfaces
+    /// facing away from the light are traced (their verdict unused): the same image, for
+    /// measuring what the masking saves.
+    #[arg(long)]
+    pub stream_no_mask: bool,
+    /// --tracer stream: the paper's single-sided Möller–Trumbore test ("the fastest known
+    /// single sided algorithm", seed 004 ch. 3): a triangle seen from its back is no hit.
+    /// Default: two-sided, as every tracer here.
+    #[arg(long)]
+    pub stream_single_sided: bool,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
     /// compact lists, 3D-DDA.
     #[arg(long, value_enum, default_value = "exact")]
@@ -113,6 +125,8 @@ impl GridArgs {
             stream_steps: self.stream_steps,
             stream_max_calls: self.stream_max_calls,
             stream_naive_shadows: self.stream_naive_shadows,
+            stream_no_mask: self.stream_no_mask,
+            stream_single_sided: self.stream_single_sided,
             triangles_per_dispatch: None,
         }
     }

@@ -119,6 +119,12 @@ fn check_grid_options(options: &raytrace::RenderOptions) -> Result<()> {
     if options.grid.stream_naive_shadows && !stream {
         anyhow::bail!("--stream-naive-shadows applies to --tracer stream only");
     }
+    if options.grid.stream_no_mask && !stream {
+        anyhow::bail!("--stream-no-mask applies to --tracer stream only");
+    }
+    if options.grid.stream_single_sided && !stream {
+        anyhow::bail!("--stream-single-sided applies to --tracer stream only");
+    }
     if options.grid.axes.is_some() && !stream {
         anyhow::bail!(
             "--grid GXxGYxGZ applies to --tracer stream only (the compute grids are cubic)"

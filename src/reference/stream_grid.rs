@@ -106,9 +106,13 @@ impl GridBox {
     }
 }
 
-/// `--grid auto`: the paper's heuristic g = 3·∛n cells per axis (ch. 4), within 1..=1024.
+/// `--grid auto`: the paper's heuristic g = ∛n cells per axis (ch. 4), within 1..=1024. The
+/// seed's text reads "gx,y,z = 3 √n": the 3 is the radical's index, not a factor — the paper's
+/// own arithmetic needs the cube root, since with g³ = n its M = 96·n + 16·g³ is 112 bytes a
+/// triangle and 256 MB hold its "2.3 million triangles" (3·∛n would make it 528 bytes and
+/// about 0.5 million).
 pub fn auto_dims(triangles: usize) -> UVec3 {
-    UVec3::splat(((3.0 * (triangles as f64).cbrt()).round() as u32).clamp(1, 1024))
+    UVec3::splat(((triangles as f64).cbrt().round() as u32).clamp(1, 1024))
 }
 
 /// The grid of Fig. 3: per cell (pointer, count, proximity distance), the references tightly
@@ -477,5 +481,25 @@ impl CpuAccelerator for StreamGrid {
         };
         let (h, n) = self.trace(&r, Rule::AnyHit(f.offset), false);
         (h.is_some(), n.tests)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The heuristic against the paper's own figure: with g = ∛n per axis, M = 96·n + 16·g³
+    /// bytes for 2.3 million triangles fits the test GPU's 256 MB, which 3·∛n would overflow
+    /// about four times.
+    #[test]
+    fn auto_grid_is_the_cube_root_the_papers_memory_figure_needs() {
+        assert_eq!(auto_dims(636), UVec3::splat(9)); // ∛636 ≈ 8.60
+        assert_eq!(auto_dims(69451), UVec3::splat(41)); // ∛69451 ≈ 41.11
+        assert_eq!(auto_dims(1), UVec3::ONE);
+        let n: u64 = 2_300_000;
+        let g = auto_dims(n as usize).x as u64;
+        let bytes = 96 * n + 16 * g * g * g;
+        assert!(bytes <= 256 << 20, "M = {bytes} for g = {g}");
+        assert!(96 * n + 16 * (3 * g).pow(3) > 4 * (256 << 20));
     }
 }

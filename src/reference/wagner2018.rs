@@ -46,7 +46,10 @@ pub struct Ray {
 
 /// The camera of Listing 4.1 as the host computes it for the kernel: the position, the
 /// direction to the upper-left corner of the image, unit vectors to the right and down, and
-/// the image's width and height along them (at the distance of `direction`).
+/// the image's width and height along them (at the distance of `direction`). The thesis does
+/// not say where `camera.direction` points; since the listing adds α, β ∈ [0, 1] times the
+/// image's extent to it, it must be the corner where both are 0 (our reading, listed in
+/// `docs/listings.md`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WagnerCamera {
     pub position: Vec3,

@@ -120,10 +120,11 @@ fn stream(proximity_clouds: bool) -> impl Fn(usize) -> TracerSpec {
         axes: auto_dims(t).to_array(),
         proximity_clouds,
         naive_shadows: false,
+        no_mask: false,
     }
 }
 
-/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's 3·∛T
+/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's ∛T
 /// per axis).
 pub const ACCELERATORS: [Accelerator; 8] = [
     Accelerator {

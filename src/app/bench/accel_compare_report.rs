@@ -131,7 +131,7 @@ fn intro(s: Sizing, scale: Scale) -> String {
     format!(
         "{}, camera and objects fixed, {} frames after {} warm-up, each scene at its own \
          reflection depth. Grids at `--grid auto` (N = ∛(T/5)), the stream's at the paper's \
-         3·∛T per axis. Mrays/s = rays / GPU ms of the kind's dispatches (GL timer queries); \
+         ∛T per axis. Mrays/s = rays / GPU ms of the kind's dispatches (GL timer queries); \
          the stream's fragment passes are counted and timed per kind as Müller's kernels are; \
          Wagner's megakernel traces every ray in one dispatch, so it has only the frame's figure. \
          Every pipeline counts the rays it \

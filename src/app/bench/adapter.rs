@@ -64,11 +64,13 @@ fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)
             axes,
             proximity_clouds,
             naive_shadows,
+            no_mask,
         } => {
             let grid = GridOptions {
                 axes: Some(axes),
                 proximity_clouds,
                 stream_naive_shadows: naive_shadows,
+                stream_no_mask: no_mask,
                 ..d
             };
             return Ok((TracerKind::Stream, grid));

@@ -44,14 +44,14 @@ pub enum ProtocolId {
     #[value(name = "wagner-a2")]
     WagnerA2,
     /// Seed 004, Table 1: ray casting (eye rays), streaming grid g and pc vs the compute grid.
-    #[value(name = "purcell-table1")]
-    PurcellTable1,
+    #[value(name = "proximity-clouds-table1", alias = "purcell-table1")]
+    ProximityCloudsTable1,
     /// Seed 004, Table 2: shadow casting (eye and shadow rays), g and pc vs the compute grid.
-    #[value(name = "purcell-table2")]
-    PurcellTable2,
+    #[value(name = "proximity-clouds-table2", alias = "purcell-table2")]
+    ProximityCloudsTable2,
     /// Seed 004, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs compute grid.
-    #[value(name = "purcell-table3")]
-    PurcellTable3,
+    #[value(name = "proximity-clouds-table3", alias = "purcell-table3")]
+    ProximityCloudsTable3,
     /// Issue 15: every accelerator on every scene and kind of ray (and the stadium).
     #[value(name = "accel-compare")]
     AccelCompare,
@@ -207,7 +207,7 @@ pub struct KleeArgs {
 pub struct WagnerArgs {
     /// Image sizes of the Wagner 2018 protocols, comma-separated, e.g. 320x240,640x480
     /// (default: the protocol's for the scale; 320x240 is always measured, the reference); of
-    /// purcell-table1…3 too, which render square images W×W.
+    /// proximity-clouds-table1…3 too, which render square images W×W.
     #[arg(long, value_delimiter = ',', value_name = "WxH,...", value_parser = parse_size)]
     pub sizes: Option<Vec<(u32, u32)>>,
     /// Subdivision levels of the square for wagner-a1, comma-separated: level L has 2·4^L

@@ -65,11 +65,13 @@ pub enum TracerSpec {
     /// Seed 004's streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
     /// proximity clouds: the paper's columns pc and g.
     /// With `naive_shadows`, the naive shadow rays the paper's optimisation is measured
-    /// against (`--stream-naive-shadows`).
+    /// against (`--stream-naive-shadows`); with `no_mask`, without the masking kernel's
+    /// optimisation (`--stream-no-mask`).
     Stream {
         axes: [u32; 3],
         proximity_clouds: bool,
         naive_shadows: bool,
+        no_mask: bool,
     },
     /// The compute exact grid (`--tracer grid`) of N³ voxels with proximity clouds
     /// (`--tracer grid --proximity-clouds`, issue 12 §3).
@@ -134,12 +136,17 @@ impl TracerSpec {
             TracerSpec::Stream {
                 proximity_clouds,
                 naive_shadows,
+                no_mask,
                 ..
-            } => Some(match (proximity_clouds, naive_shadows) {
-                (false, false) => "g",
-                (true, false) => "pc",
-                (false, true) => "g-naive",
-                (true, true) => "pc-naive",
+            } => Some(match (proximity_clouds, naive_shadows, no_mask) {
+                (false, false, false) => "g",
+                (true, false, false) => "pc",
+                (false, true, false) => "g-naive",
+                (true, true, false) => "pc-naive",
+                (false, false, true) => "g-nomask",
+                (true, false, true) => "pc-nomask",
+                (false, true, true) => "g-naive-nomask",
+                (true, true, true) => "pc-naive-nomask",
             }),
             TracerSpec::GridPc { .. } => Some("exact-pc"),
         }

@@ -66,11 +66,11 @@ pub mod machine;
 pub mod outcome;
 pub mod plots;
 pub mod protocol;
+pub mod proximity_clouds;
+pub mod proximity_clouds_report;
 pub mod published;
-pub mod published_purcell;
+pub mod published_proximity_clouds;
 pub mod published_wagner;
-pub mod purcell;
-pub mod purcell_report;
 pub mod report;
 pub mod runner;
 pub mod shard;
@@ -107,9 +107,9 @@ pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
         ProtocolId::KleeFig13 => &klee::KLEE_FIG13,
         ProtocolId::WagnerA1 => &wagner::WAGNER_A1,
         ProtocolId::WagnerA2 => &wagner::WAGNER_A2,
-        ProtocolId::PurcellTable1 => &purcell::PURCELL_TABLE1,
-        ProtocolId::PurcellTable2 => &purcell::PURCELL_TABLE2,
-        ProtocolId::PurcellTable3 => &purcell::PURCELL_TABLE3,
+        ProtocolId::ProximityCloudsTable1 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE1,
+        ProtocolId::ProximityCloudsTable2 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE2,
+        ProtocolId::ProximityCloudsTable3 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE3,
         ProtocolId::AccelCompare => &accel_compare::ACCEL_COMPARE,
     }
 }

@@ -34,7 +34,7 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
         (muller, MULLER),
         (klee, KLEE),
         (wagner, WAGNER),
-        (ran("purcell-"), SEED004),
+        (ran("proximity-clouds-"), SEED004),
     ];
     let cited: Vec<&str> = sources.iter().filter(|s| s.0).map(|s| s.1).collect();
     let command = bench.command.clone();

@@ -59,7 +59,7 @@ pub struct StreamOptions {
     pub height: u32,
     /// reflection bounces after the primary rays (the paper's Table 3: 2)
     pub refl_depth: u32,
-    /// gx, gy, gz (`None`: the paper's 3·∛n per axis)
+    /// gx, gy, gz (`None`: the paper's ∛n per axis)
     pub dims: Option<[u32; 3]>,
     pub proximity_clouds: bool,
     /// steps (triangle tests or cell moves) per traverse call
@@ -68,6 +68,10 @@ pub struct StreamOptions {
     pub max_calls: u32,
     /// shadow rays as a naive closest-hit search (`--stream-naive-shadows`)
     pub naive_shadows: bool,
+    /// without the masking kernel's optimisation (`--stream-no-mask`)
+    pub no_mask: bool,
+    /// the paper's single-sided ray–triangle test (`--stream-single-sided`)
+    pub single_sided: bool,
     pub aovs: bool,
 }
 
@@ -84,6 +88,8 @@ impl StreamOptions {
             steps_per_call: g.stream_steps,
             max_calls: g.stream_max_calls,
             naive_shadows: g.stream_naive_shadows,
+            no_mask: g.stream_no_mask,
+            single_sided: g.stream_single_sided,
             aovs: o.aovs,
         }
     }
@@ -183,10 +189,13 @@ fn check(info: &GlInfo, scene: &Scene, o: &StreamOptions) -> Result<()> {
 }
 
 fn defines(scene: &Scene, o: &StreamOptions) -> Defines {
-    let mut d = Defines::new().set("STEPS_PER_CALL", o.steps_per_call).set(
-        "SHADOW_OFFSET",
-        format!("{:?}", scene.settings.shadow_offset),
-    );
+    let mut d = Defines::new()
+        .set("STEPS_PER_CALL", o.steps_per_call)
+        .set(
+            "SHADOW_OFFSET",
+            format!("{:?}", scene.settings.shadow_offset),
+        )
+        .set("SINGLE_SIDED", o.single_sided as u32);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -264,6 +273,7 @@ impl StreamRenderer {
         t.bind_rays(gl, &t.rays[from]);
         let cam = camera.rays(t.width, t.height);
         k.set_i32("generate", generate);
+        k.set_i32("masking", !self.options.no_mask as i32);
         k.set_vec3("camImgPosition", cam.cam_img_position.to_array());
         k.set_vec3("camImgOffset", cam.cam_img_offset.to_array());
         k.set_vec3("camWidth", cam.cam_width.to_array());
@@ -289,6 +299,7 @@ impl StreamRenderer {
         self.use_kernel(k);
         t.bind_rays(gl, t.ray_set(rays));
         k.set_i32("shadowRays", shadow as i32);
+        k.set_i32("masking", !self.options.no_mask as i32);
         t.draw(gl, &mut self.timers, k, t.fbo.state[0]);
         t.unbind(gl);
         t.state[1].tmax.clear(gl);
@@ -516,6 +527,8 @@ impl StreamRenderer {
             ("grid_build_ms", json!(self.grid_ms)),
             ("proximity_clouds", json!(self.options.proximity_clouds)),
             ("naive_shadows", json!(self.options.naive_shadows)),
+            ("masking", json!(!self.options.no_mask)),
+            ("single_sided", json!(self.options.single_sided)),
             ("steps_per_call", json!(self.options.steps_per_call)),
         ] {
             stats.facts.insert(k.into(), v);
@@ -524,7 +537,8 @@ impl StreamRenderer {
     }
 
     /// The AOVs of the last frame, row 0 = the top row; the normal from the hit record and
-    /// the triangles' normals, as shading.frag interpolates it (no shadow AOV).
+    /// the triangles' normals, as shading.frag interpolates it; the shadow AOV from the
+    /// shadow rays' results (`shadow_shares`).
     fn aovs(&self) -> Option<Aovs> {
         let AovTargets { rays, hit, .. } = self.targets.primary.as_ref()?;
         let (w, h) = (self.options.width, self.options.height);
@@ -641,6 +655,8 @@ impl Renderer for StreamRenderer {
             ("steps_per_call", json!(o.steps_per_call)),
             ("max_calls", json!(o.max_calls)),
             ("naive_shadows", json!(o.naive_shadows)),
+            ("masking", json!(!o.no_mask)),
+            ("single_sided", json!(o.single_sided)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
