@@ -461,15 +461,17 @@ fn area_centres_lit(scene: &Scene) -> Scene {
     });
     Scene {
         lights: lights.collect(),
+        area_lights: Vec::new(), // now point lights: none is ignored
         ..scene.clone()
     }
 }
 
-/// `scene` with its point lights removed: eye (and reflection) rays only, no shadow rays
-/// (seed 004's Table 1, "ray casting (eye rays only)").
+/// `scene` with its lights removed: eye (and reflection) rays only, no shadow rays (seed 004's
+/// Table 1, "ray casting (eye rays only)").
 fn without_lights(scene: &Scene) -> Scene {
     Scene {
         lights: Vec::new(),
+        area_lights: Vec::new(),
         ..scene.clone()
     }
 }
