@@ -6,6 +6,31 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+/// Host bytes per pixel of a frame: the colour read back (RGBA32F 16), kept (12) and encoded
+/// (8-bit RGB 3, its PNG at most as much again), and the GPU's images of the frame, at most
+/// twelve RGBA32F (a software driver's GPU memory is the host's).
+const FRAME_PIXEL_BYTES: u64 = 16 + 12 + 3 + 3 + 12 * 16;
+/// Host bytes per pixel of the AOVs: four RGBA32F images read back, the arrays kept (ray
+/// origin, direction and normal 12 each; hit_t, triangle id and shadow 4 each) and the vectors
+/// flattened for the `.npy` encoder (36).
+const AOV_PIXEL_BYTES: u64 = 4 * 16 + 48 + 36;
+
+/// Host bytes a `width`×`height` frame takes, rendered, read back and written.
+pub fn host_bytes(width: u32, height: u32, aovs: bool) -> u64 {
+    let per_pixel = FRAME_PIXEL_BYTES + if aovs { AOV_PIXEL_BYTES } else { 0 };
+    width as u64 * height as u64 * per_pixel
+}
+
+/// A `width`×`height` frame within the host's memory, checked before any of it is allocated.
+pub fn check_host(width: u32, height: u32, aovs: bool) -> Result<(), String> {
+    let what = match aovs {
+        true => format!("a {width}x{height} frame with its AOVs"),
+        false => format!("a {width}x{height} frame"),
+    };
+    let bytes = host_bytes(width, height, aovs);
+    crate::scene::budget::reserve(&what, "--width with --height", bytes)
+}
+
 /// Statistics of one frame.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct FrameStats {

@@ -253,6 +253,33 @@ fn each_design_is_estimated_before_it_is_built() {
 }
 
 #[test]
+fn a_frame_is_estimated_before_it_is_rendered() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    write(dir, "t.obj", TRIANGLE);
+    let scene = obj_scene(dir, "t.obj", "");
+    let s = scene.to_str().unwrap();
+    let size = ["--width", "4096", "--height", "4096"];
+    for design in [&["--tracer", "base"][..], &["--tracer", "stream"]] {
+        let args = [
+            &["render", s, "-o", "o.png", "--aov-dir", "a"][..],
+            &size,
+            design,
+        ]
+        .concat();
+        let o = run_in(dir, &args, Some("1G"), 30);
+        refused(
+            &o,
+            &[
+                "4096x4096 frame with its AOVs",
+                "--width with --height",
+                "1.0 GiB",
+            ],
+        );
+    }
+}
+
+#[test]
 fn a_memory_limit_that_is_no_size_is_refused() {
     let d = tempfile::tempdir().unwrap();
     for bad in ["abc", "-5", "1.5G", "0"] {

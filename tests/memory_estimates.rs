@@ -175,3 +175,40 @@ fn random_builds_allocate_within_their_estimates() {
         );
     }
 }
+
+/// A frame with its AOVs, rendered, read back and staged as the files `--aov-dir` writes: the
+/// host's part of it within the frame's estimate.
+#[test]
+fn a_frame_and_its_aovs_allocate_within_their_estimate() {
+    use gpgpu_rt::accel::TracerKind;
+    let _s = serial();
+    let ctx = common::context();
+    let scene = common::load("teapot1.toml");
+    let (w, h) = (256, 192);
+    let opts = gpgpu_rt::pipeline::raytrace::RenderOptions {
+        tracer: TracerKind::Bvh,
+        ..common::options(w, h, 1)
+    };
+    let shaders = Default::default();
+    let mut r =
+        gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts).unwrap();
+    r.render(&scene.camera).unwrap(); // the first frame builds the BVH
+    let dir = tempfile::tempdir().unwrap();
+    let ((), peak) = peak_of(|| {
+        let f = r.render(&scene.camera).unwrap();
+        let img = gpgpu_rt::output::frame_image(&f);
+        let mut s = gpgpu_rt::output::Staging::new();
+        let png = dir.path().join("c.png");
+        s.file(&png, |o| gpgpu_rt::output::encode_image(&img, &png, o))
+            .unwrap();
+        let a = f.aovs.as_ref().unwrap();
+        gpgpu_rt::output::stage_aovs(&mut s, &dir.path().join("a"), w, h, a).unwrap();
+        s.commit().unwrap();
+    });
+    within(
+        "frame 256x192 with AOVs",
+        peak,
+        gpgpu_rt::frame::host_bytes(w, h, true),
+        4.0,
+    );
+}

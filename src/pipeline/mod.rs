@@ -77,6 +77,8 @@ pub fn ray_tracer(
         check("the grid resolution", n, &crate::limits::GRID_RES).map_err(anyhow::Error::msg)?;
     }
     check_grid_options(&options)?;
+    crate::frame::check_host(options.width, options.height, options.aovs)
+        .map_err(anyhow::Error::msg)?;
     if !scene.area_lights.is_empty() {
         anyhow::bail!(
             "{}: the point-light ray tracers light with [[light]]s only; the scene's {} \

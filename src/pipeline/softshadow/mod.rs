@@ -198,6 +198,9 @@ impl SoftShadowRenderer {
         if options.width == 0 || options.height == 0 {
             bail!("width and height must be positive");
         }
+        // (its G-buffer and shadow values are read back for the AOVs whenever they are asked)
+        crate::frame::check_host(options.width, options.height, true)
+            .map_err(anyhow::Error::msg)?;
         let pixels = PixelGrid::new(
             options.width,
             options.height,
