@@ -294,13 +294,16 @@ fn a_memory_limit_that_is_no_size_is_refused() {
 // ---- class 3: no NaN after the transforms ----
 
 /// A tetrahedron at coordinates of `scale` (1e10, 1e-12) with `fit = 2`: every pixel that hits
-/// it has a unit normal on every point-light design.
+/// it has a unit normal on every point-light design, the same (smooth, area-weighted) normal
+/// as the tetrahedron at unit size.
 #[test]
 fn models_far_from_unit_size_fit_without_nan() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    for scale in [1e10f64, 1e-12] {
-        let v = |x: f64, y: f64, z: f64| format!("v {} {} {}\n", x * scale, y * scale, z * scale);
+    let mut unit_size: Vec<Vec<f32>> = Vec::new();
+    for scale in [1.0f64, 1e10, 1e-12] {
+        let v =
+            |x: f64, y: f64, z: f64| format!("v {:e} {:e} {:e}\n", x * scale, y * scale, z * scale);
         let obj = v(1.0, 1.0, 1.0) + &v(3.0, 1.0, 1.0) + &v(1.0, 3.0, 1.0) + &v(1.0, 1.0, 3.0);
         write(
             dir,
@@ -308,11 +311,14 @@ fn models_far_from_unit_size_fit_without_nan() {
             &(obj + "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n"),
         );
         let scene = obj_scene(dir, "tet.obj", "fit = 2.0\n");
-        for tracer in [
+        for (k, tracer) in [
             &["--tracer", "base"][..],
             &["--tracer", "bvh", "--bvh-variant", "wagner"],
             &["--tracer", "stream"],
-        ] {
+        ]
+        .into_iter()
+        .enumerate()
+        {
             let s = scene.to_str().unwrap();
             let args = [
                 &[
@@ -350,6 +356,16 @@ fn models_far_from_unit_size_fit_without_nan() {
                     "{at}: pixel {i}: normal of length {len}"
                 );
             }
+            if scale == 1.0 {
+                unit_size.push(n);
+                continue;
+            }
+            let far = n.iter().zip(&unit_size[k]).map(|(a, b)| (a - b).abs());
+            let worst = far.fold(0.0f32, f32::max);
+            assert!(
+                worst < 1e-3,
+                "{at}: normals {worst} from the unit-size model's"
+            );
         }
     }
 }
