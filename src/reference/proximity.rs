@@ -11,6 +11,8 @@
 
 use glam::{IVec3, UVec3, Vec3};
 
+use crate::progress::Progress;
+
 /// The 26 neighbour offsets (dz, dy, dx) before a cell in x-fastest scan order.
 fn causal_neighbours() -> Vec<IVec3> {
     let mut v = Vec::new();
@@ -38,12 +40,10 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
     let idx = |c: IVec3| ((c.z * d.y + c.y) * d.x + c.x) as usize;
     let inside = |c: IVec3| c.cmpge(IVec3::ZERO).all() && c.cmplt(d).all();
     let back = causal_neighbours();
-    // the scan order, without a list of the cells (a 512³ grid would need 1.6 GB for it)
-    let cells = || {
-        (0..d.z).flat_map(move |z| {
-            (0..d.y).flat_map(move |y| (0..d.x).map(move |x| IVec3::new(x, y, z)))
-        })
-    };
+    // a grid of 2^24 cells or more has long passes: their progress is shown by slices
+    let cells = filled.len() as u64;
+    let worth = if cells >= 1 << 24 { 0 } else { u64::MAX };
+    let progress = Progress::new("proximity clouds", 2 * d.z as u64, worth);
     let mut relax = |c: IVec3, offsets: &mut dyn Iterator<Item = IVec3>| {
         let mut best = dist[idx(c)];
         for o in offsets {
@@ -53,16 +53,23 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
         }
         dist[idx(c)] = best;
     };
-    for c in cells() {
-        relax(c, &mut back.iter().copied());
+    // forward in x-fastest scan order, then backward (no list of the cells: a 512³ grid would
+    // need 1.6 GB for it)
+    for z in 0..d.z {
+        for y in 0..d.y {
+            for x in 0..d.x {
+                relax(IVec3::new(x, y, z), &mut back.iter().copied());
+            }
+        }
+        progress.inc(1);
     }
-    let reverse = (0..d.z).rev().flat_map(move |z| {
-        (0..d.y)
-            .rev()
-            .flat_map(move |y| (0..d.x).rev().map(move |x| IVec3::new(x, y, z)))
-    });
-    for c in reverse {
-        relax(c, &mut back.iter().map(|o| -*o));
+    for z in (0..d.z).rev() {
+        for y in (0..d.y).rev() {
+            for x in (0..d.x).rev() {
+                relax(IVec3::new(x, y, z), &mut back.iter().map(|o| -*o));
+            }
+        }
+        progress.inc(1);
     }
     dist.into_iter().map(|v| v.min(far)).collect()
 }
