@@ -12,7 +12,6 @@ use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard, Once};
 
 /// What a staging made and has not yet committed or removed.
-#[derive(Default)]
 pub struct Registry {
     next: u64,
     entries: Vec<(u64, PathBuf, bool)>,

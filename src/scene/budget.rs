@@ -110,7 +110,7 @@ pub fn check_against(what: &str, bytes: u64, limit: Option<(u64, &str)>) -> Resu
 /// memory: an error naming both when that is more than the limit. Every structure a scene or
 /// an option sizes is estimated through here before it is allocated.
 pub fn reserve(what: &str, decided_by: &str, bytes: u64) -> Result<(), String> {
-    check_host(what, bytes).map_err(|e| format!("{e} ({decided_by} decides its size)"))
+    Tracker::new(what, decided_by).add(bytes)
 }
 
 /// A build that allocates as it goes (a tree whose size shows only while it is built): each

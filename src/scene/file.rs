@@ -64,11 +64,7 @@ fn open(path: &Path) -> std::io::Result<File> {
 /// The bytes of the regular file `path`, within the host's memory. The error is a sentence
 /// without the path (the caller names the file and its role).
 pub fn read(path: &Path) -> Result<Vec<u8>, String> {
-    regular(&std::fs::metadata(path).map_err(|e| e.to_string())?)?;
-    let file = open(path).map_err(|e| e.to_string())?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
-    regular(&meta)?;
-    let len = meta.len();
+    let (file, len) = open_regular(path)?;
     budget::check_file(len)?;
     let mut bytes = Vec::with_capacity(len as usize);
     file.take(len.saturating_add(1))

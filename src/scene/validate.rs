@@ -24,12 +24,17 @@ fn first_bad2(v: &[Vec2]) -> Option<usize> {
 fn first_zero_normal(o: &Object) -> Option<usize> {
     let m = &o.mesh;
     let nm = o.normal_matrix();
-    (0..m.positions.len()).find(|&i| {
-        let t = i - i % 3;
-        let world = [0, 1, 2].map(|k| o.model.transform_point3(m.positions[t + k]));
-        let has_area = super::mesh::face_normal(world) != Vec3::ZERO;
-        has_area && (nm * m.normals[i]).normalize_or_zero() == Vec3::ZERO
-    })
+    let triangles = m.positions.chunks_exact(3).zip(m.normals.chunks_exact(3));
+    for (t, (p, n)) in triangles.enumerate() {
+        let world = [0, 1, 2].map(|k| o.model.transform_point3(p[k]));
+        if super::mesh::face_normal(world) == Vec3::ZERO {
+            continue; // no area
+        }
+        if let Some(k) = (0..3).find(|&k| (nm * n[k]).normalize_or_zero() == Vec3::ZERO) {
+            return Some(3 * t + k);
+        }
+    }
+    None
 }
 
 /// An object's uploaded arrays, world space, all finite, normals with a direction; material
