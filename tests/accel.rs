@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use gpgpu_rt::accel::{GridOptions, REGISTRY};
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::Reference;
 

@@ -10,7 +10,7 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use gpgpu_rt::accel::{self, GridOptions, TracerKind};
-use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Light;
 

@@ -10,7 +10,7 @@ use std::path::Path;
 use gpgpu_rt::gl::kernel::Kernel;
 use gpgpu_rt::gl::program::Defines;
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{Light, Scene};
 

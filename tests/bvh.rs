@@ -12,7 +12,7 @@ use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::Bvh;
 use gpgpu_rt::accel::TracerKind;
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use serde_json::json;
 

@@ -16,7 +16,7 @@ use gpgpu_rt::accel::{BvhVariant, GridOptions, REGISTRY};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline;
-use gpgpu_rt::pipeline::raytrace::RenderOptions;
+use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::reference::wagner2018::Ray;
 use gpgpu_rt::reference::wagner_bvh::WagnerBvh;
 use gpgpu_rt::reference::Reference;

@@ -12,7 +12,7 @@ use gpgpu_rt::accel::thesis_grid::ThesisGrid;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::grid::{tri_box_overlap, GridSpace};
 use gpgpu_rt::scene::Scene;

@@ -372,7 +372,7 @@ fn the_upload_check_catches_scenes_built_by_code() {
 
 #[test]
 fn too_many_lights_suggests_bits_only_where_bits_would_hold_them() {
-    use gpgpu_rt::pipeline::raytrace::{too_many_lights, ShadowFlags};
+    use gpgpu_rt::pipeline::mueller2015::{too_many_lights, ShadowFlags};
     let d = tempfile::tempdir().unwrap();
     let mut scene = load(d.path(), "[[object]]\ntype = \"floor\"\nquads = 1\n", &[]).unwrap();
     let light = gpgpu_rt::scene::Light {

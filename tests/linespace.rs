@@ -6,7 +6,7 @@ mod common;
 use glam::Vec3;
 use gpgpu_rt::frame::{Aovs, FrameStats};
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::linespace::ShadowCounts;
 use gpgpu_rt::reference::ntree::{

@@ -75,7 +75,7 @@ fn each_design_allocates_within_its_estimate() {
         ("wagner", TracerKind::Bvh, BvhVariant::Wagner),
         ("stream", TracerKind::Stream, BvhVariant::Sah),
     ] {
-        let opts = gpgpu_rt::pipeline::raytrace::RenderOptions {
+        let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
             tracer,
             bvh_variant: variant,
             ..common::options(8, 8, 0)
@@ -185,7 +185,7 @@ fn a_frame_and_its_aovs_allocate_within_their_estimate() {
     let ctx = common::context();
     let scene = common::load("teapot1.toml");
     let (w, h) = (256, 192);
-    let opts = gpgpu_rt::pipeline::raytrace::RenderOptions {
+    let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
         tracer: TracerKind::Bvh,
         ..common::options(w, h, 1)
     };

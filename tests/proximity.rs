@@ -12,7 +12,7 @@ use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlContext;
-use gpgpu_rt::pipeline::raytrace::RenderOptions;
+use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::exact_grid::ExactGrid as Twin;
 use gpgpu_rt::reference::grid::GridMapping;

@@ -251,7 +251,7 @@ fn stream_and_grid_first_hits_agree_with_the_base_tracer() {
         let g = render_gpu(
             &ctx,
             &scene,
-            gpgpu_rt::pipeline::raytrace::RenderOptions {
+            gpgpu_rt::pipeline::mueller2015::RenderOptions {
                 tracer: TracerKind::Grid,
                 grid,
                 ..options(SIZE, SIZE, 0)

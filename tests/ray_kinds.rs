@@ -10,7 +10,7 @@ mod common;
 use common::*;
 use gpgpu_rt::accel::{self, GridVariant, TracerKind};
 use gpgpu_rt::frame::{Frame, RAY_KINDS};
-use gpgpu_rt::pipeline::raytrace::RenderOptions;
+use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::reference::Reference;
 
 const SIZE: u32 = 24;

@@ -429,7 +429,7 @@ fn a_moved_object_is_rebuilt() {
 fn ray_tracer_picks_wagners_pipeline() {
     let ctx = context();
     let scene = load("cow.toml");
-    let opts = gpgpu_rt::pipeline::raytrace::RenderOptions {
+    let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
         tracer: TracerKind::Bvh,
         bvh_variant: BvhVariant::Wagner,
         ..options(32, 32, 1)

@@ -110,7 +110,7 @@ impl Accelerator for BruteForce {
         &self.intersect1
     }
 
-    fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
         self.intersect2.use_program();
         // the dispatches before the last need the light now
         self.intersect2.set_i32("lightSource", light as i32);

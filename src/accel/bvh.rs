@@ -241,7 +241,7 @@ impl Accelerator for Bvh {
         &self.intersect1
     }
 
-    fn any_hit(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
         self.bind(f.gl, glow::READ_ONLY);
         self.intersect2.use_program();
         &self.intersect2

@@ -275,7 +275,7 @@ impl Accelerator for ExactGrid {
         &self.intersect1
     }
 
-    fn any_hit(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
         self.lists.bind(f.gl);
         self.intersect2.use_program();
         self.frame.set_uniforms(&self.intersect2);

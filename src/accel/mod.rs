@@ -36,7 +36,7 @@ use crate::reference::CpuAccelerator;
 use crate::scene::Scene;
 
 /// Pixels each invocation of `glsl/common/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
-/// a #define of `pipeline::raytrace::records`), for the accelerators whose kernels store
+/// a #define of `pipeline::mueller2015::records`), for the accelerators whose kernels store
 /// per-pixel counts ([`Accelerator::records`]).
 pub const PIXELS_PER_INVOCATION: u32 = 16;
 /// The most events one pixel's walk may count (node visits, triangle tests) so that those sums
@@ -54,13 +54,13 @@ pub trait Accelerator {
     /// dispatches it over the image.
     fn closest_hit(&mut self, f: &mut FrameContext, pass: u32) -> &Kernel;
     /// The same for intersect2, the shadow feelers towards light `light` (any hit).
-    fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel;
+    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel;
     /// Add the design's facts (sizes, build time, settings) and events to the statistics.
     fn stats(&self, stats: &mut FrameStats);
     /// Whether the design's intersect1 stores hit records and its intersection kernels store
     /// per-pixel counts (`HIT_RECORDS`, `PIXEL_COUNTS`: `glsl/common/records.glsl`), for the
     /// pipeline to evaluate the hits and add the counts after them
-    /// (`pipeline::raytrace::records`). The thesis' designs evaluate and count in the kernel.
+    /// (`pipeline::mueller2015::records`). The thesis' designs evaluate and count in the kernel.
     fn records(&self) -> bool {
         false
     }

@@ -176,7 +176,7 @@ impl Accelerator for ThesisGrid {
         &self.intersect1
     }
 
-    fn any_hit(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
         self.traverse(f, Some(light));
         self.intersect2.use_program();
         self.frame.set_uniforms(&self.intersect2);

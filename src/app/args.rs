@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use gpgpu_rt::accel::{GridOptions, GridVariant};
 use gpgpu_rt::limits;
-use gpgpu_rt::pipeline::softshadow::{KleeShading, SoftShadowOptions};
+use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions};
 use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
 
 #[derive(clap::Args, Debug, Clone)]

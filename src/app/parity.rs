@@ -16,8 +16,8 @@ use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output::write_npy;
-use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::scene::{Scene, ShadowMode};
 

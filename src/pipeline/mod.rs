@@ -3,14 +3,14 @@
 //!
 //! | pipeline | source | module | kernels | accelerators |
 //! |---|---|---|---|---|
-//! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`raytrace`] | `glsl/mueller2015/` | every one of [`crate::accel::REGISTRY`] |
-//! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`softshadow`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
+//! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`mueller2015`] | `glsl/mueller2015/` | every one of [`crate::accel::REGISTRY`] |
+//! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`klee2016`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
 //! | one kernel per pixel (primary ray, BVH walk, Lambert, hard shadow) | Wagner 2018 | [`wagner2018`] | `glsl/wagner2018/` | its BVH in three textures (`--tracer bvh --bvh-variant wagner`) |
 //! | fragment programs over a viewport-sized quad, traversal looped until an occlusion query counts no fragment | seed 004 | [`stream`] | `glsl/stream/` | its static grid in textures, proximity clouds (`--tracer stream`) |
 
+pub mod klee2016;
+pub mod mueller2015;
 pub mod ray_kinds;
-pub mod raytrace;
-pub mod softshadow;
 pub mod stream;
 pub mod wagner2018;
 
@@ -67,7 +67,7 @@ pub fn ray_tracer(
     info: &GlInfo,
     scene: &Scene,
     shaders: &ShaderSource,
-    options: raytrace::RenderOptions,
+    options: mueller2015::RenderOptions,
 ) -> Result<Box<dyn Renderer>> {
     use crate::limits::{check, IMAGE_SIDE, REFL_DEPTH};
     check("the image width", options.width, &IMAGE_SIDE).map_err(anyhow::Error::msg)?;
@@ -106,17 +106,17 @@ pub fn ray_tracer(
             gl, info, scene, shaders, o,
         )?));
     }
-    let r = raytrace::RayTracer::new(gl, info, scene, shaders, options)?;
+    let r = mueller2015::RayTracer::new(gl, info, scene, shaders, options)?;
     Ok(Box::new(r))
 }
 
-fn is_wagner(options: &raytrace::RenderOptions) -> bool {
+fn is_wagner(options: &mueller2015::RenderOptions) -> bool {
     options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner
 }
 
 /// The grid options that only some designs take, refused for the others (before any design
 /// is built, so that none of them ignores one).
-fn check_grid_options(options: &raytrace::RenderOptions) -> Result<()> {
+fn check_grid_options(options: &mueller2015::RenderOptions) -> Result<()> {
     let stream = options.tracer == TracerKind::Stream;
     if options.grid.stream_naive_shadows && !stream {
         anyhow::bail!("--stream-naive-shadows applies to --tracer stream only");
@@ -148,7 +148,7 @@ fn check_grid_options(options: &raytrace::RenderOptions) -> Result<()> {
 /// the peak of the allocations). Every design makes the world-space triangles (36) and
 /// attributes (136), and the driver keeps a copy of what is uploaded (a software driver's GPU
 /// memory is the host's).
-pub fn host_bytes_per_triangle(options: &raytrace::RenderOptions) -> u64 {
+pub fn host_bytes_per_triangle(options: &mueller2015::RenderOptions) -> u64 {
     const WORLD: u64 = 36 + 136;
     // vertex arrays on the GPU: positions, normals, colours, texture coordinates, material
     const UPLOAD: u64 = 136;

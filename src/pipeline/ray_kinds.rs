@@ -61,7 +61,7 @@ impl Bank {
     }
 
     /// The bank of the feelers towards `light`.
-    pub fn any_hit(light: usize) -> Bank {
+    pub fn occluded(light: usize) -> Bank {
         match light {
             0 => Bank::ShadowFirstLight,
             _ => Bank::ShadowOtherLights,

@@ -8,7 +8,7 @@ use glam::Vec3;
 use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::pipeline::raytrace::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::Scene;

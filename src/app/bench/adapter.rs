@@ -1,5 +1,5 @@
 //! The bench's only door to the library's GPU side: the GL context and kernel sources, Müller
-//! 2015's ray tracer with an accelerator (`pipeline::raytrace::RayTracer`, `RenderOptions`,
+//! 2015's ray tracer with an accelerator (`pipeline::mueller2015::RayTracer`, `RenderOptions`,
 //! `GridOptions`) and Klee 2016's soft-shadow renderer (`SoftShadowRenderer`,
 //! `SoftShadowOptions`), both driven through the `Renderer` interface. Everything
 //! else in the bench speaks the bench's own terms: a [`Config`] and the command line in, a
@@ -15,8 +15,8 @@ use super::args::BenchArgs;
 use super::config::{BvhVariant, Config, Sizing, TracerSpec};
 use gpgpu_rt::accel::{GridOptions, TracerKind};
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
-use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::softshadow::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::reference::linespace::LinespaceShadows;
 use gpgpu_rt::scene::{Camera, Scene, ShadowMode};

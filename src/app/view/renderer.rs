@@ -13,13 +13,13 @@ use super::group_digits;
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::{Gl, GlInfo, ShaderSource};
-use gpgpu_rt::pipeline::softshadow::{scene_light, SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::klee2016::{scene_light, SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::{self, Renderer};
 use gpgpu_rt::scene::{Camera, Scene};
 
 pub use crate::args::GridArgs;
 pub use gpgpu_rt::accel::{BvhVariant, GridVariant, TracerKind};
-pub use gpgpu_rt::pipeline::raytrace::{RenderOptions, ShadowFlags};
+pub use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 pub use gpgpu_rt::scene::ShadowMode;
 
 /// The ray tracer's options for the window (no AOVs: the window shows the output texture).

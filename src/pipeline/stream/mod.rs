@@ -32,8 +32,8 @@ use serde_json::json;
 
 use self::grid_textures::GridTextures;
 use self::targets::{AovTargets, Targets};
+use super::mueller2015::RenderOptions;
 use super::ray_kinds::{self, Bank, CounterBanks};
-use super::raytrace::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
@@ -449,7 +449,7 @@ impl StreamRenderer {
         }
         self.shade(cur, 0, 0);
         for light in 0..self.scene.lights.len() {
-            self.count_as(Bank::any_hit(light));
+            self.count_as(Bank::occluded(light));
             self.generate(camera, 1, cur, 2, light);
             self.trace(2, true);
             self.count_as(Bank::Frame);

@@ -25,7 +25,7 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gpu::{Images, SceneTextures};
-use super::raytrace::RenderOptions;
+use super::mueller2015::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};

@@ -315,8 +315,8 @@ impl RayTracer {
         // would inherit the flags of the pass before it)
         self.images.shadow.clear(&self.gl);
         for light in 0..self.lighting.lights {
-            self.counters.bind(f.gl, f.timers, Bank::any_hit(light));
-            let k = self.accel.any_hit(&mut f, light);
+            self.counters.bind(f.gl, f.timers, Bank::occluded(light));
+            let k = self.accel.occluded(&mut f, light);
             k.set_i32("lightSource", light as i32);
             k.dispatch_pixels(f.timers, f.pixels);
             if let Some(r) = &self.records {
