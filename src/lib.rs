@@ -2,6 +2,7 @@
 //! tracer and the per-frame uniform grid) and related designs. See the README.
 
 pub mod accel;
+pub mod design;
 pub mod frame;
 pub mod gl;
 pub mod limits;

@@ -1,4 +1,4 @@
-//! Every accelerator of the registry (`accel::REGISTRY`) against its CPU twin, through the same
+//! Every accelerator of the registry (`design::accelerators()`) against its CPU twin, through the same
 //! interface: the GPU's ray tracer with the accelerator and the CPU reference with the twin
 //! trace the same frame (primary rays, one reflection pass, shadow feelers), and their first
 //! hits, hit distances and triangle-test counts are compared.
@@ -6,7 +6,8 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::{GridOptions, REGISTRY};
+use gpgpu_rt::accel::GridOptions;
+use gpgpu_rt::design::accelerators;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
@@ -17,7 +18,7 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
     let ctx = context();
     let scene = load("cow.toml");
     let (w, h) = (64, 48);
-    for entry in REGISTRY {
+    for entry in accelerators() {
         let grid = GridOptions {
             variant: entry.grid_variant.unwrap_or_default(),
             resolution: Some(12),

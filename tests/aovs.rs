@@ -10,6 +10,7 @@ mod common;
 use common::*;
 use glam::{DVec3, Vec3};
 use gpgpu_rt::accel::{self, GridOptions, TracerKind};
+use gpgpu_rt::design::Design;
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Light;
@@ -116,10 +117,7 @@ fn shadow_aov_is_the_share_of_unblocked_lights() {
         color: Vec3::splat(0.3),
     });
     let (w, h) = (48, 40);
-    let twin = (accel::entry(TracerKind::Bvh, &GridOptions::default())
-        .unwrap()
-        .cpu)(&scene, &GridOptions::default())
-    .expect("CPU twin");
+    let twin = (accel::bvh::ENTRY.cpu)(&scene, &GridOptions::default()).expect("CPU twin");
     let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
     let want = cpu
         .aovs
@@ -191,16 +189,12 @@ fn aovs_mean_the_first_triangle_its_distance_and_its_normal() {
     let tris = scene.world_triangles();
     let ctx = context();
     let (w, h) = (48u32, 40u32);
-    for variant in [accel::BvhVariant::Sah, accel::BvhVariant::Wagner] {
-        let opts = RenderOptions {
-            bvh_variant: variant,
-            ..bvh_options(w, h)
-        };
-        let shaders = gpgpu_rt::gl::ShaderSource::default();
-        let mut r =
-            gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
-                .unwrap();
-        let f = r.render(&scene.camera).unwrap();
+    let sah = bvh_options(w, h);
+    for design in [Design::Mueller2015(sah.clone()), wagner(&sah)] {
+        let variant = design.row().name;
+        let f = renderer(&ctx, &scene, &design)
+            .render(&scene.camera)
+            .unwrap();
         let a = f.aovs.as_ref().unwrap();
         let cam = scene.camera.rays(w, h);
         let mut seen = [0usize; 4];
@@ -231,7 +225,7 @@ fn aovs_mean_the_first_triangle_its_distance_and_its_normal() {
                 assert_eq!(
                     id,
                     first.map_or(-1, |(_, k)| k as i32),
-                    "{variant:?}: pixel ({x}, {row})"
+                    "{variant}: pixel ({x}, {row})"
                 );
                 let Some((_, k)) = first else { continue };
                 seen[k] += 1;
@@ -246,7 +240,7 @@ fn aovs_mean_the_first_triangle_its_distance_and_its_normal() {
                 let t = a.hit_t[i] as f64;
                 assert!(
                     (t - want_t).abs() < 1e-5 * want_t,
-                    "{variant:?}: pixel ({x}, {row}): hit_t {t} vs {want_t}"
+                    "{variant}: pixel ({x}, {row}): hit_t {t} vs {want_t}"
                 );
                 // normal: the face normal turned towards the ray (triangles 1 and 2 are wound
                 // away from the camera, so their vertex normals must be turned)
@@ -255,11 +249,11 @@ fn aovs_mean_the_first_triangle_its_distance_and_its_normal() {
                 let d = (got - want).length();
                 assert!(
                     d < 1e-5,
-                    "{variant:?}: pixel ({x}, {row}): normal {got} vs face normal {n} of {k}"
+                    "{variant}: pixel ({x}, {row}): normal {got} vs face normal {n} of {k}"
                 );
             }
         }
-        eprintln!("{variant:?}: pixels per triangle {seen:?}");
-        assert!(seen.iter().all(|&s| s > 20), "{variant:?}: {seen:?}");
+        eprintln!("{variant}: pixels per triangle {seen:?}");
+        assert!(seen.iter().all(|&s| s > 20), "{variant}: {seen:?}");
     }
 }

@@ -338,7 +338,7 @@ fn split_dispatches_render_the_frame_of_one_dispatch() {
     let per = 1000;
     let split_opts = |per: Option<u32>| {
         let mut o = options(64, 48, 2);
-        o.grid.triangles_per_dispatch = per;
+        o.triangles_per_dispatch = per;
         o
     };
     let split = render_gpu(&ctx, &scene, split_opts(Some(per)));
@@ -373,7 +373,7 @@ fn a_loop_the_implementation_cuts_short_is_refused() {
     let ctx = context();
     let scene = load("bunny.toml");
     let mut opts = options(8, 8, 0);
-    opts.grid.triangles_per_dispatch = Some(u32::MAX);
+    opts.triangles_per_dispatch = Some(u32::MAX);
     let one = ray_tracer(&ctx, &scene, opts.clone()).render(&scene.camera);
     if ctx.info.is_llvmpipe() {
         let Err(err) = one else {
@@ -382,7 +382,7 @@ fn a_loop_the_implementation_cuts_short_is_refused() {
         let err = format!("{err:#}");
         assert!(err.contains("stopped early"), "{err}");
     } else {
-        opts.grid.triangles_per_dispatch = None;
+        opts.triangles_per_dispatch = None;
         let split = render_gpu(&ctx, &scene, opts);
         assert_eq!(one.expect("one dispatch").color, split.color);
     }

@@ -290,9 +290,14 @@ fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
     other.int64 = false;
     other.renderer = "another GL implementation".into();
     let shaders = gpgpu_rt::gl::ShaderSource::default();
-    let mut tracer =
-        gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &other, &scene, &shaders, opts.clone())
-            .expect("a tracer");
+    let mut tracer = gpgpu_rt::pipeline::mueller2015::RayTracer::new(
+        ctx.gl.clone(),
+        &other,
+        &scene,
+        &shaders,
+        opts.clone(),
+    )
+    .expect("a tracer");
     let plain = tracer.render(&scene.camera).expect("frame");
     let this = render_gpu(&ctx, &scene, opts);
     assert_eq!(

@@ -433,7 +433,7 @@ fn options_of_the_other_pipeline_are_refused() {
     );
     assert_fails(
         &with(&["--shadows", "exact", "--grid", "8", "--refl-depth", "1"]),
-        &["--refl-depth, --grid do not apply", "from --shadows"],
+        &["--grid, --refl-depth do not apply", "from --shadows"],
     );
     let cow = scene("cow.toml");
     let mut a = vec!["render", cow.as_str(), "--light-samples", "3x3"];
@@ -447,7 +447,10 @@ fn options_of_the_other_pipeline_are_refused() {
     ] {
         let mut a = vec!["render", cow.as_str(), "--tracer", "grid", flag];
         a.extend_from_slice(&small);
-        assert_fails(&run(&a), &[flag, "applies to --tracer stream only"]);
+        assert_fails(
+            &run(&a),
+            &[flag, "applies to stream (--tracer stream) only"],
+        );
     }
     // the defaults of both pipelines' options are not "given": these render
     let o = with(&["--tile", "64", "--frames", "2", "--light-samples", "2x2"]);

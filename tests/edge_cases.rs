@@ -1,5 +1,4 @@
-//! The cases real scenes almost never exercise, for every tracer (`accel::REGISTRY` and Wagner
-//! 2018's megakernel), GPU and CPU alike, against expectations computed here in f64:
+//! The cases real scenes almost never exercise, for every point-light design of `design::REGISTRY`, GPU and CPU alike, against expectations computed here in f64:
 //! - ties: at exactly equal distance the lower triangle id wins (the same triangle twice,
 //!   and coplanar overlapping triangles whose hit distances are bit for bit equal);
 //! - shadow feelers end at the light: an occluder beyond a point light does not shadow, one
@@ -12,52 +11,33 @@ use std::path::Path;
 
 use common::*;
 use glam::{DVec3, Vec3};
-use gpgpu_rt::accel::{BvhVariant, GridOptions, REGISTRY};
+use gpgpu_rt::design::{Design, Pipeline, Row, REGISTRY};
 use gpgpu_rt::frame::Frame;
-use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::pipeline;
-use gpgpu_rt::pipeline::mueller2015::RenderOptions;
+use gpgpu_rt::gl::GlContext;
 use gpgpu_rt::reference::wagner2018::Ray;
 use gpgpu_rt::reference::wagner_bvh::WagnerBvh;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
-/// Every tracer: each registry entry (the grids at `grid_resolution`) and Wagner's megakernel,
-/// with a name for messages.
-fn every_tracer(grid_resolution: u32) -> Vec<(String, RenderOptions)> {
-    let mut v: Vec<(String, RenderOptions)> = REGISTRY
-        .iter()
-        .map(|e| {
-            let grid = GridOptions {
-                variant: e.grid_variant.unwrap_or_default(),
-                resolution: Some(grid_resolution),
-                ..GridOptions::default()
-            };
-            (
-                e.label.to_string(),
-                RenderOptions {
-                    tracer: e.tracer,
-                    grid,
-                    ..options(64, 64, 0)
-                },
-            )
-        })
-        .collect();
-    v.push((
-        "bvh-wagner".into(),
-        RenderOptions {
-            tracer: gpgpu_rt::accel::TracerKind::Bvh,
-            bvh_variant: BvhVariant::Wagner,
-            ..options(64, 64, 0)
-        },
-    ));
-    v
+/// Every point-light design of the registry, the grids at `grid_resolution` cells per axis,
+/// its AOVs kept.
+fn every_tracer(grid_resolution: u32) -> Vec<(&'static Row, Design)> {
+    let rows = REGISTRY.iter().filter(|r| r.pipeline != Pipeline::Klee2016);
+    rows.map(|row| {
+        let mut d = Design::plain(row, 64, 64, 0);
+        d.keep_aovs();
+        match &mut d {
+            Design::Mueller2015(o) => o.grid.resolution = Some(grid_resolution),
+            Design::Stream(o) => o.dims = Some([grid_resolution; 3]),
+            _ => {}
+        }
+        (row, d)
+    })
+    .collect()
 }
 
-fn render(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {
-    let shaders = ShaderSource::default();
-    let mut r = pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, &shaders, opts).unwrap();
-    r.render(&scene.camera).unwrap()
+fn render(ctx: &GlContext, scene: &Scene, design: &Design) -> Frame {
+    renderer(ctx, scene, design).render(&scene.camera).unwrap()
 }
 
 /// (t, u, v) of the line o + t·d through the triangle's plane, in f64 (None: parallel).
@@ -163,17 +143,19 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
     let (scene, ties) = tie_scene(dir.path());
     let ctx = context();
     let wagner_cpu = WagnerBvh::build(scene.world_triangles()).unwrap();
-    for (name, opts) in every_tracer(4) {
-        let gpu = render(&ctx, &scene, opts.clone());
+    for (row, design) in every_tracer(4) {
+        let name = row.name;
+        let gpu = render(&ctx, &scene, &design);
         let a = gpu.aovs.as_ref().unwrap();
-        // the CPU side: the registry entry's twin, or Wagner's BVH on the CPU
-        let cpu_ids: Vec<i32> = match REGISTRY.iter().find(|e| e.label == name) {
-            Some(e) => {
-                let twin = (e.cpu)(&scene, &opts.grid).unwrap();
+        // the CPU side: the accelerator's twin, Wagner's BVH on the CPU; the stream's twin is
+        // held against its GPU side in tests/stream.rs, here only the GPU's ids are checked
+        let cpu_ids: Vec<i32> = match (&design, row.accel) {
+            (Design::Mueller2015(o), Some(e)) => {
+                let twin = (e.cpu)(&scene, &o.grid).unwrap();
                 let cpu = Reference::with_accelerator(&scene, twin).render(
                     &scene.camera,
-                    opts.width,
-                    opts.height,
+                    o.width,
+                    o.height,
                     0,
                 );
                 // same ids, same colours, pixel by pixel
@@ -182,7 +164,8 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
                 assert_eq!(c.color_outliers, 0.0, "{name}: GPU vs CPU twin: {c:?}");
                 cpu.aovs.triangle_id
             }
-            None => (0..a.triangle_id.len())
+            (Design::Stream(_), _) => a.triangle_id.clone(),
+            _ => (0..a.triangle_id.len())
                 .map(|i| {
                     let ray = Ray {
                         origin: Vec3::from(a.ray_origin[i]),
@@ -310,8 +293,9 @@ fn shadow_feelers_run_from_the_offset_to_the_light_on_every_tracer() {
     let light = scene.lights[0].position;
     let offset = scene.settings.shadow_offset as f64;
     let ctx = context();
-    for (name, opts) in every_tracer(8) {
-        let gpu = render(&ctx, &scene, opts);
+    for (row, design) in every_tracer(8) {
+        let name = row.name;
+        let gpu = render(&ctx, &scene, &design);
         let a = gpu.aovs.as_ref().unwrap();
         let shadow = a.shadow.as_ref().unwrap();
         // pixels on the floor whose feeler meets: only the roof beyond the light, the occluder

@@ -7,7 +7,8 @@
 
 mod common;
 
-use gpgpu_rt::accel::{GridOptions, GridVariant, REGISTRY};
+use gpgpu_rt::accel::{GridOptions, GridVariant};
+use gpgpu_rt::design::accelerators;
 use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
@@ -27,7 +28,7 @@ fn every_kernel_compiles_without_warnings() {
 
     // the ray tracer with every accelerator of the registry, both shadow-flag layouts
     let scene = common::load("teapot1.toml");
-    for entry in REGISTRY {
+    for entry in accelerators() {
         for shadow_flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
             let opts = RenderOptions {
                 tracer: entry.tracer,

@@ -61,41 +61,29 @@ fn within(what: &str, peak: u64, estimate: u64, slack: f64) {
 #[test]
 fn each_design_allocates_within_its_estimate() {
     let _s = serial();
-    use gpgpu_rt::accel::{BvhVariant, TracerKind};
+    use gpgpu_rt::design::{Design, Pipeline, REGISTRY};
     use gpgpu_rt::reference::stream_grid::{CELL_BYTES, REFERENCE_BYTES};
     use gpgpu_rt::scene::{Overrides, Scene};
     let ctx = common::context();
     let o = Overrides { level: Some(7) };
     let scene = Scene::load_with(&common::scene_path("square.toml"), &o).unwrap();
     let t = scene.triangle_count() as u64;
-    for (name, tracer, variant) in [
-        ("base", TracerKind::Base, BvhVariant::Sah),
-        ("grid", TracerKind::Grid, BvhVariant::Sah),
-        ("bvh", TracerKind::Bvh, BvhVariant::Sah),
-        ("wagner", TracerKind::Bvh, BvhVariant::Wagner),
-        ("stream", TracerKind::Stream, BvhVariant::Sah),
-    ] {
-        let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
-            tracer,
-            bvh_variant: variant,
-            ..common::options(8, 8, 0)
-        };
-        let shaders = Default::default();
-        let per_triangle = gpgpu_rt::pipeline::host_bytes_per_triangle(&opts);
+    // every point-light design (Klee 2016's N-tree is checked as it is built: below)
+    for row in REGISTRY.iter().filter(|r| r.pipeline != Pipeline::Klee2016) {
+        let design = Design::plain(row, 8, 8, 0);
         let (stats, peak) = peak_of(|| {
-            let gl = ctx.gl.clone();
-            let mut r =
-                gpgpu_rt::pipeline::ray_tracer(gl, &ctx.info, &scene, &shaders, opts).unwrap();
+            let mut r = common::renderer(&ctx, &scene, &design);
             r.render(&scene.camera).unwrap().stats
         });
-        let mut estimate = t * per_triangle;
-        if tracer == TracerKind::Stream {
+        let mut estimate = t * row.host_bytes_per_triangle;
+        if row.pipeline == Pipeline::Stream {
             let fact = |k: &str| stats.facts[k].clone();
             let dims: [u64; 3] = serde_json::from_value(fact("grid_dims")).unwrap();
             let cells: u64 = dims.iter().product();
             let refs = fact("grid_references").as_u64().unwrap();
             estimate += cells * CELL_BYTES + refs * REFERENCE_BYTES;
         }
+        let name = row.name;
         within(name, peak, estimate, 3.0);
     }
 }
@@ -181,6 +169,7 @@ fn random_builds_allocate_within_their_estimates() {
 #[test]
 fn a_frame_and_its_aovs_allocate_within_their_estimate() {
     use gpgpu_rt::accel::TracerKind;
+    use gpgpu_rt::pipeline::Renderer;
     let _s = serial();
     let ctx = common::context();
     let scene = common::load("teapot1.toml");
@@ -189,9 +178,7 @@ fn a_frame_and_its_aovs_allocate_within_their_estimate() {
         tracer: TracerKind::Bvh,
         ..common::options(w, h, 1)
     };
-    let shaders = Default::default();
-    let mut r =
-        gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts).unwrap();
+    let mut r = common::ray_tracer(&ctx, &scene, opts);
     r.render(&scene.camera).unwrap(); // the first frame builds the BVH
     let dir = tempfile::tempdir().unwrap();
     let ((), peak) = peak_of(|| {

@@ -27,7 +27,7 @@ fn accelerators() -> Vec<(&'static str, RenderOptions)> {
     };
     // the base tracer with its triangles split over 4 dispatches: a ray is counted once
     let mut split = with(TracerKind::Base, GridVariant::Exact, false);
-    split.grid.triangles_per_dispatch = Some(2000);
+    split.triangles_per_dispatch = Some(2000);
     vec![
         ("base", with(TracerKind::Base, GridVariant::Exact, false)),
         ("base split", split),
@@ -69,7 +69,7 @@ fn every_kind_of_ray_is_counted_and_timed_apart() {
         base.rays
     );
     for (label, opts) in accelerators() {
-        let entry = accel::entry(opts.tracer, &opts.grid).expect("an accelerator");
+        let entry = accel::entry(opts.tracer, &opts.grid);
         let twin = (entry.cpu)(&scene, &opts.grid).expect("its CPU twin");
         let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, SIZE, SIZE, 1);
         let f = render_gpu(&ctx, &scene, opts);
@@ -142,16 +142,15 @@ fn one_light_and_no_reflection_leave_their_kinds_out() {
     assert_eq!(count(&f, "primary", "rays"), (SIZE * SIZE) as u64);
 }
 
-/// A frame of the pipeline `opts` choose (Müller's, Wagner's megakernel or the stream).
+/// A frame of `design` (Wagner's megakernel or the stream).
 fn pipeline_frame(
     ctx: &gpgpu_rt::gl::GlContext,
     scene: &gpgpu_rt::scene::Scene,
-    opts: RenderOptions,
+    design: gpgpu_rt::design::Design,
 ) -> Frame {
-    let shaders = gpgpu_rt::gl::ShaderSource::default();
-    let mut r = gpgpu_rt::pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, &shaders, opts)
-        .expect("a pipeline");
-    r.render(&scene.camera).expect("frame")
+    common::renderer(ctx, scene, &design)
+        .render(&scene.camera)
+        .expect("frame")
 }
 
 /// The rays of `f`'s frame: `rays` among its events.
@@ -170,8 +169,7 @@ fn the_own_pipelines_count_the_rays_they_trace() {
     let mueller = render_gpu(&ctx, &scene, opts.clone());
     let reflection = count(&mueller, "reflection", "rays");
     assert!(reflection > 0, "the teapot reflects");
-    opts.tracer = TracerKind::Stream;
-    let stream = pipeline_frame(&ctx, &scene, opts.clone());
+    let stream = pipeline_frame(&ctx, &scene, common::stream(&opts));
     assert_eq!(rays(&stream), rays(&mueller), "stream rays");
     // and counts them per kind, as Müller's pipeline does
     for kind in RAY_KINDS {
@@ -193,11 +191,8 @@ fn the_own_pipelines_count_the_rays_they_trace() {
     );
     assert!(stream.stats.ray_kinds.values().all(|k| k.gpu_ms > 0.0));
     // Wagner's kernel: the eye rays and the first light's feelers, no reflection
-    opts.tracer = TracerKind::Bvh;
-    opts.bvh_variant = gpgpu_rt::accel::BvhVariant::Wagner;
     opts.refl_depth = 0;
-    let wagner = pipeline_frame(&ctx, &scene, opts.clone());
-    opts.bvh_variant = Default::default();
+    let wagner = pipeline_frame(&ctx, &scene, common::wagner(&opts));
     let eye_and_feelers = render_gpu(&ctx, &scene, opts);
     assert_eq!(rays(&wagner), rays(&eye_and_feelers), "Wagner's rays");
     assert_eq!(

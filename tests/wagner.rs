@@ -11,11 +11,10 @@ use std::process::Command;
 
 use common::*;
 use glam::{Mat4, Vec3};
-use gpgpu_rt::accel::{BvhVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
-use gpgpu_rt::pipeline::{self, Renderer};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::wagner2018::{brute_force_closest, shade, Ray, Trace, WagnerCamera};
 use gpgpu_rt::reference::wagner_bvh::{Aabb, NodeKind, WagnerBvh, LEAF_BELOW, MAX_DEPTH};
 use gpgpu_rt::scene::Scene;
@@ -426,16 +425,12 @@ fn a_moved_object_is_rebuilt() {
 // the library's and the command line's way to it
 
 #[test]
-fn ray_tracer_picks_wagners_pipeline() {
+fn the_design_registry_makes_wagners_pipeline() {
     let ctx = context();
     let scene = load("cow.toml");
-    let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
-        tracer: TracerKind::Bvh,
-        bvh_variant: BvhVariant::Wagner,
-        ..options(32, 32, 1)
-    };
-    let shaders = ShaderSource::default();
-    let mut r = pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts).unwrap();
+    let row = gpgpu_rt::design::row("bvh-wagner").unwrap();
+    let design = gpgpu_rt::design::Design::plain(row, 32, 32, 0);
+    let mut r = renderer(&ctx, &scene, &design);
     assert_eq!(r.settings()["pipeline"], "wagner2018");
     let f = r.render(&scene.camera).unwrap();
     assert_eq!(f.stats.gpu_ms.keys().collect::<Vec<_>>(), ["raytrace"]);
@@ -480,7 +475,7 @@ fn the_command_line_reports_wagners_bvh_and_refuses_what_does_not_apply() {
         (with(&["--tile", "24"]), "multiple of 16"),
         (
             vec!["--tracer", "base", "--bvh-variant", "wagner"],
-            "--tracer bvh only",
+            "--bvh-variant does not apply",
         ),
     ] {
         let o = render_cow(dir.path(), &args);

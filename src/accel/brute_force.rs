@@ -67,8 +67,8 @@ pub struct BruteForce {
 }
 
 impl BruteForce {
-    fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        let per = o
+    fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+        let per = b
             .triangles_per_dispatch
             .unwrap_or_else(|| triangles_per_dispatch(b.info));
         Ok(Box::new(BruteForce {

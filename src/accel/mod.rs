@@ -14,7 +14,7 @@
 //! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
 //! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). The base tracer's
 //! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
-//! `glsl/common/intersect1_hit.glsl`. [`REGISTRY`] lists every accelerator once.
+//! `glsl/common/intersect1_hit.glsl`. Each is one row of `design::REGISTRY`.
 
 pub mod brute_force;
 pub mod bvh;
@@ -25,7 +25,7 @@ pub mod thesis_grid;
 use std::any::Any;
 use std::sync::Arc;
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use glam::Mat4;
 use serde::Serialize;
 
@@ -88,6 +88,10 @@ pub struct BuildContext<'a> {
     pub defines: &'a Defines,
     pub width: u32,
     pub height: u32,
+    /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
+    /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
+    /// split only where the GL implementation ends long loops.
+    pub triangles_per_dispatch: Option<u32>,
 }
 
 impl BuildContext<'_> {
@@ -107,7 +111,8 @@ impl BuildContext<'_> {
     }
 }
 
-/// The `--tracer` choices of the four-kernel pipeline.
+/// The accelerators of Müller 2015's four-kernel pipeline (`--tracer`; seed 004's `--tracer
+/// stream` is a pipeline of its own, `design::Design::Stream`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TracerKind {
@@ -116,12 +121,8 @@ pub enum TracerKind {
     /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
     Grid,
     /// A BVH built on the CPU with the SAH, rebuilt when an object moved (ours, after Wagner
-    /// 2018 ch. 3.2, 4.2); the grid options are ignored.
+    /// 2018 ch. 3.2, 4.2).
     Bvh,
-    /// The streaming ray tracer of seed 004: fragment-program kernels over a viewport-sized
-    /// quad, a static grid built once on the CPU, an occlusion query as the halting condition
-    /// (`pipeline::stream`; its own pipeline).
-    Stream,
 }
 
 impl TracerKind {
@@ -131,7 +132,6 @@ impl TracerKind {
             TracerKind::Base => "base",
             TracerKind::Grid => "grid",
             TracerKind::Bvh => "bvh",
-            TracerKind::Stream => "stream",
         }
     }
 }
@@ -175,7 +175,7 @@ impl BvhVariant {
     }
 }
 
-/// Options of the accelerators (today: the grids').
+/// Options of the grid accelerators.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GridOptions {
     pub variant: GridVariant,
@@ -185,31 +185,9 @@ pub struct GridOptions {
     /// Listing 17: 512) and ray_array_length (voxel ids per ray; `None`: 3·N as Listing 17).
     pub voxel_array_length: u32,
     pub ray_array_length: Option<u32>,
-    /// The streaming tracer's grid, gx×gy×gz cells (`--grid 14x16x14`); `None`: `resolution`
-    /// on every axis, or the paper's ∛n with neither.
-    pub axes: Option<[u32; 3]>,
-    /// The streaming tracer: skip empty cells by their proximity-cloud distances
+    /// The exact grid: skip empty cells by their proximity-cloud distances
     /// (`--proximity-clouds`).
     pub proximity_clouds: bool,
-    /// The streaming tracer: steps (triangle tests or cell moves) per traverse call.
-    pub stream_steps: u32,
-    /// The streaming tracer: the most traverse calls per traversal (rays still walking then
-    /// are counted in `truncated_rays` and the frame refused).
-    pub stream_max_calls: u32,
-    /// The streaming tracer: shadow rays as the naive closest-hit search the paper's shadow
-    /// optimisation improves on (`--stream-naive-shadows`).
-    pub stream_naive_shadows: bool,
-    /// The streaming tracer without its masking kernel's optimisation (`--stream-no-mask`):
-    /// rays that need no work are found by the traverse kernel's first call instead, and the
-    /// shadow rays of surfaces facing away from the light are traced.
-    pub stream_no_mask: bool,
-    /// The streaming tracer with the paper's single-sided Möller–Trumbore test
-    /// (`--stream-single-sided`): back faces are no hits.
-    pub stream_single_sided: bool,
-    /// The base tracer: the most triangles one dispatch of its intersect1/intersect2 tests
-    /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
-    /// split only where the GL implementation ends long loops.
-    pub triangles_per_dispatch: Option<u32>,
 }
 
 impl Default for GridOptions {
@@ -219,14 +197,7 @@ impl Default for GridOptions {
             resolution: None,
             voxel_array_length: 512,
             ray_array_length: None,
-            axes: None,
             proximity_clouds: false,
-            stream_steps: 64,
-            stream_max_calls: 10_000,
-            stream_naive_shadows: false,
-            stream_no_mask: false,
-            stream_single_sided: false,
-            triangles_per_dispatch: None,
         }
     }
 }
@@ -243,31 +214,27 @@ pub type MakeGpu = fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Acc
 /// Makes the CPU twin of an accelerator.
 pub type MakeCpu = fn(&Scene, &GridOptions) -> Result<Box<dyn CpuAccelerator>>;
 
-/// One accelerator: how the command line names it, and how its GPU side and CPU twin are made.
+/// One accelerator of Müller 2015's pipeline: how the command line names it, and how its GPU
+/// side and CPU twin are made (its row in `design::REGISTRY` says what else belongs to it).
 pub struct Entry {
     /// The `--tracer` value.
     pub tracer: TracerKind,
     /// The `--grid-variant` it answers to (`None`: any; the option is then ignored).
     pub grid_variant: Option<GridVariant>,
-    /// A name for reports: "base", "grid-thesis", "grid-exact", "bvh".
+    /// Its row's name in `design::REGISTRY`: "base", "grid-thesis", "grid-exact", "bvh".
     pub label: &'static str,
     pub gpu: MakeGpu,
     /// The CPU twin over the scene as loaded.
     pub cpu: MakeCpu,
 }
 
-/// Every accelerator of the four-kernel pipeline.
-pub const REGISTRY: &[Entry] = &[
-    brute_force::ENTRY,
-    thesis_grid::ENTRY,
-    exact_grid::ENTRY,
-    bvh::ENTRY,
-];
-
-/// The accelerator `--tracer tracer` with `options` selects.
-pub fn entry(tracer: TracerKind, options: &GridOptions) -> Result<&'static Entry> {
-    REGISTRY
-        .iter()
-        .find(|e| e.tracer == tracer && e.grid_variant.is_none_or(|v| v == options.variant))
-        .ok_or_else(|| anyhow!("no accelerator for --tracer {tracer:?} with {options:?}"))
+/// The accelerator `--tracer tracer` with `options` selects; `design::REGISTRY` lists each in
+/// its row.
+pub fn entry(tracer: TracerKind, options: &GridOptions) -> &'static Entry {
+    match (tracer, options.variant) {
+        (TracerKind::Base, _) => &brute_force::ENTRY,
+        (TracerKind::Grid, GridVariant::Thesis) => &thesis_grid::ENTRY,
+        (TracerKind::Grid, GridVariant::Exact) => &exact_grid::ENTRY,
+        (TracerKind::Bvh, _) => &bvh::ENTRY,
+    }
 }

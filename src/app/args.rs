@@ -1,12 +1,21 @@
 //! Command-line options shared by `render`, `view` and `bench`: the GL device, the kernels'
-//! folder, the grid's options and the soft-shadow options.
+//! folder, and the design with its options ([`DesignArgs`]), parsed into one
+//! [`gpgpu_rt::design::Design`] — with the options that do not belong to it refused.
 
 use std::path::PathBuf;
 
-use gpgpu_rt::accel::{GridOptions, GridVariant};
+use anyhow::Result;
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Parser as _, ValueEnum};
+
+use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant};
+use gpgpu_rt::design::{self, Design, Pipeline, Row};
 use gpgpu_rt::limits;
 use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions};
-use gpgpu_rt::scene::{parse_samples, RenderSettings, ShadowMode};
+use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::stream::StreamOptions;
+use gpgpu_rt::pipeline::wagner2018::WagnerOptions;
+use gpgpu_rt::scene::{parse_samples, RenderSettings, Scene, ShadowMode};
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct GpuArgs {
@@ -108,6 +117,7 @@ pub struct GridArgs {
 }
 
 impl GridArgs {
+    /// The grid accelerators' options.
     pub fn options(&self) -> GridOptions {
         GridOptions {
             variant: self.grid_variant,
@@ -115,19 +125,28 @@ impl GridArgs {
                 GridResolution::N(n) => Some(n),
                 _ => None,
             },
-            axes: match self.grid {
-                GridResolution::Axes(a) => Some(a),
-                _ => None,
-            },
             voxel_array_length: self.voxel_array_length,
             ray_array_length: self.ray_array_length,
             proximity_clouds: self.proximity_clouds,
-            stream_steps: self.stream_steps,
-            stream_max_calls: self.stream_max_calls,
-            stream_naive_shadows: self.stream_naive_shadows,
-            stream_no_mask: self.stream_no_mask,
-            stream_single_sided: self.stream_single_sided,
-            triangles_per_dispatch: None,
+        }
+    }
+
+    /// Seed 004's streaming tracer with these options for a `width`×`height` image.
+    pub fn stream(&self, width: u32, height: u32, refl_depth: u32, aovs: bool) -> StreamOptions {
+        StreamOptions {
+            dims: match self.grid {
+                GridResolution::Auto => None,
+                GridResolution::N(n) => Some([n; 3]),
+                GridResolution::Axes(a) => Some(a),
+            },
+            proximity_clouds: self.proximity_clouds,
+            steps_per_call: self.stream_steps,
+            max_calls: self.stream_max_calls,
+            naive_shadows: self.stream_naive_shadows,
+            no_mask: self.stream_no_mask,
+            single_sided: self.stream_single_sided,
+            aovs,
+            ..StreamOptions::new(width, height, refl_depth)
         }
     }
 }
@@ -198,4 +217,174 @@ impl SoftShadowArgs {
             tile,
         }
     }
+}
+
+/// `--tracer`: an accelerator of Müller 2015's pipeline, or seed 004's streaming tracer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TracerArg {
+    /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
+    Base,
+    /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
+    Grid,
+    /// A BVH: ours (SAH, in Müller 2015's pipeline) or Wagner 2018's; see `--bvh-variant`.
+    Bvh,
+    /// The streaming ray tracer of seed 004: fragment-program kernels over a viewport-sized
+    /// quad, a static grid built once on the CPU, an occlusion query as the halting condition.
+    Stream,
+}
+
+/// The command-line name of a value (`base`, `linespace-dda`).
+pub fn value_name<T: ValueEnum>(v: T) -> String {
+    v.to_possible_value()
+        .map(|v| v.get_name().to_string())
+        .expect("no value is skipped")
+}
+
+/// The design and its options, as `render` and `view` take them.
+#[derive(clap::Args, Debug, Clone)]
+pub struct DesignArgs {
+    /// The accelerator of Müller 2015's pipeline: `bvh` (ours: an SAH BVH, the fastest; or
+    /// Wagner 2018's with --bvh-variant wagner), `base` (the thesis' base tracer, every ray
+    /// against every triangle) or `grid` (the thesis' uniform grid, see --grid-variant); or
+    /// `stream`, seed 004's streaming tracer (fragment-program kernels, a static grid,
+    /// occlusion-query halting).
+    #[arg(long, value_enum, default_value = "bvh")]
+    pub tracer: TracerArg,
+    /// With --tracer bvh: `sah` (ours, in the four-kernel pipeline) or `wagner` (Wagner 2018
+    /// faithful: his BVH build, three textures, one kernel per pixel, one light, Lambert, hard
+    /// shadows, no reflection).
+    #[arg(long, value_enum, default_value = "sah")]
+    pub bvh_variant: BvhVariant,
+    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
+    /// scene's).
+    #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
+    pub refl_depth: Option<u32>,
+    /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
+    #[arg(long, value_enum, default_value = "bits")]
+    pub shadow_flags: ShadowFlags,
+    /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling),
+    /// so that no dispatch runs long enough for a driver watchdog.
+    #[arg(long, default_value_t = 256, value_name = "N")]
+    pub tile: u32,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    #[command(flatten)]
+    pub soft: SoftShadowArgs,
+}
+
+/// A command line of design options alone, for [`DesignArgs::of_row`].
+#[derive(clap::Parser)]
+struct DesignLine {
+    #[command(flatten)]
+    design: DesignArgs,
+}
+
+impl DesignArgs {
+    /// The options that select `row`, `extra` options, and the command line's defaults for
+    /// the rest: what `render` would parse from `--tracer grid --grid-variant exact …`.
+    pub fn of_row(row: &Row, extra: &[&str]) -> Result<DesignArgs> {
+        let words = row
+            .select
+            .iter()
+            .flat_map(|(o, v)| [format!("--{o}"), v.to_string()])
+            .chain(extra.iter().map(|w| w.to_string()));
+        let line = DesignLine::try_parse_from(std::iter::once("design".to_string()).chain(words))?;
+        Ok(line.design)
+    }
+
+    /// The value of a selecting option of [`Row::select`] (long name), given or default.
+    fn value(&self, option: &str) -> String {
+        match option {
+            "tracer" => value_name(self.tracer),
+            "bvh-variant" => value_name(self.bvh_variant),
+            "grid-variant" => value_name(self.grid.grid_variant),
+            _ => String::new(),
+        }
+    }
+
+    /// The point-light design these options select (Klee 2016's is chosen by `--shadows`).
+    pub fn tracer_row(&self) -> &'static Row {
+        design::select(false, |o| self.value(o)).expect("every --tracer has a design")
+    }
+
+    /// The design for `scene`: Klee 2016's soft shadows with `--shadows` (or the scene's
+    /// render.shadows), else the point-light design `--tracer` selects; `size` and `aovs`
+    /// as the command asks. `matches` (the command's): the options given explicitly, refused
+    /// where they do not belong to the design.
+    pub fn design(
+        &self,
+        scene: &Scene,
+        size: (u32, u32),
+        aovs: bool,
+        matches: Option<&ArgMatches>,
+    ) -> Result<Design> {
+        let soft = self.soft.clone().with_scene_defaults(&scene.settings);
+        let row = match soft.shadows {
+            Some(_) => design::row("linespace")?,
+            None => self.tracer_row(),
+        };
+        let chosen = match (soft.shadows, self.soft.shadows) {
+            (Some(_), None) => format!("from render.shadows in {}", scene.path.display()),
+            (Some(_), Some(_)) => "from --shadows".to_string(),
+            (None, _) => format!("from {}", row.command_line()),
+        };
+        design::refuse_foreign(row, &given(matches), &chosen)?;
+        if let Some(mode) = soft.shadows {
+            return Ok(Design::Klee2016(
+                soft.options(mode, size.0, size.1, self.tile),
+            ));
+        }
+        let refl_depth = self.refl_depth.unwrap_or(scene.settings.refl_depth);
+        Ok(self.tracer_design(row, size, refl_depth, aovs))
+    }
+
+    /// The point-light design `row` with these options.
+    pub fn tracer_design(
+        &self,
+        row: &Row,
+        (width, height): (u32, u32),
+        refl_depth: u32,
+        aovs: bool,
+    ) -> Design {
+        match row.pipeline {
+            Pipeline::Wagner2018 => Design::Wagner2018(WagnerOptions {
+                width,
+                height,
+                tile: self.tile,
+                aovs,
+            }),
+            Pipeline::Stream => Design::Stream(self.grid.stream(width, height, refl_depth, aovs)),
+            _ => Design::Mueller2015(RenderOptions {
+                tracer: row
+                    .accel
+                    .expect("Müller 2015's rows name their accelerator")
+                    .tracer,
+                width,
+                height,
+                refl_depth,
+                tile: self.tile,
+                shadow_flags: self.shadow_flags,
+                aovs,
+                grid: self.grid.options(),
+                triangles_per_dispatch: None,
+            }),
+        }
+    }
+}
+
+/// The design options the command line gave explicitly (long names): those of every row of
+/// the registry, looked up in `matches`.
+fn given(matches: Option<&ArgMatches>) -> Vec<String> {
+    let Some(m) = matches else { return Vec::new() };
+    let mut all: Vec<&str> = design::REGISTRY
+        .iter()
+        .flat_map(|r| r.options)
+        .copied()
+        .collect();
+    all.sort_unstable();
+    all.dedup();
+    all.into_iter()
+        .filter(|o| m.value_source(&o.replace('-', "_")) == Some(ValueSource::CommandLine))
+        .map(str::to_string)
+        .collect()
 }

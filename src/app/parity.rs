@@ -12,16 +12,15 @@ use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
-use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant, TracerKind};
+use gpgpu_rt::design::{self, Pipeline, Row};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output::write_npy;
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::{self, Renderer};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{Scene, ShadowMode};
 
-use crate::args::GpuArgs;
+use crate::args::{DesignArgs, GpuArgs};
 
 #[derive(clap::Args, Debug)]
 pub struct ParityArgs {
@@ -54,57 +53,59 @@ pub struct ParityArgs {
     pub gpu: GpuArgs,
 }
 
-/// The designs and accelerators, as `render` names them.
-#[derive(Debug, Clone, Copy)]
-enum Design {
-    Ray {
-        tracer: TracerKind,
-        grid: Option<GridVariant>,
-        clouds: bool,
-        bvh: BvhVariant,
-    },
-    Soft(ShadowMode),
+/// One case's design: a row of the registry, with proximity clouds where the row takes them,
+/// or Klee 2016's soft shadows in one mode.
+#[derive(Clone, Copy)]
+struct Case {
+    row: &'static Row,
+    clouds: bool,
+    mode: Option<ShadowMode>,
 }
 
-const fn ray(tracer: TracerKind, grid: Option<GridVariant>, clouds: bool) -> Design {
-    Design::Ray {
-        tracer,
-        grid,
-        clouds,
-        bvh: BvhVariant::Sah,
+impl Case {
+    /// "grid-exact", "grid-exact-pc", "soft-linespace".
+    fn name(&self) -> String {
+        match self.mode {
+            Some(mode) => format!("soft-{}", mode.name()),
+            None if self.clouds => format!("{}-pc", self.row.name),
+            None => self.row.name.to_string(),
+        }
     }
 }
 
-const DESIGNS: [(&str, Design); 11] = [
-    ("base", ray(TracerKind::Base, None, false)),
-    (
-        "grid-thesis",
-        ray(TracerKind::Grid, Some(GridVariant::Thesis), false),
-    ),
-    (
-        "grid-exact",
-        ray(TracerKind::Grid, Some(GridVariant::Exact), false),
-    ),
-    (
-        "grid-exact-pc",
-        ray(TracerKind::Grid, Some(GridVariant::Exact), true),
-    ),
-    ("bvh-sah", ray(TracerKind::Bvh, None, false)),
-    (
-        "bvh-wagner",
-        Design::Ray {
-            tracer: TracerKind::Bvh,
-            grid: None,
-            clouds: false,
-            bvh: BvhVariant::Wagner,
-        },
-    ),
-    ("stream", ray(TracerKind::Stream, None, false)),
-    ("stream-pc", ray(TracerKind::Stream, None, true)),
-    ("soft-exact", Design::Soft(ShadowMode::Exact)),
-    ("soft-linespace", Design::Soft(ShadowMode::Linespace)),
-    ("soft-linespace-dda", Design::Soft(ShadowMode::LinespaceDda)),
+/// The soft-shadow modes of the parity set (the thesis' two variants are `exact` and
+/// `linespace` under other names).
+const SOFT_MODES: [ShadowMode; 3] = [
+    ShadowMode::Exact,
+    ShadowMode::Linespace,
+    ShadowMode::LinespaceDda,
 ];
+
+/// Every design of the registry: each point-light row, with and without proximity clouds
+/// where it takes them, and the soft shadows in each of [`SOFT_MODES`].
+fn designs() -> Vec<Case> {
+    let mut v = Vec::new();
+    for row in design::REGISTRY {
+        if row.pipeline == Pipeline::Klee2016 {
+            v.extend(SOFT_MODES.map(|m| Case {
+                row,
+                clouds: false,
+                mode: Some(m),
+            }));
+            continue;
+        }
+        for clouds in [false, true] {
+            if !clouds || row.takes("proximity-clouds") {
+                v.push(Case {
+                    row,
+                    clouds,
+                    mode: None,
+                });
+            }
+        }
+    }
+    v
+}
 
 /// A scene of the parity set: its file below `scenes/`, and the object that turns about the
 /// vertical axis by 15° a frame over three frames (the grids rebuild, the BVH refits).
@@ -159,40 +160,22 @@ struct CaseRecord {
     skipped: String,
 }
 
-/// The point-light ray tracer of `design` (a `Design::Ray`).
+/// The point-light ray tracer of `case`, the first hits kept, without tiles.
 fn ray_tracer(
     ctx: &GlContext,
     scene: &Scene,
     shaders: &ShaderSource,
-    design: Design,
+    case: Case,
     size: u32,
 ) -> Result<Box<dyn Renderer>> {
-    match design {
-        Design::Ray {
-            tracer,
-            grid,
-            clouds,
-            bvh,
-        } => {
-            let options = RenderOptions {
-                tracer,
-                width: size,
-                height: size,
-                refl_depth: scene.settings.refl_depth,
-                tile: 0,
-                shadow_flags: ShadowFlags::Bits,
-                aovs: true,
-                grid: GridOptions {
-                    variant: grid.unwrap_or_default(),
-                    proximity_clouds: clouds,
-                    ..GridOptions::default()
-                },
-                bvh_variant: bvh,
-            };
-            pipeline::ray_tracer(ctx.gl.clone(), &ctx.info, scene, shaders, options)
-        }
-        Design::Soft(_) => unreachable!("the soft shadows are made by soft_renderer"),
-    }
+    let clouds: &[&str] = if case.clouds {
+        &["--proximity-clouds"]
+    } else {
+        &[]
+    };
+    let args = DesignArgs::of_row(case.row, &[&["--tile", "0"], clouds].concat())?;
+    let design = args.tracer_design(case.row, (size, size), scene.settings.refl_depth, true);
+    design.renderer(ctx.gl.clone(), &ctx.info, scene, shaders)
 }
 
 /// The soft-shadow renderer in `mode` (3×3 rays): the one of the case before, switched to the
@@ -244,7 +227,7 @@ fn render_case(r: &mut dyn Renderer, scene: &Scene, turning: Option<usize>) -> R
 
 /// The counts of a frame that a second driver must reproduce, and why none are where they
 /// depend on the order of execution.
-fn counts_of(design: Design, frame: &Frame) -> (BTreeMap<String, u64>, String) {
+fn counts_of(case: Case, frame: &Frame) -> (BTreeMap<String, u64>, String) {
     let s = &frame.stats;
     let mut counts: BTreeMap<String, u64> = s
         .triangle_tests
@@ -257,12 +240,10 @@ fn counts_of(design: Design, frame: &Frame) -> (BTreeMap<String, u64>, String) {
             counts.insert(key.to_string(), v);
         }
     }
-    let why = match design {
-        // the fixed-size lists keep whichever references their atomics placed first
-        Design::Ray {
-            grid: Some(GridVariant::Thesis),
-            ..
-        } if s.events.get("dropped_triangle_refs").copied().unwrap_or(0) > 0 => {
+    // the fixed-size lists keep whichever references their atomics placed first
+    let dropped = s.events.get("dropped_triangle_refs").copied().unwrap_or(0) > 0;
+    let why = match case.row.name {
+        "grid-thesis" if dropped => {
             "the thesis grid dropped references: which ones depends on the order of its atomics"
         }
         _ => "",
@@ -291,15 +272,15 @@ fn write_case(dir: &Path, frame: Option<&Frame>, record: &CaseRecord) -> Result<
 }
 
 /// Every case of the matrix: (folder name, design, scene).
-fn cases(only: Option<&str>) -> Vec<(String, Design, &'static SceneCase)> {
+fn cases(only: Option<&str>) -> Vec<(String, Case, &'static SceneCase)> {
     let mut out = Vec::new();
-    for (name, design) in DESIGNS {
-        let scenes: &'static [SceneCase] = match design {
-            Design::Soft(_) => &SOFT_SCENES,
-            Design::Ray { .. } => &RAY_SCENES,
+    for design in designs() {
+        let scenes: &'static [SceneCase] = match design.mode {
+            Some(_) => &SOFT_SCENES,
+            None => &RAY_SCENES,
         };
         for s in scenes {
-            let case = format!("{name}.{}", s.name);
+            let case = format!("{}.{}", design.name(), s.name);
             if only.is_none_or(|o| case.contains(o)) {
                 out.push((case, design, s));
             }
@@ -321,12 +302,10 @@ fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
         let scene = &scenes[s.file];
         let t0 = std::time::Instant::now();
         let mut ray;
-        let r: &mut dyn Renderer = match design {
-            Design::Soft(mode) => {
-                soft_renderer(&mut soft, ctx, (s.file, scene), &shaders, mode, args.size)
-                    .with_context(|| format!("parity case {case}"))?
-            }
-            Design::Ray { .. } => {
+        let r: &mut dyn Renderer = match design.mode {
+            Some(mode) => soft_renderer(&mut soft, ctx, (s.file, scene), &shaders, mode, args.size)
+                .with_context(|| format!("parity case {case}"))?,
+            None => {
                 ray = ray_tracer(ctx, scene, &shaders, design, args.size)
                     .with_context(|| format!("parity case {case}"))?;
                 ray.as_mut()

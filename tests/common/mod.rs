@@ -37,7 +37,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         shadow_flags: ShadowFlags::Bits,
         aovs: true,
         grid: Default::default(),
-        bvh_variant: Default::default(),
+        triangles_per_dispatch: None,
     }
 }
 
@@ -262,4 +262,35 @@ pub fn tri_obj(t: [Vec3; 3]) -> String {
         s += &format!("v {:?} {:?} {:?}\n", v.x, v.y, v.z);
     }
     s + "f 1 2 3\n"
+}
+
+/// Wagner 2018's design with the size, tiles and AOVs of `o` (its other options do not apply).
+pub fn wagner(o: &RenderOptions) -> gpgpu_rt::design::Design {
+    gpgpu_rt::design::Design::Wagner2018(gpgpu_rt::pipeline::wagner2018::WagnerOptions {
+        width: o.width,
+        height: o.height,
+        tile: o.tile,
+        aovs: o.aovs,
+    })
+}
+
+/// Seed 004's streaming tracer with the size, reflection depth and AOVs of `o`, the command
+/// line's defaults otherwise.
+pub fn stream(o: &RenderOptions) -> gpgpu_rt::design::Design {
+    use gpgpu_rt::pipeline::stream::StreamOptions;
+    gpgpu_rt::design::Design::Stream(StreamOptions {
+        aovs: o.aovs,
+        ..StreamOptions::new(o.width, o.height, o.refl_depth)
+    })
+}
+
+/// The renderer of `design` for `scene`, kernels built in.
+pub fn renderer(
+    ctx: &GlContext,
+    scene: &Scene,
+    design: &gpgpu_rt::design::Design,
+) -> Box<dyn gpgpu_rt::pipeline::Renderer> {
+    design
+        .renderer(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default())
+        .expect("a renderer")
 }

@@ -14,10 +14,13 @@ use glam::Mat4;
 use super::args::BenchArgs;
 use super::config::{BvhVariant, Config, Sizing, TracerSpec};
 use gpgpu_rt::accel::{GridOptions, TracerKind};
+use gpgpu_rt::design::Design;
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::{self, Renderer};
+use gpgpu_rt::pipeline::stream::StreamOptions;
+use gpgpu_rt::pipeline::wagner2018::WagnerOptions;
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::linespace::LinespaceShadows;
 use gpgpu_rt::scene::{Camera, Scene, ShadowMode};
 
@@ -55,51 +58,72 @@ pub fn grid_list_defaults() -> (u32, Option<u32>) {
 /// `--bvh-variants` says otherwise): ours in Müller's pipeline and Wagner's megakernel.
 pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
 
-/// The tracer kind and grid options of configuration `c`, with the command line's list
-/// lengths.
-fn tracer_kind(c: &Config, args: &BenchArgs) -> Result<(TracerKind, GridOptions)> {
+/// The design of configuration `c`, with the command line's `--tile` and list lengths; the
+/// first hits kept where the configuration is judged against the CPU reference.
+fn design(c: &Config, args: &BenchArgs) -> Design {
     let d = GridOptions::default();
+    let (width, height, aovs) = (c.width, c.height, c.judge);
+    let mueller = |tracer, grid| {
+        Design::Mueller2015(RenderOptions {
+            tracer,
+            width,
+            height,
+            refl_depth: c.refl_depth,
+            tile: args.tile,
+            shadow_flags: ShadowFlags::Rgba,
+            aovs,
+            grid,
+            triangles_per_dispatch: None,
+        })
+    };
     match c.tracer {
+        TracerSpec::Base => mueller(TracerKind::Base, d),
+        TracerSpec::Grid {
+            variant,
+            resolution,
+        } => mueller(
+            TracerKind::Grid,
+            GridOptions {
+                variant,
+                resolution: Some(resolution),
+                voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
+                ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
+                ..d
+            },
+        ),
+        TracerSpec::GridPc { resolution } => mueller(
+            TracerKind::Grid,
+            GridOptions {
+                resolution: Some(resolution),
+                proximity_clouds: true,
+                ..d
+            },
+        ),
+        TracerSpec::Bvh {
+            variant: BvhVariant::Sah,
+        } => mueller(TracerKind::Bvh, d),
+        TracerSpec::Bvh {
+            variant: BvhVariant::Wagner,
+        } => Design::Wagner2018(WagnerOptions {
+            width,
+            height,
+            tile: args.tile,
+            aovs,
+        }),
         TracerSpec::Stream {
             axes,
             proximity_clouds,
             naive_shadows,
             no_mask,
-        } => {
-            let grid = GridOptions {
-                axes: Some(axes),
-                proximity_clouds,
-                stream_naive_shadows: naive_shadows,
-                stream_no_mask: no_mask,
-                ..d
-            };
-            return Ok((TracerKind::Stream, grid));
-        }
-        TracerSpec::GridPc { resolution } => {
-            let grid = GridOptions {
-                resolution: Some(resolution),
-                proximity_clouds: true,
-                ..d
-            };
-            return Ok((TracerKind::Grid, grid));
-        }
-        _ => {}
+        } => Design::Stream(StreamOptions {
+            dims: Some(axes),
+            proximity_clouds,
+            naive_shadows,
+            no_mask,
+            aovs,
+            ..StreamOptions::new(width, height, c.refl_depth)
+        }),
     }
-    let Some((variant, resolution)) = c.tracer.grid() else {
-        let kind = match c.tracer {
-            TracerSpec::Bvh { .. } => TracerKind::Bvh,
-            _ => TracerKind::Base,
-        };
-        return Ok((kind, d));
-    };
-    let grid = GridOptions {
-        variant,
-        resolution: Some(resolution),
-        voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
-        ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
-        ..d
-    };
-    Ok((TracerKind::Grid, grid))
 }
 
 /// A ray tracer made for one scene (Müller 2015's pipeline with the base tracer, the grid or
@@ -110,21 +134,8 @@ impl RayTracer {
     /// The tracer of configuration `c` (with the command line's `--tile` and list lengths):
     /// compile the kernels and upload `scene`.
     pub fn new(gpu: &Gpu, scene: &Scene, c: &Config, args: &BenchArgs) -> Result<RayTracer> {
-        let (kind, grid) = tracer_kind(c, args)?;
-        let options = RenderOptions {
-            tracer: kind,
-            width: c.width,
-            height: c.height,
-            refl_depth: c.refl_depth,
-            tile: args.tile,
-            shadow_flags: ShadowFlags::Rgba,
-            // first hits kept where the configuration is judged against the CPU reference
-            aovs: c.judge,
-            grid,
-            bvh_variant: c.tracer.bvh_variant().unwrap_or_default(),
-        };
         let (gl, info) = (gpu.ctx.gl.clone(), &gpu.ctx.info);
-        let tracer = pipeline::ray_tracer(gl, info, scene, &gpu.shaders, options)?;
+        let tracer = design(c, args).renderer(gl, info, scene, &gpu.shaders)?;
         Ok(RayTracer(tracer))
     }
 

@@ -120,13 +120,6 @@ impl TracerSpec {
             _ => None,
         }
     }
-    /// The BVH's variant; `None` for the other tracers.
-    pub fn bvh_variant(&self) -> Option<BvhVariant> {
-        match *self {
-            TracerSpec::Bvh { variant } => Some(variant),
-            _ => None,
-        }
-    }
     /// The variant's name, of the grid or the BVH: "thesis", "sah"; `None` for the base tracer.
     pub fn variant_label(&self) -> Option<&'static str> {
         match *self {

@@ -7,7 +7,7 @@
 use anyhow::Result;
 
 use super::adapter::Frame;
-use gpgpu_rt::accel::{self, GridOptions, TracerKind};
+use gpgpu_rt::accel::{self, GridOptions};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
@@ -40,7 +40,7 @@ impl Judge {
             ("CPU brute force", Reference::new(&unlit))
         } else {
             let grid = GridOptions::default();
-            let twin = (accel::entry(TracerKind::Bvh, &grid)?.cpu)(&unlit, &grid)?;
+            let twin = (accel::bvh::ENTRY.cpu)(&unlit, &grid)?;
             ("CPU SAH BVH", Reference::with_accelerator(&unlit, twin))
         };
         let f = reference.render(&scene.camera, width, height, 0);

@@ -1,12 +1,9 @@
 //! What the window shows: a ray tracer with its options, or the soft shadows with theirs.
 
-use std::fmt::Debug;
-
-use clap::ValueEnum;
-
 use super::renderer::{
-    soft_shadow_support, BvhVariant, RenderOptions, ShadowMode, Show, Stats, TracerKind,
+    soft_shadow_support, BvhVariant, ShadowMode, Show, Stats, TracerArg, TracerOptions,
 };
+pub use crate::args::value_name;
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::scene::Scene;
 
@@ -14,8 +11,8 @@ use gpgpu_rt::scene::Scene;
 /// made from them.
 pub struct Design {
     /// The ray tracer and its options (kept while the soft shadows are shown).
-    pub kind: TracerKind,
-    pub options: RenderOptions,
+    pub kind: TracerArg,
+    pub options: TracerOptions,
     /// Soft shadows shown (`None`: the ray tracer `kind`).
     pub shadows: Option<ShadowMode>,
     /// Light samples U×V of the soft shadows.
@@ -28,18 +25,11 @@ pub struct Design {
     pub grid_in_use: Option<u32>,
 }
 
-/// The command-line name of a value (`base`, `linespace-dda`).
-pub fn value_name<T: ValueEnum + Debug>(v: T) -> String {
-    v.to_possible_value()
-        .map(|v| v.get_name().to_string())
-        .unwrap_or_else(|| format!("{v:?}").to_lowercase())
-}
-
 impl Design {
     /// The ray tracer `kind` with `options`, or the soft shadows `soft.shadows`, for `scene`.
     pub fn new(
-        kind: TracerKind,
-        options: RenderOptions,
+        kind: TracerArg,
+        options: TracerOptions,
         soft: SoftShadowArgs,
         scene: &Scene,
     ) -> Design {
@@ -86,8 +76,8 @@ impl Design {
                 self.samples.0,
                 self.samples.1
             ),
-            None if self.kind == TracerKind::Bvh => {
-                format!("bvh {} tracer", value_name(self.options.bvh_variant))
+            None if self.kind == TracerArg::Bvh => {
+                format!("bvh {} tracer", value_name(self.options.args.bvh_variant))
             }
             None => format!("{} tracer", value_name(self.kind)),
         }
@@ -115,23 +105,26 @@ impl Design {
 
     /// Wagner 2018's pipeline (`--tracer bvh --bvh-variant wagner`): no reflection.
     fn wagner(&self) -> bool {
-        self.kind == TracerKind::Bvh && self.options.bvh_variant == BvhVariant::Wagner
+        self.kind == TracerArg::Bvh && self.options.args.bvh_variant == BvhVariant::Wagner
     }
 
     /// "base", "bvh sah", "bvh wagner", "grid exact 16³", "grid thesis auto=12³".
     fn tracer_title(&self) -> String {
         let mut t = value_name(self.kind);
-        if self.kind == TracerKind::Bvh {
-            t += &format!(" {}", value_name(self.options.bvh_variant));
+        if self.kind == TracerArg::Bvh {
+            t += &format!(" {}", value_name(self.options.args.bvh_variant));
         }
-        if self.kind == TracerKind::Grid {
-            let g = &self.options.grid;
-            let res = g
-                .resolution
+        if self.kind == TracerArg::Grid {
+            let res = self
+                .options
+                .resolution()
                 .map(|r| r.to_string())
                 .or_else(|| self.grid_in_use.map(|r| format!("auto={r}")))
                 .unwrap_or_else(|| "auto".into());
-            t += &format!(" {} {res}³", value_name(g.variant));
+            t += &format!(
+                " {} {res}³",
+                value_name(self.options.args.grid.grid_variant)
+            );
         }
         t
     }

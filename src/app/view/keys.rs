@@ -8,7 +8,7 @@ use winit::keyboard::Key::{self, Character as Ch, Named};
 use winit::keyboard::NamedKey;
 
 use super::design::value_name;
-use super::renderer::{BvhVariant, GridVariant, ShadowMode, TracerKind};
+use super::renderer::{BvhVariant, GridResolution, GridVariant, ShadowMode, TracerArg};
 use super::window::Viewport;
 use super::{orbit, App};
 
@@ -173,7 +173,7 @@ fn reset_camera(app: &mut App, _: &Press) {
 }
 
 fn next_tracer(app: &mut App, press: &Press) {
-    let kinds = TracerKind::value_variants();
+    let kinds = TracerArg::value_variants();
     let design = &app.design;
     let next = step(kinds, &design.kind, press.shift);
     if design.shadows.is_some() {
@@ -195,24 +195,23 @@ fn next_tracer(app: &mut App, press: &Press) {
 
 fn next_variant(app: &mut App, _: &Press) {
     let mut o = app.design.options.clone();
-    o.grid.variant = step(GridVariant::value_variants(), &o.grid.variant, false);
-    let what = format!("grid variant {}", value_name(o.grid.variant));
+    let g = &mut o.args.grid;
+    g.grid_variant = step(GridVariant::value_variants(), &g.grid_variant, false);
+    let what = format!("grid variant {}", value_name(g.grid_variant));
     app.change_grid(o, what);
 }
 
 fn next_bvh_variant(app: &mut App, _: &Press) {
     let mut o = app.design.options.clone();
-    o.bvh_variant = step(BvhVariant::value_variants(), &o.bvh_variant, false);
-    let what = format!("BVH variant {}", value_name(o.bvh_variant));
-    app.change_for(TracerKind::Bvh, o, what);
+    let b = &mut o.args.bvh_variant;
+    *b = step(BvhVariant::value_variants(), b, false);
+    let what = format!("BVH variant {}", value_name(*b));
+    app.change_for(TracerArg::Bvh, o, what);
 }
 
 fn grid_step(app: &mut App, press: &Press) {
     let design = &app.design;
-    let current = design
-        .options
-        .grid
-        .resolution
+    let current = (design.options.resolution())
         .or(design.grid_in_use)
         .unwrap_or(16);
     let next = if press.shift {
@@ -221,13 +220,13 @@ fn grid_step(app: &mut App, press: &Press) {
         current.saturating_add(GRID_STEP)
     };
     let mut o = design.options.clone();
-    o.grid.resolution = Some(next);
+    o.args.grid.grid = GridResolution::N(next);
     app.change_grid(o, format!("grid resolution {next}³"));
 }
 
 fn grid_auto(app: &mut App, _: &Press) {
     let mut o = app.design.options.clone();
-    o.grid.resolution = None;
+    o.args.grid.grid = GridResolution::Auto;
     app.change_grid(o, "grid resolution auto".into());
 }
 

@@ -39,7 +39,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::ModifiersState;
 use winit::window::WindowId;
 
-use crate::args::SoftShadowArgs;
+use crate::args::DesignArgs;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::limits;
 use gpgpu_rt::output::{self, Format, Target};
@@ -47,10 +47,7 @@ use gpgpu_rt::scene::{Camera, Scene};
 
 use design::Design;
 use frames::{Clock, FrameCount, Picture};
-use renderer::{
-    render_options, soft_shadow_support, BvhVariant, GridArgs, RenderOptions, Renderers,
-    ShadowFlags, ShadowMode, Show, Stats, TracerKind,
-};
+use renderer::{soft_shadow_support, Renderers, ShadowMode, Show, Stats, TracerArg, TracerOptions};
 use watch::GlslWatcher;
 use window::{
     compile_quad_program, fit_viewport, read_back_buffer, save_image, GlWindow, ScreenQuad,
@@ -72,31 +69,11 @@ pub struct ViewArgs {
     /// Render height in pixels, 1 to 16384 (default: the scene's render.height).
     #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     pub height: Option<u32>,
-    /// The tracer to start with (T switches).
-    #[arg(long, value_enum, default_value = "bvh")]
-    pub tracer: TracerKind,
-    /// With --tracer bvh: `sah` (ours) or `wagner` (Wagner 2018's own one-kernel pipeline; B
-    /// switches).
-    #[arg(long, value_enum, default_value = "sah")]
-    pub bvh_variant: BvhVariant,
-    /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
-    /// scene's).
-    #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
-    pub refl_depth: Option<u32>,
-    /// Shadow flags: `rgba` as the thesis (4 lights) or `bits` (128 lights).
-    #[arg(long, value_enum, default_value = "bits")]
-    pub shadow_flags: ShadowFlags,
-    /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling).
-    #[arg(long, default_value_t = 256, value_name = "N")]
-    pub tile: u32,
-    /// The grid tracer's options, as for `render` (G / shift+G / A change the resolution, V
-    /// the variant).
+    /// The design to start with and the options of every design, as for `render` (T switches
+    /// the tracer, B the BVH variant; G / shift+G / A change the grid's resolution, V its
+    /// variant; S cycles the soft shadows' mode, L / shift+L their samples).
     #[command(flatten)]
-    pub grid: GridArgs,
-    /// The soft-shadow options, as for `render` (scenes with an `[[area_light]]`; S cycles the
-    /// mode, L / shift+L the samples).
-    #[command(flatten)]
-    pub soft: SoftShadowArgs,
+    pub design: DesignArgs,
     /// Load the kernels from this directory and reload them whenever a file in it changes.
     #[arg(long, value_name = "DIR")]
     pub glsl_dir: Option<PathBuf>,
@@ -133,23 +110,18 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     let scene = Scene::load(&args.scene)?;
     output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     // as `render`: the scene file's render.shadows and render.light_samples by default
-    args.soft = args.soft.clone().with_scene_defaults(&scene.settings);
-    if args.soft.shadows.is_some() {
+    args.design.soft = (args.design.soft.clone()).with_scene_defaults(&scene.settings);
+    if args.design.soft.shadows.is_some() {
         // the same message as `render --shadows`
         soft_shadow_support(&scene)?;
     }
     let shaders = ShaderSource::from_dir(args.glsl_dir.clone())?;
-    let options = render_options(
-        (
-            args.width.unwrap_or(scene.settings.width),
-            args.height.unwrap_or(scene.settings.height),
-        ),
-        args.refl_depth.unwrap_or(scene.settings.refl_depth),
-        args.tile,
-        args.shadow_flags,
-        &args.grid,
-        args.bvh_variant,
-    );
+    let options = TracerOptions {
+        args: args.design.clone(),
+        width: args.width.unwrap_or(scene.settings.width),
+        height: args.height.unwrap_or(scene.settings.height),
+        refl_depth: (args.design.refl_depth).unwrap_or(scene.settings.refl_depth),
+    };
     if options.width == 0 || options.height == 0 {
         bail!(
             "the image size {}x{} must not be zero",
@@ -252,9 +224,14 @@ fn group_digits(n: u64) -> String {
 }
 
 impl App {
-    fn new(args: ViewArgs, scene: Scene, shaders: ShaderSource, options: RenderOptions) -> App {
+    fn new(args: ViewArgs, scene: Scene, shaders: ShaderSource, options: TracerOptions) -> App {
         App {
-            design: Design::new(args.tracer, options, args.soft.clone(), &scene),
+            design: Design::new(
+                args.design.tracer,
+                options,
+                args.design.soft.clone(),
+                &scene,
+            ),
             camera: scene.camera,
             frames: FrameCount::new(
                 args.frames.map(u64::from),
@@ -336,8 +313,8 @@ impl App {
     /// runs already. On failure what runs stays.
     fn show_tracer(
         &mut self,
-        kind: TracerKind,
-        options: RenderOptions,
+        kind: TracerArg,
+        options: TracerOptions,
         rebuild: bool,
     ) -> Result<()> {
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
@@ -453,7 +430,7 @@ impl App {
     /// New options of the ray tracer (keys). While the soft shadows are shown they are kept
     /// for it (it is built with them when S shows it again); else it is rebuilt, and on
     /// failure the running one stays.
-    fn change(&mut self, kind: TracerKind, options: RenderOptions, what: String) {
+    fn change(&mut self, kind: TracerArg, options: TracerOptions, what: String) {
         if self.design.shadows.is_some() {
             self.design.kind = kind;
             self.design.options = options;
@@ -469,12 +446,12 @@ impl App {
     }
 
     /// Grid options only matter to tracers that use them; the base tracer keeps running.
-    fn change_grid(&mut self, options: RenderOptions, what: String) {
-        self.change_for(TracerKind::Grid, options, what);
+    fn change_grid(&mut self, options: TracerOptions, what: String) {
+        self.change_for(TracerArg::Grid, options, what);
     }
 
     /// Options only `used_by` uses: another tracer keeps running, the options are kept.
-    fn change_for(&mut self, used_by: TracerKind, options: RenderOptions, what: String) {
+    fn change_for(&mut self, used_by: TracerArg, options: TracerOptions, what: String) {
         if self.design.kind != used_by {
             self.design.options = options;
             let name = design::value_name(used_by);

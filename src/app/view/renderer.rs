@@ -14,34 +14,42 @@ use crate::args::SoftShadowArgs;
 use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::{Gl, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{scene_light, SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::pipeline::{self, Renderer};
+use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{Camera, Scene};
 
-pub use crate::args::GridArgs;
-pub use gpgpu_rt::accel::{BvhVariant, GridVariant, TracerKind};
-pub use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
+pub use crate::args::{DesignArgs, GridResolution, TracerArg};
+pub use gpgpu_rt::accel::{BvhVariant, GridVariant};
+use gpgpu_rt::design::Design;
 pub use gpgpu_rt::scene::ShadowMode;
 
-/// The ray tracer's options for the window (no AOVs: the window shows the output texture).
-pub fn render_options(
-    size: (u32, u32),
-    refl_depth: u32,
-    tile: u32,
-    shadow_flags: ShadowFlags,
-    grid: &GridArgs,
-    bvh_variant: BvhVariant,
-) -> RenderOptions {
-    RenderOptions {
-        // set to the kind shown when the tracer is made
-        tracer: TracerKind::Base,
-        width: size.0,
-        height: size.1,
-        refl_depth,
-        tile,
-        shadow_flags,
-        aovs: false,
-        grid: grid.options(),
-        bvh_variant,
+/// The ray tracer's options in the window: the command line's design options, which the keys
+/// change, with the image size and the reflection depth (no AOVs: the window shows the output
+/// texture).
+#[derive(Debug, Clone)]
+pub struct TracerOptions {
+    pub args: DesignArgs,
+    pub width: u32,
+    pub height: u32,
+    pub refl_depth: u32,
+}
+
+impl TracerOptions {
+    /// The design of the ray tracer `kind` with these options (as `render` parses it).
+    pub fn design(&self, kind: TracerArg) -> Design {
+        let args = DesignArgs {
+            tracer: kind,
+            ..self.args.clone()
+        };
+        let row = args.tracer_row();
+        args.tracer_design(row, (self.width, self.height), self.refl_depth, false)
+    }
+
+    /// The grid's resolution N (`None`: auto, or cells per axis for the stream).
+    pub fn resolution(&self) -> Option<u32> {
+        match self.args.grid.grid {
+            GridResolution::N(n) => Some(n),
+            _ => None,
+        }
     }
 }
 
@@ -54,14 +62,14 @@ pub fn soft_shadow_support(scene: &Scene) -> Result<()> {
 #[derive(Clone, Copy)]
 pub enum Show<'a> {
     /// The ray tracer `kind` with `options`.
-    Tracer(TracerKind, &'a RenderOptions),
+    Tracer(TracerArg, &'a TracerOptions),
     /// The soft shadows `mode` with U×V light `samples`; the N-tree as the command line
     /// (`args`) says, the image size and the tiles as the ray tracer's `options`.
     Soft {
         mode: ShadowMode,
         samples: (u32, u32),
         args: &'a SoftShadowArgs,
-        options: &'a RenderOptions,
+        options: &'a TracerOptions,
     },
 }
 
@@ -125,14 +133,12 @@ impl Renderers {
         &self,
         scene: &Scene,
         shaders: &ShaderSource,
-        kind: TracerKind,
-        options: &RenderOptions,
+        kind: TracerArg,
+        options: &TracerOptions,
     ) -> Result<Box<dyn Renderer>> {
-        let options = RenderOptions {
-            tracer: kind,
-            ..options.clone()
-        };
-        pipeline::ray_tracer(self.gl.clone(), &self.info, scene, shaders, options)
+        options
+            .design(kind)
+            .renderer(self.gl.clone(), &self.info, scene, shaders)
     }
 
     fn show_soft(
@@ -231,9 +237,9 @@ impl Renderers {
 fn soft_options(
     args: &SoftShadowArgs,
     mode: ShadowMode,
-    options: &RenderOptions,
+    options: &TracerOptions,
 ) -> SoftShadowOptions {
-    args.options(mode, options.width, options.height, options.tile)
+    args.options(mode, options.width, options.height, options.args.tile)
 }
 
 /// The statistics of a drawn frame.

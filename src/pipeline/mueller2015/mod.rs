@@ -57,7 +57,7 @@ impl ShadowFlags {
     }
 }
 
-/// Options of one render.
+/// Options of Müller 2015's pipeline with one of its accelerators (`design::Design::Mueller2015`).
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
     /// The accelerator (`--tracer`, with `grid.variant` for the grid).
@@ -71,11 +71,11 @@ pub struct RenderOptions {
     pub shadow_flags: ShadowFlags,
     /// Keep the primary rays and first hits for the AOVs.
     pub aovs: bool,
-    /// Grid options (ignored by the other accelerators).
+    /// The grid's options (`tracer` grid; the other accelerators have none).
     pub grid: GridOptions,
-    /// `--bvh-variant` of `--tracer bvh`: `sah` is this pipeline's accelerator, `wagner` is
-    /// Wagner 2018's own pipeline ([`super::wagner2018`]; [`super::ray_tracer`] picks).
-    pub bvh_variant: BvhVariant,
+    /// The base tracer's triangles per dispatch (`accel::BuildContext`); `None`: as the GL
+    /// implementation needs.
+    pub triangles_per_dispatch: Option<u32>,
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -162,12 +162,6 @@ pub struct RayTracer {
 
 /// Refuse options the pipeline cannot honour, before anything is allocated.
 fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Result<PixelGrid> {
-    if options.tracer == TracerKind::Bvh && options.bvh_variant == BvhVariant::Wagner {
-        bail!(
-            "--bvh-variant wagner is Wagner 2018's own pipeline, not an accelerator of this one \
-             (make it with pipeline::ray_tracer)"
-        );
-    }
     if scene.lights.len() > options.shadow_flags.max_lights() {
         bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
@@ -210,7 +204,7 @@ impl RayTracer {
         options: RenderOptions,
     ) -> Result<RayTracer> {
         let pixels = check_options(info, scene, &options)?;
-        let entry = accel::entry(options.tracer, &options.grid)?;
+        let entry = accel::entry(options.tracer, &options.grid);
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
         let defines = kernel_defines(scene, &options);
         let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
@@ -229,6 +223,7 @@ impl RayTracer {
             defines: &defines,
             width: w,
             height: h,
+            triangles_per_dispatch: options.triangles_per_dispatch,
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
         let records = accel
@@ -456,7 +451,7 @@ impl Renderer for RayTracer {
             ("tile", json!(o.tile)),
         ]
         .into_iter()
-        .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(o.bvh_variant))))
+        .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
         .map(|(k, v)| (k.to_string(), v))
         .collect()
     }

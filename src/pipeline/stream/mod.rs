@@ -32,7 +32,6 @@ use serde_json::json;
 
 use self::grid_textures::GridTextures;
 use self::targets::{AovTargets, Targets};
-use super::mueller2015::RenderOptions;
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
@@ -76,21 +75,22 @@ pub struct StreamOptions {
 }
 
 impl StreamOptions {
-    /// The streaming tracer's part of the ray tracer's options.
-    pub fn of(o: &RenderOptions) -> StreamOptions {
-        let g = &o.grid;
+    /// A `width`×`height` image with `refl_depth` bounces and the command line's defaults: the
+    /// paper's ∛n grid, no proximity clouds, the paper's shadow optimisations, 64 steps per
+    /// call and at most 10 000 calls.
+    pub fn new(width: u32, height: u32, refl_depth: u32) -> StreamOptions {
         StreamOptions {
-            width: o.width,
-            height: o.height,
-            refl_depth: o.refl_depth,
-            dims: g.axes.or(g.resolution.map(|n| [n; 3])),
-            proximity_clouds: g.proximity_clouds,
-            steps_per_call: g.stream_steps,
-            max_calls: g.stream_max_calls,
-            naive_shadows: g.stream_naive_shadows,
-            no_mask: g.stream_no_mask,
-            single_sided: g.stream_single_sided,
-            aovs: o.aovs,
+            width,
+            height,
+            refl_depth,
+            dims: None,
+            proximity_clouds: false,
+            steps_per_call: 64,
+            max_calls: 10_000,
+            naive_shadows: false,
+            no_mask: false,
+            single_sided: false,
+            aovs: false,
         }
     }
 }

@@ -25,7 +25,6 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gpu::{Images, SceneTextures};
-use super::mueller2015::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};
@@ -58,19 +57,6 @@ pub struct WagnerOptions {
     pub tile: u32,
     /// Keep the rays, normals and shadow flags for the AOVs.
     pub aovs: bool,
-}
-
-impl WagnerOptions {
-    /// The size, tiles and AOVs of the ray tracer's options (its other options do not apply:
-    /// no reflection, one light, no shadow-flag texture).
-    pub fn of(o: &RenderOptions) -> WagnerOptions {
-        WagnerOptions {
-            width: o.width,
-            height: o.height,
-            tile: o.tile,
-            aovs: o.aovs,
-        }
-    }
 }
 
 /// The scene in world space as the kernel sees it, and the model matrices it was built for.
