@@ -8,79 +8,59 @@
 //!
 //! # Structure
 //!
-//! Every protocol reads as **configure → measure → report**, with the pieces shared:
+//! Every protocol reads as **configure → measure → report**; the folders hold those parts:
 //!
-//! - [`Protocol`] (in [`protocol`]): a protocol's name (the command-line value), title and
-//!   `run`, which measures and returns its [`Section`] of the report. [`ProtocolId`] (in
-//!   [`args`], with the rest of the command line) lists the command line's values;
-//!   [`protocol_of`] is the registry that says which protocol each one runs.
-//! - configure: [`config`]: [`config::Sizing`] (image size, angles, warm-up at a scale) and
-//!   [`config::Config`] (scene, tracer, image size, reflection depth, rotation angles, warm-up
-//!   frames); [`runner::Bench::sizing`], [`runner::Bench::grid_resolutions`] and
-//!   [`runner::Bench::variants`] give a protocol's choices at the chosen `--scale` with the
-//!   command line's overrides applied.
-//! - measure: [`runner::Bench`], the session every protocol gets (the GPU, the options, the
-//!   output folder, the scenes); [`runner::Bench::measure`] renders a list of configurations
-//!   with a progress bar into [`outcome::Outcome`]s and writes the two CSVs ([`csv_files`]).
-//!   [`klee_measure`] times Klee 2016's soft shadows on the GPU and the CPU.
-//! - report: [`format`] (numbers, markdown tables), [`plots`] (line charts as PNG,
-//!   [`plots::Figure`]), [`sweep`] (what the grid-resolution protocols share), [`published`]
-//!   (the published numbers, typed in as data with their figure numbers), [`report`]
-//!   (`report.md`), [`stats`] (median/min/max/mean), [`machine`].
-//! - [`adapter`]: the only module that uses the library's renderers (the GL context, the ray
-//!   tracers and the soft-shadow renderer); the rest speaks the bench's own terms.
+//! - [`protocols`]: one file per published evaluation it replicates (Müller 2015's ch. 5.1–5.3,
+//!   Klee 2016's tables and figures, Wagner 2018's Tables A.1/A.2, seed 004's Tables 1–3) and
+//!   `accel-compare`: its configurations and what it compares. [`Protocol`] is a protocol's
+//!   name (the command-line value), title and `run`, which measures and returns its
+//!   [`Section`] of the report; [`protocol_of`] is the registry that says which protocol each
+//!   [`runner::args::ProtocolId`] runs.
+//! - [`published`]: the published numbers, typed in as data with their table or figure
+//!   numbers, one file per source.
+//! - [`report`]: `report.md`, the protocols' reports that outgrow their protocol's file, the
+//!   CSVs ([`report::csv_files`]), numbers and markdown tables ([`report::format`]) and the PNG
+//!   plots ([`report::plots`], [`report::plots::Figure`]).
+//! - [`runner`]: the session every protocol gets ([`runner::Bench`]: the GPU, the options, the
+//!   output folder, the scenes) and its measuring loop ([`runner::Bench::measure`] renders a
+//!   list of configurations with a progress bar into [`runner::outcome::Outcome`]s and writes
+//!   the two CSVs); the command line ([`runner::args`]); the configurations
+//!   ([`runner::config`]: [`runner::config::Sizing`] and [`runner::config::Config`]; the
+//!   protocol's choices at the chosen `--scale`, with the command line's overrides applied,
+//!   come from [`runner::Bench::sizing`], [`runner::Bench::grid_resolutions`] and
+//!   [`runner::Bench::variants`]); [`runner::adapter`], the only module that uses the library's
+//!   renderers (the GL context, the ray tracers and the soft-shadow renderer), so the rest
+//!   speaks the bench's own terms; the CPU reference's judgement of first hits
+//!   ([`runner::judge`]); median/min/max/mean ([`runner::stats`]); the machine
+//!   ([`runner::machine`]); and [`runner::shard`]: the units of work (a configuration, or a
+//!   whole protocol: [`Units`]) that `--list` prints, `--shard K/N` measures a part of and
+//!   `bench merge` replays from the shards' records; [`Bench`]'s [`runner::shard::Mode`] says
+//!   which, so a protocol's `run` is the same in all.
 //!
-//! - [`shard`]: the units of work (a configuration, or a whole protocol: [`Units`]) that
-//!   `--list` prints, `--shard K/N` measures a part of and `bench merge` replays from the shards'
-//!   records; [`Bench`]'s [`shard::Mode`] says which, so a protocol's `run` is the same in all.
-//!
-//! No module here imports one that imports it; only this file imports the protocols.
+//! This file runs the protocols of the command line: the whole run, `--list`, a shard, a merge.
 //!
 //! # Adding a protocol (e.g. a new table of Klee 2016)
 //!
-//! 1. Put the published numbers beside the protocol or into [`published`], each with its table
-//!    or figure number.
-//! 2. Write the protocol: a `const` [`Protocol`] whose `run` configures (the
-//!    [`config::Config`]s for the scale), measures (`bench.measure(p.name, &configs)`: the CSV
-//!    files come for free) and reports (a [`Section`] whose markdown sets the published values
-//!    beside ours, with its [`plots::Figure`]s: [`Section::of_sweep`]); see [`thesis_5_3`] for
-//!    a complete example. Work that is not a list of rendered frames (a CPU implementation, a
-//!    build-time measurement) goes through [`adapter`] and [`klee_measure`] or helpers like them.
+//! 1. Put the published numbers into [`published`] (or beside the protocol when few), each
+//!    with its table or figure number.
+//! 2. Write the protocol, a file in [`protocols`]: a `const` [`Protocol`] whose `run`
+//!    configures (the [`runner::config::Config`]s for the scale), measures
+//!    (`bench.measure(p.name, &configs)`: the CSV files come for free) and reports (a
+//!    [`Section`] whose markdown sets the published values beside ours, with its
+//!    [`report::plots::Figure`]s: [`Section::of_sweep`]); see [`protocols::thesis_5_3`] for a
+//!    complete example. Work that is not a list of rendered frames (a CPU implementation, a
+//!    build-time measurement) goes through [`runner::adapter`] and
+//!    [`protocols::klee_measure`] or helpers like them.
 //! 3. Say what its units are: `Units::Configs` when everything it measures goes through
 //!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
 //!    measurements depend on each other.
-//! 4. Add a variant with `#[value(name = "...")]` to [`ProtocolId`] and its line in
+//! 4. Add a variant with `#[value(name = "...")]` to [`runner::args::ProtocolId`] and its line in
 //!    [`protocol_of`]; mention it in the README's benchmark section.
 
-pub mod accel_compare;
-pub mod accel_compare_report;
-pub mod adapter;
-pub mod args;
-pub mod config;
-pub mod csv_files;
-pub mod format;
-pub mod judge;
-pub mod klee;
-pub mod klee_measure;
-pub mod machine;
-pub mod outcome;
-pub mod plots;
-pub mod protocol;
-pub mod proximity_clouds;
-pub mod proximity_clouds_report;
+pub mod protocols;
 pub mod published;
-pub mod published_proximity_clouds;
-pub mod published_wagner;
 pub mod report;
 pub mod runner;
-pub mod shard;
-pub mod stats;
-pub mod sweep;
-pub mod thesis_5_1;
-pub mod thesis_5_2;
-pub mod thesis_5_3;
-pub mod wagner;
-pub mod wagner_report;
 
 use std::path::Path;
 use std::time::Instant;
@@ -89,30 +69,10 @@ use anyhow::{bail, Result};
 use clap::Parser as _;
 use gpgpu_rt::output::Batch;
 
-pub use args::{BenchArgs, BenchCommand, MergeArgs, ProtocolId};
-pub use protocol::{Protocol, Section, Units};
+pub use protocols::{protocol_of, Protocol, Section, Units};
+pub use runner::args::{BenchArgs, BenchCommand, MergeArgs};
+use runner::shard::{self, Mode, Shard};
 pub use runner::{Bench, NotMeasuredHere};
-use shard::{Mode, Shard};
-
-/// The registry: the protocol each command-line value runs.
-pub fn protocol_of(id: ProtocolId) -> &'static Protocol {
-    match id {
-        ProtocolId::Thesis51 => &thesis_5_1::PROTOCOL,
-        ProtocolId::Thesis52 => &thesis_5_2::PROTOCOL,
-        ProtocolId::Thesis53 => &thesis_5_3::PROTOCOL,
-        ProtocolId::KleeTable1 => &klee::KLEE_TABLE1,
-        ProtocolId::KleeTable2 => &klee::KLEE_TABLE2,
-        ProtocolId::KleeTable3 => &klee::KLEE_TABLE3,
-        ProtocolId::KleeFig12 => &klee::KLEE_FIG12,
-        ProtocolId::KleeFig13 => &klee::KLEE_FIG13,
-        ProtocolId::WagnerA1 => &wagner::WAGNER_A1,
-        ProtocolId::WagnerA2 => &wagner::WAGNER_A2,
-        ProtocolId::ProximityCloudsTable1 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE1,
-        ProtocolId::ProximityCloudsTable2 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE2,
-        ProtocolId::ProximityCloudsTable3 => &proximity_clouds::PROXIMITY_CLOUDS_TABLE3,
-        ProtocolId::AccelCompare => &accel_compare::ACCEL_COMPARE,
-    }
-}
 
 /// Run the protocols of `args` and write the report (or list their units, or measure one
 /// shard of them, or merge shards). Fails (after writing everything) when a configuration or
@@ -271,7 +231,7 @@ fn merge(m: &MergeArgs) -> Result<()> {
     let shards = shard::read_shards(&m.dirs)?;
     let recorded = shard::recorded(&shards)?;
     let first = &shards[0].0;
-    let mut args = args::Standalone::try_parse_from(&first.argv)
+    let mut args = runner::args::Standalone::try_parse_from(&first.argv)
         .map_err(|e| anyhow::anyhow!("the shards' command line `{}`: {e}", first.argv.join(" ")))?
         .args;
     args.out = m.out.clone();

@@ -16,18 +16,18 @@
 //!   stream count and time them apart, `pipeline::ray_kinds`) Mrays/s, triangle tests and
 //!   voxels/nodes visited per ray; the frame's Mrays/s (all rays over all of the frame's GPU
 //!   time, the one figure every pipeline has); agreement of the first hits with the CPU
-//!   reference ([`super::judge`]).
+//!   reference ([`crate::bench::runner::judge`]).
 //!
-//! The tables, figures and analysis are in [`super::accel_compare_report`].
+//! The tables, figures and analysis are in [`crate::bench::report::accel_compare`].
 
 use anyhow::Result;
 
-use super::accel_compare_report as report;
-use super::args::Scale;
-use super::config::{BvhVariant, Config, GridVariant, Sizing, TracerSpec};
-use super::outcome::Outcome;
-use super::protocol::{Protocol, Section, Units};
-use super::runner::Bench;
+use super::{Protocol, Section, Units};
+use crate::bench::report::accel_compare as report;
+use crate::bench::runner::args::Scale;
+use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::Bench;
 use gpgpu_rt::accel::auto_resolution;
 use gpgpu_rt::frame::{FrameStats, RAY_KINDS};
 use gpgpu_rt::reference::stream_grid::auto_dims;

@@ -2,6 +2,21 @@
 //! configuration-based protocol shares: load the scenes, make the tracer, render warm-up frames
 //! (not counted), render one frame per angle of the rotation, and write the per-frame and
 //! per-configuration CSVs.
+//!
+//! Beside it, what a run needs: the command line ([`args`]), the configurations ([`config`]),
+//! the only door to the library's renderers ([`adapter`]), the CPU reference that judges first
+//! hits ([`judge`]), a configuration's frames and statistics ([`outcome`], [`stats`]), the
+//! machine it ran on ([`machine`]), and the units of work of `--list`, `--shard` and `bench
+//! merge` ([`shard`]).
+
+pub mod adapter;
+pub mod args;
+pub mod config;
+pub mod judge;
+pub mod machine;
+pub mod outcome;
+pub mod shard;
+pub mod stats;
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
@@ -14,16 +29,16 @@ use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::adapter::{Frame, FrameStats, Gpu, RayTracer, BVH_VARIANTS};
-use super::args::{BenchArgs, Rotation, Scale};
-use super::config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
-use super::csv_files;
-use super::judge::Judge;
-use super::machine::Machine;
-use super::outcome::{FrameRecord, Outcome};
-use super::protocol::Section;
-use super::shard::{self, Measured, Mode, Shard};
+use crate::bench::protocols::Section;
+use crate::bench::report::csv_files;
+use adapter::{Frame, FrameStats, Gpu, RayTracer, BVH_VARIANTS};
+use args::{BenchArgs, Rotation, Scale};
+use config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
 use gpgpu_rt::scene::{Camera, Scene};
+use judge::Judge;
+use machine::Machine;
+use outcome::{FrameRecord, Outcome};
+use shard::{Measured, Mode, Shard};
 
 /// A benchmark session: the GPU, the options, the output folder and the scenes; what it does
 /// with each unit of work (measure, list, replay: [`Mode`]) and what it measured.

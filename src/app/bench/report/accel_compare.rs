@@ -1,18 +1,18 @@
-//! The report of `accel-compare` ([`super::accel_compare`]): its CSV, tables, figures and the
-//! analysis in the sources' terms.
+//! The report of `accel-compare` ([`crate::bench::protocols::accel_compare`]): its CSV,
+//! tables, figures and the analysis in the sources' terms.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::accel_compare::{Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
-use super::accel_compare::{QUICK_WAGNER_MAX_TRIANGLES, STADIUM};
-use super::args::Scale;
-use super::config::Sizing;
 use super::csv_files::write_rows;
 use super::format::{int, num, ratio, table};
 use super::plots::{Chart, Figure, Series, Style};
+use crate::bench::protocols::accel_compare::{Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
+use crate::bench::protocols::accel_compare::{QUICK_WAGNER_MAX_TRIANGLES, STADIUM};
+use crate::bench::runner::args::Scale;
+use crate::bench::runner::config::Sizing;
 
 /// The row's work of one kind of ray.
 type KindOf = fn(&Row) -> Work;

@@ -6,7 +6,7 @@
 //! summaries, plots and `report.md` as one unsharded run would write them.
 //!
 //! A unit is one configuration of the protocols that measure rendered frames
-//! ([`super::runner::Bench::measure`]: warm-up included, so a shard's timings are as good as
+//! ([`super::Bench::measure`]: warm-up included, so a shard's timings are as good as
 //! an unsharded run's), or a whole protocol where its measurements depend on each other (the
 //! Klee 2016 protocols time the CPU on the GPU's G-buffer): [`Units::Whole`].
 
@@ -18,8 +18,8 @@ use serde::{Deserialize, Serialize};
 
 use super::machine::Machine;
 use super::outcome::{FrameRecord, Outcome};
-use super::protocol::Section;
-use super::runner::Bench;
+use super::Bench;
+use crate::bench::protocols::Section;
 use gpgpu_rt::frame::FrameStats;
 
 /// The version of `shard.json`'s layout.

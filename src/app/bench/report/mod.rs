@@ -1,20 +1,32 @@
 //! `report.md`: the machine, the settings, and one section per protocol with our numbers
 //! beside the published ones.
+//!
+//! Beside it, what the reports are made of: numbers and markdown tables ([`format`]), the CSVs
+//! ([`csv_files`]), PNG line charts shaped like the papers' figures ([`plots`], with the font
+//! they draw in, `fonts/`), and the reports of the protocols whose tables and figures outgrow
+//! their protocol's file ([`accel_compare`], [`proximity_clouds`], [`wagner`]).
+
+pub mod accel_compare;
+pub mod csv_files;
+pub mod format;
+pub mod plots;
+pub mod proximity_clouds;
+pub mod wagner;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
 
-use super::adapter::grid_list_defaults;
-use super::args::{BenchArgs, Rotation, Scale};
-use super::config::{FULL_SIZE, QUICK_SIZE};
-use super::format::table;
-use super::machine::Machine;
-use super::protocol::Section;
-use super::published;
-use super::runner::Bench;
-use super::shard::Shard;
+use crate::bench::protocols::Section;
+use crate::bench::published::thesis;
+use crate::bench::runner::adapter::grid_list_defaults;
+use crate::bench::runner::args::{BenchArgs, Rotation, Scale};
+use crate::bench::runner::config::{FULL_SIZE, QUICK_SIZE};
+use crate::bench::runner::machine::Machine;
+use crate::bench::runner::shard::Shard;
+use crate::bench::runner::Bench;
+use format::table;
 
 const MULLER: &str = "Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL 4.5 compute \
                       shaders and a per-frame uniform grid*), ch. 5";
@@ -130,13 +142,13 @@ fn machine(m: &Machine, muller: bool) -> String {
     let row = |what: &str, ours: String, theirs: &str| vec![what.into(), ours, theirs.into()];
     let cpu = format!("{} ({} logical CPUs)", m.cpu, m.logical_cpus);
     let rows = vec![
-        row("GL renderer", m.gl_renderer.clone(), published::GPU),
+        row("GL renderer", m.gl_renderer.clone(), thesis::GPU),
         row("GL version", m.gl_version.clone(), "OpenGL 4.5"),
         row("GL vendor", m.gl_vendor.clone(), "NVIDIA"),
         row("GLSL", m.glsl_version.clone(), "4.50"),
         row("EGL device", m.egl_device.clone(), "– (a window)"),
-        row("CPU", cpu, published::CPU),
-        row("OS", m.os.clone(), published::OS),
+        row("CPU", cpu, thesis::CPU),
+        row("OS", m.os.clone(), thesis::OS),
         row("gpgpu-rt", m.gpgpu_rt_version.clone(), "–"),
     ];
     let mut s = String::from("## Machine\n\n");
@@ -201,8 +213,8 @@ fn muller_settings(a: &BenchArgs) -> String {
     let _ = writeln!(
         s,
         "- Müller 2015's test system: {}. It measured {}.",
-        published::HARDWARE,
-        published::MEASURES
+        thesis::HARDWARE,
+        thesis::MEASURES
     );
     s
 }
@@ -228,7 +240,7 @@ fn image_size_settings(a: &BenchArgs) -> String {
         QUICK_SIZE.1,
         FULL_SIZE.0,
         FULL_SIZE.1,
-        published::bunny_base_tests_per_triangle()
+        thesis::bunny_base_tests_per_triangle()
     )
 }
 

@@ -7,13 +7,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::config::TracerSpec;
 use super::csv_files::write_rows;
 use super::format::{int, num, ratio, table};
-use super::outcome::Outcome;
 use super::plots::{Chart, Figure, Series, Style};
-use super::proximity_clouds::{Plan, SPARSE};
-use super::published_proximity_clouds::{self as pp, PaperScene};
+use crate::bench::protocols::proximity_clouds::{Plan, SPARSE};
+use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
+use crate::bench::runner::config::TracerSpec;
+use crate::bench::runner::outcome::Outcome;
 
 /// The paper's columns and ours.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -485,7 +485,7 @@ fn sparse_line(plan: &Plan, outcomes: &[Outcome]) -> String {
 
 fn bunny_line(outcomes: &[Outcome]) -> String {
     let file = pp::STANFORD_BUNNY.file;
-    let side = super::proximity_clouds::BUNNY_SIDE;
+    let side = crate::bench::protocols::proximity_clouds::BUNNY_SIDE;
     let at = |c| ours(outcomes, file, side, c);
     match (at(Column::StreamG), at(Column::GridG)) {
         (Some(g), Some(gg)) => format!(

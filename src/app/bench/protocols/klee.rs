@@ -19,12 +19,12 @@
 
 use anyhow::Result;
 
-use super::config::Sizing;
-use super::format::{int, num, percent, ratio, table};
 use super::klee_measure::{section, Row, Setup, READINGS};
-use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
-use super::protocol::{Protocol, Section, Units};
-use super::runner::Bench;
+use super::{Protocol, Section, Units};
+use crate::bench::report::format::{int, num, percent, ratio, table};
+use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
+use crate::bench::runner::config::Sizing;
+use crate::bench::runner::Bench;
 use gpgpu_rt::scene::ShadowMode;
 
 pub const BUNNY: &str = "bunny_area.toml";

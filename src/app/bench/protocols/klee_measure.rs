@@ -8,12 +8,12 @@ use std::time::Instant;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::adapter::{ShadowFrame, SoftShadows};
-use super::config::Sizing;
-use super::csv_files::write_rows;
-use super::plots::Figure;
-use super::protocol::{Protocol, Section};
-use super::runner::Bench;
+use super::{Protocol, Section};
+use crate::bench::report::csv_files::write_rows;
+use crate::bench::report::plots::Figure;
+use crate::bench::runner::adapter::{ShadowFrame, SoftShadows};
+use crate::bench::runner::config::Sizing;
+use crate::bench::runner::Bench;
 use gpgpu_rt::reference::linespace::ShadowCounts;
 use gpgpu_rt::scene::{Scene, ShadowMode};
 

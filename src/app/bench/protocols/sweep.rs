@@ -1,10 +1,10 @@
 //! What the grid-resolution protocols (ch. 5.2, 5.3) share: configurations over resolutions
 //! and variants, the table per resolution, and the curves per variant.
 
-use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
-use super::format::{int, ratio, table};
-use super::outcome::{Outcome, MEASURED_COLUMNS};
-use super::plots::{Chart, Series, Style};
+use crate::bench::report::format::{int, ratio, table};
+use crate::bench::report::plots::{Chart, Series, Style};
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::outcome::{Outcome, MEASURED_COLUMNS};
 
 /// Grid configurations for every variant × resolution of `scene`.
 pub fn grid_configs(

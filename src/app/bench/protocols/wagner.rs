@@ -10,17 +10,17 @@
 //! Every configuration names its BVH variant (`sah`, ours; `wagner`, the faithful megakernel):
 //! which variants run is `adapter::BVH_VARIANTS` (or `--bvh-variants`). Hardware-independent
 //! comparisons: FPS(n)/FPS(8) per size (A.1), FPS(size)/FPS(320×240) per object (A.2). The
-//! tables and figures are in [`super::wagner_report`].
+//! tables and figures are in [`crate::bench::report::wagner`].
 
 use anyhow::Result;
 
-use super::args::Scale;
-use super::config::{BvhVariant, Config, Sizing, TracerSpec};
-use super::outcome::Outcome;
-use super::protocol::{Protocol, Section, Units};
-use super::published_wagner as pw;
-use super::runner::Bench;
-use super::wagner_report::{self as report, Ratios};
+use super::{Protocol, Section, Units};
+use crate::bench::published::wagner as pw;
+use crate::bench::report::wagner::{self as report, Ratios};
+use crate::bench::runner::args::Scale;
+use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
+use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::Bench;
 
 pub const SQUARE: &str = "square.toml";
 pub const SPHERE: &str = "sphere.toml";

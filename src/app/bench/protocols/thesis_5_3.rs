@@ -6,15 +6,15 @@
 
 use anyhow::Result;
 
-use super::args::Scale;
-use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
-use super::format::{int, num, ratio, table};
-use super::outcome::Outcome;
-use super::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
-use super::protocol::{Protocol, Section, Units};
-use super::published::{self as p, Published};
-use super::runner::Bench;
 use super::sweep::{self, resolution_chart};
+use super::{Protocol, Section, Units};
+use crate::bench::published::thesis::{self as p, Published};
+use crate::bench::report::format::{int, num, ratio, table};
+use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
+use crate::bench::runner::args::Scale;
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.3",

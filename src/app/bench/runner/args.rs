@@ -9,8 +9,8 @@ use gpgpu_rt::limits;
 use super::config::{BvhVariant, GridVariant};
 use super::shard::{parse_shard, Shard};
 
-/// The protocols `gpgpu-rt bench` knows: the command line's values (`super::protocol_of` says
-/// which protocol each one runs).
+/// The protocols `gpgpu-rt bench` knows: the command line's values
+/// (`crate::bench::protocols::protocol_of` says which protocol each one runs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
 pub enum ProtocolId {
     /// Müller 2015, ch. 5.1: the base tracer on 1, 3 and 6 teapots over a 360° rotation (Fig. 19, 20).

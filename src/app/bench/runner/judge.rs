@@ -11,8 +11,8 @@ use gpgpu_rt::accel::{self, GridOptions};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
-/// Brute force judges a scene while triangles × pixels stays within this (about a second on
-/// two cores).
+/// Brute force judges a scene while triangles × pixels stays within this (a second or so of CPU
+/// time: the judge stays cheap beside the frames it judges).
 pub const BRUTE_FORCE_MAX_TESTS: f64 = 2e8;
 
 /// Hit distances this close (relative) count as the same hit: a ray through a shared edge or a

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use super::stats::Stats;
+use crate::bench::runner::stats::Stats;
 
 /// An integer with thousands separators: 1,137,720,816.
 pub fn int(v: f64) -> String {

@@ -5,13 +5,13 @@
 
 use anyhow::Result;
 
-use super::config::{Config, Sizing, TracerSpec};
-use super::format::{int, percent, ratio, table};
-use super::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
-use super::plots::{self, Chart, Figure, Series, Style};
-use super::protocol::{Protocol, Section, Units};
-use super::published::{self, TEAPOT_TRIANGLES};
-use super::runner::Bench;
+use super::{Protocol, Section, Units};
+use crate::bench::published::thesis::{self, TEAPOT_TRIANGLES};
+use crate::bench::report::format::{int, percent, ratio, table};
+use crate::bench::report::plots::{self, Chart, Figure, Series, Style};
+use crate::bench::runner::config::{Config, Sizing, TracerSpec};
+use crate::bench::runner::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
+use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.1",
@@ -91,7 +91,7 @@ fn setup_text(s: Sizing) -> String {
     format!(
         "Setup (thesis): {}. Ours: `scenes/teapot1.toml`, `teapot3.toml`, `teapot6.toml`, reflection depth \
          1, one light, {} pixels, {} angles ({angles}), {} warm-up frame(s) per scene.\n\n",
-        published::SEC51_SETUP,
+        thesis::SEC51_SETUP,
         s.size(),
         s.angles,
         s.warmup
@@ -135,7 +135,7 @@ fn per_scene(ok: &[&Outcome], f: impl Fn(&Outcome) -> Option<String>) -> String 
 /// The thesis' findings (its text; Fig. 19 and 20 are plots) beside ours.
 fn findings(outcomes: &[Outcome]) -> String {
     let ok: Vec<&Outcome> = outcomes.iter().filter(|o| o.ok()).collect();
-    let [proportional, fluctuates, test_phases, reflections] = published::SEC51_FINDINGS;
+    let [proportional, fluctuates, test_phases, reflections] = thesis::SEC51_FINDINGS;
     let mut rows = Vec::new();
     if let Some(ours) = inverse_proportion(&ok) {
         rows.push((proportional, ours));
@@ -158,7 +158,7 @@ fn findings(outcomes: &[Outcome]) -> String {
         reflections,
         "see the curves of Fig. 20 (ours); with reflection depth 1 a ray reflects once".to_string(),
     ));
-    published::beside_findings("Fig. 19 and 20", rows)
+    thesis::beside_findings("Fig. 19 and 20", rows)
 }
 
 /// FPS of the first scene over the last beside their triangles' ratio, and FPS × triangles per

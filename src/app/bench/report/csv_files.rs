@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::args::Rotation;
-use super::outcome::{FrameRecord, Outcome};
-use super::stats::Stats;
+use crate::bench::runner::args::Rotation;
+use crate::bench::runner::outcome::{FrameRecord, Outcome};
+use crate::bench::runner::stats::Stats;
 
 /// The two CSV files of `protocol`, relative to the output folder.
 pub fn names(protocol: &str) -> Vec<PathBuf> {

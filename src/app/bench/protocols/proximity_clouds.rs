@@ -9,15 +9,15 @@
 //! Every scene is measured with `--tracer stream` at the paper's grid (g, and pc where the
 //! paper has it) and with the compute exact grid (`--tracer grid`, cubic: the paper's largest
 //! axis) on the same frames; a sparse scene (`sparse_room.toml`) is added, where skipping empty
-//! cells should pay. The report is in [`super::proximity_clouds_report`].
+//! cells should pay. The report is in [`crate::bench::report::proximity_clouds`].
 
 use anyhow::Result;
 
-use super::config::{Config, GridVariant, Sizing, TracerSpec};
-use super::protocol::{Protocol, Section, Units};
-use super::proximity_clouds_report as report;
-use super::published_proximity_clouds::{self as pp, PaperScene};
-use super::runner::Bench;
+use super::{Protocol, Section, Units};
+use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
+use crate::bench::report::proximity_clouds as report;
+use crate::bench::runner::config::{Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::Bench;
 
 /// The sparse scene (not in the paper): a small detailed object in a large empty room.
 pub const SPARSE: PaperScene = PaperScene {

@@ -1,7 +1,7 @@
-//! The report of the Wagner 2018 protocols ([`super::wagner`]): our FPS beside the published
-//! ones with the hardware-independent ratios (a CSV and markdown tables), the published tables
-//! as typed in, the dragon's BVH build beside the thesis' remark, and figures shaped like
-//! Fig. 5.1 and Fig. 5.4.
+//! The report of the Wagner 2018 protocols ([`crate::bench::protocols::wagner`]): our FPS
+//! beside the published ones with the hardware-independent ratios (a CSV and markdown tables),
+//! the published tables as typed in, the dragon's BVH build beside the thesis' remark, and
+//! figures shaped like Fig. 5.1 and Fig. 5.4.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -10,10 +10,10 @@ use anyhow::Result;
 
 use super::csv_files::write_rows;
 use super::format::{int, num, ratio, table};
-use super::outcome::Outcome;
 use super::plots::{Chart, Figure, Series, Style};
-use super::published_wagner as pw;
-use super::wagner::{size, Plan};
+use crate::bench::protocols::wagner::{size, Plan};
+use crate::bench::published::wagner as pw;
+use crate::bench::runner::outcome::Outcome;
 
 /// One measured configuration beside the published numbers.
 #[derive(Debug, Clone)]

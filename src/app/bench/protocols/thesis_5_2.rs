@@ -5,14 +5,14 @@
 
 use anyhow::Result;
 
-use super::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
-use super::format::{int, num};
-use super::outcome::Outcome;
-use super::plots::Figure;
-use super::protocol::{Protocol, Section, Units};
-use super::published;
-use super::runner::Bench;
 use super::sweep::{self, resolution_chart};
+use super::{Protocol, Section, Units};
+use crate::bench::published::thesis;
+use crate::bench::report::format::{int, num};
+use crate::bench::report::plots::Figure;
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
     name: "thesis-5.2",
@@ -85,7 +85,7 @@ fn setup_text(s: Sizing, resolutions: &[u32], variants: &[GridVariant]) -> Strin
          `scenes/{SCENE}`, reflection depth 1, {} pixels, {} angles of the rotation, {} warm-up \
          frame(s) per configuration, resolutions {}, variants {}; the base tracer on the same frames \
          as the reference for speed-up (FPS (run) ratio) and test reduction (mean tests ratio).\n\n",
-        published::SEC52_SETUP,
+        thesis::SEC52_SETUP,
         s.size(),
         s.angles,
         s.warmup,
@@ -96,7 +96,7 @@ fn setup_text(s: Sizing, resolutions: &[u32], variants: &[GridVariant]) -> Strin
 
 /// The thesis' findings (its text; Fig. 21 and 22 are plots) beside ours.
 fn findings(grid: &[&Outcome]) -> String {
-    let [optimum, fewer_tests, memory] = published::SEC52_FINDINGS;
+    let [optimum, fewer_tests, memory] = thesis::SEC52_FINDINGS;
     let memory_ours =
         "see the grid MiB column (the thesis variant's fixed lists: voxels × list length × 4 bytes)";
     let rows = vec![
@@ -104,12 +104,12 @@ fn findings(grid: &[&Outcome]) -> String {
         (fewer_tests, tests_trend(grid)),
         (memory, memory_ours.to_string()),
     ];
-    published::beside_findings("Fig. 21 and 22", rows)
+    thesis::beside_findings("Fig. 21 and 22", rows)
 }
 
 /// The best resolution per variant, inside or outside the thesis' optimum.
 fn best_text(grid: &[&Outcome]) -> String {
-    let (lo, hi) = published::SEC52_OPTIMUM;
+    let (lo, hi) = thesis::SEC52_OPTIMUM;
     let best = sweep::best_resolutions(grid);
     if best.is_empty() {
         return "no grid configuration was measured".to_string();
