@@ -92,6 +92,12 @@ pub struct Row {
     pub host_bytes_per_triangle: u64,
 }
 
+impl std::fmt::Debug for Row {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "design `{}`", self.name)
+    }
+}
+
 impl Row {
     /// "--tracer grid --grid-variant exact", "--shadows".
     pub fn command_line(&self) -> String {

@@ -20,6 +20,8 @@
 //!
 //! The tables, figures and analysis are in [`crate::bench::report::accel_compare`].
 
+use std::sync::LazyLock;
+
 use anyhow::Result;
 
 use super::{Protocol, Section, Units};
@@ -29,6 +31,7 @@ use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, Trac
 use crate::bench::runner::outcome::Outcome;
 use crate::bench::runner::Bench;
 use gpgpu_rt::accel::auto_resolution;
+use gpgpu_rt::design::{self, Pipeline};
 use gpgpu_rt::frame::{FrameStats, RAY_KINDS};
 use gpgpu_rt::reference::stream_grid::auto_dims;
 
@@ -78,115 +81,102 @@ pub const QUICK_BASE_MAX_TRIANGLES: usize = 30_000;
 /// triangles (above it takes minutes, as the thesis says of 100k).
 pub const QUICK_WAGNER_MAX_TRIANGLES: usize = 50_000;
 
-/// An accelerator of the comparison: its name in the tables and figures, its pipeline, and
-/// the tracer for a scene of `triangles` triangles.
-#[derive(Debug)]
+/// An accelerator of the comparison: a point-light design of `design::REGISTRY`, with or
+/// without proximity clouds where it takes them, and its name in the tables and figures.
+#[derive(Debug, Clone, Copy)]
 pub struct Accelerator {
     pub name: &'static str,
-    pub pipeline: Pipeline,
-    tracer: fn(usize) -> TracerSpec,
+    pub row: &'static design::Row,
+    pub proximity_clouds: bool,
 }
 
-/// Which pipeline an accelerator runs in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pipeline {
-    /// Müller 2015's four compute kernels: every kind of ray counted and timed apart.
-    Mueller,
-    /// Wagner 2018's megakernel: one dispatch for every ray of the frame.
-    Wagner,
-    /// Seed 004's fragment passes.
-    Stream,
-}
-
-impl Pipeline {
-    pub fn label(self) -> &'static str {
-        match self {
-            Pipeline::Mueller => "Müller 2015 (4 kernels)",
-            Pipeline::Wagner => "own: Wagner 2018 megakernel",
+impl Accelerator {
+    /// The pipeline it runs in, as the tables name it.
+    pub fn pipeline(&self) -> &'static str {
+        match self.row.pipeline {
+            Pipeline::Mueller2015 => "Müller 2015 (4 kernels)",
+            Pipeline::Wagner2018 => "own: Wagner 2018 megakernel",
             Pipeline::Stream => "own: seed 004 fragment passes",
+            Pipeline::Klee2016 => "own: Klee 2016 soft shadows",
+        }
+    }
+
+    /// Its configuration on a scene of `t` triangles: the grids at `--grid auto`'s
+    /// N = ∛(T/5), the stream's at the paper's ∛T per axis.
+    fn tracer(&self, t: usize) -> TracerSpec {
+        let resolution = auto_resolution(t);
+        match (self.row.name, self.proximity_clouds) {
+            ("grid-exact", true) => TracerSpec::GridPc { resolution },
+            ("stream", proximity_clouds) => TracerSpec::Stream {
+                axes: auto_dims(t).to_array(),
+                proximity_clouds,
+                naive_shadows: false,
+                no_mask: false,
+            },
+            ("grid-thesis", _) => TracerSpec::Grid {
+                variant: GridVariant::Thesis,
+                resolution,
+            },
+            ("grid-exact", _) => TracerSpec::Grid {
+                variant: GridVariant::Exact,
+                resolution,
+            },
+            ("bvh", _) => TracerSpec::Bvh {
+                variant: BvhVariant::Sah,
+            },
+            ("bvh-wagner", _) => TracerSpec::Bvh {
+                variant: BvhVariant::Wagner,
+            },
+            ("base", _) => TracerSpec::Base,
+            (other, _) => unreachable!("accel-compare has no configuration of `{other}`"),
         }
     }
 }
 
-fn grid(variant: GridVariant) -> impl Fn(usize) -> TracerSpec {
-    move |t| TracerSpec::Grid {
-        variant,
-        resolution: auto_resolution(t),
-    }
-}
-
-fn stream(proximity_clouds: bool) -> impl Fn(usize) -> TracerSpec {
-    move |t| TracerSpec::Stream {
-        axes: auto_dims(t).to_array(),
-        proximity_clouds,
-        naive_shadows: false,
-        no_mask: false,
-    }
-}
-
-/// The accelerators, grids at `--grid auto`'s N = ∛(T/5) (the stream's at the paper's ∛T
-/// per axis).
-pub const ACCELERATORS: [Accelerator; 8] = [
-    Accelerator {
-        name: "base",
-        pipeline: Pipeline::Mueller,
-        tracer: |_| TracerSpec::Base,
-    },
-    Accelerator {
-        name: "grid thesis",
-        pipeline: Pipeline::Mueller,
-        tracer: |t| grid(GridVariant::Thesis)(t),
-    },
-    Accelerator {
-        name: "grid exact",
-        pipeline: Pipeline::Mueller,
-        tracer: |t| grid(GridVariant::Exact)(t),
-    },
-    Accelerator {
-        name: "grid exact+pc",
-        pipeline: Pipeline::Mueller,
-        tracer: |t| TracerSpec::GridPc {
-            resolution: auto_resolution(t),
-        },
-    },
-    Accelerator {
-        name: "bvh sah",
-        pipeline: Pipeline::Mueller,
-        tracer: |_| TracerSpec::Bvh {
-            variant: BvhVariant::Sah,
-        },
-    },
-    Accelerator {
-        name: "bvh wagner",
-        pipeline: Pipeline::Wagner,
-        tracer: |_| TracerSpec::Bvh {
-            variant: BvhVariant::Wagner,
-        },
-    },
-    Accelerator {
-        name: "stream g",
-        pipeline: Pipeline::Stream,
-        tracer: |t| stream(false)(t),
-    },
-    Accelerator {
-        name: "stream pc",
-        pipeline: Pipeline::Stream,
-        tracer: |t| stream(true)(t),
-    },
+/// The tables' names of the designs (the columns of the reports since the first run).
+const NAMES: [(&str, bool, &str); 8] = [
+    ("base", false, "base"),
+    ("grid-thesis", false, "grid thesis"),
+    ("grid-exact", false, "grid exact"),
+    ("grid-exact", true, "grid exact+pc"),
+    ("bvh", false, "bvh sah"),
+    ("bvh-wagner", false, "bvh wagner"),
+    ("stream", false, "stream g"),
+    ("stream", true, "stream pc"),
 ];
+
+/// Every point-light design of the registry, with and without proximity clouds where it takes
+/// them, in the registry's order.
+pub static ACCELERATORS: LazyLock<Vec<Accelerator>> = LazyLock::new(|| {
+    let rows = design::REGISTRY
+        .iter()
+        .filter(|r| r.pipeline != Pipeline::Klee2016);
+    rows.flat_map(|row| {
+        let clouds = [false, true].into_iter();
+        clouds
+            .filter(|&pc| !pc || row.takes("proximity-clouds"))
+            .map(move |pc| {
+                let name = NAMES
+                    .iter()
+                    .find(|(r, c, _)| (*r, *c) == (row.name, pc))
+                    .map_or(row.name, |n| n.2);
+                Accelerator {
+                    name,
+                    row,
+                    proximity_clouds: pc,
+                }
+            })
+    })
+    .collect()
+});
 
 /// The accelerator a configuration's tracer belongs to.
 pub fn accelerator_of(spec: &TracerSpec) -> &'static Accelerator {
-    let i = match *spec {
-        TracerSpec::Base => 0,
-        TracerSpec::Grid { variant, .. } => 1 + (variant == GridVariant::Exact) as usize,
-        TracerSpec::GridPc { .. } => 3,
-        TracerSpec::Bvh { variant } => 4 + (variant == BvhVariant::Wagner) as usize,
-        TracerSpec::Stream {
-            proximity_clouds, ..
-        } => 6 + proximity_clouds as usize,
-    };
-    &ACCELERATORS[i]
+    let key = (spec.row().name, spec.proximity_clouds());
+    ACCELERATORS
+        .iter()
+        .find(|a| (a.row.name, a.proximity_clouds) == key)
+        .expect("every configuration's design is compared")
 }
 
 /// Whether `a` runs on a scene of `triangles` triangles at `scale`.
@@ -209,7 +199,7 @@ fn configs(bench: &mut Bench) -> Result<Vec<Config>> {
         let loaded = bench.scene(scene)?;
         let (t, refl) = (loaded.triangle_count(), loaded.settings.refl_depth);
         for a in ACCELERATORS.iter().filter(|a| runs(a, t, scale)) {
-            let mut c = Config::fixed(scene, (a.tracer)(t), (s.width, s.height), s);
+            let mut c = Config::fixed(scene, a.tracer(t), (s.width, s.height), s);
             c.refl_depth = refl;
             c.judge = true;
             v.push(c);
@@ -353,5 +343,37 @@ fn row(o: &Outcome) -> Row {
             e("dropped_triangle_refs") + e("ray_list_overflows")
         }),
         error: o.error.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every point-light design of the registry is compared, with and without proximity clouds
+    /// where it takes them, and each configuration finds its way back to its accelerator.
+    #[test]
+    fn every_point_light_design_is_compared() {
+        for row in design::REGISTRY {
+            let pc = row.takes("proximity-clouds");
+            let compared: Vec<bool> = ACCELERATORS
+                .iter()
+                .filter(|a| a.row.name == row.name)
+                .map(|a| a.proximity_clouds)
+                .collect();
+            let want = match row.pipeline {
+                Pipeline::Klee2016 => vec![],
+                _ if pc => vec![false, true],
+                _ => vec![false],
+            };
+            assert_eq!(compared, want, "{row:?}");
+        }
+        for a in ACCELERATORS.iter() {
+            let spec = a.tracer(70_000);
+            assert_eq!(spec.row().name, a.row.name, "{}", a.name);
+            assert_eq!(accelerator_of(&spec).name, a.name);
+        }
+        let names: Vec<&str> = ACCELERATORS.iter().map(|a| a.name).collect();
+        assert_eq!(names, NAMES.map(|n| n.2), "the reports' columns");
     }
 }

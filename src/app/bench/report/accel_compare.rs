@@ -65,7 +65,7 @@ pub fn write_csv(out: &Path, protocol: &str, rows: &[Row]) -> Result<PathBuf> {
                 r.triangles.to_string(),
                 r.lights.to_string(),
                 r.accelerator.name.into(),
-                r.accelerator.pipeline.label().into(),
+                r.accelerator.pipeline().into(),
                 r.tracer.clone(),
                 kind.into(),
                 format!("{}", w.rays),
@@ -228,7 +228,7 @@ fn configs_table(rows: &[Row]) -> String {
             vec![
                 r.scene.clone(),
                 r.tracer.clone(),
-                r.accelerator.pipeline.label().into(),
+                r.accelerator.pipeline().into(),
                 opt_num(r.build_ms),
                 opt_num(r.bytes.map(|b| b / 1e6)),
                 opt_num(r.frame.mrays_per_s()),

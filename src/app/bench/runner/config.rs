@@ -1,6 +1,7 @@
 //! What a protocol configures: the sizes at each scale, and the configurations it measures
 //! (scene, tracer, image size, reflection depth, rotation angles, warm-up frames).
 
+use gpgpu_rt::design::Row;
 pub use gpgpu_rt::scene::Overrides;
 
 /// Default image size at `--scale quick`: small enough for Mesa llvmpipe.
@@ -79,6 +80,37 @@ pub enum TracerSpec {
 }
 
 impl TracerSpec {
+    /// Its design in `design::REGISTRY`.
+    pub fn row(&self) -> &'static Row {
+        let name = match self {
+            TracerSpec::Base => "base",
+            TracerSpec::Grid {
+                variant: GridVariant::Thesis,
+                ..
+            } => "grid-thesis",
+            TracerSpec::Grid { .. } | TracerSpec::GridPc { .. } => "grid-exact",
+            TracerSpec::Bvh {
+                variant: BvhVariant::Sah,
+            } => "bvh",
+            TracerSpec::Bvh {
+                variant: BvhVariant::Wagner,
+            } => "bvh-wagner",
+            TracerSpec::Stream { .. } => "stream",
+        };
+        gpgpu_rt::design::row(name).expect("the registry has every tracer of the bench")
+    }
+
+    /// Whether it skips empty cells by proximity clouds.
+    pub fn proximity_clouds(&self) -> bool {
+        match *self {
+            TracerSpec::GridPc { .. } => true,
+            TracerSpec::Stream {
+                proximity_clouds, ..
+            } => proximity_clouds,
+            _ => false,
+        }
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             TracerSpec::Base => "base",
