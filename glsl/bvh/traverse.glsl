@@ -38,31 +38,31 @@
 // costs several times more than these loads (docs/design/bvh.md, steps 0 and 1).
 //
 // Two loops in a loop (ours; "while-while", Aila and Laine 2009): the inner node loop walks
-// until the lane has entered a leaf or is done, the inner triangle loop then tests that
-// leaf's triangles, and the outer loop goes on while the walk does. llvmpipe runs the 8
-// invocations of a SIMD group in lock step and executes both sides of an `if` under a lane
-// mask, so each inner loop runs until its last lane leaves it, the others waiting: a lane that
-// entered a leaf waits for the group's other lanes to enter theirs. That waiting costs less
-// than the alternative, a single loop whose every iteration takes a node step or a triangle:
-// there every lane pays Algorithm 1 and a triangle's texels in every step, where a node step
-// reads one texel (docs/design/bvh.md, steps 5, 10 and 17). The walk's order and counts are
-// the same either way. Each node is visited at most once, so the node steps are bounded by the records
+// until the lane has entered a leaf or is done, the inner triangle loop then tests that leaf's
+// triangles, and the outer loop goes on while the walk does. llvmpipe runs the 8 invocations of
+// a SIMD group in lock step and executes both sides of an `if` under a lane mask, so each inner
+// loop runs until its last lane leaves it, the others waiting: a lane that entered a leaf waits
+// for the group's other lanes to enter theirs. That waiting costs less than the alternative, a
+// single loop whose every iteration takes a node step or a triangle: there every lane pays
+// Algorithm 1 and a triangle's texels in every step, where a node step reads one texel
+// (docs/design/bvh.md, steps 5, 10 and 17). The walk's order and counts are the same either
+// way. Each node is visited at most once, so the node steps are bounded by the records
 // (`guard`, which also counts the nodes visited: no counter in the node loop), the triangle
 // loop by its leaf's count (below 2^BVH_LEAF_COUNT_BITS), and the outer loop by the node steps,
 // as each of its passes takes one; a walk cut short (that bound, or llvmpipe's loop limit, see
 // loopLimit in common/intersect.glsl) counts the ray as truncated.
 //
-// The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the
-// end of an iteration, and an `if` around a loop did not skip it, so a loop entered with no
-// lane left to run, or a `while` whose last lanes leave at its top, still executes one whole
-// pass under an empty mask. As do-whiles — entered where every active lane has work (the first step of a walk, of its
-// next leaf search), the triangle loop behind the lanes that entered a leaf — each loop's exit
-// test is its back edge, and what is left is one triangle pass per SIMD group (the last outer
-// pass, whose lanes all end their walk without a leaf) (docs/design/bvh.md, step 18).
-// The outer loop's first pass needs no test of its own: the test inside it holds (node < end,
-// guard = 0 < bound) unless the walk's block entry is empty (node == end, bvh/entry.comp: every
-// ray of the block misses the root), and the outer loop goes on only with node < end and
-// guard < bound.
+// The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the end
+// of an iteration, and an `if` around a loop did not skip it, so a loop entered with no lane
+// left to run, or a `while` whose last lanes leave at its top, still executes one whole pass
+// under an empty mask. As do-whiles — entered where every active lane has work (the first step
+// of a walk, of its next leaf search), the triangle loop behind the lanes that entered a leaf —
+// each loop's exit test is its back edge, and what is left is one triangle pass per SIMD group
+// (the last outer pass, whose lanes all end their walk without a leaf) (docs/design/bvh.md,
+// step 18). The outer loop's first pass needs no test of its own: the test inside it holds
+// (node < end, guard = 0 < bound) unless the walk's block entry is empty (node == end,
+// bvh/entry.comp: every ray of the block misses the root), and the outer loop goes on only with
+// node < end and guard < bound.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
