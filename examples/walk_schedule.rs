@@ -11,7 +11,7 @@
 //! leaves it, and a loop entered by no lane once under an empty mask
 //! (`glsl/bvh/traverse.glsl`). This program walks each primary ray of the AOV directory through
 //! the records of [`Bvh::gpu_words`] as `traverse` does — node passes of one record, or of two
-//! where the walk goes on at the next record (step 24 of `docs/results/bvh_steps.md`), the
+//! where the walk goes on at the next record (step 24 of `docs/design/bvh.md`), the
 //! triangle loop over each entered leaf — and counts per SIMD group the passes of the node
 //! loop and of the triangle loop, which are the trip counts callgrind measures per JIT block,
 //! beside what the lanes would need alone. It then counts two schedules that Mesa 22.3's
@@ -48,7 +48,7 @@ const TILE: usize = 256;
 
 /// A SIMD group's instructions (callgrind, the dragon's intersect1 at step 24): a node pass
 /// 212, a triangle pass 249, the rest of the kernel about 1,420 (its straight-line code and
-/// the record store, docs/results/bvh_steps.md, sixth session).
+/// the record store; `docs/design/bvh.md`).
 fn group_cost(c: &Counts) -> f64 {
     212.0 * c.node_passes as f64 + 249.0 * c.triangle_passes as f64 + 1420.0
 }
@@ -76,7 +76,7 @@ struct Records<'a> {
 }
 
 /// The entry point of every 8×8 block of the image (`glsl/bvh/entry.comp`, step 26 of
-/// `docs/results/bvh_steps.md`), the blocks in GL's order (rows from the bottom).
+/// `docs/design/bvh.md`), the blocks in GL's order (rows from the bottom).
 struct Entries {
     blocks: Vec<Option<BlockEntry>>,
     width: usize,

@@ -8,8 +8,8 @@
 // In the word buffer rather than an image of their own (ours): the BVH's kernels bind the
 // pipeline's ray-state images at units 0–6 and the word buffer at 7, the 8 image units GL 4.5
 // guarantees (GL_MAX_IMAGE_UNITS), and intersect1 reads its entry as it reads a node record.
-// (A storage buffer instead took 1.08 of the dragon's intersect1 time on llvmpipe, 12 pairs:
-// its load per invocation is not the image's one texel load; docs/results/bvh_steps.md.)
+// (Not a storage buffer: on llvmpipe its load per invocation is a loop of per-lane loads where
+// the image's is one texel load; docs/design/bvh.md, step 26b.)
 
 // (BVH_ENTRY_TEXELS: the image's blocks, BVH_BLOCKS_X of them a row; #defines of the host)
 // the texel of the entry of the block of pixels 8·block .. 8·block + 7

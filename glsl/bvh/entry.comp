@@ -18,10 +18,8 @@
 // the first dispatch (the host uploads zeros; bvh/entries.glsl), and its rays walk from their
 // roots.
 //
-// On llvmpipe (docs/results/bvh_steps.md, step 26): the primary rays of the dragon at 512²
-// visit 22.8 nodes each instead of 31.0, for 8.8 M instructions in this kernel (some 3 % of
-// the dragon's intersect1, 6 % of the bunny's: mostly the loads of the blocks' rays); the
-// kernel is timed as part of intersect1.
+// The kernel is timed as part of intersect1; what it saves there and what it costs:
+// docs/design/bvh.md, step 26.
 #include "../common/images.glsl"
 #define BVH_WORDS_WRITABLE
 #include "words.glsl"

@@ -20,12 +20,12 @@
 //             and a leaf's miss link is the next record;
 //   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0.
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh.rs. The header as uniforms took more instructions on llvmpipe than its
-// two texels: docs/results/bvh_steps.md, step 23.) A node step reads one texel, a triangle
+// host, src/accel/bvh.rs. The header is two texels, not uniforms: llvmpipe's uniform loads
+// cost more than texel loads, docs/design/bvh.md, step 23.) A node step reads one texel, a triangle
 // three (on llvmpipe each eight 128-bit loads, a transpose and a bounds check, where a 32-bit
 // word costs a gather with its bounds check). Ours: the copies per octant (twice the memory of
 // one 64-byte node with 8 links) save the texel of the links, the choice of the octant's link
-// and near child, and the slab test's choice of planes (docs/results/bvh_steps.md, step 16);
+// and near child, and the slab test's choice of planes (docs/design/bvh.md, step 16);
 // the 16-bit planes (the box on the grid holds the node's float box: low planes rounded down,
 // high ones up) save the second texel of a node, for two instructions more per plane (step 23).
 //
@@ -35,38 +35,34 @@
 // plane, unless the ray points down the split axis — and every box missed, or beyond the
 // limit, and every leaf done is followed by its miss link: a depth-first walk, near side first,
 // pruned by the closest hit so far (or the light). On llvmpipe a per-invocation stack array
-// costs several times more than these loads (docs/results/bvh_steps.md).
+// costs several times more than these loads (docs/design/bvh.md, steps 0 and 1).
 //
 // Two loops in a loop (ours; "while-while", Aila and Laine 2009): the inner node loop walks
-// until the lane has entered a leaf or is done, the inner triangle loop then tests that
-// leaf's triangles, and the outer loop goes on while the walk does. llvmpipe runs the 8
-// invocations of a SIMD group in lock step and executes both sides of an `if` under a lane
-// mask, so each inner loop runs until its last lane leaves it, the others waiting: a lane that
-// entered a leaf waits for the group's other lanes to enter theirs. Until step 16 a single
-// loop whose every iteration took a node step or a triangle, then a second node step, paid
-// less (a lane tested its triangles while the others walked on); since a node step then read only
-// two texels (the octant's records), the node loop is a third of that iteration — Algorithm 1
-// and the triangle's third texel no longer paid in every step — and the waiting costs less
-// than it (docs/results/bvh_steps.md, step 17). The walk's order and counts are the same
-// either way. Each node is visited at most once, so the node steps are bounded by the records
+// until the lane has entered a leaf or is done, the inner triangle loop then tests that leaf's
+// triangles, and the outer loop goes on while the walk does. llvmpipe runs the 8 invocations of
+// a SIMD group in lock step and executes both sides of an `if` under a lane mask, so each inner
+// loop runs until its last lane leaves it, the others waiting: a lane that entered a leaf waits
+// for the group's other lanes to enter theirs. That waiting costs less than the alternative, a
+// single loop whose every iteration takes a node step or a triangle: there every lane pays
+// Algorithm 1 and a triangle's texels in every step, where a node step reads one texel
+// (docs/design/bvh.md, steps 5, 10 and 17). The walk's order and counts are the same either
+// way. Each node is visited at most once, so the node steps are bounded by the records
 // (`guard`, which also counts the nodes visited: no counter in the node loop), the triangle
 // loop by its leaf's count (below 2^BVH_LEAF_COUNT_BITS), and the outer loop by the node steps,
 // as each of its passes takes one; a walk cut short (that bound, or llvmpipe's loop limit, see
 // loopLimit in common/intersect.glsl) counts the ray as truncated.
 //
-// The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the
-// end of an iteration, and an `if` around a loop did not skip it, so a loop entered with no
-// lane left to run, or a `while` whose last lanes leave at its top, still executes one whole
-// pass under an empty mask. Counted per instruction (callgrind, bunny): the while loops ran
-// 20.5 node passes and 4.9 triangle passes per SIMD group where the group needs 17.9 and 2.3.
-// As do-whiles — entered where every active lane has work (the first step of a walk, of its
-// next leaf search), the triangle loop behind the lanes that entered a leaf — each loop's exit
-// test is its back edge, and what is left is one triangle pass per SIMD group (the last outer
-// pass, whose lanes all end their walk without a leaf) (docs/results/bvh_steps.md, step 18).
-// The outer loop's first pass needs no test of its own: the test inside it holds (node < end,
-// guard = 0 < bound) unless the walk's block entry is empty (node == end, bvh/entry.comp: every
-// ray of the block misses the root), and the outer loop goes on only with node < end and
-// guard < bound.
+// The loops are do-whiles (ours): Mesa 22.3's llvmpipe tests a loop's lane mask only at the end
+// of an iteration, and an `if` around a loop did not skip it, so a loop entered with no lane
+// left to run, or a `while` whose last lanes leave at its top, still executes one whole pass
+// under an empty mask. As do-whiles — entered where every active lane has work (the first step
+// of a walk, of its next leaf search), the triangle loop behind the lanes that entered a leaf —
+// each loop's exit test is its back edge, and what is left is one triangle pass per SIMD group
+// (the last outer pass, whose lanes all end their walk without a leaf) (docs/design/bvh.md,
+// step 18). The outer loop's first pass needs no test of its own: the test inside it holds
+// (node < end, guard = 0 < bound) unless the walk's block entry is empty (node == end,
+// bvh/entry.comp: every ray of the block misses the root), and the outer loop goes on only with
+// node < end and guard < bound.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
 // (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
@@ -91,7 +87,7 @@ int triangleBase = 0;
 // of the root's extent plus the ray origin's distance from the grid — where (plane − ro)·inv
 // errs by 2^-24 of the distance to the plane — and the boxes' padding of 1e-5 of the scene's
 // extent (src/reference/bvh/build.rs) covers it for origins within some 80 extents of the scene
-// (docs/results/bvh_steps.md, step 23).
+// (docs/design/bvh.md, step 23).
 //
 // Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
 // bits — llvmpipe's float min and max are NaN-aware, three instructions each, the integer ones
@@ -125,10 +121,8 @@ void nodeStep(bool entered, int reference, inout int node, inout int leaf)
 // One pass of the node loop: the step of the record at texel `node`, and where that step goes
 // on to the next record — after an inner node entered or a leaf missed — the step of that record
 // too, whose texel is loaded and tested beside the first (ours). On llvmpipe the second
-// record's independent load and test cost less than a pass of their own: the bunny's node
-// passes per SIMD group 17.9 → 12.1 at 210 instructions instead of 122, 0.95 of the time
-// (docs/results/bvh_steps.md, step 24; not for the overlap of two chains of latencies alone:
-// a second walk's chain in the same loop did not pay, sixth session). `steps`: 1 or 2, the
+// record's independent load and test cost less than a pass of their own (docs/design/bvh.md,
+// step 24). `steps`: 1 or 2, the
 // nodes visited; the walk's order and counts are those of single steps. (At the octant's last
 // record the second texel is the next octant's root or the first leaf triangle, or for an
 // empty last octant past the buffer, which imageLoad reads as 0: loaded, never used.)

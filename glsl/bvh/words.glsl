@@ -11,8 +11,7 @@ layout(rgba32ui, binding = IMAGE_BVH) readonly uniform uimageBuffer bvh;
 // The texel of index `texel` (a node record). Its index masked to BVH_TEXEL_INDEX_MASK (the
 // host's: the buffer has fewer texels, so no valid index changes): llvmpipe's LLVM then knows
 // the index is not negative and zero-extends each lane's texel offset for free, where it
-// sign-extended them (8 `movslq` per texel load; the node loop 160 -> 146 instructions a pass,
-// docs/results/bvh_steps.md, step 19).
+// sign-extended them (8 `movslq` per texel load; docs/design/bvh.md, step 19).
 uvec4 bvhRecord(int texel) { return imageLoad(bvh, int(uint(texel) & BVH_TEXEL_INDEX_MASK)); }
 // The texel at word address `at` (a multiple of 4: the header, a leaf triangle).
 uvec4 bvhTexel(int at) { return bvhRecord(int(uint(at) >> 2u)); }

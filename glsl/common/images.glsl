@@ -28,19 +28,15 @@ uniform ivec2 tileOffset;
 // on — ours, not in the thesis; any one-to-one map does, and a GPU hardly cares. On llvmpipe:
 // - Mesa's llvmpipe hands each of its N threads one contiguous 1/N of a dispatch's work groups,
 //   row after row, so with an object in the middle of the image one thread got the busy rows
-//   and the others waited (the bunny's BVH intersect1: 34 ms on two threads, 26 ms with
-//   LP_NUM_THREADS=3 on the same two cores). Work-group row y < rows − 1 therefore covers the
+//   and the others waited. Work-group row y < rows − 1 therefore covers the
 //   tile's row y·tileRowStride mod (rows − 1), and the last row itself: where the N threads
 //   divide the rows the stride is N, which gives thread t the rows t, t + N, t + 2N, … —
 //   neighbours of the other threads' rows, so every share costs about the same; else a stride
 //   coprime to rows − 1 near (rows − 1)/φ, which spreads every contiguous share over the tile
-//   (PixelGrid::row_stride, GlInfo::dispatch_threads). The earlier order, y·s mod rows with s
-//   near rows/φ for any thread count, left two threads' shares 0.91 of an even split (the
-//   bunny's and the dragon's BVH intersect1, examples/walk_schedule.rs), the shuffle 0.98–0.99;
-//   24 alternating pairs gave 0.92 of the time, later runs on a slower machine did not confirm
-//   it (docs/results/bvh_steps.md, step 25).
+//   (PixelGrid::row_stride, GlInfo::dispatch_threads; examples/walk_schedule.rs weighs the
+//   shares; docs/design/frame.md).
 // - llvmpipe runs 8 invocations of consecutive x as one SIMD group; they take a 4×2 block of
-//   pixels instead of a row of 8, whose rays diverge less (BVH intersect1 ~5 % faster).
+//   pixels instead of a row of 8, whose rays diverge less (docs/design/frame.md).
 uniform int tileRowStride;
 
 // The pixel this invocation works on (storePos in the thesis, ch. 4).

@@ -16,11 +16,9 @@
 // invocation also loads the ray texels of its place in the next work group, 8
 // pixels on in x — the group the same llvmpipe thread runs next (its share of a dispatch is a
 // contiguous run of work groups, row by row) — so that they are in the core's caches when that
-// group starts. The first use of an invocation's own ray texels was the kernel's one hot spot
-// outside the walk (15 % of the BVH intersect1's samples, bunny), where a SIMD group's walk
-// waits for its ray; with the loads, the BVH intersect1 took 0.93 of the time (paired alternating
-// renders; two work groups ahead: 1.12; in intersect2, or for the pixel records, no gain)
-// (docs/results/bvh_steps.md, step 21). Their values are folded into `truncated` through
+// group starts: the first use of an invocation's own ray texels is where a SIMD group's walk
+// waits for its ray (docs/design/frame.md; docs/design/bvh.md, step 21). One group ahead, not
+// two; in intersect1 only. Their values are folded into `truncated` through
 // prefetchZero, a uniform the host never sets (GL makes it 0 at link time), so that the
 // compiler must keep the loads and nothing changes. Out of the image, imageLoad reads zeros.
 #if PREFETCH_RAYS

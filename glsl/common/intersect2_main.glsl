@@ -37,11 +37,9 @@ void trace(ivec2 storePos)
     vec3 n = imageLoad(normalTexture, storePos).xyz;
     // Ours: the pixel's shadow flags are loaded here, before the search, where Listing 15
     // loads them after it to set the flag — no other invocation writes this texel in the
-    // dispatch, so the value is the same, and its load's latency hides behind the search. On
-    // llvmpipe the load after the walk waited for memory at the end of every invocation (in a
-    // sampling profile of the dragon's intersect2, about 5 % of the kernel); loaded here, the
-    // BVH's intersect2 took 0.94 of the time on the dragon, 0.98 on the bunny (12 alternating
-    // pairs each, docs/results/bvh_steps.md, ninth session).
+    // dispatch, so the value is the same, and its load's latency hides behind the search (on
+    // llvmpipe a load after the walk waits for memory at the end of every invocation:
+    // docs/design/frame.md; docs/design/bvh.md, step 27).
 #if SHADOW_BITS
     uvec4 flags = imageLoad(shadowTexture, storePos);
 #else

@@ -7,8 +7,8 @@
 // from which common/evaluate_hit.comp finds the hit again (t, triangle id, u, v;
 // bvh/hit_record.glsl) and then does what Listings 13 and 14 do inside the thesis' intersect1.
 // Both are plain vector stores: on llvmpipe an image store goes lane by lane and component by
-// component, and a shared-memory atomic lane by lane (docs/results/bvh_steps.md), which made
-// them cost more than the BVH walk itself.
+// component, and a shared-memory atomic lane by lane, which made them cost more than the BVH
+// walk itself (docs/design/frame.md).
 
 // What intersect1's closestHit leaves for evaluate_hit.comp to find its hit again — the SAH
 // BVH, the one design with hit records: the word address of the hit's leaf triangle
@@ -17,16 +17,14 @@ int closestHitRecord = -1;
 
 // One record per pixel: xy its counts (packCounts), z its hit record (intersect1 only). One
 // store per invocation: on llvmpipe every store costs a loop over the 8 lanes per component
-// and about as much again for the store itself (a second store of the hit record cost ~1 ms
-// of the bunny's intersect1, docs/results/bvh_steps.md).
+// and about as much again for the store itself (docs/design/frame.md).
 layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordBuffer { uvec4 pixelRecord[]; };
 #if RECORD_STORE_64
 // The same records as two 64-bit words (GL_ARB_gpu_shader_int64, which the including kernel
 // enables): the counts' two words and the hit record's (its high half 0), for the stores of
 // intersect_head.glsl (intersect1: both, one store of two components; intersect2: the
-// counts) — on llvmpipe a store costs a loop over the 8 lanes per component, and the BVH's
-// intersect1 took 0.95 of the time with two components instead of three
-// (docs/results/bvh_steps.md, step 22).
+// counts) — on llvmpipe a store costs a loop over the 8 lanes per component, so two
+// components cost less than three (docs/design/frame.md; docs/design/bvh.md, step 22).
 layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordWords {
     u64vec2 pixelRecordWords[];
 };

@@ -63,7 +63,7 @@ fn upload(gl: &Gl, bvh: &CpuBvh, blocks: u32) -> Result<TextureBuffers> {
 /// Bits of a texel index of the word buffer: its 16-byte texels number fewer than 2^27, as
 /// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more. `glsl/bvh/words.glsl` masks the
 /// index to them (no valid index changes), which lets llvmpipe's LLVM see that it is not
-/// negative (`docs/results/bvh_steps.md`, step 19).
+/// negative (`docs/design/bvh.md`, step 19).
 const TEXEL_INDEX_BITS: u32 = 27;
 
 /// `BVH_TEXEL_INDEX_MASK` ([`TEXEL_INDEX_BITS`]) for every kernel that reads the word buffer

@@ -323,7 +323,7 @@ impl TextureBuffer {
     /// Bind to image unit `unit` with `access` (`glow::READ_ONLY`: an `imageBuffer` with
     /// `layout(format, binding = unit) readonly`). llvmpipe generates image loads inline, where
     /// it calls a function for every `texelFetch` of a format other than 8-bit RGBA
-    /// (docs/results/bvh_steps.md).
+    /// (docs/design/bvh.md, step 2).
     pub fn bind_image(&self, gl: &Gl, unit: u32, access: u32) {
         bind_image_unit(gl, unit, self.texture, access, self.format);
     }

@@ -77,8 +77,8 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
 /// The largest distance the exact grid's per-frame pass computes (`glsl/exact_grid/
 /// proximity.comp`, uniform `cloudCap`): each voxel scans its line outward only as far as its
 /// distance so far, so the cap bounds the pass at 2·(cap − 1) reads per voxel and axis (without
-/// it the empty voxels of the bunny's 128³ grid scanned their whole lines: 9.6 s a frame on
-/// llvmpipe, more than the jumps saved). A capped distance, min(d, cap), is still safe — it
+/// it the empty voxels scan their whole lines, which costs more than the jumps save:
+/// `docs/design/exact-grid.md`). A capped distance, min(d, cap), is still safe — it
 /// only claims a smaller cube empty — and the separable passes compute exactly min(d, cap);
 /// the jumps then skip at most 2·cap − 1 voxels. The streaming grid's distances, computed once
 /// on the CPU, are not capped.

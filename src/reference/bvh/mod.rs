@@ -26,9 +26,9 @@
 //! plane (the left unless the ray points down the split axis), and skipping a subtree by its
 //! miss link when the ray misses its box or enters it beyond the current limit (the closest
 //! hit so far, or the light). This is the ordered, pruned traversal of a stack walk with the
-//! order decided by the split axis instead of the entry distances; we measured it several
-//! times faster on llvmpipe, where a per-invocation stack array costs far more than a texel
-//! fetch (docs/results/bvh_steps.md).
+//! order decided by the split axis instead of the entry distances: on llvmpipe a
+//! per-invocation stack array costs far more than a texel fetch (docs/design/bvh.md, steps 0
+//! and 1).
 
 use std::ops::ControlFlow;
 

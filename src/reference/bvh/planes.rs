@@ -1,5 +1,5 @@
 //! The boxes of the kernels' node records as 16-bit planes on a grid over the root's box (ours;
-//! `docs/results/bvh_steps.md`, step 23): a record is one texel, where the box as floats took
+//! `docs/design/bvh.md`, step 23): a record is one texel, where the box as floats took
 //! two, and a slab's distance is the plane's grid step count times one per-ray factor plus
 //! another. The CPU twin tests the same boxes with the same arithmetic ([`RayGrid::t`]).
 
