@@ -50,7 +50,7 @@
 //!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
 //!    measurements depend on each other.
 //! 4. Add a variant with `#[value(name = "...")]` to [`ProtocolId`] and its line in
-//!    [`protocol_of`]; mention it in the README's benchmark section.
+//!    [`protocol_of`]; mention it in `docs/bench.md`.
 
 pub mod accel_compare;
 pub mod accel_compare_report;
