@@ -31,7 +31,7 @@ pub fn message(kernel: &str, files: &[&str], renderer: &str) -> String {
         "error: the GL driver ({renderer}) crashed; the program in use was kernel `{kernel}` \
          ({}). The driver's own message, if it printed one, is above. The program compiled \
          and linked; a driver that builds its pipelines late (zink) may still refuse it when \
-         it first runs. Try another driver (README, \"Drivers\") or report it with the \
+         it first runs. Try another driver (docs/drivers.md) or report it with the \
          command line.\n",
         files.join(" + ")
     )

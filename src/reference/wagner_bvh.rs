@@ -11,7 +11,7 @@
 //!                       SAH(left) + SAH(right) < minimumCost → remember, else increase distance
 //! ```
 //!
-//! Where the listings leave a choice, we chose (also in the README, "Wagner 2018"):
+//! Where the listings leave a choice, we chose (also in `docs/wagner2018.md`):
 //! - **`distance`** is the distance of the split plane from the node's minimum along the axis,
 //!   and a triangle's box goes left when its centre (centroid of the box) lies below the plane.
 //!   **"increase distance"** moves the plane to the next box centre along the axis: every

@@ -1,6 +1,6 @@
 //! Scenes: a TOML scene file with a camera, background and ambient colour, point lights and
 //! objects (OBJ and PLY files, or the procedural `teapot`, `floor`, `sphere` and `square`), each
-//! with a transform and a material. See `scenes/*.toml` and the README for the format.
+//! with a transform and a material. See `scenes/*.toml` and `docs/scenes.md` for the format.
 
 pub mod bpt;
 pub mod budget;

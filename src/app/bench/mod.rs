@@ -55,7 +55,7 @@
 //!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
 //!    measurements depend on each other.
 //! 4. Add a variant with `#[value(name = "...")]` to [`runner::args::ProtocolId`] and its line in
-//!    [`protocol_of`]; mention it in the README's benchmark section.
+//!    [`protocol_of`]; mention it in `docs/bench.md`.
 
 pub mod protocols;
 pub mod published;
