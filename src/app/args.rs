@@ -174,8 +174,8 @@ pub struct SoftShadowArgs {
     /// 3": root, nodes of 1/N, leaves of 1/N²; only one level of line spaces is asked, no
     /// cascade) or 4 (reading B: "Tiefe null ist die Tiefe der Kinder des Wurzelknotens", so
     /// depths 0, 1, 2 below the root; leaves of 1/N³, a cascade of two line-space levels).
-    /// The number counts levels with the root, not the thesis' depth index (README, "where we
-    /// differ").
+    /// The number counts levels with the root, not the thesis' depth index (docs/klee2016.md,
+    /// "where we differ").
     #[arg(long, default_value_t = 3, value_name = "LEVELS")]
     pub ntree_depth: u32,
     /// How the shadow value s lights a pixel: `lit` (ours: diffuse · (ambient + light · s ·
