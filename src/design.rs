@@ -68,7 +68,7 @@ pub const COMMON_OPTIONS: &[&str] = &[
 ];
 
 /// The options of Müller 2015's pipeline, whatever its accelerator.
-const MUELLER: [&str; 4] = ["tracer", "refl-depth", "shadow-flags", "tile"];
+const MUELLER: &[&str] = &["tracer", "refl-depth", "shadow-flags", "tile"];
 
 /// One design of the registry.
 pub struct Row {
@@ -82,8 +82,9 @@ pub struct Row {
     pub select: &'static [(&'static str, &'static str)],
     /// The accelerator of Müller 2015's pipeline (its GPU side and CPU twin).
     pub accel: Option<&'static accel::Entry>,
-    /// The options, beyond [`COMMON_OPTIONS`], that belong to it (long names without `--`).
-    pub options: &'static [&'static str],
+    /// The options, beyond [`COMMON_OPTIONS`], that belong to it (long names without `--`),
+    /// in groups (those of its pipeline, of its accelerator).
+    pub options: &'static [&'static [&'static str]],
     /// Its shader folders under `glsl/` (beside `glsl/common/`).
     pub glsl: &'static [&'static str],
     /// Host bytes per triangle it takes while it is built and uploaded, beyond the loaded mesh
@@ -112,9 +113,14 @@ impl Row {
         v.join(" ")
     }
 
+    /// The options, beyond [`COMMON_OPTIONS`], that belong to it.
+    pub fn options(&self) -> impl Iterator<Item = &'static str> {
+        self.options.iter().flat_map(|group| group.iter().copied())
+    }
+
     /// Whether `option` (a long name) belongs to it.
     pub fn takes(&self, option: &str) -> bool {
-        COMMON_OPTIONS.contains(&option) || self.options.contains(&option)
+        COMMON_OPTIONS.contains(&option) || self.options().any(|o| o == option)
     }
 }
 
@@ -139,25 +145,8 @@ mod host_bytes {
     pub const KLEE: u64 = 0;
 }
 
-const GRID_THESIS: &[&str] = &[
-    "tracer",
-    "refl-depth",
-    "shadow-flags",
-    "tile",
-    "grid",
-    "grid-variant",
-    "voxel-array-length",
-    "ray-array-length",
-];
-const GRID_EXACT: &[&str] = &[
-    "tracer",
-    "refl-depth",
-    "shadow-flags",
-    "tile",
-    "grid",
-    "grid-variant",
-    "proximity-clouds",
-];
+/// The options of the uniform grids of Müller 2015's pipeline.
+const GRID: &[&str] = &["grid", "grid-variant"];
 
 /// Every design, in the order reports list them.
 pub const REGISTRY: &[Row] = &[
@@ -167,7 +156,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the base tracer (every ray against every triangle)",
         select: &[("tracer", "base")],
         accel: Some(&accel::brute_force::ENTRY),
-        options: &MUELLER,
+        options: &[MUELLER],
         glsl: &["mueller2015", "brute_force"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
     },
@@ -177,7 +166,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the thesis' uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "thesis")],
         accel: Some(&accel::thesis_grid::ENTRY),
-        options: GRID_THESIS,
+        options: &[MUELLER, GRID, &["voxel-array-length", "ray-array-length"]],
         glsl: &["mueller2015", "thesis_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
     },
@@ -187,7 +176,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the exact uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "exact")],
         accel: Some(&accel::exact_grid::ENTRY),
-        options: GRID_EXACT,
+        options: &[MUELLER, GRID, &["proximity-clouds"]],
         glsl: &["mueller2015", "exact_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
     },
@@ -197,13 +186,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with our SAH BVH",
         select: &[("tracer", "bvh"), ("bvh-variant", "sah")],
         accel: Some(&accel::bvh::ENTRY),
-        options: &[
-            "tracer",
-            "refl-depth",
-            "shadow-flags",
-            "tile",
-            "bvh-variant",
-        ],
+        options: &[MUELLER, &["bvh-variant"]],
         glsl: &["mueller2015", "bvh"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD + host_bytes::SAH_BVH,
     },
@@ -213,7 +196,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Wagner 2018's kernel (one light, hard shadows, no reflection) over his BVH",
         select: &[("tracer", "bvh"), ("bvh-variant", "wagner")],
         accel: None,
-        options: &["tracer", "bvh-variant", "tile"],
+        options: &[&["tracer", "bvh-variant", "tile"]],
         glsl: &["wagner2018"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::WAGNER,
     },
@@ -223,7 +206,7 @@ pub const REGISTRY: &[Row] = &[
         title: "seed 004's streaming tracer (fragment programs, a static grid)",
         select: &[("tracer", "stream")],
         accel: None,
-        options: &[
+        options: &[&[
             "tracer",
             "refl-depth",
             "grid",
@@ -233,7 +216,7 @@ pub const REGISTRY: &[Row] = &[
             "stream-naive-shadows",
             "stream-no-mask",
             "stream-single-sided",
-        ],
+        ]],
         glsl: &["stream"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::STREAM,
     },
@@ -243,14 +226,14 @@ pub const REGISTRY: &[Row] = &[
         title: "Klee 2016's soft shadows (N-tree, Cascaded Line Space)",
         select: &[],
         accel: None,
-        options: &[
+        options: &[&[
             "shadows",
             "light-samples",
             "ntree-n",
             "ntree-depth",
             "klee-shading",
             "tile",
-        ],
+        ]],
         glsl: &["klee2016"],
         host_bytes_per_triangle: host_bytes::KLEE,
     },
@@ -296,7 +279,7 @@ pub fn refuse_foreign(row: &Row, given: &[String], chosen: &str) -> Result<()> {
         .map(|o| {
             let takers: Vec<String> = REGISTRY
                 .iter()
-                .filter(|r| r.options.contains(&o.as_str()))
+                .filter(|r| r.options().any(|t| t == o.as_str()))
                 .map(|r| format!("{} ({})", r.name, r.command_line()))
                 .collect();
             format!("--{o} applies to {} only", takers.join(", "))

@@ -376,11 +376,7 @@ impl DesignArgs {
 /// the registry, looked up in `matches`.
 fn given(matches: Option<&ArgMatches>) -> Vec<String> {
     let Some(m) = matches else { return Vec::new() };
-    let mut all: Vec<&str> = design::REGISTRY
-        .iter()
-        .flat_map(|r| r.options)
-        .copied()
-        .collect();
+    let mut all: Vec<&str> = design::REGISTRY.iter().flat_map(|r| r.options()).collect();
     all.sort_unstable();
     all.dedup();
     all.into_iter()
