@@ -1,10 +1,9 @@
 //! What the window shows: a ray tracer with its options, or the soft shadows with theirs.
 
-use super::renderer::{
-    soft_shadow_support, BvhVariant, ShadowMode, Show, Stats, TracerArg, TracerOptions,
-};
+use super::renderer::{soft_shadow_support, ShadowMode, Show, Stats, TracerArg, TracerOptions};
 pub use crate::args::value_name;
 use crate::args::SoftShadowArgs;
+use gpgpu_rt::design::Pipeline;
 use gpgpu_rt::scene::Scene;
 
 /// The design shown and the options of both kinds: the keys change them, the renderers are
@@ -105,7 +104,7 @@ impl Design {
 
     /// Wagner 2018's pipeline (`--tracer bvh --bvh-variant wagner`): no reflection.
     fn wagner(&self) -> bool {
-        self.kind == TracerArg::Bvh && self.options.args.bvh_variant == BvhVariant::Wagner
+        self.options.row(self.kind).pipeline == Pipeline::Wagner2018
     }
 
     /// "base", "bvh sah", "bvh wagner", "grid exact 16³", "grid thesis auto=12³".

@@ -19,7 +19,7 @@ use gpgpu_rt::scene::{Camera, Scene};
 
 pub use crate::args::{DesignArgs, GridResolution, TracerArg};
 pub use gpgpu_rt::accel::{BvhVariant, GridVariant};
-use gpgpu_rt::design::Design;
+use gpgpu_rt::design::{Design, Row};
 pub use gpgpu_rt::scene::ShadowMode;
 
 /// The ray tracer's options in the window: the command line's design options, which the keys
@@ -34,14 +34,22 @@ pub struct TracerOptions {
 }
 
 impl TracerOptions {
+    /// The ray tracer `kind` with these options: its row of the registry.
+    pub fn row(&self, kind: TracerArg) -> &'static Row {
+        self.with(kind).tracer_row()
+    }
+
     /// The design of the ray tracer `kind` with these options (as `render` parses it).
     pub fn design(&self, kind: TracerArg) -> Design {
-        let args = DesignArgs {
+        let (w, h) = (self.width, self.height);
+        (self.with(kind)).tracer_design(self.row(kind), (w, h), self.refl_depth, false)
+    }
+
+    fn with(&self, kind: TracerArg) -> DesignArgs {
+        DesignArgs {
             tracer: kind,
             ..self.args.clone()
-        };
-        let row = args.tracer_row();
-        args.tracer_design(row, (self.width, self.height), self.refl_depth, false)
+        }
     }
 
     /// The grid's resolution N (`None`: auto, or cells per axis for the stream).
