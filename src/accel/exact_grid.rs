@@ -215,7 +215,9 @@ impl ExactGrid {
                 (&mut l.voxel_tris_filled, "voxelTrisFilled"),
                 (&mut l.voxel_tris, "voxelTris"),
             ] {
-                b.delete(&self.gl);
+                // a 16-byte stand-in first, so the old buffer is deleted before the larger
+                // one is made: the peak holds one of them, not both
+                *b = Ssbo::sized(&self.gl, name, 16, None, self.max_ssbo, SIZED_BY)?;
                 *b = Ssbo::sized(&self.gl, name, bytes, None, self.max_ssbo, SIZED_BY)?;
             }
         }
@@ -316,13 +318,5 @@ impl Accelerator for ExactGrid {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-impl Drop for ExactGrid {
-    fn drop(&mut self) {
-        for (b, _) in self.lists.all() {
-            b.delete(&self.gl);
-        }
     }
 }

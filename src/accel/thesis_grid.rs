@@ -9,7 +9,6 @@
 //! `reference::thesis_grid`.
 
 use std::any::Any;
-use std::sync::Arc;
 
 use anyhow::{bail, Result};
 use serde_json::json;
@@ -46,7 +45,6 @@ pub const ENTRY: Entry = Entry {
 };
 
 pub struct ThesisGrid {
-    gl: Arc<Gl>,
     frame: GridFrame,
     triangles: usize,
     build: Kernel,
@@ -88,7 +86,6 @@ impl ThesisGrid {
             "the image size with --ray-array-length",
         );
         Ok(Box::new(ThesisGrid {
-            gl: b.gl.clone(),
             triangles: scene.triangle_count(),
             build: b.kernel("thesis_grid/build.comp", &defs, "build")?,
             order: b.kernel("thesis_grid/order.comp", &defs, "grid_order")?,
@@ -208,18 +205,5 @@ impl Accelerator for ThesisGrid {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-impl Drop for ThesisGrid {
-    fn drop(&mut self) {
-        for b in [
-            &self.voxelslist,
-            &self.voxelcontains,
-            &self.rayslist,
-            &self.raycontains,
-        ] {
-            b.delete(&self.gl);
-        }
     }
 }

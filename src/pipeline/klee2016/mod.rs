@@ -233,7 +233,7 @@ impl SoftShadowRenderer {
                 background: scene.settings.background,
             },
             options,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             pixels,
             ray_batches: 1,
             loop_limit: limit,
@@ -324,13 +324,13 @@ impl SoftShadowRenderer {
         let counts = self.shadow.run(
             &mut self.timers,
             pixels,
-            &self.gbuffer.textures,
+            &self.gbuffer.textures(),
             &self.uniforms,
             batches,
         );
         crate::gl::check_error(&self.gl, "the shadow pass")?;
         self.present
-            .draw(&mut self.timers, self.gbuffer.textures[2]);
+            .draw(&mut self.timers, self.gbuffer.textures()[2]);
         crate::gl::check_error(&self.gl, "the screen-filling quad")?;
         let truncated = counts.get("truncated");
         let mut stats = FrameStats {
@@ -354,8 +354,12 @@ impl SoftShadowRenderer {
     fn aovs(&self, camera: &Camera) -> Aovs {
         let (w, h) = self.size();
         let (position, normal) = self.read_gbuffer();
-        let shadow =
-            crate::gl::resources::read_texture_rgba32f(&self.gl, self.shadow.shadow_texture, w, h);
+        let shadow = crate::gl::resources::read_texture_rgba32f(
+            &self.gl,
+            self.shadow.shadow_texture(),
+            w,
+            h,
+        );
         let rays = camera.rays(w, h);
         let mut aovs = Aovs {
             shadow: Some(flip_rows(&shadow, w, h).iter().map(|c| c[0]).collect()),
@@ -489,7 +493,8 @@ impl Renderer for SoftShadowRenderer {
             .clone()
             .ok_or_else(|| anyhow!("no frame drawn yet"))?;
         let (w, h) = self.size();
-        let color = crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output, w, h);
+        let color =
+            crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output(), w, h);
         let aovs = self.aovs(&camera);
         stats.wall_ms += t0.elapsed().as_secs_f64() * 1e3;
         Ok(Frame {
@@ -504,7 +509,7 @@ impl Renderer for SoftShadowRenderer {
     /// The RGBA32F output texture of the last frame (what the screen-filling quad drew), GL
     /// row order.
     fn output_texture(&self) -> glow::Texture {
-        self.present.output
+        self.present.output()
     }
 
     fn set_model(&mut self, _object: usize, _model: Mat4) -> Result<()> {
@@ -520,11 +525,5 @@ impl Renderer for SoftShadowRenderer {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for SoftShadowRenderer {
-    fn drop(&mut self) {
-        self.timers.delete(&self.gl);
     }
 }

@@ -240,7 +240,7 @@ impl WagnerRenderer {
             scene,
             world,
             textures,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             lighting,
             builds,
             last: None,
@@ -274,7 +274,7 @@ impl WagnerRenderer {
         let start = Instant::now();
         let world = World::build(&self.scene)?;
         let textures = SceneTextures::upload(&self.gl, &world.bvh, &world.normals, &world.colors)?;
-        self.textures.delete(&self.gl);
+        // the old textures drop here, after the new ones are made
         self.textures = textures;
         self.world = world;
         self.builds.stats = self.world.bvh.stats;
@@ -395,7 +395,7 @@ impl Renderer for WagnerRenderer {
     }
 
     fn output_texture(&self) -> glow::Texture {
-        self.images.output.texture
+        self.images.output.texture.raw()
     }
 
     fn set_model(&mut self, object: usize, model: Mat4) -> Result<()> {
@@ -418,15 +418,5 @@ impl Renderer for WagnerRenderer {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for WagnerRenderer {
-    fn drop(&mut self) {
-        let gl = self.gl.clone();
-        self.textures.delete(&gl);
-        self.images.delete(&gl);
-        self.counters.delete(&gl);
-        self.timers.delete(&gl);
     }
 }
