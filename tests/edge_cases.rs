@@ -17,8 +17,8 @@ use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline;
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
+use gpgpu_rt::pipeline::wagner2018::bvh::WagnerBvh;
 use gpgpu_rt::reference::wagner2018::Ray;
-use gpgpu_rt::reference::wagner_bvh::WagnerBvh;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 

@@ -1,7 +1,7 @@
 //! The CPU twin of Wagner 2018's ray-tracing kernel (`glsl/wagner2018/raytrace.comp`): the same
 //! functions with the same f32 arithmetic — `createRay` (Listing 4.1), `intersectTriangle`
 //! (Listing 4.2, Möller–Trumbore with its ε), `intersectAABB` (Listing 4.5) — the same walk
-//! through the hierarchy of [`super::wagner_bvh`] in the same order with the same counts, and
+//! through the hierarchy of [`WagnerBvh`] in the same order with the same counts, and
 //! the same Lambert shading with one hard shadow ray. The tests hold the GPU against it.
 //!
 //! The walk (ch. 4.2.3: "test the root, then both children; the nearer hit is investigated
@@ -20,8 +20,8 @@
 
 use glam::Vec3;
 
-use super::wagner_bvh::{NodeKind, WagnerBvh, MAX_DEPTH};
 use super::Hit;
+use crate::pipeline::wagner2018::bvh::{NodeKind, WagnerBvh, MAX_DEPTH};
 use crate::scene::Camera;
 
 /// ε of Listings 4.2 and 4.5 (the thesis gives no value; Möller and Trumbore's paper, its

@@ -6,7 +6,7 @@
 //!    diffuse textures (`glsl/klee2016/gbuffer.vert`, `gbuffer.frag`);
 //! 2. **shadow pass** ([`shadow_pass`]): a compute kernel (`glsl/klee2016/linespace_shadow.comp`)
 //!    gives every pixel its shadow value — the fraction of its SAMPLES_U × SAMPLES_V shadow rays
-//!    that reach the light — by traversing the N-tree ([`crate::reference::ntree`]) with its
+//!    that reach the light — by traversing the N-tree ([`crate::pipeline::klee2016::ntree`]) with its
 //!    line spaces, and multiplies it into the diffuse texture;
 //! 3. **screen-filling quad** ([`present`], `glsl/klee2016/linespace_quad.*`): the diffuse
 //!    texture drawn into the output texture (headless: read back into the PNG).
@@ -15,6 +15,7 @@
 //! buffer (RG32UI), the line spaces into a 3D R32UI texture laid out as Listing 3.
 
 pub mod gbuffer;
+pub mod ntree;
 pub mod present;
 pub mod shadow_pass;
 
@@ -27,6 +28,7 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gbuffer::GBuffer;
+use self::ntree::{NTree, PackedLinespaces};
 use self::present::Present;
 use self::shadow_pass::{shadow_kernel, ShadowPass, ShadowUniforms};
 use super::Renderer;
@@ -34,7 +36,6 @@ use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
 use crate::gl::context::LoopLimit;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
-use crate::reference::ntree::{self, NTree, PackedLinespaces};
 pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 

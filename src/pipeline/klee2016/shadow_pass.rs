@@ -11,12 +11,12 @@ use glam::Vec3;
 use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
+use super::ntree::{NTree, PackedLinespaces};
 use super::{KleeShading, SoftShadowOptions};
 use crate::gl::context::LoopLimit;
 use crate::gl::resources::{GpuTimers, Owned, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::reference::ntree::{NTree, PackedLinespaces};
 use crate::scene::{AreaLight, ShadowMode};
 
 /// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`.

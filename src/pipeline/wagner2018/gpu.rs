@@ -10,8 +10,8 @@ use glam::Vec3;
 use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
 use crate::gl::slots::{image, sampler};
 use crate::gl::{Gl, Kernel};
+use crate::pipeline::wagner2018::bvh::WagnerBvh;
 use crate::reference::wagner2018::{Lighting, WagnerCamera};
-use crate::reference::wagner_bvh::WagnerBvh;
 
 /// RGBA32F texels of `v` (w = 0): CUDA's float4 textures held float3 too (Wagner 2018, ch. 6).
 fn float4(v: &[Vec3]) -> Vec<[f32; 4]> {

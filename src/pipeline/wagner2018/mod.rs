@@ -2,7 +2,7 @@
 //! CUDA ray tracer with a BVH, here as its own pipeline (`--tracer bvh --bvh-variant wagner`):
 //!
 //! 1. the BVH is **built on the CPU** by Listings 4.3/4.4 with the simplified SAH of eq. 4.1
-//!    ([`crate::reference::wagner_bvh`]) — again whenever an object moved (ch. 3.2: "rebuild
+//!    ([`crate::pipeline::wagner2018::bvh`]) — again whenever an object moved (ch. 3.2: "rebuild
 //!    the BVH completely") — and uploaded with the triangles into texture buffers: the three
 //!    textures of Fig. 4.3 and three for the triangles' vertices, normals and colours
 //!    ([`gpu`]);
@@ -15,6 +15,7 @@
 //!
 //! The CPU twin of the kernel is [`crate::reference::wagner2018`].
 
+pub mod bvh;
 pub mod gpu;
 
 use std::sync::Arc;
@@ -31,8 +32,8 @@ use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+use crate::pipeline::wagner2018::bvh::{WagnerBvh, WagnerStats};
 use crate::reference::wagner2018::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
-use crate::reference::wagner_bvh::{WagnerBvh, WagnerStats};
 use crate::scene::{Camera, Scene};
 
 /// The kernel's work group: 16×16 (ch. 3.3.2).
