@@ -13,6 +13,7 @@ use std::any::Any;
 use anyhow::{bail, Result};
 use serde_json::json;
 
+use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
 use super::TracerKind;
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
@@ -20,7 +21,7 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
-use crate::reference::{self, grid::GridMapping, CpuAccelerator};
+use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 /// Largest resolution: the per-ray lists sort up to 3N crossings with BubbleSort (and
