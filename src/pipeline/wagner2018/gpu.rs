@@ -7,11 +7,11 @@ use std::sync::Arc;
 use anyhow::Result;
 use glam::Vec3;
 
+use super::uniforms::{Lighting, WagnerCamera};
 use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
 use crate::gl::slots::{image, sampler};
 use crate::gl::{Gl, Kernel};
 use crate::pipeline::wagner2018::bvh::WagnerBvh;
-use crate::reference::wagner2018::{Lighting, WagnerCamera};
 
 /// RGBA32F texels of `v` (w = 0): CUDA's float4 textures held float3 too (Wagner 2018, ch. 6).
 fn float4(v: &[Vec3]) -> Vec<[f32; 4]> {

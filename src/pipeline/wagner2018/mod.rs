@@ -17,6 +17,7 @@
 
 pub mod bvh;
 pub mod gpu;
+pub mod uniforms;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -26,6 +27,7 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gpu::{Images, SceneTextures};
+use self::uniforms::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
 use super::mueller2015::RenderOptions;
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
@@ -33,7 +35,6 @@ use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::pipeline::wagner2018::bvh::{WagnerBvh, WagnerStats};
-use crate::reference::wagner2018::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
 use crate::scene::{Camera, Scene};
 
 /// The kernel's work group: 16×16 (ch. 3.3.2).
