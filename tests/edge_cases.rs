@@ -14,8 +14,8 @@ use glam::{DVec3, Vec3};
 use gpgpu_rt::design::{Design, Pipeline, Row, REGISTRY};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlContext;
+use gpgpu_rt::pipeline::wagner2018::bvh::WagnerBvh;
 use gpgpu_rt::reference::wagner2018::Ray;
-use gpgpu_rt::reference::wagner_bvh::WagnerBvh;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 

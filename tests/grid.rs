@@ -440,7 +440,7 @@ fn gpu_voxel_lists_equal_the_reference_on_adversarial_triangles() {
         let mut tris = adversarial_triangles(n);
         tris.extend(clamp_cases(n, 12));
         let scene = adversarial_scene(dir.path(), &tris);
-        let m = gpgpu_rt::reference::grid::GridMapping::of_scene(&scene);
+        let m = gpgpu_rt::accel::grid_frame::GridMapping::of_scene(&scene);
         assert_eq!((m.center, m.scale), (Vec3::ZERO, SCALE));
         for variant in [GridVariant::Thesis, GridVariant::Exact] {
             check_lists(&ctx, &scene, variant, n);

@@ -6,13 +6,13 @@ mod common;
 use glam::Vec3;
 use gpgpu_rt::frame::{Aovs, FrameStats};
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
-use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::reference::linespace::ShadowCounts;
-use gpgpu_rt::reference::ntree::{
+use gpgpu_rt::pipeline::klee2016::ntree::{
     self, build_linespace, build_linespace_brute_force, entry_index, face_rect, get_bit,
     pack_linespaces, shaft_hits_box, Aabb, NTree,
 };
+use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::reference::linespace::ShadowCounts;
 use gpgpu_rt::scene::Scene;
 use gpgpu_rt::scene::{Camera, ShadowMode};
 

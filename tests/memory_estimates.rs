@@ -106,7 +106,7 @@ fn the_stream_grid_allocates_within_its_estimate() {
 #[test]
 fn the_ntree_allocates_within_its_estimate() {
     let _s = serial();
-    use gpgpu_rt::reference::ntree::NTree;
+    use gpgpu_rt::pipeline::klee2016::ntree::NTree;
     let scene = common::load("bunny_area.toml");
     let tris = scene.world_triangles();
     for (n, depth) in [(10, 3), (6, 4)] {
@@ -125,7 +125,7 @@ fn the_ntree_allocates_within_its_estimate() {
 #[test]
 fn random_builds_allocate_within_their_estimates() {
     use glam::{UVec3, Vec3};
-    use gpgpu_rt::reference::ntree::NTree;
+    use gpgpu_rt::pipeline::klee2016::ntree::NTree;
     use gpgpu_rt::reference::stream_grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
     let _s = serial();
     let seed = std::env::var("FUZZ_SEED")

@@ -9,14 +9,15 @@ mod common;
 use common::*;
 use glam::UVec3;
 use gpgpu_rt::accel::exact_grid::ExactGrid;
+use gpgpu_rt::accel::exact_grid::EXACT_GRID_CLOUD_CAP;
+use gpgpu_rt::accel::grid_frame::GridMapping;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlContext;
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::exact_grid::ExactGrid as Twin;
-use gpgpu_rt::reference::grid::GridMapping;
-use gpgpu_rt::reference::proximity::{chebyshev_distances, EXACT_GRID_CLOUD_CAP};
+use gpgpu_rt::reference::proximity::chebyshev_distances;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 

@@ -13,10 +13,11 @@ use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::pipeline::wagner2018::bvh::{Aabb, NodeKind, WagnerBvh, LEAF_BELOW, MAX_DEPTH};
+use gpgpu_rt::pipeline::wagner2018::uniforms::WagnerCamera;
 use gpgpu_rt::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::reference::wagner2018::{brute_force_closest, shade, Ray, Trace, WagnerCamera};
-use gpgpu_rt::reference::wagner_bvh::{Aabb, NodeKind, WagnerBvh, LEAF_BELOW, MAX_DEPTH};
+use gpgpu_rt::reference::wagner2018::{brute_force_closest, shade, Ray, Trace};
 use gpgpu_rt::scene::Scene;
 
 // ---------------------------------------------------------------------------------------------

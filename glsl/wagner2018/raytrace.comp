@@ -10,7 +10,7 @@
 //   ch. 5       one point light, hard shadows, no reflection or refraction
 // The whole algorithm in one kernel ("megakernel"; the thesis' ch. 6 names this as one of its
 // design decisions that turned out not to be optimal). Built on the CPU by Listings 4.3/4.4
-// (src/reference/wagner_bvh.rs). CPU twin: src/reference/wagner2018.rs — the same functions,
+// (src/pipeline/wagner2018/bvh.rs). CPU twin: src/reference/wagner2018.rs — the same functions,
 // the same order, the same counts.
 //
 // Ours (the thesis does not say, or says otherwise):

@@ -44,7 +44,7 @@ pub const ENTRY: Entry = Entry {
 /// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
 /// `glsl/bvh/entry.comp` to write its entry point into (`glsl/bvh/entries.glsl`), 0 (no entry)
 /// until it does: the same image unit, so the BVH binds no more than GL 4.5's 8.
-fn upload(gl: &Gl, bvh: &CpuBvh, blocks: u32) -> Result<TextureBuffers> {
+fn upload(gl: &Arc<Gl>, bvh: &CpuBvh, blocks: u32) -> Result<TextureBuffers> {
     let mut words = bvh.gpu_words();
     words.resize(words.len() + 4 * blocks as usize, 0);
     let data = TexelData::new;
@@ -192,9 +192,8 @@ impl Bvh {
             );
         }
         let buffers = upload(&self.gl, &bvh, self.blocks)?;
-        if let Some(old) = self.buffers.replace(buffers) {
-            old.delete(&self.gl);
-        }
+        // the old buffers (if any) drop after the new ones are made, as before
+        self.buffers = Some(buffers);
         self.stats = bvh.stats;
         // the rest: the world transform, the words (octant records, leaf triangles), the upload
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
@@ -266,14 +265,6 @@ impl Accelerator for Bvh {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-impl Drop for Bvh {
-    fn drop(&mut self) {
-        if let Some(b) = &self.buffers {
-            b.delete(&self.gl);
-        }
     }
 }
 

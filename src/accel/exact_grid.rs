@@ -12,6 +12,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use serde_json::json;
 
+use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
 use super::TracerKind;
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
@@ -19,12 +20,21 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
-use crate::reference::proximity::EXACT_GRID_CLOUD_CAP;
-use crate::reference::{self, grid::GridMapping, CpuAccelerator};
+use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 /// Largest resolution: the prefix sum handles 2048 blocks of 1024 voxels.
 pub const MAX_RESOLUTION: u32 = 128;
+
+/// The largest distance the exact grid's per-frame pass computes (`glsl/exact_grid/
+/// proximity.comp`, uniform `cloudCap`): each voxel scans its line outward only as far as its
+/// distance so far, so the cap bounds the pass at 2·(cap − 1) reads per voxel and axis (without
+/// it the empty voxels of a large grid scan their whole lines, which costs more than the jumps
+/// save). A capped distance, min(d, cap), is still safe — it only claims a smaller cube empty —
+/// and the separable passes compute exactly min(d, cap); the jumps then skip at most 2·cap − 1
+/// voxels. The streaming grid's distances, computed once
+/// on the CPU, are not capped.
+pub const EXACT_GRID_CLOUD_CAP: u32 = 8;
 
 pub const ENTRY: Entry = Entry {
     tracer: TracerKind::Grid,
@@ -215,7 +225,9 @@ impl ExactGrid {
                 (&mut l.voxel_tris_filled, "voxelTrisFilled"),
                 (&mut l.voxel_tris, "voxelTris"),
             ] {
-                b.delete(&self.gl);
+                // a 16-byte stand-in first, so the old buffer is deleted before the larger
+                // one is made: the peak holds one of them, not both
+                *b = Ssbo::sized(&self.gl, name, 16, None, self.max_ssbo, SIZED_BY)?;
                 *b = Ssbo::sized(&self.gl, name, bytes, None, self.max_ssbo, SIZED_BY)?;
             }
         }
@@ -316,13 +328,5 @@ impl Accelerator for ExactGrid {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-impl Drop for ExactGrid {
-    fn drop(&mut self) {
-        for (b, _) in self.lists.all() {
-            b.delete(&self.gl);
-        }
     }
 }

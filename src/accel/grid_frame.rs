@@ -2,10 +2,9 @@
 //! scene's current bounds onto the thesis' grid space [-1, 1)³ and hand the mapping to their
 //! kernels (`glsl/common/grid.glsl`).
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use crate::gl::Kernel;
-use crate::reference::grid::GridMapping;
 use crate::scene::Scene;
 
 /// The grid's resolution and this frame's scene-to-grid mapping.
@@ -71,4 +70,56 @@ pub fn lists_of(n3: usize, ids: &[u32], range: impl Fn(usize) -> (usize, usize))
             ids[start..start + len].iter().map(|&x| x as i32).collect()
         })
         .collect()
+}
+
+/// The scene-to-grid mapping of `glsl/common/grid.glsl`: grid = (p − centre) · scale, which
+/// puts the scene's current bounds onto [-1, 1)³ with one scale (so ray parameters are the
+/// same in scene and grid space).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridMapping {
+    pub center: Vec3,
+    pub scale: f32,
+}
+
+impl GridMapping {
+    /// The mapping for the objects' object-space bounds under their model matrices, slightly
+    /// enlarged so the far faces stay inside — what the GPU grids compute every frame.
+    pub fn of_objects(object_bounds: &[(Vec3, Vec3)], models: &[Mat4]) -> GridMapping {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for ((olo, ohi), m) in object_bounds.iter().zip(models) {
+            for k in 0..8 {
+                let c = Vec3::new(
+                    if k & 1 == 0 { olo.x } else { ohi.x },
+                    if k & 2 == 0 { olo.y } else { ohi.y },
+                    if k & 4 == 0 { olo.z } else { ohi.z },
+                );
+                let w = m.transform_point3(c);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        let extent = (hi - lo).max_element().max(1e-6) * 1.001;
+        GridMapping {
+            center: (lo + hi) * 0.5,
+            scale: 2.0 / extent,
+        }
+    }
+
+    /// The mapping of a scene as loaded (every object at its model matrix).
+    pub fn of_scene(scene: &crate::scene::Scene) -> GridMapping {
+        let bounds: Vec<_> = scene.objects.iter().map(|o| o.mesh.bounds()).collect();
+        let models: Vec<_> = scene.objects.iter().map(|o| o.model).collect();
+        Self::of_objects(&bounds, &models)
+    }
+
+    /// toGridSpace
+    pub fn to_grid(&self, p: Vec3) -> Vec3 {
+        (p - self.center) * self.scale
+    }
+
+    /// A scene-space triangle in grid space.
+    pub fn triangle(&self, t: &[Vec3; 3]) -> [Vec3; 3] {
+        t.map(|p| self.to_grid(p))
+    }
 }

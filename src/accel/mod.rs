@@ -16,6 +16,7 @@
 //! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
 //! `glsl/common/intersect1_hit.glsl`. Each is one row of `design::REGISTRY`.
 
+pub mod aabb;
 pub mod brute_force;
 pub mod bvh;
 pub mod exact_grid;

@@ -9,11 +9,11 @@
 //! `reference::thesis_grid`.
 
 use std::any::Any;
-use std::sync::Arc;
 
 use anyhow::{bail, Result};
 use serde_json::json;
 
+use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
 use super::TracerKind;
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
@@ -21,7 +21,7 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
-use crate::reference::{self, grid::GridMapping, CpuAccelerator};
+use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 /// Largest resolution: the per-ray lists sort up to 3N crossings with BubbleSort (and
@@ -46,7 +46,6 @@ pub const ENTRY: Entry = Entry {
 };
 
 pub struct ThesisGrid {
-    gl: Arc<Gl>,
     frame: GridFrame,
     triangles: usize,
     build: Kernel,
@@ -88,7 +87,6 @@ impl ThesisGrid {
             "the image size with --ray-array-length",
         );
         Ok(Box::new(ThesisGrid {
-            gl: b.gl.clone(),
             triangles: scene.triangle_count(),
             build: b.kernel("thesis_grid/build.comp", &defs, "build")?,
             order: b.kernel("thesis_grid/order.comp", &defs, "grid_order")?,
@@ -208,18 +206,5 @@ impl Accelerator for ThesisGrid {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-}
-
-impl Drop for ThesisGrid {
-    fn drop(&mut self) {
-        for b in [
-            &self.voxelslist,
-            &self.voxelcontains,
-            &self.rayslist,
-            &self.raycontains,
-        ] {
-            b.delete(&self.gl);
-        }
     }
 }

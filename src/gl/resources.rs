@@ -1,16 +1,78 @@
 //! Typed helpers for the GL objects the tracers own: shader storage buffers, RGBA32F images,
-//! GPU timers.
+//! GPU timers. Each GL object name is held in an [`Owned`], which deletes it when dropped, so
+//! the pipelines and accelerators that hold these need no `Drop` of their own.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Result};
 use glow::HasContext;
 
 use super::context::Gl;
 
+/// A kind of GL object name and the call that deletes it.
+pub trait GlObject: Copy {
+    /// Delete `name` (a name of this kind, created on the context `gl` belongs to).
+    ///
+    /// # Safety
+    /// The context must be current and `name` must not be used afterwards.
+    unsafe fn delete(gl: &Gl, name: Self);
+}
+
+macro_rules! gl_object {
+    ($($ty:ty => $delete:ident),* $(,)?) => {
+        $(impl GlObject for $ty {
+            unsafe fn delete(gl: &Gl, name: Self) {
+                gl.$delete(name)
+            }
+        })*
+    };
+}
+
+// glow's native types (what `glow::Buffer` and the others name on a native context): trait
+// impls cannot name them through the `HasContext` projections
+gl_object! {
+    glow::NativeBuffer => delete_buffer,
+    glow::NativeTexture => delete_texture,
+    glow::NativeFramebuffer => delete_framebuffer,
+    glow::NativeRenderbuffer => delete_renderbuffer,
+    glow::NativeVertexArray => delete_vertex_array,
+    glow::NativeQuery => delete_query,
+    glow::NativeProgram => delete_program,
+}
+
+/// A GL object name owned: deleted when this drops. It holds the [`Gl`] it was made with; the
+/// context ([`super::GlContext`]) must outlive it, as it outlives the renderers that hold these.
+pub struct Owned<T: GlObject> {
+    gl: Arc<Gl>,
+    name: T,
+}
+
+impl<T: GlObject> Owned<T> {
+    /// Own `name`, a name just created on `gl`'s context (`gl.create_buffer()`, ...).
+    pub fn new(gl: &Arc<Gl>, name: T) -> Owned<T> {
+        Owned {
+            gl: gl.clone(),
+            name,
+        }
+    }
+
+    /// The GL name, for GL calls (valid while this lives).
+    pub fn raw(&self) -> T {
+        self.name
+    }
+}
+
+impl<T: GlObject> Drop for Owned<T> {
+    fn drop(&mut self) {
+        // SAFETY: the name is ours and dies with us; the context outlives its objects.
+        unsafe { T::delete(&self.gl, self.name) };
+    }
+}
+
 /// A shader storage buffer of fixed size.
 pub struct Ssbo {
-    pub buffer: glow::Buffer,
+    pub buffer: Owned<glow::Buffer>,
     pub bytes: usize,
     pub name: &'static str,
 }
@@ -20,7 +82,7 @@ impl Ssbo {
     /// after checking the size against `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`; a buffer the scene
     /// or the image size decides (see [`Ssbo::sized`]).
     pub fn new(
-        gl: &Gl,
+        gl: &Arc<Gl>,
         name: &'static str,
         bytes: usize,
         data: Option<&[u8]>,
@@ -39,7 +101,7 @@ impl Ssbo {
     /// [`Ssbo::new`] for a buffer whose size `sized_by` decides (options such as `--grid
     /// with --voxel-array-length`): the refusal names them.
     pub fn sized(
-        gl: &Gl,
+        gl: &Arc<Gl>,
         name: &'static str,
         bytes: usize,
         data: Option<&[u8]>,
@@ -58,8 +120,8 @@ impl Ssbo {
         }
         // SAFETY: plain buffer creation on a current context; data is bytes long if given.
         unsafe {
-            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer));
+            let buffer = Owned::new(gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(buffer.raw()));
             let padded;
             let data = match data {
                 Some(d) if d.len() < bytes => {
@@ -89,7 +151,13 @@ impl Ssbo {
 
     pub fn bind(&self, gl: &Gl, binding: u32) {
         // SAFETY: binding an existing buffer.
-        unsafe { gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, binding, Some(self.buffer)) };
+        unsafe {
+            gl.bind_buffer_base(
+                glow::SHADER_STORAGE_BUFFER,
+                binding,
+                Some(self.buffer.raw()),
+            )
+        };
     }
 
     /// Bind `bytes` bytes from `offset` (a multiple of `GlInfo::ssbo_offset_alignment`).
@@ -100,7 +168,7 @@ impl Ssbo {
             gl.bind_buffer_range(
                 glow::SHADER_STORAGE_BUFFER,
                 binding,
-                Some(self.buffer),
+                Some(self.buffer.raw()),
                 offset as i32,
                 bytes as i32,
             )
@@ -110,7 +178,7 @@ impl Ssbo {
     /// `glClearBufferData` with a 32-bit value.
     pub fn clear_u32(&self, gl: &Gl, value: u32) {
         // SAFETY: binding an existing buffer.
-        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer)) };
+        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer.raw())) };
         gl.clear_buffer_u32(glow::SHADER_STORAGE_BUFFER, value);
         unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None) };
     }
@@ -119,16 +187,11 @@ impl Ssbo {
         let mut bytes = vec![0u8; self.bytes];
         // SAFETY: the slice is the buffer's size.
         unsafe {
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer));
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer.raw()));
             gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
             gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
         }
         bytemuck::pod_collect_to_vec(&bytes)
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own buffer.
-        unsafe { gl.delete_buffer(self.buffer) };
     }
 }
 
@@ -140,18 +203,18 @@ fn bind_image_unit(gl: &Gl, unit: u32, texture: glow::Texture, access: u32, form
 
 /// A 2D texture used as an image (RGBA32F or RGBA32UI).
 pub struct Image2d {
-    pub texture: glow::Texture,
+    pub texture: Owned<glow::Texture>,
     pub width: u32,
     pub height: u32,
     pub format: u32,
 }
 
 impl Image2d {
-    pub fn new(gl: &Gl, width: u32, height: u32, format: u32) -> Result<Image2d> {
+    pub fn new(gl: &Arc<Gl>, width: u32, height: u32, format: u32) -> Result<Image2d> {
         // SAFETY: texture creation on a current context.
         unsafe {
-            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
-            gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+            let texture = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+            gl.bind_texture(glow::TEXTURE_2D, Some(texture.raw()));
             gl.tex_storage_2d(glow::TEXTURE_2D, 1, format, width as i32, height as i32);
             let texel = match format {
                 glow::R32UI | glow::R32F | glow::RGBA8 => 4,
@@ -181,13 +244,13 @@ impl Image2d {
     }
 
     pub fn bind_image(&self, gl: &Gl, unit: u32) {
-        bind_image_unit(gl, unit, self.texture, glow::READ_WRITE, self.format);
+        bind_image_unit(gl, unit, self.texture.raw(), glow::READ_WRITE, self.format);
     }
 
     pub fn clear(&self, gl: &Gl) {
         match self.format {
-            glow::RGBA32UI => gl.clear_tex_u32(self.texture, glow::RGBA_INTEGER, [0; 4]),
-            _ => gl.clear_tex_f32(self.texture, [0.0; 4]),
+            glow::RGBA32UI => gl.clear_tex_u32(self.texture.raw(), glow::RGBA_INTEGER, [0; 4]),
+            _ => gl.clear_tex_f32(self.texture.raw(), [0.0; 4]),
         }
     }
 
@@ -196,13 +259,13 @@ impl Image2d {
         // SAFETY: glCopyImageSubData between two of our textures of the same size and format.
         unsafe {
             gl.copy_image_sub_data(
-                src.texture,
+                src.texture.raw(),
                 glow::TEXTURE_2D,
                 0,
                 0,
                 0,
                 0,
-                self.texture,
+                self.texture.raw(),
                 glow::TEXTURE_2D,
                 0,
                 0,
@@ -217,7 +280,7 @@ impl Image2d {
 
     /// Read back RGBA32F texels, row 0 = the bottom row (GL order).
     pub fn read_f32(&self, gl: &Gl) -> Vec<[f32; 4]> {
-        read_texture_rgba32f(gl, self.texture, self.width, self.height)
+        read_texture_rgba32f(gl, self.texture.raw(), self.width, self.height)
     }
 
     /// Read back RGBA32UI texels, row 0 = the bottom row (GL order).
@@ -225,7 +288,7 @@ impl Image2d {
         let mut data = vec![[0u32; 4]; (self.width * self.height) as usize];
         // SAFETY: the slice holds w·h RGBA uints.
         unsafe {
-            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture));
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.texture.raw()));
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
             gl.get_tex_image(
                 glow::TEXTURE_2D,
@@ -238,11 +301,6 @@ impl Image2d {
         }
         data
     }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own texture.
-        unsafe { gl.delete_texture(self.texture) };
-    }
 }
 
 /// A buffer texture (`GL_TEXTURE_BUFFER`): texels in a buffer, read by kernels with
@@ -250,8 +308,9 @@ impl Image2d {
 /// For data every invocation reads at its own index: llvmpipe fetches texels for its 8 lanes
 /// at once, where it loads storage buffers lane by lane.
 pub struct TextureBuffer {
-    pub buffer: glow::Buffer,
-    pub texture: glow::Texture,
+    // the texture first: it drops before the buffer it reads
+    pub texture: Owned<glow::Texture>,
+    pub buffer: Owned<glow::Buffer>,
     /// The texel format (`GL_RGBA32F`, ...).
     pub format: u32,
     /// Texels and bytes of the data.
@@ -263,7 +322,7 @@ impl TextureBuffer {
     /// Upload `data` as texels of `format` (`texel_bytes` each), after checking the count
     /// against `GL_MAX_TEXTURE_BUFFER_SIZE`; `name` is for the message.
     pub fn new(
-        gl: &Gl,
+        gl: &Arc<Gl>,
         name: &str,
         format: u32,
         texel_bytes: usize,
@@ -290,19 +349,19 @@ impl TextureBuffer {
         }
         // SAFETY: buffer and texture creation on a current context.
         unsafe {
-            let buffer = gl.create_buffer().map_err(|e| anyhow!(e))?;
-            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer));
+            let buffer = Owned::new(gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
+            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(buffer.raw()));
             gl.buffer_data_u8_slice(glow::TEXTURE_BUFFER, &padded, glow::STATIC_DRAW);
             gl.bind_buffer(glow::TEXTURE_BUFFER, None);
             let what = format!("the texture buffer `{name}` (sized by the scene)");
             super::check_alloc(gl, &what, padded.len() as u64)?;
-            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture));
-            gl.tex_buffer(format, buffer);
+            let texture = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(texture.raw()));
+            gl.tex_buffer(format, buffer.raw());
             gl.bind_texture(glow::TEXTURE_BUFFER, None);
             Ok(TextureBuffer {
-                buffer,
                 texture,
+                buffer,
                 format,
                 texels,
                 bytes: data.len(),
@@ -315,7 +374,7 @@ impl TextureBuffer {
         // SAFETY: binding our own texture to a texture unit.
         unsafe {
             gl.active_texture(glow::TEXTURE0 + unit);
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture));
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(self.texture.raw()));
             gl.active_texture(glow::TEXTURE0);
         }
     }
@@ -325,15 +384,7 @@ impl TextureBuffer {
     /// it calls a function for every `texelFetch` of a format other than 8-bit RGBA
     /// (docs/design/bvh.md, step 2).
     pub fn bind_image(&self, gl: &Gl, unit: u32, access: u32) {
-        bind_image_unit(gl, unit, self.texture, access, self.format);
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own texture and buffer.
-        unsafe {
-            gl.delete_texture(self.texture);
-            gl.delete_buffer(self.buffer);
-        }
+        bind_image_unit(gl, unit, self.texture.raw(), access, self.format);
     }
 }
 
@@ -378,20 +429,15 @@ impl<'a> TexelData<'a> {
 pub struct TextureBuffers(Vec<(TextureBuffer, u32)>);
 
 impl TextureBuffers {
-    /// Upload every one; on an error the ones made so far are deleted.
+    /// Upload every one; on an error the ones made so far are deleted (as they drop).
     pub fn upload<'a>(
-        gl: &Gl,
+        gl: &Arc<Gl>,
         data: impl IntoIterator<Item = TexelData<'a>>,
     ) -> Result<TextureBuffers> {
         let mut made = TextureBuffers(Vec::new());
         for d in data {
-            match TextureBuffer::new(gl, d.name, d.format, d.texel_bytes, &d.bytes) {
-                Ok(t) => made.0.push((t, d.unit)),
-                Err(e) => {
-                    made.delete(gl);
-                    return Err(e);
-                }
-            }
+            let t = TextureBuffer::new(gl, d.name, d.format, d.texel_bytes, &d.bytes)?;
+            made.0.push((t, d.unit));
         }
         Ok(made)
     }
@@ -412,10 +458,6 @@ impl TextureBuffers {
         for (t, unit) in &self.0 {
             t.bind_image(gl, *unit, access);
         }
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.0.iter().for_each(|(t, _)| t.delete(gl));
     }
 }
 
@@ -443,9 +485,10 @@ pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> 
 /// before and after every dispatch, differences summed per kernel name when the frame is
 /// resolved. (Timestamps rather than `GL_TIME_ELAPSED`, whose compute-dispatch results Mesa's
 /// llvmpipe does not fill in; both are GL timer queries.) Dispatches timed while a ray kind is
-/// set ([`GpuTimers::set_ray_kind`]) are also summed per ray kind.
-#[derive(Default)]
+/// set ([`GpuTimers::set_ray_kind`]) are also summed per ray kind. The queries are deleted as
+/// the timers drop.
 pub struct GpuTimers {
+    gl: Arc<Gl>,
     free: Vec<glow::Query>,
     pending: Vec<Pending>,
     ray_kind: Option<&'static str>,
@@ -456,6 +499,17 @@ pub struct GpuTimers {
 type Pending = (&'static str, Option<&'static str>, glow::Query, glow::Query);
 
 impl GpuTimers {
+    /// Timers with no query yet (made as dispatches are timed, reused frame after frame).
+    pub fn new(gl: &Arc<Gl>) -> GpuTimers {
+        GpuTimers {
+            gl: gl.clone(),
+            free: Vec::new(),
+            pending: Vec::new(),
+            ray_kind: None,
+            ray_kind_ms: BTreeMap::new(),
+        }
+    }
+
     fn query(&mut self, gl: &Gl) -> glow::Query {
         match self.free.pop() {
             Some(q) => q,
@@ -505,8 +559,10 @@ impl GpuTimers {
     pub fn take_ray_kind_ms(&mut self) -> BTreeMap<String, f64> {
         std::mem::take(&mut self.ray_kind_ms)
     }
+}
 
-    pub fn delete(&mut self, gl: &Gl) {
+impl Drop for GpuTimers {
+    fn drop(&mut self) {
         let pending = std::mem::take(&mut self.pending);
         for q in self
             .free
@@ -514,7 +570,7 @@ impl GpuTimers {
             .chain(pending.into_iter().flat_map(|p| [p.2, p.3]))
         {
             // SAFETY: deleting our own queries.
-            unsafe { gl.delete_query(q) };
+            unsafe { self.gl.delete_query(q) };
         }
     }
 }
@@ -522,7 +578,7 @@ impl GpuTimers {
 /// A 3D texture of RGB32F texels read with `texelFetch` through a `sampler3D` (nearest
 /// filtering, one level): the cells and the triangle data of seed 004's grid (Fig. 3).
 pub struct Texture3d {
-    pub texture: glow::Texture,
+    pub texture: Owned<glow::Texture>,
     pub size: [u32; 3],
     pub bytes: usize,
 }
@@ -530,7 +586,12 @@ pub struct Texture3d {
 impl Texture3d {
     /// Upload `texels` (x fastest, then y, then z; `size` = texels per axis) after checking
     /// every side against `GL_MAX_3D_TEXTURE_SIZE`; `name` is for the message.
-    pub fn rgb32f(gl: &Gl, name: &str, size: [u32; 3], texels: &[[f32; 3]]) -> Result<Texture3d> {
+    pub fn rgb32f(
+        gl: &Arc<Gl>,
+        name: &str,
+        size: [u32; 3],
+        texels: &[[f32; 3]],
+    ) -> Result<Texture3d> {
         // SAFETY: a limit query on a current context.
         let max = unsafe { gl.get_parameter_i32(glow::MAX_3D_TEXTURE_SIZE) } as u32;
         if size.iter().any(|&s| s == 0 || s > max) {
@@ -551,8 +612,8 @@ impl Texture3d {
         }
         // SAFETY: texture creation and upload on a current context; the slice holds n texels.
         unsafe {
-            let texture = gl.create_texture().map_err(|e| anyhow!(e))?;
-            gl.bind_texture(glow::TEXTURE_3D, Some(texture));
+            let texture = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+            gl.bind_texture(glow::TEXTURE_3D, Some(texture.raw()));
             gl.tex_storage_3d(
                 glow::TEXTURE_3D,
                 1,
@@ -592,13 +653,8 @@ impl Texture3d {
         // SAFETY: binding our own texture to a texture unit.
         unsafe {
             gl.active_texture(glow::TEXTURE0 + unit);
-            gl.bind_texture(glow::TEXTURE_3D, Some(self.texture));
+            gl.bind_texture(glow::TEXTURE_3D, Some(self.texture.raw()));
             gl.active_texture(glow::TEXTURE0);
         }
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own texture.
-        unsafe { gl.delete_texture(self.texture) };
     }
 }

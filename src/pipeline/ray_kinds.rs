@@ -10,6 +10,7 @@
 //! way ([`GpuTimers::set_ray_kind`]).
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use anyhow::Result;
 
@@ -80,7 +81,7 @@ pub struct CounterBanks {
 }
 
 impl CounterBanks {
-    pub fn new(gl: &Gl, info: &GlInfo, slots: usize) -> Result<CounterBanks> {
+    pub fn new(gl: &Arc<Gl>, info: &GlInfo, slots: usize) -> Result<CounterBanks> {
         let align = info.ssbo_offset_alignment.max(1) as usize;
         let stride = (8 * slots).div_ceil(align) * align;
         let bytes = stride * BANKS.len();
@@ -119,10 +120,6 @@ impl CounterBanks {
                     .collect()
             })
             .collect()
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.ssbo.delete(gl);
     }
 }
 

@@ -22,10 +22,10 @@
 
 use glam::{IVec3, Vec3};
 
-use crate::reference::intersect_triangle;
-use crate::reference::ntree::{
+use crate::pipeline::klee2016::ntree::{
     entry_index, face_axes, NTree, PackedLinespaces, CHILDREN_BIT, GEOMETRY_BIT,
 };
+use crate::reference::intersect_triangle;
 use crate::scene::AreaLight;
 use crate::scene::ShadowMode;
 

@@ -3,19 +3,16 @@
 //! arithmetic and the same pass structure as the kernels. It is the oracle of the tests: the
 //! GPU's triangle ids, hit distances, colours and triangle-test counts are compared with it.
 
-pub mod aabb;
 pub mod brute_force;
 pub mod bvh;
 pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
-pub mod ntree;
 pub mod proximity;
 pub mod stream_grid;
 pub mod stream_shading;
 pub mod thesis_grid;
 pub mod wagner2018;
-pub mod wagner_bvh;
 
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;

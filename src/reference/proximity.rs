@@ -74,16 +74,6 @@ pub fn chebyshev_distances(dims: UVec3, filled: &[bool]) -> Vec<u32> {
     dist.into_iter().map(|v| v.min(far)).collect()
 }
 
-/// The largest distance the exact grid's per-frame pass computes (`glsl/exact_grid/
-/// proximity.comp`, uniform `cloudCap`): each voxel scans its line outward only as far as its
-/// distance so far, so the cap bounds the pass at 2·(cap − 1) reads per voxel and axis (without
-/// it the empty voxels scan their whole lines, which costs more than the jumps save:
-/// `docs/design/exact-grid.md`). A capped distance, min(d, cap), is still safe — it
-/// only claims a smaller cube empty — and the separable passes compute exactly min(d, cap);
-/// the jumps then skip at most 2·cap − 1 voxels. The streaming grid's distances, computed once
-/// on the CPU, are not capped.
-pub const EXACT_GRID_CLOUD_CAP: u32 = 8;
-
 /// The cells a 3D-DDA enters strictly between cells `a` and `b` of its walk: each of its
 /// steps moves one cell along one axis, so it takes |b − a|₁ steps from `a` to `b`.
 pub fn cells_between(a: IVec3, b: IVec3) -> u64 {

@@ -8,8 +8,9 @@
 
 use glam::Vec3;
 
-use super::grid::{clip_to_grid, GridMapping, GridSpace};
+use super::grid::{clip_to_grid, GridSpace};
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
+use crate::accel::grid_frame::GridMapping;
 
 pub struct ThesisGrid {
     triangles: Vec<[Vec3; 3]>,

@@ -1,7 +1,7 @@
 //! The CPU twin of Wagner 2018's ray-tracing kernel (`glsl/wagner2018/raytrace.comp`): the same
 //! functions with the same f32 arithmetic — `createRay` (Listing 4.1), `intersectTriangle`
 //! (Listing 4.2, Möller–Trumbore with its ε), `intersectAABB` (Listing 4.5) — the same walk
-//! through the hierarchy of [`super::wagner_bvh`] in the same order with the same counts, and
+//! through the hierarchy of [`WagnerBvh`] in the same order with the same counts, and
 //! the same Lambert shading with one hard shadow ray. The tests hold the GPU against it.
 //!
 //! The walk (ch. 4.2.3: "test the root, then both children; the nearer hit is investigated
@@ -20,22 +20,11 @@
 
 use glam::Vec3;
 
-use super::wagner_bvh::{NodeKind, WagnerBvh, MAX_DEPTH};
 use super::Hit;
-use crate::scene::Camera;
-
-/// ε of Listings 4.2 and 4.5 (the thesis gives no value; Möller and Trumbore's paper, its
-/// [1], uses 10⁻⁶): a triangle whose determinant is smaller is parallel to the ray, a slab
-/// whose direction component is smaller is tested as parallel.
-pub const EPSILON: f32 = 1e-6;
-/// Iterations of one walk before it stops as truncated (see the module comment).
-pub const LOOP_BUDGET: u32 = 32000;
-const _: () = assert!(
-    2 * LOOP_BUDGET < 65535,
-    "two walks must fit llvmpipe's loop limit"
-);
-/// Entries of the traversal stack: one per level is enough ([`MAX_DEPTH`]).
-pub const STACK: usize = MAX_DEPTH as usize;
+use crate::pipeline::wagner2018::bvh::{NodeKind, WagnerBvh};
+use crate::pipeline::wagner2018::uniforms::{
+    Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK,
+};
 
 /// A ray (Listing 4.1's `Ray(direction, origin)`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,36 +33,7 @@ pub struct Ray {
     pub direction: Vec3,
 }
 
-/// The camera of Listing 4.1 as the host computes it for the kernel: the position, the
-/// direction to the upper-left corner of the image, unit vectors to the right and down, and
-/// the image's width and height along them (at the distance of `direction`). The thesis does
-/// not say where `camera.direction` points; since the listing adds α, β ∈ [0, 1] times the
-/// image's extent to it, it must be the corner where both are 0 (our reading, listed in
-/// `docs/listings.md`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WagnerCamera {
-    pub position: Vec3,
-    pub direction: Vec3,
-    pub x_direction: Vec3,
-    pub y_direction: Vec3,
-    pub x_scale: f32,
-    pub y_scale: f32,
-}
-
 impl WagnerCamera {
-    /// The camera of a scene for a `width`×`height` image (the image plane of `Camera::rays`).
-    pub fn new(camera: &Camera, width: u32, height: u32) -> WagnerCamera {
-        let r = camera.rays(width, height);
-        WagnerCamera {
-            position: r.cam_position,
-            direction: r.cam_img_offset,
-            x_direction: r.cam_width.normalize(),
-            y_direction: r.cam_height.normalize(),
-            x_scale: r.cam_width.length() * width as f32,
-            y_scale: r.cam_height.length() * height as f32,
-        }
-    }
-
     /// Listing 4.1 for pixel (x, y), y = 0 the top row. Ours: through the pixel's centre
     /// (+0.5), and the direction normalised (so `t` is a distance).
     pub fn create_ray(&self, x: u32, y: u32, width: u32, height: u32) -> Ray {
@@ -329,25 +289,6 @@ pub fn brute_force_closest(triangles: &[[Vec3; 3]], ray: &Ray) -> Option<Hit> {
         }
     }
     best
-}
-
-/// The per-vertex normals and colours of the triangles (3 per triangle, world space), as the
-/// kernel's textures hold them.
-#[derive(Debug, Clone, Copy)]
-pub struct Surface<'a> {
-    pub normals: &'a [Vec3],
-    pub colors: &'a [Vec3],
-}
-
-/// The kernel's lighting: one point light, the scene's ambient light and background, and the
-/// shadow ray's offset.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lighting {
-    pub light_position: Vec3,
-    pub light_color: Vec3,
-    pub ambient: Vec3,
-    pub background: Vec3,
-    pub shadow_offset: f32,
 }
 
 /// A shaded hit: colour, the normal (turned towards the ray), whether the light reaches it,

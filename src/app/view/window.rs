@@ -23,6 +23,7 @@ use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
 use gpgpu_rt::gl::context::{load_gl, query_info};
+use gpgpu_rt::gl::resources::Owned;
 use gpgpu_rt::gl::{compile_program, Defines, Gl, GlInfo, ShaderSource};
 use gpgpu_rt::output;
 
@@ -275,9 +276,10 @@ pub fn fit_viewport(window: (u32, u32), image: (u32, u32)) -> Viewport {
 /// object, ch. 3.3) and the program that textures it with the output texture.
 pub struct ScreenQuad {
     gl: Arc<Gl>,
-    program: glow::Program,
-    vao: glow::VertexArray,
-    vbo: glow::Buffer,
+    program: Owned<glow::Program>,
+    vao: Owned<glow::VertexArray>,
+    // held for the VAO, which reads it
+    _vbo: Owned<glow::Buffer>,
 }
 
 impl ScreenQuad {
@@ -286,10 +288,11 @@ impl ScreenQuad {
         let positions: [f32; 8] = [-1.0, -1.0, 1.0, -1.0, -1.0, 1.0, 1.0, 1.0];
         // SAFETY: object creation and vertex setup on the current context.
         unsafe {
-            let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-            let vbo = gl.create_buffer().map_err(|e| anyhow!(e))?;
-            gl.bind_vertex_array(Some(vao));
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo));
+            let program = Owned::new(&gl, program);
+            let vao = Owned::new(&gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
+            let vbo = Owned::new(&gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
+            gl.bind_vertex_array(Some(vao.raw()));
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(vbo.raw()));
             gl.buffer_data_u8_slice(
                 glow::ARRAY_BUFFER,
                 bytemuck::cast_slice(&positions),
@@ -303,16 +306,14 @@ impl ScreenQuad {
                 gl,
                 program,
                 vao,
-                vbo,
+                _vbo: vbo,
             })
         }
     }
 
     /// Replace the program (after a live reload); the old one is deleted.
     pub fn set_program(&mut self, program: glow::Program) {
-        // SAFETY: deleting our own program.
-        unsafe { self.gl.delete_program(self.program) };
-        self.program = program;
+        self.program = Owned::new(&self.gl, program);
     }
 
     /// Clear the bound draw framebuffer (`size`: its size) to the letterbox colour and draw
@@ -330,10 +331,10 @@ impl ScreenQuad {
                 viewport.width as i32,
                 viewport.height as i32,
             );
-            gl.use_program(Some(self.program));
+            gl.use_program(Some(self.program.raw()));
             gl.active_texture(glow::TEXTURE0);
             gl.bind_texture(glow::TEXTURE_2D, Some(texture));
-            gl.bind_vertex_array(Some(self.vao));
+            gl.bind_vertex_array(Some(self.vao.raw()));
             gl.draw_arrays(glow::TRIANGLE_STRIP, 0, 4);
             gl.bind_vertex_array(None);
             gl.bind_texture(glow::TEXTURE_2D, None);
@@ -381,17 +382,6 @@ impl ScreenQuad {
             gl.delete_framebuffer(fbo);
             gl.delete_renderbuffer(rb);
             result
-        }
-    }
-}
-
-impl Drop for ScreenQuad {
-    fn drop(&mut self) {
-        // SAFETY: deleting our own objects.
-        unsafe {
-            self.gl.delete_program(self.program);
-            self.gl.delete_vertex_array(self.vao);
-            self.gl.delete_buffer(self.vbo);
         }
     }
 }

@@ -7,19 +7,21 @@ use anyhow::{anyhow, bail, Result};
 use glam::{Mat4, Vec3};
 use glow::HasContext;
 
-use crate::gl::resources::{read_texture_rgba32f, GpuTimers, Image2d};
+use crate::gl::resources::{read_texture_rgba32f, GpuTimers, Image2d, Owned};
 use crate::gl::{Defines, Gl, Kernel, ShaderSource};
 use crate::scene::Scene;
 
 pub struct GBuffer {
     gl: Arc<Gl>,
     raster: Kernel,
-    vao: glow::VertexArray,
-    vbos: Vec<glow::Buffer>,
-    fbo: glow::Framebuffer,
-    depth: glow::Renderbuffer,
+    // the FBO and the VAO before what they hold: they drop first
+    fbo: Owned<glow::Framebuffer>,
+    vao: Owned<glow::VertexArray>,
+    // held for the VAO and the FBO, which use them
+    _vbos: Vec<Owned<glow::Buffer>>,
+    _depth: Owned<glow::Renderbuffer>,
     /// position (w: 1 = geometry), normal (w: triangle id), diffuse (RGBA32F)
-    pub textures: [glow::Texture; 3],
+    textures: [Owned<glow::Texture>; 3],
     triangles: i32,
     width: u32,
     height: u32,
@@ -40,13 +42,16 @@ pub fn raster_kernel(gl: &Arc<Gl>, shaders: &ShaderSource) -> Result<Kernel> {
 }
 
 /// A w×h RGBA32F texture.
-pub fn rgba32f_texture(gl: &Gl, w: u32, h: u32) -> Result<glow::Texture> {
+pub fn rgba32f_texture(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Owned<glow::Texture>> {
     Ok(Image2d::new(gl, w, h, glow::RGBA32F)?.texture)
 }
 
 /// The world-space triangles' positions, normals and colours in three vertex buffers of a VAO
 /// (attribute locations 0, 1, 2 of gbuffer.vert).
-fn upload_vertices(gl: &Gl, scene: &Scene) -> Result<(glow::VertexArray, Vec<glow::Buffer>)> {
+fn upload_vertices(
+    gl: &Arc<Gl>,
+    scene: &Scene,
+) -> Result<(Owned<glow::VertexArray>, Vec<Owned<glow::Buffer>>)> {
     let attrs = scene.world_attributes();
     // the world positions in triangle-id order, as `Scene::world_triangles`
     let pos: Vec<[f32; 3]> = attrs.positions.iter().map(|v| v.to_array()).collect();
@@ -54,12 +59,12 @@ fn upload_vertices(gl: &Gl, scene: &Scene) -> Result<(glow::VertexArray, Vec<glo
     let col: Vec<[f32; 3]> = attrs.colors.iter().map(|v| v.to_array()).collect();
     // SAFETY: GL object creation and uploads on a current context; slices match sizes.
     unsafe {
-        let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-        gl.bind_vertex_array(Some(vao));
+        let vao = Owned::new(gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
+        gl.bind_vertex_array(Some(vao.raw()));
         let mut vbos = Vec::new();
         for (loc, data) in [(0u32, &pos), (1, &nor), (2, &col)] {
-            let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
-            gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
+            let b = Owned::new(gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
+            gl.bind_buffer(glow::ARRAY_BUFFER, Some(b.raw()));
             gl.buffer_data_u8_slice(
                 glow::ARRAY_BUFFER,
                 bytemuck::cast_slice(&data[..]),
@@ -75,12 +80,15 @@ fn upload_vertices(gl: &Gl, scene: &Scene) -> Result<(glow::VertexArray, Vec<glo
     }
 }
 
+/// An FBO, its depth renderbuffer and the three textures attached to it.
+type Framebuffer = (
+    Owned<glow::Framebuffer>,
+    Owned<glow::Renderbuffer>,
+    [Owned<glow::Texture>; 3],
+);
+
 /// An FBO with the three G-buffer textures and a depth renderbuffer.
-fn framebuffer(
-    gl: &Gl,
-    w: u32,
-    h: u32,
-) -> Result<(glow::Framebuffer, glow::Renderbuffer, [glow::Texture; 3])> {
+fn framebuffer(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Framebuffer> {
     let textures = [
         rgba32f_texture(gl, w, h)?,
         rgba32f_texture(gl, w, h)?,
@@ -88,25 +96,26 @@ fn framebuffer(
     ];
     // SAFETY: FBO set-up with our textures on a current context.
     unsafe {
-        let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-        let depth = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+        let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
+        let depth = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth.raw()));
         gl.renderbuffer_storage(
             glow::RENDERBUFFER,
             glow::DEPTH_COMPONENT32F,
             w as i32,
             h as i32,
         );
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.raw()));
         for (i, t) in textures.iter().enumerate() {
             let attachment = glow::COLOR_ATTACHMENT0 + i as u32;
-            gl.framebuffer_texture_2d(glow::FRAMEBUFFER, attachment, glow::TEXTURE_2D, Some(*t), 0);
+            let t = Some(t.raw());
+            gl.framebuffer_texture_2d(glow::FRAMEBUFFER, attachment, glow::TEXTURE_2D, t, 0);
         }
         gl.framebuffer_renderbuffer(
             glow::FRAMEBUFFER,
             glow::DEPTH_ATTACHMENT,
             glow::RENDERBUFFER,
-            Some(depth),
+            Some(depth.raw()),
         );
         gl.draw_buffers(&[
             glow::COLOR_ATTACHMENT0,
@@ -136,10 +145,10 @@ impl GBuffer {
         Ok(GBuffer {
             gl: gl.clone(),
             raster,
-            vao,
-            vbos,
             fbo,
-            depth,
+            vao,
+            _vbos: vbos,
+            _depth: depth,
             textures,
             triangles: scene.triangle_count() as i32,
             width: w,
@@ -170,7 +179,7 @@ impl GBuffer {
         timers.time(gl, "gbuffer", || {
             // SAFETY: drawing with our program, VAO and FBO.
             unsafe {
-                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo.raw()));
                 gl.viewport(0, 0, w, h);
                 gl.enable(glow::DEPTH_TEST);
                 gl.depth_func(glow::LESS);
@@ -178,7 +187,7 @@ impl GBuffer {
                 gl.clear_buffer_f32_slice(glow::COLOR, 1, &[0.0, 0.0, 0.0, -1.0]);
                 gl.clear_buffer_f32_slice(glow::COLOR, 2, &[bg[0], bg[1], bg[2], 0.0]);
                 gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[1.0]);
-                gl.bind_vertex_array(Some(self.vao));
+                gl.bind_vertex_array(Some(self.vao.raw()));
                 gl.draw_arrays(glow::TRIANGLES, 0, 3 * self.triangles);
                 gl.bind_vertex_array(None);
                 gl.disable(glow::DEPTH_TEST);
@@ -187,26 +196,14 @@ impl GBuffer {
         });
     }
 
+    /// The position (w: 1 = geometry), normal (w: triangle id) and diffuse (RGBA32F)
+    /// textures.
+    pub fn textures(&self) -> [glow::Texture; 3] {
+        self.textures.each_ref().map(Owned::raw)
+    }
+
     /// Texture `i` (0 position, 1 normal, 2 diffuse) read back, GL row order.
     pub fn read(&self, i: usize) -> Vec<[f32; 4]> {
-        read_texture_rgba32f(&self.gl, self.textures[i], self.width, self.height)
-    }
-}
-
-impl Drop for GBuffer {
-    fn drop(&mut self) {
-        let gl = &self.gl;
-        // SAFETY: deleting our own objects.
-        unsafe {
-            gl.delete_vertex_array(self.vao);
-            for b in &self.vbos {
-                gl.delete_buffer(*b);
-            }
-            gl.delete_framebuffer(self.fbo);
-            gl.delete_renderbuffer(self.depth);
-            for t in self.textures {
-                gl.delete_texture(t);
-            }
-        }
+        read_texture_rgba32f(&self.gl, self.textures[i].raw(), self.width, self.height)
     }
 }

@@ -6,7 +6,7 @@
 //!    diffuse textures (`glsl/klee2016/gbuffer.vert`, `gbuffer.frag`);
 //! 2. **shadow pass** ([`shadow_pass`]): a compute kernel (`glsl/klee2016/linespace_shadow.comp`)
 //!    gives every pixel its shadow value — the fraction of its SAMPLES_U × SAMPLES_V shadow rays
-//!    that reach the light — by traversing the N-tree ([`crate::reference::ntree`]) with its
+//!    that reach the light — by traversing the N-tree ([`crate::pipeline::klee2016::ntree`]) with its
 //!    line spaces, and multiplies it into the diffuse texture;
 //! 3. **screen-filling quad** ([`present`], `glsl/klee2016/linespace_quad.*`): the diffuse
 //!    texture drawn into the output texture (headless: read back into the PNG).
@@ -15,6 +15,7 @@
 //! buffer (RG32UI), the line spaces into a 3D R32UI texture laid out as Listing 3.
 
 pub mod gbuffer;
+pub mod ntree;
 pub mod present;
 pub mod shadow_pass;
 
@@ -27,6 +28,7 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gbuffer::GBuffer;
+use self::ntree::{NTree, PackedLinespaces};
 use self::present::Present;
 use self::shadow_pass::{shadow_kernel, ShadowPass, ShadowUniforms};
 use super::Renderer;
@@ -34,7 +36,6 @@ use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
 use crate::gl::context::LoopLimit;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
-use crate::reference::ntree::{self, NTree, PackedLinespaces};
 pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 
@@ -233,7 +234,7 @@ impl SoftShadowRenderer {
                 background: scene.settings.background,
             },
             options,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             pixels,
             ray_batches: 1,
             loop_limit: limit,
@@ -324,13 +325,13 @@ impl SoftShadowRenderer {
         let counts = self.shadow.run(
             &mut self.timers,
             pixels,
-            &self.gbuffer.textures,
+            &self.gbuffer.textures(),
             &self.uniforms,
             batches,
         );
         crate::gl::check_error(&self.gl, "the shadow pass")?;
         self.present
-            .draw(&mut self.timers, self.gbuffer.textures[2]);
+            .draw(&mut self.timers, self.gbuffer.textures()[2]);
         crate::gl::check_error(&self.gl, "the screen-filling quad")?;
         let truncated = counts.get("truncated");
         let mut stats = FrameStats {
@@ -354,8 +355,12 @@ impl SoftShadowRenderer {
     fn aovs(&self, camera: &Camera) -> Aovs {
         let (w, h) = self.size();
         let (position, normal) = self.read_gbuffer();
-        let shadow =
-            crate::gl::resources::read_texture_rgba32f(&self.gl, self.shadow.shadow_texture, w, h);
+        let shadow = crate::gl::resources::read_texture_rgba32f(
+            &self.gl,
+            self.shadow.shadow_texture(),
+            w,
+            h,
+        );
         let rays = camera.rays(w, h);
         let mut aovs = Aovs {
             shadow: Some(flip_rows(&shadow, w, h).iter().map(|c| c[0]).collect()),
@@ -489,7 +494,8 @@ impl Renderer for SoftShadowRenderer {
             .clone()
             .ok_or_else(|| anyhow!("no frame drawn yet"))?;
         let (w, h) = self.size();
-        let color = crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output, w, h);
+        let color =
+            crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output(), w, h);
         let aovs = self.aovs(&camera);
         stats.wall_ms += t0.elapsed().as_secs_f64() * 1e3;
         Ok(Frame {
@@ -504,7 +510,7 @@ impl Renderer for SoftShadowRenderer {
     /// The RGBA32F output texture of the last frame (what the screen-filling quad drew), GL
     /// row order.
     fn output_texture(&self) -> glow::Texture {
-        self.present.output
+        self.present.output()
     }
 
     fn set_model(&mut self, _object: usize, _model: Mat4) -> Result<()> {
@@ -520,11 +526,5 @@ impl Renderer for SoftShadowRenderer {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for SoftShadowRenderer {
-    fn drop(&mut self) {
-        self.timers.delete(&self.gl);
     }
 }

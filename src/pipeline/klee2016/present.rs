@@ -9,16 +9,17 @@ use anyhow::{anyhow, bail, Result};
 use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
-use crate::gl::resources::GpuTimers;
+use crate::gl::resources::{GpuTimers, Owned};
 use crate::gl::slots::sampler;
 use crate::gl::{Defines, Gl, Kernel, ShaderSource};
 
 pub struct Present {
     gl: Arc<Gl>,
     quad: Kernel,
-    vao: glow::VertexArray,
-    fbo: glow::Framebuffer,
-    pub output: glow::Texture,
+    vao: Owned<glow::VertexArray>,
+    // before the texture attached to it: it drops first
+    fbo: Owned<glow::Framebuffer>,
+    output: Owned<glow::Texture>,
     width: u32,
     height: u32,
 }
@@ -43,13 +44,13 @@ impl Present {
         let output = rgba32f_texture(gl, w, h)?;
         // SAFETY: FBO and VAO creation on a current context.
         unsafe {
-            let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+            let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.raw()));
             gl.framebuffer_texture_2d(
                 glow::FRAMEBUFFER,
                 glow::COLOR_ATTACHMENT0,
                 glow::TEXTURE_2D,
-                Some(output),
+                Some(output.raw()),
                 0,
             );
             let complete =
@@ -58,16 +59,22 @@ impl Present {
             if !complete {
                 bail!("the output FBO is incomplete");
             }
+            let vao = Owned::new(gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
             Ok(Present {
                 gl: gl.clone(),
                 quad,
-                vao: gl.create_vertex_array().map_err(|e| anyhow!(e))?,
+                vao,
                 fbo,
                 output,
                 width: w,
                 height: h,
             })
         }
+    }
+
+    /// The output texture.
+    pub fn output(&self) -> glow::Texture {
+        self.output.raw()
     }
 
     /// Replace the program (the viewer's live reload).
@@ -82,27 +89,16 @@ impl Present {
         timers.time(gl, self.quad.timer(), || {
             // SAFETY: drawing the quad with our program into our FBO.
             unsafe {
-                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo.raw()));
                 gl.viewport(0, 0, self.width as i32, self.height as i32);
                 gl.active_texture(glow::TEXTURE0 + sampler::QUAD_COLOR);
                 gl.bind_texture(glow::TEXTURE_2D, Some(color));
-                gl.bind_vertex_array(Some(self.vao));
+                gl.bind_vertex_array(Some(self.vao.raw()));
                 gl.draw_arrays(glow::TRIANGLES, 0, 3);
                 gl.bind_vertex_array(None);
                 gl.bind_texture(glow::TEXTURE_2D, None);
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         });
-    }
-}
-
-impl Drop for Present {
-    fn drop(&mut self) {
-        // SAFETY: deleting our own objects.
-        unsafe {
-            self.gl.delete_vertex_array(self.vao);
-            self.gl.delete_framebuffer(self.fbo);
-            self.gl.delete_texture(self.output);
-        }
     }
 }

@@ -11,12 +11,12 @@ use glam::Vec3;
 use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
+use super::ntree::{NTree, PackedLinespaces};
 use super::{KleeShading, SoftShadowOptions};
 use crate::gl::context::LoopLimit;
-use crate::gl::resources::{GpuTimers, Ssbo, TextureBuffer};
+use crate::gl::resources::{GpuTimers, Owned, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::reference::ntree::{NTree, PackedLinespaces};
 use crate::scene::{AreaLight, ShadowMode};
 
 /// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`.
@@ -101,10 +101,10 @@ pub struct ShadowPass {
     gl: Arc<Gl>,
     pub kernel: Kernel,
     /// r: shadow value, g: lit rays (summed over batches)
-    pub shadow_texture: glow::Texture,
+    shadow_texture: Owned<glow::Texture>,
     /// the node pool (Fig. 8–9), RG32UI texels
     node_pool: TextureBuffer,
-    linespace_texture: glow::Texture,
+    linespace_texture: Owned<glow::Texture>,
     /// triVertex, leafTriangles, counters
     buffers: [Ssbo; 3],
     min_bound: Vec3,
@@ -113,7 +113,7 @@ pub struct ShadowPass {
 }
 
 /// The line spaces as a 3D R32UI texture laid out as Listing 3.
-fn linespace_texture(gl: &Gl, packed: &PackedLinespaces) -> Result<glow::Texture> {
+fn linespace_texture(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owned<glow::Texture>> {
     let (x, y, z) = (
         packed.tex_x_res as i32,
         packed.tex_y_res as i32,
@@ -121,8 +121,8 @@ fn linespace_texture(gl: &Gl, packed: &PackedLinespaces) -> Result<glow::Texture
     );
     // SAFETY: texture creation and upload; the slice holds x·y·z texels.
     unsafe {
-        let t = gl.create_texture().map_err(|e| anyhow!(e))?;
-        gl.bind_texture(glow::TEXTURE_3D, Some(t));
+        let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+        gl.bind_texture(glow::TEXTURE_3D, Some(t.raw()));
         gl.tex_storage_3d(glow::TEXTURE_3D, 1, glow::R32UI, x, y, z);
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
         let texels = glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(&packed.texels)));
@@ -215,8 +215,8 @@ impl ShadowPass {
             img(image::GBUFFER_POSITION, gbuffer[0], ro, f);
             img(image::GBUFFER_NORMAL, gbuffer[1], ro, f);
             img(image::GBUFFER_DIFFUSE, gbuffer[2], rw, f);
-            img(image::SHADOW_VALUE, self.shadow_texture, rw, f);
-            let ls = Some(self.linespace_texture);
+            img(image::SHADOW_VALUE, self.shadow_texture.raw(), rw, f);
+            let ls = Some(self.linespace_texture.raw());
             gl.bind_image_texture(image::LINESPACE, ls, 0, true, 0, ro, glow::R32UI);
         }
         let [tris, leaves, counters] = &self.buffers;
@@ -254,13 +254,18 @@ impl ShadowPass {
         }))
     }
 
+    /// The shadow texture (r: shadow value, g: lit rays).
+    pub fn shadow_texture(&self) -> glow::Texture {
+        self.shadow_texture.raw()
+    }
+
     /// Read the 3D line-space texture back (`texels` of them; the round-trip test).
     pub fn read_linespace_texture(&self, texels: usize) -> Vec<u32> {
         let gl = &self.gl;
         let mut data = vec![0u32; texels];
         // SAFETY: the slice holds all texels of the texture.
         unsafe {
-            gl.bind_texture(glow::TEXTURE_3D, Some(self.linespace_texture));
+            gl.bind_texture(glow::TEXTURE_3D, Some(self.linespace_texture.raw()));
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
             gl.get_tex_image(
                 glow::TEXTURE_3D,
@@ -272,20 +277,5 @@ impl ShadowPass {
             gl.bind_texture(glow::TEXTURE_3D, None);
         }
         data
-    }
-}
-
-impl Drop for ShadowPass {
-    fn drop(&mut self) {
-        let gl = &self.gl;
-        // SAFETY: deleting our own objects.
-        unsafe {
-            gl.delete_texture(self.shadow_texture);
-            gl.delete_texture(self.linespace_texture);
-        }
-        self.node_pool.delete(gl);
-        for b in &self.buffers {
-            b.delete(gl);
-        }
     }
 }

@@ -3,11 +3,13 @@
 //! the transform pass (`glsl/mueller2015/transform.vert`, rasterizer discarded) from the VBOs and each
 //! object's model and normal matrices. Materials, lights and textures live beside them.
 
+use std::sync::Arc;
+
 use anyhow::{anyhow, bail, Context as _, Result};
 use glam::{Mat3, Mat4};
 use glow::HasContext;
 
-use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::resources::{GpuTimers, Owned, Ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
 use crate::scene::{budget, Scene};
 
@@ -15,9 +17,10 @@ use crate::scene::{budget, Scene};
 pub use crate::gl::slots::ssbo as binding;
 
 pub struct GpuScene {
-    vao: glow::VertexArray,
-    light_vao: glow::VertexArray,
-    vbos: Vec<glow::Buffer>,
+    vao: Owned<glow::VertexArray>,
+    light_vao: Owned<glow::VertexArray>,
+    /// held for the VAOs, which read them
+    _vbos: Vec<Owned<glow::Buffer>>,
     /// (first vertex, vertex count) of every object in the VBOs and SSBOs.
     ranges: Vec<(i32, i32)>,
     light_count: i32,
@@ -25,17 +28,17 @@ pub struct GpuScene {
     transform: Kernel,
     /// An FBO with a 1×1 renderbuffer: a surfaceless context has no default framebuffer to
     /// draw the (discarded) points into.
-    fbo: glow::Framebuffer,
-    rbo: glow::Renderbuffer,
-    pub textures: glow::Texture,
+    fbo: Owned<glow::Framebuffer>,
+    _rbo: Owned<glow::Renderbuffer>,
+    textures: Owned<glow::Texture>,
     pub triangles: usize,
 }
 
-fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
+fn upload_vbo(gl: &Arc<Gl>, data: &[u8]) -> Result<Owned<glow::Buffer>> {
     // SAFETY: buffer creation with data on a current context.
     unsafe {
-        let b = gl.create_buffer().map_err(|e| anyhow!(e))?;
-        gl.bind_buffer(glow::ARRAY_BUFFER, Some(b));
+        let b = Owned::new(gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
+        gl.bind_buffer(glow::ARRAY_BUFFER, Some(b.raw()));
         gl.buffer_data_u8_slice(glow::ARRAY_BUFFER, data, glow::STATIC_DRAW);
         crate::gl::check_alloc(gl, "a vertex buffer of the scene", data.len() as u64)?;
         Ok(b)
@@ -43,7 +46,7 @@ fn upload_vbo(gl: &Gl, data: &[u8]) -> Result<glow::Buffer> {
 }
 
 /// A VBO of `size`-component float vectors as vertex attribute `loc` of the bound VAO.
-fn float_attribute(gl: &Gl, loc: u32, data: &[u8], size: i32) -> Result<glow::Buffer> {
+fn float_attribute(gl: &Arc<Gl>, loc: u32, data: &[u8], size: i32) -> Result<Owned<glow::Buffer>> {
     let b = upload_vbo(gl, data)?;
     // SAFETY: attribute setup of the bound VAO from the bound buffer `b`.
     unsafe {
@@ -111,16 +114,19 @@ fn check_device(info: &GlInfo, scene: &Scene) -> Result<()> {
 }
 
 /// The transform pass' VAOs, objects and lights, and all their VBOs.
-fn vertex_arrays(
-    gl: &Gl,
-    scene: &Scene,
-    data: &VertexData,
-) -> Result<(glow::VertexArray, glow::VertexArray, Vec<glow::Buffer>)> {
+type VertexArrays = (
+    Owned<glow::VertexArray>,
+    Owned<glow::VertexArray>,
+    Vec<Owned<glow::Buffer>>,
+);
+
+/// The transform pass' VAOs, objects and lights, and all their VBOs.
+fn vertex_arrays(gl: &Arc<Gl>, scene: &Scene, data: &VertexData) -> Result<VertexArrays> {
     let mut vbos = Vec::new();
     // SAFETY: VAO/VBO setup on a current context.
     unsafe {
-        let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-        gl.bind_vertex_array(Some(vao));
+        let vao = Owned::new(gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
+        gl.bind_vertex_array(Some(vao.raw()));
         for (loc, bytes, n) in [
             (0u32, bytemuck::cast_slice::<_, u8>(&data.positions), 3),
             (1, bytemuck::cast_slice(&data.normals), 3),
@@ -134,8 +140,8 @@ fn vertex_arrays(
         gl.vertex_attrib_pointer_i32(4, 1, glow::INT, 0, 0);
         vbos.push(b);
 
-        let light_vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-        gl.bind_vertex_array(Some(light_vao));
+        let light_vao = Owned::new(gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
+        gl.bind_vertex_array(Some(light_vao.raw()));
         let lp: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.position.to_array()).collect();
         let lc: Vec<[f32; 3]> = scene.lights.iter().map(|l| l.color.to_array()).collect();
         for (loc, v) in [(0u32, lp), (2, lc)] {
@@ -149,7 +155,7 @@ fn vertex_arrays(
 
 /// The SSBOs the kernels read: per vertex and per light, filled by the transform pass, and the
 /// materials (reflection, specular, shininess, texture layer or -1), uploaded here.
-fn scene_ssbos(gl: &Gl, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
+fn scene_ssbos(gl: &Arc<Gl>, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>> {
     let materials: Vec<[f32; 4]> = scene
         .materials
         .iter()
@@ -221,19 +227,19 @@ pub fn check_sizes(info: &GlInfo, scene: &Scene) -> Result<()> {
 }
 
 /// An FBO with a 1×1 renderbuffer for the transform pass' (discarded) points.
-fn point_target(gl: &Gl) -> Result<(glow::Framebuffer, glow::Renderbuffer)> {
+fn point_target(gl: &Arc<Gl>) -> Result<(Owned<glow::Framebuffer>, Owned<glow::Renderbuffer>)> {
     // SAFETY: framebuffer setup on a current context.
     unsafe {
-        let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-        let rbo = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo));
+        let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
+        let rbo = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rbo.raw()));
         gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, 1, 1);
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.raw()));
         gl.framebuffer_renderbuffer(
             glow::FRAMEBUFFER,
             glow::COLOR_ATTACHMENT0,
             glow::RENDERBUFFER,
-            Some(rbo),
+            Some(rbo.raw()),
         );
         gl.bind_framebuffer(glow::FRAMEBUFFER, None);
         Ok((fbo, rbo))
@@ -242,7 +248,7 @@ fn point_target(gl: &Gl) -> Result<(glow::Framebuffer, glow::Renderbuffer)> {
 
 impl GpuScene {
     pub fn new(
-        gl: &std::sync::Arc<Gl>,
+        gl: &Arc<Gl>,
         info: &GlInfo,
         scene: &Scene,
         shaders: &ShaderSource,
@@ -267,13 +273,13 @@ impl GpuScene {
         Ok(GpuScene {
             vao,
             light_vao,
-            vbos,
+            _vbos: vbos,
             ranges: data.ranges,
             light_count: scene.lights.len() as i32,
             ssbos,
             transform: program,
             fbo,
-            rbo,
+            _rbo: rbo,
             textures,
             triangles: scene.triangle_count(),
         })
@@ -291,7 +297,7 @@ impl GpuScene {
         // SAFETY: binding our texture array to its unit (sampler `textures`).
         unsafe {
             gl.active_texture(glow::TEXTURE0 + crate::gl::slots::sampler::TEXTURES);
-            gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.textures));
+            gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(self.textures.raw()));
         }
     }
 
@@ -309,10 +315,10 @@ impl GpuScene {
         timers.time(gl, k.timer(), || {
             // SAFETY: draws with our program and VAOs; rasterization is discarded.
             unsafe {
-                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo));
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo.raw()));
                 gl.enable(glow::RASTERIZER_DISCARD);
                 k.set_i32("transformLights", 0);
-                gl.bind_vertex_array(Some(self.vao));
+                gl.bind_vertex_array(Some(self.vao.raw()));
                 for (&(first, count), model) in self.ranges.iter().zip(models) {
                     let normal = Mat3::from_mat4(*model).inverse().transpose();
                     k.set_mat4("modelMatrix", &model.to_cols_array());
@@ -322,7 +328,7 @@ impl GpuScene {
                 if self.light_count > 0 {
                     k.set_i32("transformLights", 1);
                     k.set_mat4("modelMatrix", &Mat4::IDENTITY.to_cols_array());
-                    gl.bind_vertex_array(Some(self.light_vao));
+                    gl.bind_vertex_array(Some(self.light_vao.raw()));
                     gl.draw_arrays(glow::POINTS, 0, self.light_count);
                 }
                 gl.bind_vertex_array(None);
@@ -331,23 +337,6 @@ impl GpuScene {
             }
         });
         crate::gl::sync::barrier(gl);
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        // SAFETY: deleting our own objects.
-        unsafe {
-            gl.delete_vertex_array(self.vao);
-            gl.delete_vertex_array(self.light_vao);
-            for b in &self.vbos {
-                gl.delete_buffer(*b);
-            }
-            for (_, s) in &self.ssbos {
-                s.delete(gl);
-            }
-            gl.delete_framebuffer(self.fbo);
-            gl.delete_renderbuffer(self.rbo);
-            gl.delete_texture(self.textures);
-        }
     }
 }
 
@@ -367,7 +356,7 @@ fn check_texture_memory(info: &GlInfo, scene: &Scene) -> Result<()> {
 
 /// All textures as layers of one RGBA8 2D array texture (bilinear, repeat), sampled by
 /// intersect1 with the material's layer. A scene without textures gets one white texel.
-fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Texture> {
+fn upload_textures(gl: &Arc<Gl>, info: &GlInfo, scene: &Scene) -> Result<Owned<glow::Texture>> {
     check_texture_memory(info, scene)?;
     let (w, h, layers) = scene.texture_layers(info.max_texture_size as u32);
     if layers.len() > info.max_array_texture_layers.max(1) as usize {
@@ -383,8 +372,8 @@ fn upload_textures(gl: &Gl, info: &GlInfo, scene: &Scene) -> Result<glow::Textur
     }
     // SAFETY: texture upload of w·h·layers RGBA8 texels.
     unsafe {
-        let t = gl.create_texture().map_err(|e| anyhow!(e))?;
-        gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(t));
+        let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+        gl.bind_texture(glow::TEXTURE_2D_ARRAY, Some(t.raw()));
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
         gl.tex_image_3d(
             glow::TEXTURE_2D_ARRAY,

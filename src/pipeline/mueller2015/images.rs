@@ -2,6 +2,8 @@
 //! `glsl/common/images.glsl` ([`crate::gl::slots::image`]) and cleared every frame — and the
 //! copies of the primary rays, normals and shadow flags kept for the AOVs.
 
+use std::sync::Arc;
+
 use anyhow::Result;
 
 use super::ShadowFlags;
@@ -23,7 +25,7 @@ pub struct RayImages {
 }
 
 impl RayImages {
-    pub fn new(gl: &Gl, w: u32, h: u32, flags: ShadowFlags) -> Result<RayImages> {
+    pub fn new(gl: &Arc<Gl>, w: u32, h: u32, flags: ShadowFlags) -> Result<RayImages> {
         let f = glow::RGBA32F;
         let shadow = flags.format();
         Ok(RayImages {
@@ -60,12 +62,6 @@ impl RayImages {
             img.clear(gl);
         }
     }
-
-    pub fn delete(&self, gl: &Gl) {
-        for (img, _) in self.all() {
-            img.delete(gl);
-        }
-    }
 }
 
 /// The primary rays, and the first hits' normals and shadow flags, copied on the GPU while a
@@ -81,7 +77,13 @@ pub struct AovImages {
 }
 
 impl AovImages {
-    pub fn new(gl: &Gl, w: u32, h: u32, flags: ShadowFlags, lights: usize) -> Result<AovImages> {
+    pub fn new(
+        gl: &Arc<Gl>,
+        w: u32,
+        h: u32,
+        flags: ShadowFlags,
+        lights: usize,
+    ) -> Result<AovImages> {
         Ok(AovImages {
             ray_origin: Image2d::new(gl, w, h, glow::RGBA32F)?,
             ray_dir: Image2d::new(gl, w, h, glow::RGBA32F)?,
@@ -146,12 +148,6 @@ impl AovImages {
             triangle_id: hit.iter().map(|v| v[1].to_bits() as i32).collect(),
             normal: flip_xyz(&self.normal.read_f32(gl), w, h),
             shadow: Some(flip_rows(&self.lit_share(gl), w, h)),
-        }
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        for img in [&self.ray_origin, &self.ray_dir, &self.normal, &self.shadow] {
-            img.delete(gl);
         }
     }
 }

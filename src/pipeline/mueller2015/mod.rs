@@ -240,7 +240,7 @@ impl RayTracer {
             scene: gpu_scene,
             kernels,
             counters,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             lighting: Lighting {
                 lights: scene.lights.len(),
                 background: scene.settings.background,
@@ -430,7 +430,7 @@ impl Renderer for RayTracer {
     }
 
     fn output_texture(&self) -> glow::Texture {
-        self.images.final_color.texture
+        self.images.final_color.texture.raw()
     }
 
     fn set_model(&mut self, object: usize, model: Mat4) -> Result<()> {
@@ -454,21 +454,5 @@ impl Renderer for RayTracer {
         .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for RayTracer {
-    fn drop(&mut self) {
-        let gl = self.gl.clone();
-        self.scene.delete(&gl);
-        self.images.delete(&gl);
-        if let Some(a) = &self.aov_images {
-            a.delete(&gl);
-        }
-        self.counters.delete(&gl);
-        if let Some(r) = &self.records {
-            r.delete(&gl);
-        }
-        self.timers.delete(&gl);
     }
 }

@@ -97,8 +97,4 @@ impl Records {
             self.pixels.div_ceil(PIXELS_PER_INVOCATION * COUNT_GROUP),
         );
     }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.records.delete(gl);
-    }
 }

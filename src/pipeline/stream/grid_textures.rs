@@ -4,6 +4,8 @@
 //! RGB32F textures of 4 depth slices each (v0, edge1, edge2, diffuse colour; n0, n1, n2,
 //! reflectivity) — 8 texels, the paper's 96 bytes, per triangle.
 
+use std::sync::Arc;
+
 use anyhow::{bail, Result};
 use glam::Vec3;
 
@@ -59,7 +61,7 @@ fn triangle_texels(
 impl GridTextures {
     /// Upload `grid` (built over `scene`'s world triangles) with the scene's normals, colours
     /// and reflectivities.
-    pub fn upload(gl: &Gl, grid: &StreamGrid, scene: &Scene) -> Result<GridTextures> {
+    pub fn upload(gl: &Arc<Gl>, grid: &StreamGrid, scene: &Scene) -> Result<GridTextures> {
         let n = grid.triangles.len();
         if grid.refs.len() >= FLOAT_EXACT || n >= FLOAT_EXACT {
             bail!(
@@ -123,12 +125,5 @@ impl GridTextures {
         k.set_vec3("cellSize", b.cell.to_array());
         k.set_ivec3("gridSize", b.dims.as_ivec3().to_array());
         k.set_i32("triTextureWidth", self.tri_width as i32);
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.cells.delete(gl);
-        self.refs.delete(gl);
-        self.tri_vertex.delete(gl);
-        self.tri_normal.delete(gl);
     }
 }

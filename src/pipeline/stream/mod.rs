@@ -35,7 +35,7 @@ use self::targets::{AovTargets, Targets};
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
-use crate::gl::resources::GpuTimers;
+use crate::gl::resources::{GpuTimers, Owned};
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, ShaderSource};
 use crate::reference::stream_grid::{auto_dims, StreamGrid};
 use crate::scene::{Camera, Scene};
@@ -152,7 +152,7 @@ pub struct StreamRenderer {
     kernels: Kernels,
     counters: CounterBanks,
     timers: GpuTimers,
-    query: glow::Query,
+    query: Owned<glow::Query>,
     calls: Calls,
     /// for the shadow AOV: per pixel (GL row order), the lights whose first-bounce shadow ray
     /// found no blocker
@@ -229,7 +229,7 @@ impl StreamRenderer {
         let targets = Targets::new(&gl, options.width, options.height, options.aovs)?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         // SAFETY: query creation on a current context.
-        let query = unsafe { gl.create_query().map_err(|e| anyhow!(e))? };
+        let query = Owned::new(&gl, unsafe { gl.create_query().map_err(|e| anyhow!(e))? });
         let r = StreamRenderer {
             scene,
             grid,
@@ -238,7 +238,7 @@ impl StreamRenderer {
             targets,
             kernels,
             counters,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             query,
             calls: Calls::default(),
             unblocked: match options.aovs {
@@ -283,9 +283,9 @@ impl StreamRenderer {
             k.set_vec3("lightPosition", l.position.to_array());
         }
         let fbo = if into == 2 {
-            t.fbo.shadow
+            t.fbo.shadow.raw()
         } else {
-            t.fbo.rays[into]
+            t.fbo.rays[into].raw()
         };
         t.draw(gl, &mut self.timers, k, fbo);
         t.unbind(gl);
@@ -300,7 +300,7 @@ impl StreamRenderer {
         t.bind_rays(gl, t.ray_set(rays));
         k.set_i32("shadowRays", shadow as i32);
         k.set_i32("masking", !self.options.no_mask as i32);
-        t.draw(gl, &mut self.timers, k, t.fbo.state[0]);
+        t.draw(gl, &mut self.timers, k, t.fbo.state[0].raw());
         t.unbind(gl);
         t.state[1].tmax.clear(gl);
         self.traverse(rays, shadow);
@@ -322,7 +322,7 @@ impl StreamRenderer {
             gl,
             &mut self.timers,
             &self.kernels.early_z,
-            t.fbo.depth_only,
+            t.fbo.depth_only.raw(),
         );
         let k = &self.kernels.traverse;
         self.use_kernel(k);
@@ -336,15 +336,15 @@ impl StreamRenderer {
         unsafe {
             gl.depth_func(glow::LESS);
             gl.depth_mask(false);
-            gl.begin_query(glow::SAMPLES_PASSED, self.query);
+            gl.begin_query(glow::SAMPLES_PASSED, self.query.raw());
         }
-        t.draw(gl, &mut self.timers, k, t.fbo.state[1 - read]);
+        t.draw(gl, &mut self.timers, k, t.fbo.state[1 - read].raw());
         // SAFETY: ending the query and reading its result (waits for the call).
         unsafe {
             gl.end_query(glow::SAMPLES_PASSED);
             gl.disable(glow::DEPTH_TEST);
             gl.depth_mask(true);
-            gl.get_query_parameter_u32(self.query, glow::QUERY_RESULT) as u64
+            gl.get_query_parameter_u32(self.query.raw(), glow::QUERY_RESULT) as u64
         }
     }
 
@@ -378,7 +378,12 @@ impl StreamRenderer {
         let (gl, t) = (&self.gl, &self.targets);
         t.bind_state(gl, 0);
         self.use_kernel(&self.kernels.hit_record);
-        t.draw(gl, &mut self.timers, &self.kernels.hit_record, t.fbo.hit);
+        t.draw(
+            gl,
+            &mut self.timers,
+            &self.kernels.hit_record,
+            t.fbo.hit.raw(),
+        );
         t.unbind(gl);
     }
 
@@ -402,7 +407,7 @@ impl StreamRenderer {
             gl.enable(glow::BLEND);
             gl.blend_func(glow::ONE, glow::ONE);
         }
-        t.draw(gl, &mut self.timers, k, t.fbo.color);
+        t.draw(gl, &mut self.timers, k, t.fbo.color.raw());
         // SAFETY: as above.
         unsafe { gl.disable(glow::BLEND) };
         t.unbind(gl);
@@ -428,7 +433,12 @@ impl StreamRenderer {
         let Some(a) = &t.primary else { return };
         t.bind_state(gl, 0);
         self.use_kernel(&self.kernels.hit_record);
-        t.draw(gl, &mut self.timers, &self.kernels.hit_record, a.shadow_fbo);
+        t.draw(
+            gl,
+            &mut self.timers,
+            &self.kernels.hit_record,
+            a.shadow_fbo.raw(),
+        );
         t.unbind(gl);
         let hits = a.shadow_hit.read_f32(gl);
         let rays = t.shadow.direction.read_f32(gl);
@@ -470,7 +480,7 @@ impl StreamRenderer {
         let gl = &self.gl;
         self.counters.clear(gl, &mut self.timers);
         self.textures.bind(gl);
-        gl.clear_tex_f32(self.targets.color.texture, [0.0, 0.0, 0.0, 1.0]);
+        gl.clear_tex_f32(self.targets.color.texture.raw(), [0.0, 0.0, 0.0, 1.0]);
         self.calls = Calls::default();
         self.unblocked.iter_mut().for_each(|n| *n = 0);
         self.count_as(Bank::Primary);
@@ -636,7 +646,7 @@ impl Renderer for StreamRenderer {
     }
 
     fn output_texture(&self) -> glow::Texture {
-        self.targets.color.texture
+        self.targets.color.texture.raw()
     }
 
     fn set_model(&mut self, _object: usize, _model: Mat4) -> Result<()> {
@@ -661,17 +671,5 @@ impl Renderer for StreamRenderer {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for StreamRenderer {
-    fn drop(&mut self) {
-        let gl = self.gl.clone();
-        self.textures.delete(&gl);
-        self.targets.delete(&gl);
-        self.counters.delete(&gl);
-        self.timers.delete(&gl);
-        // SAFETY: deleting our own query.
-        unsafe { gl.delete_query(self.query) };
     }
 }

@@ -3,10 +3,12 @@
 //! (seed 004, ch. 3: "Redirecting the results of a fragment program to framebuffer attachable
 //! images is called using multiple render targets").
 
+use std::sync::Arc;
+
 use anyhow::{anyhow, bail, Result};
 use glow::HasContext;
 
-use crate::gl::resources::{GpuTimers, Image2d};
+use crate::gl::resources::{GpuTimers, Image2d, Owned};
 use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
 
@@ -37,8 +39,9 @@ pub struct Targets {
     pub color: Image2d,
     /// for the AOVs (`--aov-dir`, tests)
     pub primary: Option<AovTargets>,
-    depth: glow::Renderbuffer,
-    vao: glow::VertexArray,
+    /// held for the FBOs it is attached to
+    _depth: Owned<glow::Renderbuffer>,
+    vao: Owned<glow::VertexArray>,
     pub fbo: Framebuffers,
 }
 
@@ -48,44 +51,29 @@ pub struct AovTargets {
     pub rays: Rays,
     pub hit: Image2d,
     pub shadow_hit: Image2d,
-    pub shadow_fbo: glow::Framebuffer,
+    pub shadow_fbo: Owned<glow::Framebuffer>,
 }
 
 /// The render-target sets.
 pub struct Framebuffers {
-    pub rays: [glow::Framebuffer; 2],
-    pub shadow: glow::Framebuffer,
-    pub state: [glow::Framebuffer; 2],
-    pub depth_only: glow::Framebuffer,
-    pub hit: glow::Framebuffer,
-    pub color: glow::Framebuffer,
-}
-
-impl Framebuffers {
-    fn all(&self) -> [glow::Framebuffer; 8] {
-        [
-            self.rays[0],
-            self.rays[1],
-            self.shadow,
-            self.state[0],
-            self.state[1],
-            self.depth_only,
-            self.hit,
-            self.color,
-        ]
-    }
+    pub rays: [Owned<glow::Framebuffer>; 2],
+    pub shadow: Owned<glow::Framebuffer>,
+    pub state: [Owned<glow::Framebuffer>; 2],
+    pub depth_only: Owned<glow::Framebuffer>,
+    pub hit: Owned<glow::Framebuffer>,
+    pub color: Owned<glow::Framebuffer>,
 }
 
 /// An FBO with `colors` as draw buffers 0.. and, if given, the depth renderbuffer.
 fn framebuffer(
-    gl: &Gl,
+    gl: &Arc<Gl>,
     colors: &[&Image2d],
     depth: Option<glow::Renderbuffer>,
-) -> Result<glow::Framebuffer> {
+) -> Result<Owned<glow::Framebuffer>> {
     // SAFETY: FBO set-up with our own textures on a current context.
     unsafe {
-        let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
+        let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
+        gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.raw()));
         let mut buffers = Vec::new();
         for (i, t) in colors.iter().enumerate() {
             let attachment = glow::COLOR_ATTACHMENT0 + i as u32;
@@ -93,7 +81,7 @@ fn framebuffer(
                 glow::FRAMEBUFFER,
                 attachment,
                 glow::TEXTURE_2D,
-                Some(t.texture),
+                Some(t.texture.raw()),
                 0,
             );
             buffers.push(attachment);
@@ -114,25 +102,24 @@ fn framebuffer(
         let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
         gl.bind_framebuffer(glow::FRAMEBUFFER, None);
         if status != glow::FRAMEBUFFER_COMPLETE {
-            gl.delete_framebuffer(fbo);
             bail!("a framebuffer of the streaming tracer is incomplete (status {status:#x})");
         }
         Ok(fbo)
     }
 }
 
-fn rgba(gl: &Gl, w: u32, h: u32) -> Result<Image2d> {
+fn rgba(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Image2d> {
     Image2d::new(gl, w, h, glow::RGBA32F)
 }
 
-fn rays(gl: &Gl, w: u32, h: u32) -> Result<Rays> {
+fn rays(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Rays> {
     Ok(Rays {
         origin: rgba(gl, w, h)?,
         direction: rgba(gl, w, h)?,
     })
 }
 
-fn state_set(gl: &Gl, w: u32, h: u32) -> Result<StateSet> {
+fn state_set(gl: &Arc<Gl>, w: u32, h: u32) -> Result<StateSet> {
     Ok(StateSet {
         tmax: rgba(gl, w, h)?,
         cell: rgba(gl, w, h)?,
@@ -141,15 +128,15 @@ fn state_set(gl: &Gl, w: u32, h: u32) -> Result<StateSet> {
 }
 
 impl Targets {
-    pub fn new(gl: &Gl, w: u32, h: u32, aovs: bool) -> Result<Targets> {
+    pub fn new(gl: &Arc<Gl>, w: u32, h: u32, aovs: bool) -> Result<Targets> {
         let ray_pair = [rays(gl, w, h)?, rays(gl, w, h)?];
         let shadow = rays(gl, w, h)?;
         let state = [state_set(gl, w, h)?, state_set(gl, w, h)?];
         let (hit, color) = (rgba(gl, w, h)?, rgba(gl, w, h)?);
         // SAFETY: renderbuffer and VAO creation on a current context.
         let (depth, vao) = unsafe {
-            let depth = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+            let depth = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth.raw()));
             gl.renderbuffer_storage(
                 glow::RENDERBUFFER,
                 glow::DEPTH_COMPONENT32F,
@@ -157,15 +144,16 @@ impl Targets {
                 h as i32,
             );
             gl.bind_renderbuffer(glow::RENDERBUFFER, None);
-            (depth, gl.create_vertex_array().map_err(|e| anyhow!(e))?)
+            let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
+            (depth, Owned::new(gl, vao))
         };
-        let set = |s: &StateSet| framebuffer(gl, &[&s.tmax, &s.cell, &s.hit], Some(depth));
+        let set = |s: &StateSet| framebuffer(gl, &[&s.tmax, &s.cell, &s.hit], Some(depth.raw()));
         let pair = |r: &Rays| framebuffer(gl, &[&r.origin, &r.direction], None);
         let fbo = Framebuffers {
             rays: [pair(&ray_pair[0])?, pair(&ray_pair[1])?],
             shadow: pair(&shadow)?,
             state: [set(&state[0])?, set(&state[1])?],
-            depth_only: framebuffer(gl, &[], Some(depth))?,
+            depth_only: framebuffer(gl, &[], Some(depth.raw()))?,
             hit: framebuffer(gl, &[&hit], None)?,
             color: framebuffer(gl, &[&color], None)?,
         };
@@ -189,7 +177,7 @@ impl Targets {
             hit,
             color,
             primary,
-            depth,
+            _depth: depth,
             vao,
             fbo,
         })
@@ -205,7 +193,7 @@ impl Targets {
             unsafe {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
                 gl.viewport(0, 0, self.width as i32, self.height as i32);
-                gl.bind_vertex_array(Some(self.vao));
+                gl.bind_vertex_array(Some(self.vao.raw()));
                 gl.draw_arrays(glow::TRIANGLE_STRIP, 0, 4);
                 gl.bind_vertex_array(None);
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
@@ -259,30 +247,6 @@ impl Targets {
         // SAFETY: restoring the default unit.
         unsafe { gl.active_texture(glow::TEXTURE0) };
     }
-
-    pub fn delete(&self, gl: &Gl) {
-        let mut images: Vec<&Image2d> = vec![&self.hit, &self.color];
-        for r in self.rays.iter().chain([&self.shadow]) {
-            images.extend([&r.origin, &r.direction]);
-        }
-        for s in &self.state {
-            images.extend([&s.tmax, &s.cell, &s.hit]);
-        }
-        if let Some(a) = &self.primary {
-            images.extend([&a.rays.origin, &a.rays.direction, &a.hit, &a.shadow_hit]);
-            // SAFETY: deleting our own FBO.
-            unsafe { gl.delete_framebuffer(a.shadow_fbo) };
-        }
-        images.iter().for_each(|i| i.delete(gl));
-        // SAFETY: deleting our own objects.
-        unsafe {
-            for f in self.fbo.all() {
-                gl.delete_framebuffer(f);
-            }
-            gl.delete_renderbuffer(self.depth);
-            gl.delete_vertex_array(self.vao);
-        }
-    }
 }
 
 /// Bind a 2D texture to texture unit `unit`.
@@ -290,7 +254,7 @@ fn bind_2d(gl: &Gl, unit: u32, image: &Image2d) {
     // SAFETY: binding our own texture to a texture unit.
     unsafe {
         gl.active_texture(glow::TEXTURE0 + unit);
-        gl.bind_texture(glow::TEXTURE_2D, Some(image.texture));
+        gl.bind_texture(glow::TEXTURE_2D, Some(image.texture.raw()));
         gl.active_texture(glow::TEXTURE0);
     }
 }

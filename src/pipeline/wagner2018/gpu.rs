@@ -2,14 +2,16 @@
 //! triangles in three more (texture buffers, bound to the samplers of [`crate::gl::slots`]),
 //! the images the kernel writes, and its uniforms.
 
+use std::sync::Arc;
+
 use anyhow::Result;
 use glam::Vec3;
 
+use super::uniforms::{Lighting, WagnerCamera};
 use crate::gl::resources::{Image2d, TexelData, TextureBuffers};
 use crate::gl::slots::{image, sampler};
 use crate::gl::{Gl, Kernel};
-use crate::reference::wagner2018::{Lighting, WagnerCamera};
-use crate::reference::wagner_bvh::WagnerBvh;
+use crate::pipeline::wagner2018::bvh::WagnerBvh;
 
 /// RGBA32F texels of `v` (w = 0): CUDA's float4 textures held float3 too (Wagner 2018, ch. 6).
 fn float4(v: &[Vec3]) -> Vec<[f32; 4]> {
@@ -64,7 +66,7 @@ fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TexelDat
 impl SceneTextures {
     /// Upload `bvh` and the triangles' per-vertex `normals` and `colors` (3 per triangle).
     pub fn upload(
-        gl: &Gl,
+        gl: &Arc<Gl>,
         bvh: &WagnerBvh,
         normals: &[Vec3],
         colors: &[Vec3],
@@ -82,10 +84,6 @@ impl SceneTextures {
     pub fn bind(&self, gl: &Gl) {
         self.textures.bind(gl);
     }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.textures.delete(gl);
-    }
 }
 
 /// The images the kernel writes (RGBA32F, GL row order).
@@ -101,7 +99,7 @@ pub struct Images {
 }
 
 impl Images {
-    pub fn new(gl: &Gl, w: u32, h: u32) -> Result<Images> {
+    pub fn new(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Images> {
         let f = glow::RGBA32F;
         Ok(Images {
             output: Image2d::new(gl, w, h, f)?,
@@ -124,10 +122,6 @@ impl Images {
         self.all()
             .iter()
             .for_each(|(i, unit)| i.bind_image(gl, *unit));
-    }
-
-    pub fn delete(&self, gl: &Gl) {
-        self.all().iter().for_each(|(i, _)| i.delete(gl));
     }
 }
 

@@ -2,7 +2,7 @@
 //! CUDA ray tracer with a BVH, here as its own pipeline (`--tracer bvh --bvh-variant wagner`):
 //!
 //! 1. the BVH is **built on the CPU** by Listings 4.3/4.4 with the simplified SAH of eq. 4.1
-//!    ([`crate::reference::wagner_bvh`]) — again whenever an object moved (ch. 3.2: "rebuild
+//!    ([`crate::pipeline::wagner2018::bvh`]) — again whenever an object moved (ch. 3.2: "rebuild
 //!    the BVH completely") — and uploaded with the triangles into texture buffers: the three
 //!    textures of Fig. 4.3 and three for the triangles' vertices, normals and colours
 //!    ([`gpu`]);
@@ -15,7 +15,9 @@
 //!
 //! The CPU twin of the kernel is [`crate::reference::wagner2018`].
 
+pub mod bvh;
 pub mod gpu;
+pub mod uniforms;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -25,13 +27,13 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use self::gpu::{Images, SceneTextures};
+use self::uniforms::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
 use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::reference::wagner2018::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
-use crate::reference::wagner_bvh::{WagnerBvh, WagnerStats};
+use crate::pipeline::wagner2018::bvh::{WagnerBvh, WagnerStats};
 use crate::scene::{Camera, Scene};
 
 /// The kernel's work group: 16×16 (ch. 3.3.2).
@@ -226,7 +228,7 @@ impl WagnerRenderer {
             scene,
             world,
             textures,
-            timers: GpuTimers::default(),
+            timers: GpuTimers::new(&gl),
             lighting,
             builds,
             last: None,
@@ -260,7 +262,7 @@ impl WagnerRenderer {
         let start = Instant::now();
         let world = World::build(&self.scene)?;
         let textures = SceneTextures::upload(&self.gl, &world.bvh, &world.normals, &world.colors)?;
-        self.textures.delete(&self.gl);
+        // the old textures drop here, after the new ones are made
         self.textures = textures;
         self.world = world;
         self.builds.stats = self.world.bvh.stats;
@@ -381,7 +383,7 @@ impl Renderer for WagnerRenderer {
     }
 
     fn output_texture(&self) -> glow::Texture {
-        self.images.output.texture
+        self.images.output.texture.raw()
     }
 
     fn set_model(&mut self, object: usize, model: Mat4) -> Result<()> {
@@ -404,15 +406,5 @@ impl Renderer for WagnerRenderer {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect()
-    }
-}
-
-impl Drop for WagnerRenderer {
-    fn drop(&mut self) {
-        let gl = self.gl.clone();
-        self.textures.delete(&gl);
-        self.images.delete(&gl);
-        self.counters.delete(&gl);
-        self.timers.delete(&gl);
     }
 }

@@ -35,8 +35,8 @@ use std::ops::ControlFlow;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-pub use super::aabb::Aabb;
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
+pub use crate::accel::aabb::Aabb;
 
 mod build;
 mod entry;

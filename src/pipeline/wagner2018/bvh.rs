@@ -46,7 +46,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use glam::Vec3;
 
-pub use super::aabb::Aabb;
+pub use crate::accel::aabb::Aabb;
 
 /// Listing 4.3, line 5: a list of fewer boxes than this is a leaf.
 pub const LEAF_BELOW: usize = 4;

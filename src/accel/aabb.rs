@@ -1,4 +1,4 @@
-//! The axis-aligned box of the BVH builders (ours, `bvh`, and Wagner 2018's, `wagner_bvh`).
+//! The axis-aligned box of the BVH builders (`accel::bvh`'s and `pipeline::wagner2018::bvh`'s).
 
 use glam::Vec3;
 
