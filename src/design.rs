@@ -89,7 +89,7 @@ pub struct Row {
     pub glsl: &'static [&'static str],
     /// Host bytes per triangle it takes while it is built and uploaded, beyond the loaded mesh
     /// (checked before it is built; `tests/memory_estimates.rs` holds each against the peak of
-    /// the allocations): see [`host_bytes`].
+    /// the allocations): what it builds, stages and uploads, counted in `host_bytes`.
     pub host_bytes_per_triangle: u64,
 }
 

@@ -15,11 +15,27 @@ pub mod ray_kinds;
 pub mod stream;
 pub mod wagner2018;
 
-use anyhow::Result;
+use std::time::Instant;
+
+use anyhow::{anyhow, Result};
 use glam::Mat4;
 
 use crate::frame::{Frame, FrameStats};
+use crate::gl::{check_error, Gl};
 use crate::scene::Camera;
+
+/// The end of every frame's draw: a GL error fails the frame (naming what was rendered), and
+/// the wall time since `start` goes into the statistics.
+pub(crate) fn end_of_frame(gl: &Gl, stats: &mut FrameStats, start: Instant) -> Result<()> {
+    check_error(gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
+    stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(())
+}
+
+/// What [`Renderer::draw`] kept of the last frame, for [`Renderer::read_back`].
+pub(crate) fn last_drawn<T: Clone>(last: &Option<T>) -> Result<T> {
+    last.clone().ok_or_else(|| anyhow!("no frame drawn yet"))
+}
 
 /// Counter `slot` of a counter buffer read back as u32 words: the 64-bit count of
 /// `glsl/common/counters.glsl`, low word at `2·slot`, high word (its carries) at `2·slot + 1`.

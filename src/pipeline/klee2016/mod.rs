@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
 use serde_json::json;
 
@@ -489,10 +489,7 @@ impl Renderer for SoftShadowRenderer {
 
     fn read_back(&mut self) -> Result<Frame> {
         let t0 = Instant::now();
-        let (camera, mut stats) = self
-            .last
-            .clone()
-            .ok_or_else(|| anyhow!("no frame drawn yet"))?;
+        let (camera, mut stats) = super::last_drawn(&self.last)?;
         let (w, h) = self.size();
         let color =
             crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output(), w, h);

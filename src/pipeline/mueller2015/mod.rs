@@ -405,17 +405,13 @@ impl Renderer for RayTracer {
                 self.renderer
             );
         }
-        check_error(&gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
-        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        super::end_of_frame(&gl, &mut stats, start)?;
         self.last = Some(stats.clone());
         Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {
-        let stats = self
-            .last
-            .clone()
-            .ok_or_else(|| anyhow!("no frame drawn yet"))?;
+        let stats = super::last_drawn(&self.last)?;
         let (w, h) = self.size();
         Ok(Frame {
             width: w,

@@ -624,17 +624,13 @@ impl Renderer for StreamRenderer {
                 self.options.max_calls
             );
         }
-        check_error(&self.gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
-        stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        super::end_of_frame(&self.gl, &mut stats, start)?;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {
-        let (_, stats) = self
-            .last
-            .clone()
-            .ok_or_else(|| anyhow!("no frame drawn yet"))?;
+        let (_, stats) = super::last_drawn(&self.last)?;
         let (w, h) = self.size();
         Ok(Frame {
             width: w,
