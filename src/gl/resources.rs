@@ -461,6 +461,24 @@ impl TextureBuffers {
     }
 }
 
+/// A 32-bit float depth renderbuffer of `w`×`h` (the depth test of a pass that rasterises the
+/// scene), unbound again.
+pub fn depth_renderbuffer(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Owned<glow::Renderbuffer>> {
+    // SAFETY: renderbuffer creation and storage on a current context.
+    unsafe {
+        let depth = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth.raw()));
+        gl.renderbuffer_storage(
+            glow::RENDERBUFFER,
+            glow::DEPTH_COMPONENT32F,
+            w as i32,
+            h as i32,
+        );
+        gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+        Ok(depth)
+    }
+}
+
 /// Read back a w×h RGBA32F 2D texture (written by image stores or by rendering into it),
 /// row 0 = the bottom row (GL order).
 pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {

@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Result};
 use glam::{Mat4, Vec3};
 use glow::HasContext;
 
-use crate::gl::resources::{read_texture_rgba32f, GpuTimers, Image2d, Owned};
+use crate::gl::resources::{depth_renderbuffer, read_texture_rgba32f, GpuTimers, Image2d, Owned};
 use crate::gl::{Defines, Gl, Kernel, ShaderSource};
 use crate::scene::Scene;
 
@@ -97,14 +97,7 @@ fn framebuffer(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Framebuffer> {
     // SAFETY: FBO set-up with our textures on a current context.
     unsafe {
         let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
-        let depth = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
-        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth.raw()));
-        gl.renderbuffer_storage(
-            glow::RENDERBUFFER,
-            glow::DEPTH_COMPONENT32F,
-            w as i32,
-            h as i32,
-        );
+        let depth = depth_renderbuffer(gl, w, h)?;
         gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo.raw()));
         for (i, t) in textures.iter().enumerate() {
             let attachment = glow::COLOR_ATTACHMENT0 + i as u32;

@@ -375,15 +375,15 @@ impl StreamRenderer {
 
     /// Copy the finished traversal's hit records out of the state sets.
     fn keep_hits(&mut self) {
+        self.hit_records_into(self.targets.fbo.hit.raw());
+    }
+
+    /// The hit-record pass over state set 0 into `fbo`.
+    fn hit_records_into(&mut self, fbo: glow::Framebuffer) {
         let (gl, t) = (&self.gl, &self.targets);
         t.bind_state(gl, 0);
         self.use_kernel(&self.kernels.hit_record);
-        t.draw(
-            gl,
-            &mut self.timers,
-            &self.kernels.hit_record,
-            t.fbo.hit.raw(),
-        );
+        t.draw(gl, &mut self.timers, &self.kernels.hit_record, fbo);
         t.unbind(gl);
     }
 
@@ -429,17 +429,12 @@ impl StreamRenderer {
     /// finished) found no blocker. A pixel without a shadow ray (no hit, or the light behind
     /// the surface: the ray generator leaves its weight 0) is not counted.
     fn count_unblocked(&mut self) {
+        let Some(fbo) = self.targets.primary.as_ref().map(|a| a.shadow_fbo.raw()) else {
+            return;
+        };
+        self.hit_records_into(fbo);
         let (gl, t) = (&self.gl, &self.targets);
         let Some(a) = &t.primary else { return };
-        t.bind_state(gl, 0);
-        self.use_kernel(&self.kernels.hit_record);
-        t.draw(
-            gl,
-            &mut self.timers,
-            &self.kernels.hit_record,
-            a.shadow_fbo.raw(),
-        );
-        t.unbind(gl);
         let hits = a.shadow_hit.read_f32(gl);
         let rays = t.shadow.direction.read_f32(gl);
         for ((n, h), d) in self.unblocked.iter_mut().zip(&hits).zip(&rays) {

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use anyhow::{anyhow, bail, Result};
 use glow::HasContext;
 
-use crate::gl::resources::{GpuTimers, Image2d, Owned};
+use crate::gl::resources::{depth_renderbuffer, GpuTimers, Image2d, Owned};
 use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
 
@@ -133,19 +133,11 @@ impl Targets {
         let shadow = rays(gl, w, h)?;
         let state = [state_set(gl, w, h)?, state_set(gl, w, h)?];
         let (hit, color) = (rgba(gl, w, h)?, rgba(gl, w, h)?);
-        // SAFETY: renderbuffer and VAO creation on a current context.
-        let (depth, vao) = unsafe {
-            let depth = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth.raw()));
-            gl.renderbuffer_storage(
-                glow::RENDERBUFFER,
-                glow::DEPTH_COMPONENT32F,
-                w as i32,
-                h as i32,
-            );
-            gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+        let depth = depth_renderbuffer(gl, w, h)?;
+        // SAFETY: VAO creation on a current context.
+        let vao = unsafe {
             let vao = gl.create_vertex_array().map_err(|e| anyhow!(e))?;
-            (depth, Owned::new(gl, vao))
+            Owned::new(gl, vao)
         };
         let set = |s: &StateSet| framebuffer(gl, &[&s.tmax, &s.cell, &s.hit], Some(depth.raw()));
         let pair = |r: &Rays| framebuffer(gl, &[&r.origin, &r.direction], None);
