@@ -541,7 +541,7 @@ fn the_command_line_reports_and_refuses() {
                 "thesis",
                 "--proximity-clouds",
             ],
-            "--grid-variant exact only",
+            "--proximity-clouds applies to grid-exact (--tracer grid --grid-variant exact), stream",
         ),
         (
             &["--tracer", "base", "--stream-steps", "8"],
