@@ -19,6 +19,7 @@
 //! The grid is static, built once on the CPU ([`crate::reference::stream_grid`], the CPU twin
 //! and oracle), and lives in the textures of Fig. 3 ([`grid_textures`]).
 
+pub mod grid;
 pub mod grid_textures;
 pub mod targets;
 

@@ -11,10 +11,10 @@
 
 use glam::{IVec3, UVec3, Vec3};
 
-use super::grid::tri_box_overlap;
-use super::proximity::cloud_jump;
-pub use super::proximity::{cells_between, chebyshev_distances};
-use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
+use crate::reference::grid::tri_box_overlap;
+use crate::reference::proximity::cloud_jump;
+pub use crate::reference::proximity::{cells_between, chebyshev_distances};
+use crate::reference::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
 use crate::scene::budget;
 
 /// Ray state of the traversal (Fig. 2, `tMax`'s w channel): still walking.
