@@ -21,6 +21,7 @@ pub mod brute_force;
 pub mod bvh;
 pub mod exact_grid;
 pub mod grid_frame;
+pub mod proximity;
 pub mod thesis_grid;
 
 use std::any::Any;
