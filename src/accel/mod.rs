@@ -23,6 +23,7 @@ pub mod exact_grid;
 pub mod grid_frame;
 pub mod proximity;
 pub mod thesis_grid;
+pub mod tribox;
 
 use std::any::Any;
 use std::sync::Arc;

@@ -8,12 +8,11 @@ pub mod bvh;
 pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
+pub mod proximity;
+pub mod stream_grid;
 pub mod stream_shading;
 pub mod thesis_grid;
 pub mod wagner2018;
-
-pub use crate::accel::proximity;
-pub use crate::pipeline::stream::grid as stream_grid;
 
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;

@@ -9,15 +9,15 @@ use std::sync::Arc;
 use anyhow::{bail, Result};
 use glam::Vec3;
 
+use super::grid::{StreamGrid, MAX_REFERENCES};
 use crate::gl::resources::{TexelData, Texture3d, TextureBuffers};
 use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
-use crate::reference::stream_grid::StreamGrid;
 use crate::scene::Scene;
 
 /// Pointers and triangle ids are stored as floats (RGB32F, R32F, as the paper): exact below
 /// 2^24.
-const FLOAT_EXACT: usize = crate::reference::stream_grid::MAX_REFERENCES;
+const FLOAT_EXACT: usize = MAX_REFERENCES;
 
 pub struct GridTextures {
     cells: Texture3d,
