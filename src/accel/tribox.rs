@@ -1,7 +1,7 @@
 //! Triangle/box overlap, the registration test of the grids that store a triangle in every cell
 //! its surface touches: the streaming tracer's static grid, built here on the CPU
 //! (`pipeline::stream::grid`), and the exact grid, whose kernels run the same test in
-//! `glsl/common/tribox.glsl` (its CPU twin: `reference::grid`).
+//! `glsl/exact_grid/tribox.glsl` (its CPU twin: `reference::grid`).
 
 use glam::Vec3;
 
@@ -12,7 +12,7 @@ fn axis_separates(axis: Vec3, v: [Vec3; 3], half: Vec3) -> bool {
 }
 
 /// Triangle/box overlap by separating axes (Akenine-Möller 2001), boundary included — as
-/// `glsl/common/tribox.glsl`.
+/// `glsl/exact_grid/tribox.glsl`.
 pub fn tri_box_overlap(center: Vec3, half: Vec3, tri: [Vec3; 3]) -> bool {
     let v = tri.map(|p| p - center);
     let lo = v[0].min(v[1]).min(v[2]);
