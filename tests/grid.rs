@@ -9,12 +9,13 @@ use common::*;
 use glam::{IVec3, Mat4, Vec3};
 use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::thesis_grid::ThesisGrid;
+use gpgpu_rt::accel::tribox::tri_box_overlap;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::reference::grid::{tri_box_overlap, GridSpace};
+use gpgpu_rt::reference::grid::GridSpace;
 use gpgpu_rt::scene::Scene;
 
 /// A small deterministic generator (no dependency needed for test data).

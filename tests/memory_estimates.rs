@@ -62,7 +62,7 @@ fn within(what: &str, peak: u64, estimate: u64, slack: f64) {
 fn each_design_allocates_within_its_estimate() {
     let _s = serial();
     use gpgpu_rt::design::{Design, Pipeline, REGISTRY};
-    use gpgpu_rt::reference::stream_grid::{CELL_BYTES, REFERENCE_BYTES};
+    use gpgpu_rt::pipeline::stream::grid::{CELL_BYTES, REFERENCE_BYTES};
     use gpgpu_rt::scene::{Overrides, Scene};
     let ctx = common::context();
     let o = Overrides { level: Some(7) };
@@ -93,7 +93,7 @@ fn each_design_allocates_within_its_estimate() {
 fn the_stream_grid_allocates_within_its_estimate() {
     let _s = serial();
     use glam::{UVec3, Vec3};
-    use gpgpu_rt::reference::stream_grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
+    use gpgpu_rt::pipeline::stream::grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
     let tri = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]];
     let (grid, peak) =
         peak_of(|| StreamGrid::build(tri, (Vec3::ZERO, Vec3::ONE), UVec3::splat(160)).unwrap());
@@ -126,7 +126,7 @@ fn the_ntree_allocates_within_its_estimate() {
 fn random_builds_allocate_within_their_estimates() {
     use glam::{UVec3, Vec3};
     use gpgpu_rt::pipeline::klee2016::ntree::NTree;
-    use gpgpu_rt::reference::stream_grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
+    use gpgpu_rt::pipeline::stream::grid::{StreamGrid, CELL_BUILD_BYTES, REFERENCE_BUILD_BYTES};
     let _s = serial();
     let seed = std::env::var("FUZZ_SEED")
         .ok()

@@ -1,6 +1,6 @@
 //! Proximity clouds in the exact grid (`--tracer grid --proximity-clouds`, issue 12 §3): the
 //! per-frame distance pass (`glsl/exact_grid/proximity.comp`) against the CPU's Chebyshev
-//! transform (`reference::proximity::chebyshev_distances`), exactly; the DDA's jumps
+//! transform (`accel::proximity::chebyshev_distances`), exactly; the DDA's jumps
 //! (`glsl/exact_grid/dda.glsl`, jumpWalk) change no first hit, shadow or colour, and the GPU's
 //! voxels visited, jumps and skipped voxels equal the CPU twin's (`reference::exact_grid`).
 
@@ -11,13 +11,13 @@ use glam::UVec3;
 use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::exact_grid::EXACT_GRID_CLOUD_CAP;
 use gpgpu_rt::accel::grid_frame::GridMapping;
+use gpgpu_rt::accel::proximity::chebyshev_distances;
 use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlContext;
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::exact_grid::ExactGrid as Twin;
-use gpgpu_rt::reference::proximity::chebyshev_distances;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 

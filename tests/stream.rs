@@ -8,10 +8,11 @@ mod common;
 use glam::{IVec3, UVec3, Vec3};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::pipeline::stream::grid::StreamGrid;
 use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::brute_force::BruteForce;
-use gpgpu_rt::reference::stream_grid::{Rule, StreamGrid, StreamRay, WalkCounts};
+use gpgpu_rt::reference::stream_grid::{Rule, StreamRay, WalkCounts};
 use gpgpu_rt::reference::stream_shading::StreamShading;
 use gpgpu_rt::reference::CpuAccelerator;
 use gpgpu_rt::scene::Scene;
@@ -165,7 +166,7 @@ fn first_hits_and_counts_equal_the_cpu_twin_on_cubic_and_non_cubic_grids() {
     let ctx = context();
     let cow = unlit(load("cow.toml"));
     // the paper's auto grid (∛5804 ≈ 17.97: 18 per axis) and a non-cubic one
-    let auto = gpgpu_rt::reference::stream_grid::auto_dims(cow.triangle_count());
+    let auto = gpgpu_rt::pipeline::stream::grid::auto_dims(cow.triangle_count());
     assert_eq!(auto, UVec3::splat(18));
     for dims in [auto.to_array(), [7, 13, 4]] {
         for pc in [false, true] {

@@ -1,15 +1,21 @@
 // The static grid and the triangles in texture memory — seed 004, ch. 3, Fig. 3 ("grid data
 // layout with two levels of indirection"), and the 3D-DDA of Amanatides and Woo that walks it.
-// The CPU twin of every function here is in src/reference/stream_grid.rs (same f32 arithmetic,
-// same order), the tests' oracle.
+// The grid is built in src/pipeline/stream/grid.rs; the CPU twin of every function here is in
+// src/reference/stream_grid.rs (same f32 arithmetic, same order), the tests' oracle.
 //
-// cells:      3D texture, RGB32F, one texel per grid cell: R the pointer to the cell's first
-//             reference, G the number of references, B the proximity-cloud distance (in cells,
-//             Chebyshev metric; 0 for a non-empty cell)
-// references: the tightly packed lists, one texel (R32F) per reference: a triangle id, i.e.
-//             the (x, y) of the triangle's texels in the two triangle textures
-// triVertex:  3D texture RGB32F, 4 depth slices: v0, edge1, edge2, diffuse colour
-// triNormal:  3D texture RGB32F, 4 depth slices: n0, n1, n2, (reflectivity, 0, 0)
+// The texels' layouts are #[repr(C)] records of src/pipeline/stream/grid_textures.rs, field by
+// field:
+// cells:      3D texture RGB32F, one CellTexel per grid cell: R `pointer` (the index in
+//             references of the cell's first reference), G `count` (its references), B
+//             `proximity` (the proximity-cloud distance, in cells, Chebyshev metric; 0 for a
+//             non-empty cell)
+// references: texture buffer R32F, the tightly packed lists, one ReferenceTexel per
+//             reference: R `triangle`, an id, i.e. the (x, y) of the triangle's texels in the
+//             two triangle textures
+// triVertex:  3D texture RGB32F, 4 depth slices: slice k holds field k of the triangle's
+//             TriangleVertexTexels, `v0`, `edge1`, `edge2`, `color` (diffuse)
+// triNormal:  3D texture RGB32F, 4 depth slices: field k of TriangleNormalTexels, `n0`, `n1`,
+//             `n2`, then (`reflectivity`, `unused`: 0, 0)
 //             ("edge1 and edge2 are stored instead of v1 and v2, to save the GPU two vector
 //             subtractions every ray-triangle intersection test", ch. 3)
 #include "../common/intersect.glsl"

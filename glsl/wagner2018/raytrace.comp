@@ -36,11 +36,15 @@ layout(local_size_x = 16, local_size_y = 16) in;
 #define COUNTER_SLOTS_PER_KERNEL 5
 #include "../common/counters.glsl"
 
-// Fig. 4.3, texture 1: two texels per node, the box's centre (xyz) and half extent (xyz)
+// Fig. 4.3, the #[repr(C)] records of src/pipeline/wagner2018/bvh.rs, field by field.
+// Texture 1: one BoundsTexels per node, two texels: `centre` (xyz; w `centre_w` = 0), then
+// `half`, the half extent (xyz; w `half_w` = 0)
 layout(binding = SAMPLER_WAGNER_BVH_BOUNDS) uniform samplerBuffer bvhBounds;
-// texture 2: (1, first, count, 0) for a leaf, (0, left child, right child, 0) for an inner node
+// texture 2: one NodeTexel per node: x `leaf` (1 or 0), y `left_or_first` (an inner node's left
+// child, a leaf's first triangle in texture 3), z `right_or_count` (the right child, the leaf's
+// triangle count), w `unused` (0)
 layout(binding = SAMPLER_WAGNER_BVH_NODES) uniform isamplerBuffer bvhNodes;
-// texture 3: the triangle ids, grouped per leaf
+// texture 3: one TriangleTexel per leaf triangle: x `id`, the triangle ids grouped per leaf
 layout(binding = SAMPLER_WAGNER_BVH_TRIANGLES) uniform isamplerBuffer bvhTriangles;
 // the triangles (ch. 4.5: a vertex list), world space, 3 texels per triangle
 layout(binding = SAMPLER_WAGNER_VERTICES) uniform samplerBuffer triVertices;

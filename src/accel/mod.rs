@@ -21,7 +21,9 @@ pub mod brute_force;
 pub mod bvh;
 pub mod exact_grid;
 pub mod grid_frame;
+pub mod proximity;
 pub mod thesis_grid;
+pub mod tribox;
 
 use std::any::Any;
 use std::sync::Arc;

@@ -11,10 +11,11 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::grid::{GridSpace, Walk};
-use super::proximity::{cells_between, chebyshev_distances};
+use super::proximity::cells_between;
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
 use crate::accel::exact_grid::EXACT_GRID_CLOUD_CAP;
 use crate::accel::grid_frame::GridMapping;
+use crate::accel::proximity::chebyshev_distances;
 
 /// The walks' counts, summed over every ray traced (shared with whoever reads them, as the
 /// GPU's counters are): voxels entered (`voxels_visited`), proximity-cloud jumps

@@ -7,6 +7,7 @@
 use glam::{IVec3, Vec3};
 
 use super::proximity::cloud_jump;
+use crate::accel::tribox::tri_box_overlap;
 
 /// clipToGrid: the parameter interval [enter, exit] of ro + t·rd (grid space) inside the grid
 /// box [-1, 1]³ (empty when enter > exit).
@@ -303,38 +304,4 @@ impl GridSpace {
         }
         out
     }
-}
-
-fn axis_separates(axis: Vec3, v: [Vec3; 3], half: Vec3) -> bool {
-    let p = v.map(|x| x.dot(axis));
-    let r = half.dot(axis.abs());
-    p[0].min(p[1]).min(p[2]) > r || p[0].max(p[1]).max(p[2]) < -r
-}
-
-/// Triangle/box overlap by separating axes (Akenine-Möller 2001), boundary included — as
-/// `glsl/common/tribox.glsl`.
-pub fn tri_box_overlap(center: Vec3, half: Vec3, tri: [Vec3; 3]) -> bool {
-    let v = tri.map(|p| p - center);
-    let lo = v[0].min(v[1]).min(v[2]);
-    let hi = v[0].max(v[1]).max(v[2]);
-    if lo.cmpgt(half).any() || hi.cmplt(-half).any() {
-        return false;
-    }
-    let e = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-    let n = e[0].cross(e[1]);
-    if n.dot(v[0]).abs() > half.dot(n.abs()) {
-        return false;
-    }
-    for e in e {
-        for axis in [
-            Vec3::new(0.0, -e.z, e.y),
-            Vec3::new(e.z, 0.0, -e.x),
-            Vec3::new(-e.y, e.x, 0.0),
-        ] {
-            if axis_separates(axis, v, half) {
-                return false;
-            }
-        }
-    }
-    true
 }

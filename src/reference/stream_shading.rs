@@ -6,7 +6,8 @@
 
 use glam::{Vec3, Vec4};
 
-use super::stream_grid::{Rule, StreamGrid, StreamRay};
+use super::stream_grid::{Rule, StreamRay};
+use crate::pipeline::stream::grid::StreamGrid;
 use crate::scene::{Scene, WorldAttributes};
 
 /// The scene as the shading reads it.

@@ -2,22 +2,24 @@
 //! (two levels of indirection): the cells in a 3D RGB32F texture (pointer, count, proximity
 //! distance), the references tightly packed in an R32F texture buffer, the triangles in two 3D
 //! RGB32F textures of 4 depth slices each (v0, edge1, edge2, diffuse colour; n0, n1, n2,
-//! reflectivity) — 8 texels, the paper's 96 bytes, per triangle.
+//! reflectivity) — 8 texels, the paper's 96 bytes, per triangle. Each texel's layout is a
+//! `#[repr(C)]` record here ([`CellTexel`], [`ReferenceTexel`], [`TriangleVertexTexels`],
+//! [`TriangleNormalTexels`]), named with its fields in `glsl/stream/grid.glsl`.
 
 use std::sync::Arc;
 
 use anyhow::{bail, Result};
-use glam::Vec3;
+use bytemuck::{Pod, Zeroable};
 
+use super::grid::{StreamGrid, MAX_REFERENCES};
 use crate::gl::resources::{TexelData, Texture3d, TextureBuffers};
 use crate::gl::slots::sampler;
 use crate::gl::{Gl, Kernel};
-use crate::reference::stream_grid::StreamGrid;
 use crate::scene::Scene;
 
 /// Pointers and triangle ids are stored as floats (RGB32F, R32F, as the paper): exact below
 /// 2^24.
-const FLOAT_EXACT: usize = crate::reference::stream_grid::MAX_REFERENCES;
+const FLOAT_EXACT: usize = MAX_REFERENCES;
 
 pub struct GridTextures {
     cells: Texture3d,
@@ -28,34 +30,119 @@ pub struct GridTextures {
     tri_width: u32,
 }
 
-/// Per triangle and slice: the texels of the two triangle textures, slices of width×height.
+/// One texel of the `cells` texture (RGB32F, one per grid cell, x fastest; Fig. 3's first
+/// level of indirection). Floats, as the paper stores them: exact below 2^24
+/// ([`FLOAT_EXACT`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct CellTexel {
+    /// R: the index in `references` of the cell's first reference
+    pub pointer: f32,
+    /// G: how many references the cell holds (they follow `pointer`, ascending ids)
+    pub count: f32,
+    /// B: the proximity-cloud distance, in cells, to the nearest non-empty cell (Chebyshev;
+    /// 0 for a non-empty cell)
+    pub proximity: f32,
+}
+const _: () = assert!(size_of::<CellTexel>() == 12);
+
+/// One texel of the `references` texture buffer (R32F): the lists of all cells, tightly
+/// packed, in cell order.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ReferenceTexel {
+    /// R: a triangle id, which places the triangle's texels in `triVertex` and `triNormal`
+    pub triangle: f32,
+}
+const _: () = assert!(size_of::<ReferenceTexel>() == 4);
+
+/// A triangle's four texels of the `triVertex` texture (RGB32F, 4 depth slices): field `k`
+/// is its texel in slice `k`, at the (x, y) of its id.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct TriangleVertexTexels {
+    /// slice 0: the first vertex, world space
+    pub v0: [f32; 3],
+    /// slice 1: v1 − v0 ("edge1 and edge2 are stored instead of v1 and v2", ch. 3)
+    pub edge1: [f32; 3],
+    /// slice 2: v2 − v0
+    pub edge2: [f32; 3],
+    /// slice 3: the diffuse colour (of the first vertex)
+    pub color: [f32; 3],
+}
+const _: () = assert!(size_of::<TriangleVertexTexels>() == 48);
+
+/// A triangle's four texels of the `triNormal` texture (RGB32F, 4 depth slices): field `k`
+/// is its texel in slice `k`, at the (x, y) of its id.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct TriangleNormalTexels {
+    /// slices 0–2: the vertex normals, world space
+    pub n0: [f32; 3],
+    pub n1: [f32; 3],
+    pub n2: [f32; 3],
+    /// slice 3, R: the material's reflectivity
+    pub reflectivity: f32,
+    /// slice 3, G and B: 0
+    pub unused: [f32; 2],
+}
+const _: () = assert!(size_of::<TriangleNormalTexels>() == 48);
+
+/// The cells' texels, in cell index order.
+fn cell_texels(grid: &StreamGrid) -> Vec<CellTexel> {
+    grid.cells
+        .iter()
+        .zip(&grid.proximity)
+        .map(|(&(first, count), &d)| CellTexel {
+            pointer: first as f32,
+            count: count as f32,
+            proximity: d as f32,
+        })
+        .collect()
+}
+
+/// Four slices of `width`×`height` texels: field `k` of record `id` at texel `id` of slice
+/// `k` (the rest 0).
+fn slices<T: Pod>(records: &[T], width: u32, height: u32) -> Vec<[f32; 3]> {
+    let slice = (width * height) as usize;
+    let mut out = vec![[0.0; 3]; 4 * slice];
+    for (id, r) in records.iter().enumerate() {
+        let fields: &[[f32; 3]] = bytemuck::cast_slice(std::slice::from_ref(r));
+        for (k, f) in fields.iter().enumerate() {
+            out[k * slice + id] = *f;
+        }
+    }
+    out
+}
+
+/// Per triangle its texels of the two triangle textures, in id order.
 fn triangle_texels(
     grid: &StreamGrid,
     scene: &Scene,
-    width: u32,
-    height: u32,
-) -> [Vec<[f32; 3]>; 2] {
+) -> (Vec<TriangleVertexTexels>, Vec<TriangleNormalTexels>) {
     let a = scene.world_attributes();
     let reflect: Vec<f32> = scene.materials.iter().map(|m| m.reflection).collect();
-    let slice = (width * height) as usize;
-    let mut vertex = vec![[0.0; 3]; 4 * slice];
-    let mut normal = vec![[0.0; 3]; 4 * slice];
-    for (id, t) in grid.triangles.iter().enumerate() {
-        let k = 3 * id;
-        let refl = reflect[a.triangle_material[id] as usize];
-        let v: [Vec3; 4] = [t[0], t[1] - t[0], t[2] - t[0], a.colors[k]];
-        let n: [Vec3; 4] = [
-            a.normals[k],
-            a.normals[k + 1],
-            a.normals[k + 2],
-            Vec3::new(refl, 0.0, 0.0),
-        ];
-        for s in 0..4 {
-            vertex[s * slice + id] = v[s].to_array();
-            normal[s * slice + id] = n[s].to_array();
-        }
-    }
-    [vertex, normal]
+    grid.triangles
+        .iter()
+        .enumerate()
+        .map(|(id, t)| {
+            let k = 3 * id;
+            let vertex = TriangleVertexTexels {
+                v0: t[0].to_array(),
+                edge1: (t[1] - t[0]).to_array(),
+                edge2: (t[2] - t[0]).to_array(),
+                color: a.colors[k].to_array(),
+            };
+            let normal = TriangleNormalTexels {
+                n0: a.normals[k].to_array(),
+                n1: a.normals[k + 1].to_array(),
+                n2: a.normals[k + 2].to_array(),
+                reflectivity: reflect[a.triangle_material[id] as usize],
+                unused: [0.0; 2],
+            };
+            (vertex, normal)
+        })
+        .unzip()
 }
 
 impl GridTextures {
@@ -70,15 +157,14 @@ impl GridTextures {
                 grid.refs.len()
             );
         }
-        let cells: Vec<[f32; 3]> = grid
-            .cells
-            .iter()
-            .zip(&grid.proximity)
-            .map(|(&(first, count), &d)| [first as f32, count as f32, d as f32])
-            .collect();
+        let cells = cell_texels(grid);
         let d = grid.bx.dims;
-        let cells = Texture3d::rgb32f(gl, "cells", [d.x, d.y, d.z], &cells)?;
-        let refs: Vec<f32> = grid.refs.iter().map(|&r| r as f32).collect();
+        let cells = Texture3d::rgb32f(gl, "cells", [d.x, d.y, d.z], bytemuck::cast_slice(&cells))?;
+        let refs: Vec<ReferenceTexel> = grid
+            .refs
+            .iter()
+            .map(|&r| ReferenceTexel { triangle: r as f32 })
+            .collect();
         let refs = TextureBuffers::upload(
             gl,
             [TexelData::new(
@@ -91,7 +177,9 @@ impl GridTextures {
         )?;
         let width = (n as u32).clamp(1, 2048);
         let height = (n as u32).div_ceil(width).max(1);
-        let [v, nn] = triangle_texels(grid, scene, width, height);
+        let (vertex, normal) = triangle_texels(grid, scene);
+        let v = slices(&vertex, width, height);
+        let nn = slices(&normal, width, height);
         Ok(GridTextures {
             cells,
             refs,

@@ -16,9 +16,10 @@
 //!    point light: shadow rays (1.–3. with any-hit traversal) and the light's diffuse term;
 //!    the reflection rays of the next bounce come from the ray generator.
 //!
-//! The grid is static, built once on the CPU ([`crate::reference::stream_grid`], the CPU twin
-//! and oracle), and lives in the textures of Fig. 3 ([`grid_textures`]).
+//! The grid is static, built once on the CPU ([`grid`]; its walk's CPU twin and oracle:
+//! `reference::stream_grid`), and lives in the textures of Fig. 3 ([`grid_textures`]).
 
+pub mod grid;
 pub mod grid_textures;
 pub mod targets;
 
@@ -30,6 +31,7 @@ use glam::{Mat4, UVec3, Vec3};
 use glow::HasContext;
 use serde_json::json;
 
+use self::grid::{auto_dims, StreamGrid};
 use self::grid_textures::GridTextures;
 use self::targets::{AovTargets, Targets};
 use super::ray_kinds::{self, Bank, CounterBanks};
@@ -37,7 +39,6 @@ use super::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Owned};
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, ShaderSource};
-use crate::reference::stream_grid::{auto_dims, StreamGrid};
 use crate::scene::{Camera, Scene};
 
 /// The 64-bit counters of the kernels (`#define COUNTER_*`).

@@ -39,11 +39,14 @@
 //! two RGBA32F texels per node, the box's centre and half extent (Listing 4.5 takes the box as
 //! centre `ac` and half extents `h`); texture 2: one RGBA32I texel per node, (1, first, count,
 //! 0) for a leaf — its triangles are `first..first + count` of texture 3 — or (0, left child,
-//! right child, 0); texture 3: one R32I texel per triangle id, grouped per leaf.
+//! right child, 0); texture 3: one R32I texel per triangle id, grouped per leaf. Each layout is
+//! a `#[repr(C)]` record ([`BoundsTexels`], [`NodeTexel`], [`TriangleTexel`]), named with its
+//! fields in `glsl/wagner2018/raytrace.comp`.
 
 use std::time::Instant;
 
 use anyhow::{bail, Result};
+use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 pub use crate::accel::aabb::Aabb;
@@ -166,30 +169,87 @@ impl WagnerBvh {
         })
     }
 
-    /// Texture 1: centre and half extent of every node (two RGBA32F texels, w = 0).
-    pub fn bounds_texels(&self) -> Vec<[f32; 4]> {
+    /// Texture 1: every node's box, in node order.
+    pub fn bounds_texels(&self) -> Vec<BoundsTexels> {
         self.nodes
             .iter()
-            .flat_map(|n| {
-                [
-                    n.centre.extend(0.0).to_array(),
-                    n.half.extend(0.0).to_array(),
-                ]
+            .map(|n| BoundsTexels {
+                centre: n.centre.to_array(),
+                centre_w: 0.0,
+                half: n.half.to_array(),
+                half_w: 0.0,
             })
             .collect()
     }
 
-    /// Texture 2: (leaf flag, left child or first triangle, right child or count, 0).
-    pub fn node_texels(&self) -> Vec<[i32; 4]> {
+    /// Texture 2: every node's kind and links, in node order.
+    pub fn node_texels(&self) -> Vec<NodeTexel> {
         self.nodes
             .iter()
             .map(|n| match n.kind {
-                NodeKind::Inner { left, right } => [0, left as i32, right as i32, 0],
-                NodeKind::Leaf { first, count } => [1, first as i32, count as i32, 0],
+                NodeKind::Inner { left, right } => NodeTexel {
+                    leaf: 0,
+                    left_or_first: left as i32,
+                    right_or_count: right as i32,
+                    unused: 0,
+                },
+                NodeKind::Leaf { first, count } => NodeTexel {
+                    leaf: 1,
+                    left_or_first: first as i32,
+                    right_or_count: count as i32,
+                    unused: 0,
+                },
             })
             .collect()
     }
+
+    /// Texture 3: the triangle ids, grouped per leaf.
+    pub fn triangle_texels(&self) -> Vec<TriangleTexel> {
+        self.tri_ids
+            .iter()
+            .map(|&id| TriangleTexel { id: id as i32 })
+            .collect()
+    }
 }
+
+/// A node's two texels of texture 1 (`bvhBounds`, RGBA32F): its box as Listing 4.5 takes it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct BoundsTexels {
+    /// texel 2·node, xyz: the box's centre (`ac`)
+    pub centre: [f32; 3],
+    /// texel 2·node, w: 0
+    pub centre_w: f32,
+    /// texel 2·node + 1, xyz: its half extent (`h`), rounded up ([`centre_half`])
+    pub half: [f32; 3],
+    /// texel 2·node + 1, w: 0
+    pub half_w: f32,
+}
+const _: () = assert!(size_of::<BoundsTexels>() == 32);
+
+/// A node's texel of texture 2 (`bvhNodes`, RGBA32I).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct NodeTexel {
+    /// x: 1 for a leaf, 0 for an inner node
+    pub leaf: i32,
+    /// y: an inner node's left child, a leaf's first triangle in texture 3
+    pub left_or_first: i32,
+    /// z: an inner node's right child, a leaf's triangle count
+    pub right_or_count: i32,
+    /// w: 0
+    pub unused: i32,
+}
+const _: () = assert!(size_of::<NodeTexel>() == 16);
+
+/// A texel of texture 3 (`bvhTriangles`, R32I).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct TriangleTexel {
+    /// x: a triangle id (its texels in `triVertices`, `triNormals`, `triColors`: 3·id..3·id + 3)
+    pub id: i32,
+}
+const _: () = assert!(size_of::<TriangleTexel>() == 4);
 
 impl Builder {
     /// Listing 4.3: the node of `list` and, recursively, its children; returns its index.

@@ -27,7 +27,6 @@ pub struct SceneTextures {
 /// The texels of the six textures.
 fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TexelData<'static>; 6] {
     let vertices: Vec<Vec3> = bvh.triangles.iter().flatten().copied().collect();
-    let tri_ids: Vec<i32> = bvh.tri_ids.iter().map(|&i| i as i32).collect();
     let data = |name, format, texel_bytes, bytes: &[u8], unit| {
         TexelData::new(name, format, texel_bytes, bytes, unit).into_owned()
     };
@@ -54,7 +53,7 @@ fn texture_data(bvh: &WagnerBvh, normals: &[Vec3], colors: &[Vec3]) -> [TexelDat
             "bvhTriangles",
             glow::R32I,
             4,
-            bytemuck::cast_slice(&tri_ids),
+            bytemuck::cast_slice(&bvh.triangle_texels()),
             sampler::WAGNER_BVH_TRIANGLES,
         ),
         float4("triVertices", &vertices, sampler::WAGNER_VERTICES),

@@ -33,7 +33,7 @@ use crate::bench::runner::Bench;
 use gpgpu_rt::accel::auto_resolution;
 use gpgpu_rt::design::{self, Pipeline};
 use gpgpu_rt::frame::{FrameStats, RAY_KINDS};
-use gpgpu_rt::reference::stream_grid::auto_dims;
+use gpgpu_rt::pipeline::stream::grid::auto_dims;
 
 pub const ACCEL_COMPARE: Protocol = Protocol {
     name: "accel-compare",
