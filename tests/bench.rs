@@ -8,6 +8,9 @@ use std::process::{Command, Output};
 
 use gpgpu_rt::accel::TracerKind;
 
+mod common;
+use common::stderr;
+
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 
 fn bench(args: &[&str]) -> Output {
@@ -28,10 +31,6 @@ fn bench_into(out: &Path, args: &[&str]) -> Output {
 const TINY: [&str; 8] = [
     "--width", "8", "--height", "8", "--angles", "1", "--warmup", "0",
 ];
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn has_grid() -> bool {
     <TracerKind as clap::ValueEnum>::from_str("grid", true).is_ok()
@@ -911,16 +910,10 @@ fn klee_tables_2_3_and_fig12_tiny_report_the_same_error_against_exact() {
     let o = bench_into(
         &out,
         &[
-            "klee-table2",
-            "klee-table3",
-            "klee-fig12",
-            "--ntree-levels",
-            "3",
-            "--width",
-            "16",
-            "--height",
-            "16",
-        ],
+            &["klee-table2", "klee-table3", "klee-fig12"][..],
+            &common::KLEE_TINY,
+        ]
+        .concat(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();

@@ -236,6 +236,10 @@ pub fn run(args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// The smallest Klee 2016 bench run: the N-tree reading A only (3 levels; reading B's tree takes
+/// minutes to build), at 16×16.
+pub const KLEE_TINY: [&str; 6] = ["--ntree-levels", "3", "--width", "16", "--height", "16"];
+
 /// The standard error of a run, as text.
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
