@@ -138,22 +138,14 @@ fn thesis_rgba_flags_equal_bitwise_flags_for_four_lights() {
 fn tiling_does_not_change_the_image() {
     let ctx = context();
     let scene = load("cow.toml");
-    let whole = render_gpu(
-        &ctx,
-        &scene,
-        RenderOptions {
-            tile: 0,
+    let at_tile = |tile| {
+        let opts = RenderOptions {
+            tile,
             ..options(72, 40, 1)
-        },
-    );
-    let tiled = render_gpu(
-        &ctx,
-        &scene,
-        RenderOptions {
-            tile: 16,
-            ..options(72, 40, 1)
-        },
-    );
+        };
+        render_gpu(&ctx, &scene, opts)
+    };
+    let (whole, tiled) = (at_tile(0), at_tile(16));
     assert_eq!(whole.color, tiled.color);
     assert_eq!(whole.stats.triangle_tests, tiled.stats.triangle_tests);
 }

@@ -8,6 +8,9 @@ use std::process::{Command, Output};
 
 use gpgpu_rt::accel::TracerKind;
 
+mod common;
+use common::stderr;
+
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 
 fn bench(args: &[&str]) -> Output {
@@ -19,9 +22,15 @@ fn bench(args: &[&str]) -> Output {
         .expect("run gpgpu-rt")
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+/// `gpgpu-rt bench ARGS --quiet --out OUT`.
+fn bench_into(out: &Path, args: &[&str]) -> Output {
+    bench(&[args, &["--quiet", "--out", out.to_str().unwrap()]].concat())
 }
+
+/// The smallest frame run: 8×8 pixels, one angle, no warm-up.
+const TINY: [&str; 8] = [
+    "--width", "8", "--height", "8", "--angles", "1", "--warmup", "0",
+];
 
 fn has_grid() -> bool {
     <TracerKind as clap::ValueEnum>::from_str("grid", true).is_ok()
@@ -145,20 +154,20 @@ fn check_report_links(out: &Path, report: &str) {
 fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b51");
-    let o = bench(&[
-        "thesis-5.1",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--angles",
-        "2",
-        "--warmup",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(
+        &out,
+        &[
+            "thesis-5.1",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--angles",
+            "2",
+            "--warmup",
+            "1",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
 
     let frames = read_csv(&out.join("thesis-5.1.csv"));
@@ -237,22 +246,22 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
 fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b53");
-    let o = bench(&[
-        "thesis-5.3",
-        "--width",
-        "16",
-        "--height",
-        "12",
-        "--angles",
-        "2",
-        "--warmup",
-        "0",
-        "--grid-res",
-        "8,24",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(
+        &out,
+        &[
+            "thesis-5.3",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--angles",
+            "2",
+            "--warmup",
+            "0",
+            "--grid-res",
+            "8,24",
+        ],
+    );
     let err = stderr(&o);
     let frames = read_csv(&out.join("thesis-5.3.csv"));
     let summary = read_csv(&out.join("thesis-5.3_summary.csv"));
@@ -386,14 +395,7 @@ fn missing_scene_fails_the_protocol_and_is_reported() {
     let scenes = dir.path().join("scenes");
     std::fs::create_dir(&scenes).unwrap();
     let out = dir.path().join("out");
-    let o = bench(&[
-        "thesis-5.1",
-        "--scenes",
-        scenes.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(&out, &["thesis-5.1", "--scenes", scenes.to_str().unwrap()]);
     assert!(!o.status.success());
     let err = stderr(&o);
     assert!(err.contains("teapot1.toml"), "{err}");
@@ -479,21 +481,21 @@ fn wagner_a1_and_a2_tiny_rows_published_values_and_ratios() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bw");
     // 64×48 and the reference 320×240 (always measured); levels 1 (always) and 2
-    let o = bench(&[
-        "wagner-a1",
-        "wagner-a2",
-        "--sizes",
-        "64x48",
-        "--levels",
-        "2",
-        "--angles",
-        "1",
-        "--warmup",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(
+        &out,
+        &[
+            "wagner-a1",
+            "wagner-a2",
+            "--sizes",
+            "64x48",
+            "--levels",
+            "2",
+            "--angles",
+            "1",
+            "--warmup",
+            "1",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
 
     // Table A.1: the square at levels 1 and 2 × two sizes × both BVH variants, nothing moving
@@ -608,21 +610,21 @@ fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> Stri
 fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bp");
-    let o = bench(&[
-        // the old name stays an alias
-        "purcell-table1",
-        "proximity-clouds-table2",
-        "proximity-clouds-table3",
-        "--sizes",
-        "16x16",
-        "--angles",
-        "1",
-        "--warmup",
-        "0",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(
+        &out,
+        &[
+            // the old name stays an alias
+            "purcell-table1",
+            "proximity-clouds-table2",
+            "proximity-clouds-table3",
+            "--sizes",
+            "16x16",
+            "--angles",
+            "1",
+            "--warmup",
+            "0",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let triangles: HashMap<&str, u64> = [
         ("knight", 636),
@@ -795,24 +797,11 @@ fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
 fn accel_compare_tiny_every_scene_and_accelerator_kinds_agreement_and_the_stadium() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ac");
-    let tiny = [
-        "accel-compare",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--angles",
-        "1",
-        "--warmup",
-        "0",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    let listed = bench(&[&tiny[..], &["--list"]].concat());
+    let tiny = [&["accel-compare"][..], &TINY].concat();
+    let listed = bench_into(&out, &[&tiny[..], &["--list"]].concat());
     assert!(listed.status.success(), "{}", stderr(&listed));
     let listed = String::from_utf8_lossy(&listed.stdout).lines().count();
-    let o = bench(&tiny);
+    let o = bench_into(&out, &tiny);
     assert!(o.status.success(), "{}", stderr(&o));
     let rows = read_csv(&out.join("accel-compare_kinds.csv"));
     let kinds = [
@@ -918,20 +907,14 @@ fn report_line<'a>(report: &'a str, first: &str) -> Vec<&'a str> {
 fn klee_tables_2_3_and_fig12_tiny_report_the_same_error_against_exact() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("klee");
-    let o = bench(&[
-        "klee-table2",
-        "klee-table3",
-        "klee-fig12",
-        "--ntree-levels",
-        "3",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = bench_into(
+        &out,
+        &[
+            &["klee-table2", "klee-table3", "klee-fig12"][..],
+            &common::KLEE_TINY,
+        ]
+        .concat(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     let table3 =
@@ -960,20 +943,8 @@ fn klee_tables_2_3_and_fig12_tiny_report_the_same_error_against_exact() {
 fn a_run_that_measures_nothing_keeps_the_previous_results() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b");
-    let tiny = [
-        "thesis-5.1",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--angles",
-        "1",
-        "--warmup",
-        "0",
-        "--quiet",
-        "--out",
-    ];
-    let o = bench(&[&tiny[..], &[out.to_str().unwrap()]].concat());
+    let tiny = [&["thesis-5.1"][..], &TINY].concat();
+    let o = bench_into(&out, &tiny);
     assert!(o.status.success(), "{}", stderr(&o));
     let snapshot = |d: &Path| {
         let mut files: Vec<(String, Vec<u8>)> = walk(d)
@@ -991,7 +962,7 @@ fn a_run_that_measures_nothing_keeps_the_previous_results() {
     let empty = dir.path().join("no-kernels");
     std::fs::create_dir(&empty).unwrap();
     let glsl = ["--glsl-dir", empty.to_str().unwrap()];
-    let o = bench(&[&tiny[..], &[out.to_str().unwrap()], &glsl[..]].concat());
+    let o = bench_into(&out, &[&tiny[..], &glsl[..]].concat());
     assert!(!o.status.success());
     assert!(
         stderr(&o).contains("nothing was measured"),

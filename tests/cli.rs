@@ -178,6 +178,21 @@ fn assert_fails(o: &Output, needles: &[&str]) {
     assert!(!e.contains("panicked"), "panic: {e}");
 }
 
+/// `gpgpu-rt render SCENE -o /dev/null --width 8 --height 8 EXTRA`.
+fn render_8x8(scene: &str, extra: &[&str]) -> Output {
+    let tiny = [
+        "render",
+        scene,
+        "-o",
+        "/dev/null",
+        "--width",
+        "8",
+        "--height",
+        "8",
+    ];
+    run(&[&tiny[..], extra].concat())
+}
+
 #[test]
 fn bad_input_fails_with_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -267,18 +282,7 @@ fn bad_input_fails_with_file_and_line() {
     );
     // bad tile size
     assert_fails(
-        &run(&[
-            "render",
-            &scene("cow.toml"),
-            "-o",
-            "/dev/null",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--tile",
-            "12",
-        ]),
+        &render_8x8(&scene("cow.toml"), &["--tile", "12"]),
         &["--tile"],
     );
     // more lights than the thesis' RGBA shadow flags hold
@@ -289,40 +293,24 @@ fn bad_input_fails_with_file_and_line() {
     }
     std::fs::write(&bad, text).unwrap();
     assert_fails(
-        &run(&[
-            "render",
-            bad.to_str().unwrap(),
-            "-o",
-            "/dev/null",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--shadow-flags",
-            "rgba",
-        ]),
+        &render_8x8(bad.to_str().unwrap(), &["--shadow-flags", "rgba"]),
         &["6 lights", "at most 4"],
     );
     // buffers beyond the GL limits: named, with the limit
     assert_fails(
-        &run(&[
-            "render",
+        &render_8x8(
             &scene("cow.toml"),
-            "-o",
-            "/dev/null",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--tracer",
-            "grid",
-            "--grid-variant",
-            "thesis",
-            "--grid",
-            "64",
-            "--voxel-array-length",
-            "4096",
-        ]),
+            &[
+                "--tracer",
+                "grid",
+                "--grid-variant",
+                "thesis",
+                "--grid",
+                "64",
+                "--voxel-array-length",
+                "4096",
+            ],
+        ),
         &["voxelslist", "GL_MAX_SHADER_STORAGE_BLOCK_SIZE"],
     );
     assert_fails(
@@ -367,18 +355,7 @@ fn bad_input_fails_with_file_and_line() {
     )
     .unwrap();
     assert_fails(
-        &run(&[
-            "render",
-            &scene("cow.toml"),
-            "-o",
-            "/dev/null",
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--glsl-dir",
-            glsl.to_str().unwrap(),
-        ]),
+        &render_8x8(&scene("cow.toml"), &["--glsl-dir", glsl.to_str().unwrap()]),
         &[&format!("shading.comp:{line}")],
     );
 }

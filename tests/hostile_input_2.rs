@@ -62,6 +62,20 @@ fn mkfifo(path: &Path) {
 
 const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
+/// `t.obj` (one triangle) in `dir` and its scene `s.toml`, with `extra` on its object.
+fn triangle_scene(dir: &Path, extra: &str) -> PathBuf {
+    write(dir, "t.obj", TRIANGLE);
+    obj_scene(dir, "t.obj", extra)
+}
+
+/// A shipped scene's path, as text.
+fn shipped(name: &str) -> String {
+    common::scene_path(name).to_str().unwrap().to_string()
+}
+
+/// A frame too small to cost time, written to `o.png`.
+const SMALL: [&str; 6] = ["--width", "8", "--height", "8", "-o", "o.png"];
+
 fn obj_scene(dir: &Path, model: &str, extra: &str) -> PathBuf {
     named_scene(dir, "s.toml", model, extra)
 }
@@ -118,34 +132,20 @@ fn inputs_that_are_not_regular_files_are_refused_without_blocking() {
 fn the_stream_grid_is_estimated_before_it_is_allocated() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    write(dir, "t.obj", TRIANGLE);
-    let scene = obj_scene(dir, "t.obj", "");
-    let args = |g: &'static str| {
+    let scene = triangle_scene(dir, "");
+    let s = scene.to_str().unwrap();
+    let args = |g| {
         [
-            "render",
-            scene.to_str().unwrap(),
-            "--tracer",
-            "stream",
-            "--grid",
-            g,
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "-o",
-            "o.png",
+            &["render", s, "--tracer", "stream", "--grid", g][..],
+            &SMALL,
         ]
-        .map(String::from)
+        .concat()
     };
     // 1024³ cells: tens of GB, whatever the host has
-    let a = args("1024");
-    let a: Vec<&str> = a.iter().map(String::as_str).collect();
-    let o = run_in(dir, &a, None, 20);
+    let o = run_in(dir, &args("1024"), None, 20);
     refused(&o, &["1024x1024x1024 cells", "--grid decides its size"]);
     // 128³ within the host, but not within a limit of 8 MiB
-    let a = args("128");
-    let a: Vec<&str> = a.iter().map(String::as_str).collect();
-    let o = run_in(dir, &a, Some("8M"), 20);
+    let o = run_in(dir, &args("128"), Some("8M"), 20);
     refused(
         &o,
         &[
@@ -190,20 +190,8 @@ fn the_ntree_is_estimated_as_it_grows() {
          [[object]]\ntype = \"floor\"\nsize = 4.0\n",
     );
     let s = scene.to_str().unwrap();
-    let args = [
-        "render",
-        s,
-        "--ntree-depth",
-        "4",
-        "--ntree-n",
-        "16",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "-o",
-        "o.png",
-    ];
+    let ntree = ["render", s, "--ntree-depth", "4", "--ntree-n", "16"];
+    let args = [&ntree[..], &SMALL].concat();
     let o = run_in(dir, &args, Some("256M"), 30);
     refused(
         &o,
@@ -227,20 +215,8 @@ fn each_design_is_estimated_before_it_is_built() {
         &format!("{HEAD}[[object]]\ntype = \"square\"\nlevel = 8\n"),
     );
     let s = scene.to_str().unwrap();
-    let wagner = [
-        "render",
-        s,
-        "--tracer",
-        "bvh",
-        "--bvh-variant",
-        "wagner",
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "-o",
-        "o.png",
-    ];
+    let wagner = ["render", s, "--tracer", "bvh", "--bvh-variant", "wagner"];
+    let wagner = [&wagner[..], &SMALL].concat();
     let o = run_in(dir, &wagner, Some("100M"), 60);
     refused(
         &o,
@@ -256,8 +232,7 @@ fn each_design_is_estimated_before_it_is_built() {
 fn a_frame_is_estimated_before_it_is_rendered() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    write(dir, "t.obj", TRIANGLE);
-    let scene = obj_scene(dir, "t.obj", "");
+    let scene = triangle_scene(dir, "");
     let s = scene.to_str().unwrap();
     let size = ["--width", "4096", "--height", "4096"];
     for design in [&["--tracer", "base"][..], &["--tracer", "stream"]] {
@@ -374,8 +349,7 @@ fn models_far_from_unit_size_fit_without_nan() {
 fn a_small_uniform_scale_is_no_zero_scale() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    write(dir, "t.obj", TRIANGLE);
-    let ok = obj_scene(dir, "t.obj", "scale = 1e-4\n");
+    let ok = triangle_scene(dir, "scale = 1e-4\n");
     let o = run_in(dir, &["info", ok.to_str().unwrap()], None, 20);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let zero = obj_scene(dir, "t.obj", "scale = [1.0, 0.0, 1.0]\n");
@@ -393,8 +367,7 @@ fn an_interrupt_while_outputs_are_written_leaves_nothing_behind() {
     for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
         let d = tempfile::tempdir().unwrap();
         let dir = d.path();
-        write(dir, "t.obj", TRIANGLE);
-        let scene = obj_scene(dir, "t.obj", "");
+        let scene = triangle_scene(dir, "");
         write(dir, "old.png", "the old image");
         mkfifo(&dir.join("stats.json"));
         let mut child = Command::new(BIN)
@@ -463,8 +436,7 @@ fn an_interrupt_while_outputs_are_written_leaves_nothing_behind() {
 fn impossible_outputs_are_refused_before_the_render() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let bunny = common::scene_path("bunny.toml");
-    let b = bunny.to_str().unwrap();
+    let b = &shipped("bunny.toml");
     let cases: [(&[&str], &[&str]); 3] = [
         (
             &["-o", "x.png", "--aov-dir", "x.png"],
@@ -498,8 +470,7 @@ fn impossible_outputs_are_refused_before_the_render() {
 fn buffer_limits_name_the_options_that_decide_them() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let s = common::scene_path("bunny_low.toml");
-    let s = s.to_str().unwrap();
+    let s = &shipped("bunny_low.toml");
     let grid = ["--tracer", "grid", "--grid-variant", "thesis"];
     let cases: [(&[&str], &str); 2] = [
         (
@@ -534,8 +505,7 @@ fn buffer_limits_name_the_options_that_decide_them() {
 fn inputs_a_design_would_ignore_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let dir = d.path();
-    let bunny = common::scene_path("bunny_low.toml");
-    let b = bunny.to_str().unwrap();
+    let b = &shipped("bunny_low.toml");
     let o = run_in(
         dir,
         &[

@@ -8,15 +8,15 @@
 mod common;
 
 use gpgpu_rt::accel::{GridOptions, GridVariant};
-use gpgpu_rt::design::accelerators;
+use gpgpu_rt::design::{accelerators, Design};
 use gpgpu_rt::gl::program::compiler_messages;
-use gpgpu_rt::gl::{compile_program, Defines, ShaderSource};
+use gpgpu_rt::gl::{compile_program, Defines, GlContext, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
-use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
-use gpgpu_rt::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
+use gpgpu_rt::pipeline::stream::StreamOptions;
+use gpgpu_rt::pipeline::wagner2018::WagnerOptions;
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::scene::ShadowMode;
+use gpgpu_rt::scene::{Scene, ShadowMode};
 
 #[test]
 fn every_kernel_compiles_without_warnings() {
@@ -56,9 +56,7 @@ fn every_kernel_compiles_without_warnings() {
         tile: 0,
         aovs: true,
     };
-    let mut r = WagnerRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
-        .expect("Wagner 2018's renderer");
-    r.render(&scene.camera).expect("frame");
+    one_frame(&ctx, &scene, Design::Wagner2018(opts));
 
     // the streaming tracer of seed 004: its six fragment programs, with a reflection bounce
     let opts = StreamOptions {
@@ -74,9 +72,7 @@ fn every_kernel_compiles_without_warnings() {
         single_sided: false,
         aovs: true,
     };
-    let mut r = StreamRenderer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
-        .expect("the streaming tracer");
-    r.render(&scene.camera).expect("frame");
+    one_frame(&ctx, &scene, Design::Stream(opts));
 
     // the soft shadows: G-buffer, the five shadow modes, the quad
     let area = common::load("bunny_area.toml");
@@ -121,6 +117,12 @@ fn every_kernel_compiles_without_warnings() {
         "kernels compiled with warnings (run with RUST_LOG=warn to see them)"
     );
     validate_with_glslang(dump.path());
+}
+
+/// A frame of `design` on `scene`, kernels built in: every kernel it dispatches compiled.
+fn one_frame(ctx: &GlContext, scene: &Scene, design: Design) {
+    let mut r = common::renderer(ctx, scene, &design);
+    r.render(&scene.camera).expect("frame");
 }
 
 /// Every dumped stage through `glslangValidator` (Debian: glslang-tools; `.ci/run` installs

@@ -235,18 +235,12 @@ fn opts(mode: ShadowMode, s: u32, w: u32) -> SoftShadowOptions {
 #[test]
 fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_shafts() {
     let ctx = common::context();
-    let scene = common::load("bunny_area.toml");
-    let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 64), tree);
+    let (scene, mut r) = bunny_renderer(&ctx, &shaders);
     // the 3D texture holds exactly the packed layout
     assert_eq!(r.read_linespace_texture(), r.scene.packed.texels);
     let mut shadows = Vec::new();
-    for mode in [
-        ShadowMode::Exact,
-        ShadowMode::Linespace,
-        ShadowMode::LinespaceDda,
-    ] {
+    for mode in MODES {
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
         let cpu = r.cpu();
@@ -418,22 +412,43 @@ fn hit_pixels(f: &SoftFrame) -> Vec<usize> {
         .collect()
 }
 
-/// A soft-shadow renderer on `scene` with the N-tree `tree`, built once for several modes.
+/// A soft-shadow renderer on `scene` with its N-tree of N = `n` and `levels` levels, built once
+/// for several modes.
 fn tree_renderer(
     ctx: &GlContext,
     scene: &Scene,
     shaders: &ShaderSource,
     o: SoftShadowOptions,
-    tree: NTree,
+    (n, levels): (u32, u32),
 ) -> SoftShadowRenderer {
+    let tree = NTree::build(&scene.world_triangles(), n, levels).unwrap();
     SoftShadowRenderer::with_tree(ctx.gl.clone(), &ctx.info, scene, shaders, o, tree).unwrap()
+}
+
+/// Klee 2016's shadow modes: exact, and the line space traversed with CGT and with DDA.
+const MODES: [ShadowMode; 3] = [
+    ShadowMode::Exact,
+    ShadowMode::Linespace,
+    ShadowMode::LinespaceDda,
+];
+
+/// The bunny under its area light with an N-tree of N = 10 and 3 levels, at 64², exact at 3×3
+/// rays.
+fn bunny_renderer(ctx: &GlContext, shaders: &ShaderSource) -> (Scene, SoftShadowRenderer) {
+    let scene = common::load("bunny_area.toml");
+    let o = opts(ShadowMode::Exact, 3, 64);
+    let r = tree_renderer(ctx, &scene, shaders, o, (10, 3));
+    (scene, r)
 }
 
 /// A floor under a 1×1 area light at y = 2, a small occluder at y = 1 between them, and a
 /// large roof at y = 2.001, just beyond the light (closer than an N-tree leaf is wide, so the
 /// traversals meet it in the leaves they visit): shadow rays run from the surface to the light
-/// samples only, so the roof shadows nothing (issue 16, class 2, for the soft shadows).
-fn roof_scene(dir: &std::path::Path) -> Scene {
+/// samples only, so the roof shadows nothing (issue 16, class 2, for the soft shadows). Its files
+/// live in a temporary folder for the load only: the scene holds its triangles.
+fn roof_scene() -> Scene {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
     let quad = |y: f32, h: f32| {
         format!(
             "v {} {y} {}\nv {h} {y} {}\nv {h} {y} {h}\nv {} {y} {h}\n",
@@ -460,17 +475,17 @@ fn roof_scene(dir: &std::path::Path) -> Scene {
 
 #[test]
 fn occluders_beyond_the_area_light_shadow_nothing() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = roof_scene(dir.path());
+    let scene = roof_scene();
     let ctx = common::context();
-    let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 48), tree);
-    for mode in [
-        ShadowMode::Exact,
-        ShadowMode::Linespace,
-        ShadowMode::LinespaceDda,
-    ] {
+    let mut r = tree_renderer(
+        &ctx,
+        &scene,
+        &shaders,
+        opts(ShadowMode::Exact, 3, 48),
+        (10, 3),
+    );
+    for mode in MODES {
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
         let hit: Vec<usize> = hit_pixels(&f);
@@ -489,37 +504,33 @@ fn occluders_beyond_the_area_light_shadow_nothing() {
     }
 }
 
+/// `gpgpu-rt render` of the bunny under its area light with `args`; it must succeed.
+fn render_bunny_ok(args: &[&str]) {
+    let bunny = common::scene_path("bunny_area.toml");
+    let o = common::run(&[&["render", bunny.to_str().unwrap()][..], args].concat());
+    assert!(o.status.success(), "{}", common::stderr(&o));
+}
+
 #[test]
 fn render_cli_writes_shadow_aov_and_stats() {
     let dir = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
-        .args([
-            "render",
-            common::scene_path("bunny_area.toml").to_str().unwrap(),
-        ])
-        .args([
-            "--shadows",
-            "linespace",
-            "--light-samples",
-            "2x2",
-            "--width",
-            "40",
-            "--height",
-            "32",
-        ])
-        .arg("-o")
-        .arg(dir.path().join("a.png"))
-        .arg("--aov-dir")
-        .arg(dir.path())
-        .arg("--stats")
-        .arg(dir.path().join("s.json"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (png, json) = (dir.path().join("a.png"), dir.path().join("s.json"));
+    render_bunny_ok(&[
+        "--shadows",
+        "linespace",
+        "--light-samples",
+        "2x2",
+        "--width",
+        "40",
+        "--height",
+        "32",
+        "-o",
+        png.to_str().unwrap(),
+        "--aov-dir",
+        dir.path().to_str().unwrap(),
+        "--stats",
+        json.to_str().unwrap(),
+    ]);
     let npy = std::fs::read(dir.path().join("shadow.npy")).unwrap();
     assert!(String::from_utf8_lossy(&npy[..128]).contains("(32, 40, )"));
     assert_eq!(npy.len() % 64, (32 * 40 * 4) % 64);
@@ -606,22 +617,11 @@ fn scene_file_soft_shadow_defaults() {
 
     let dir = tempfile::tempdir().unwrap();
     let stats = |extra: &[&str]| -> serde_json::Value {
-        let json = dir.path().join("s.json");
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
-            .arg("render")
-            .arg(common::scene_path("bunny_area.toml"))
-            .args(["--width", "24", "--height", "16", "-o"])
-            .arg(dir.path().join("a.png"))
-            .arg("--stats")
-            .arg(&json)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let (png, json) = (dir.path().join("a.png"), dir.path().join("s.json"));
+        let (png, json_path) = (png.to_str().unwrap(), json.to_str().unwrap());
+        let size = ["--width", "24", "--height", "16"];
+        let outputs = ["-o", png, "--stats", json_path];
+        render_bunny_ok(&[&size[..], &outputs, extra].concat());
         serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap()
     };
     let d = stats(&[]);
@@ -723,6 +723,29 @@ fn cpu_frame(
     (values, counts)
 }
 
+/// `mode` at `rays`×`rays` rays per area light, rendered on the GPU and by its CPU twin on the
+/// GPU's G-buffer: the frame, its hit pixels and the twin's counts, once every hit pixel's shadow
+/// and the line-space lookups are checked equal (`what` names the case in the messages).
+fn gpu_equals_twin(
+    r: &mut SoftShadowRenderer,
+    shaders: &ShaderSource,
+    camera: &Camera,
+    (mode, rays): (ShadowMode, u32),
+    what: &str,
+) -> (SoftFrame, Vec<usize>, ShadowCounts) {
+    r.reconfigure(shaders, mode, rays, rays).unwrap();
+    let f = render(r, camera).unwrap();
+    let hit: Vec<usize> = hit_pixels(&f);
+    let (cpu, counts) = cpu_frame(r, &f, mode, &hit);
+    let off = differing(&f, &hit, &cpu);
+    assert_eq!(off, 0, "{what}: pixels differ between GPU and twin");
+    assert_eq!(
+        f.stats.events["linespace_lookups"], counts.linespace_lookups,
+        "{what}: line-space lookups GPU vs twin"
+    );
+    (f, hit, counts)
+}
+
 /// Table 2's variants as the thesis defines them, on the bunny (3 levels, 3x3 rays, 64²):
 /// GPU = twin; `variant1` (exact without our near-origin rule) gives the exact image;
 /// `variant2` (linespace without it) tests no triangle and is never lighter than exact.
@@ -731,30 +754,21 @@ fn cpu_frame(
 #[test]
 fn table2_variants_as_defined_gpu_equals_twin() {
     let ctx = common::context();
-    let scene = common::load("bunny_area.toml");
-    let tree = NTree::build(&scene.world_triangles(), 10, 3).unwrap();
     let shaders = ShaderSource::default();
-    let mut r = tree_renderer(&ctx, &scene, &shaders, opts(ShadowMode::Exact, 3, 64), tree);
+    let (scene, mut r) = bunny_renderer(&ctx, &shaders);
     let mut frames = Vec::new();
     for mode in [
         ShadowMode::Exact,
         ShadowMode::Variant1,
         ShadowMode::Variant2,
     ] {
-        r.reconfigure(&shaders, mode, 3, 3).unwrap();
-        let f = render(&mut r, &scene.camera).unwrap();
-        let hit: Vec<usize> = hit_pixels(&f);
-        let (cpu, counts) = cpu_frame(&r, &f, mode, &hit);
-        let off = differing(&f, &hit, &cpu);
-        assert_eq!(off, 0, "{mode:?}: pixels differ between GPU and twin");
+        let camera = &scene.camera;
+        let (f, hit, counts) =
+            gpu_equals_twin(&mut r, &shaders, camera, (mode, 3), &format!("{mode:?}"));
         assert_eq!(
             f.stats.total_triangle_tests(),
             counts.triangle_tests,
             "{mode:?}"
-        );
-        assert_eq!(
-            f.stats.events["linespace_lookups"], counts.linespace_lookups,
-            "{mode:?}: line-space lookups GPU vs twin"
         );
         frames.push((f, hit, counts));
     }
@@ -795,34 +809,24 @@ fn table2_variants_as_defined_gpu_equals_twin() {
 /// (`linespace` still asks depth 1 below the origin's own node, so it alone would not catch it).
 #[test]
 fn four_levels_query_the_cascade_gpu_equals_twin() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = roof_scene(dir.path());
+    let scene = roof_scene();
     let ctx = common::context();
     let shaders = ShaderSource::default();
     for levels in [3, 4] {
-        let tree = NTree::build(&scene.world_triangles(), 5, levels).unwrap();
         let mut r = tree_renderer(
             &ctx,
             &scene,
             &shaders,
             opts(ShadowMode::Linespace, 2, 32),
-            tree,
+            (5, levels),
         );
         for mode in [
             ShadowMode::Linespace,
             ShadowMode::Exact,
             ShadowMode::Variant2,
         ] {
-            r.reconfigure(&shaders, mode, 2, 2).unwrap();
-            let f = render(&mut r, &scene.camera).unwrap();
-            let hit: Vec<usize> = hit_pixels(&f);
-            let (cpu, counts) = cpu_frame(&r, &f, mode, &hit);
-            let off = differing(&f, &hit, &cpu);
-            assert_eq!(off, 0, "{levels} levels, {mode:?}: GPU vs twin");
-            assert_eq!(
-                f.stats.events["linespace_lookups"], counts.linespace_lookups,
-                "{levels} levels, {mode:?}: line-space lookups GPU vs twin"
-            );
+            let what = format!("{levels} levels, {mode:?}");
+            let (_, _, counts) = gpu_equals_twin(&mut r, &shaders, &scene.camera, (mode, 2), &what);
             let by_depth = counts.lookups_by_depth;
             eprintln!("{levels} levels, {mode:?}: lookups by depth {by_depth:?}");
             assert!(by_depth[0] > 0, "{levels} levels: {by_depth:?}");

@@ -13,8 +13,6 @@ use common::{context, load, options, render_gpu, scene_path};
 use glam::Vec3;
 use gpgpu_rt::accel::{GridOptions, TracerKind};
 use gpgpu_rt::frame::Frame;
-use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
 
@@ -207,24 +205,8 @@ fn ids(f: &Frame) -> &[i32] {
 
 /// A stream frame at the paper's grid, with or without proximity clouds.
 fn stream(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, dims: [u32; 3], pc: bool) -> Frame {
-    let o = StreamOptions {
-        width: SIZE,
-        height: SIZE,
-        refl_depth: 0,
-        dims: Some(dims),
-        proximity_clouds: pc,
-        steps_per_call: 64,
-        max_calls: 10_000,
-        naive_shadows: false,
-        no_mask: false,
-        single_sided: false,
-        aovs: true,
-    };
-    // the kernels built in, or with `STREAM_TEST_GLSL_DIR=DIR` those of DIR (a planted bug)
-    let dir = std::env::var_os("STREAM_TEST_GLSL_DIR").map(Into::into);
-    let shaders = ShaderSource::from_dir(dir).expect("STREAM_TEST_GLSL_DIR");
-    let mut r =
-        StreamRenderer::new(ctx.gl.clone(), &ctx.info, scene, &shaders, o).expect("stream tracer");
+    let o = common::stream_options(SIZE, dims, pc);
+    let mut r = common::stream_renderer(ctx, scene, o);
     r.render(&scene.camera).expect("frame")
 }
 

@@ -10,29 +10,23 @@ mod common;
 
 const BIN: &str = env!("CARGO_BIN_EXE_gpgpu-rt");
 
-/// Three base-tracer configurations (thesis-5.1) and one whole protocol (klee-table2 at the
-/// N-tree reading A only: reading B's tree takes minutes to build), tiny.
-const RUN: [&str; 12] = [
-    "thesis-5.1",
-    "klee-table2",
-    "--ntree-levels",
-    "3",
-    "--width",
-    "16",
-    "--height",
-    "16",
-    "--angles",
-    "1",
-    "--warmup",
-    "0",
-];
+/// Three base-tracer configurations (thesis-5.1) and one whole protocol (klee-table2), tiny.
+fn run_args() -> Vec<&'static str> {
+    let protocols = ["thesis-5.1", "klee-table2"];
+    [
+        &protocols[..],
+        &common::KLEE_TINY,
+        &["--angles", "1", "--warmup", "0"],
+    ]
+    .concat()
+}
 
 fn bench(args: &[&str]) -> Output {
     common::run(&[&["bench"], args].concat())
 }
 
 fn run_into(out: &Path, extra: &[&str]) -> Output {
-    let mut args: Vec<&str> = RUN.to_vec();
+    let mut args = run_args();
     args.extend(extra);
     args.extend(["--quiet", "--out", out.to_str().unwrap()]);
     bench(&args)
@@ -112,7 +106,7 @@ fn two_shards_merged_equal_the_unsharded_run() {
     let dir = |n: &str| tmp.path().join(n);
 
     // --list: one line per unit, index and a unique id
-    let listed = ok(bench(&[&RUN[..], &["--list"]].concat()), "--list");
+    let listed = ok(bench(&[&run_args()[..], &["--list"]].concat()), "--list");
     let ids: Vec<String> = listed
         .lines()
         .enumerate()
@@ -137,7 +131,7 @@ fn two_shards_merged_equal_the_unsharded_run() {
     for k in ["1", "2"] {
         let task = script(
             &["--task", "2", root.to_str().unwrap()],
-            &RUN,
+            &run_args(),
             &[("SLURM_ARRAY_TASK_ID", k)],
         );
         ok(task, "an array task of slurm-bench.sh");

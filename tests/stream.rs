@@ -7,9 +7,9 @@ mod common;
 
 use glam::{IVec3, UVec3, Vec3};
 use gpgpu_rt::frame::Frame;
-use gpgpu_rt::gl::{GlContext, ShaderSource};
+use gpgpu_rt::gl::GlContext;
 use gpgpu_rt::pipeline::stream::grid::StreamGrid;
-use gpgpu_rt::pipeline::stream::{StreamOptions, StreamRenderer};
+use gpgpu_rt::pipeline::stream::StreamOptions;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::brute_force::BruteForce;
 use gpgpu_rt::reference::stream_grid::{Rule, StreamRay, WalkCounts};
@@ -17,35 +17,11 @@ use gpgpu_rt::reference::stream_shading::StreamShading;
 use gpgpu_rt::reference::CpuAccelerator;
 use gpgpu_rt::scene::Scene;
 
-use common::{context, load};
-
-fn options(size: u32, dims: [u32; 3], proximity_clouds: bool) -> StreamOptions {
-    StreamOptions {
-        width: size,
-        height: size,
-        refl_depth: 0,
-        dims: Some(dims),
-        proximity_clouds,
-        steps_per_call: 64,
-        max_calls: 10_000,
-        naive_shadows: false,
-        no_mask: false,
-        single_sided: false,
-        aovs: true,
-    }
-}
-
-/// The kernels built in, or with `STREAM_TEST_GLSL_DIR=DIR` those of DIR (a copy of `glsl/`
-/// with a planted bug: each test here was seen to fail so).
-fn renderer(ctx: &GlContext, scene: &Scene, o: StreamOptions) -> StreamRenderer {
-    let dir = std::env::var_os("STREAM_TEST_GLSL_DIR").map(Into::into);
-    let shaders = ShaderSource::from_dir(dir).expect("STREAM_TEST_GLSL_DIR");
-    StreamRenderer::new(ctx.gl.clone(), &ctx.info, scene, &shaders, o).expect("stream tracer")
-}
+use common::{context, load, stream_options, stream_renderer};
 
 /// Render one frame and keep the CPU twin's grid.
 fn render(ctx: &GlContext, scene: &Scene, o: StreamOptions) -> (Frame, StreamGrid) {
-    let mut r = renderer(ctx, scene, o);
+    let mut r = stream_renderer(ctx, scene, o);
     let f = r.render(&scene.camera).expect("frame");
     let g = r.grid();
     let grid = StreamGrid {
@@ -170,11 +146,11 @@ fn first_hits_and_counts_equal_the_cpu_twin_on_cubic_and_non_cubic_grids() {
     assert_eq!(auto, UVec3::splat(18));
     for dims in [auto.to_array(), [7, 13, 4]] {
         for pc in [false, true] {
-            check_against_twin(&ctx, &cow, options(64, dims, pc));
+            check_against_twin(&ctx, &cow, stream_options(64, dims, pc));
         }
     }
     let sphere = unlit(load("sphere.toml"));
-    check_against_twin(&ctx, &sphere, options(64, [9, 9, 9], true));
+    check_against_twin(&ctx, &sphere, stream_options(64, [9, 9, 9], true));
 }
 
 /// A floor of 8×8 quads at y = 0 under a light at y = 1; a blocker at y = 0.6 over one part,
@@ -238,7 +214,7 @@ fn check_shadows(
     naive: bool,
     no_mask: bool,
 ) -> Frame {
-    let mut o = options(64, dims, false);
+    let mut o = stream_options(64, dims, false);
     o.naive_shadows = naive;
     o.no_mask = no_mask;
     let (f, grid) = render(ctx, scene, o);
@@ -381,7 +357,7 @@ fn proximity_clouds_change_no_pixel() {
     let ctx = context();
     for (name, dims) in [("teapot1.toml", [24, 16, 24]), ("cow.toml", [40, 40, 40])] {
         let scene = load(name);
-        let mut o = options(64, dims, false);
+        let mut o = stream_options(64, dims, false);
         o.refl_depth = 2;
         let (plain, _) = render(&ctx, &scene, o);
         o.proximity_clouds = true;
@@ -447,7 +423,7 @@ fn distance_field_equals_brute_force() {
 fn the_occlusion_query_halts_after_many_bounded_calls() {
     let ctx = context();
     let scene = load("cow.toml");
-    let mut o = options(48, [30, 30, 30], false);
+    let mut o = stream_options(48, [30, 30, 30], false);
     o.steps_per_call = 4096;
     let (big, _) = render(&ctx, &scene, o);
     o.steps_per_call = 3;
@@ -459,7 +435,7 @@ fn the_occlusion_query_halts_after_many_bounded_calls() {
     assert_eq!(big.color, small.color);
     assert_eq!(big.stats.triangle_tests, small.stats.triangle_tests);
     o.max_calls = 3;
-    let mut r = renderer(&ctx, &scene, o);
+    let mut r = stream_renderer(&ctx, &scene, o);
     let e = r.render(&scene.camera).expect_err("a capped frame fails");
     assert!(e.to_string().contains("still walking"), "{e}");
 }
@@ -472,7 +448,7 @@ fn colours_with_shadows_and_reflections_equal_the_cpu_twin() {
     let ctx = context();
     let scene = load("teapot1.toml");
     for pc in [false, true] {
-        let mut o = options(64, [24, 16, 24], pc);
+        let mut o = stream_options(64, [24, 16, 24], pc);
         o.refl_depth = 2;
         let (f, grid) = render(&ctx, &scene, o);
         let twin = StreamShading::new(&scene, &grid, pc);
@@ -606,8 +582,8 @@ fn a_jump_never_passes_the_nearest_non_empty_cell() {
     }
     std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
     let scene = Scene::load(&dir.path().join("scene.toml")).unwrap();
-    let (plain, _) = render(&ctx, &scene, options(32, [16, 16, 16], false));
-    let (pc, _) = render(&ctx, &scene, options(32, [16, 16, 16], true));
+    let (plain, _) = render(&ctx, &scene, stream_options(32, [16, 16, 16], false));
+    let (pc, _) = render(&ctx, &scene, stream_options(32, [16, 16, 16], true));
     let ids = |f: &Frame| f.aovs.as_ref().unwrap().triangle_id.clone();
     let hits = ids(&plain).iter().filter(|&&t| t == 0).count();
     assert!(hits > 10, "the target covers {hits} pixels");
@@ -636,8 +612,8 @@ fn single_sided_test_drops_back_faces_only() {
     ] {
         let scene = unlit(load(file));
         let tris = scene.world_triangles();
-        let two = render(&ctx, &scene, options(64, dims, false)).0;
-        let mut o = options(64, dims, false);
+        let two = render(&ctx, &scene, stream_options(64, dims, false)).0;
+        let mut o = stream_options(64, dims, false);
         o.single_sided = true;
         let one = render(&ctx, &scene, o).0;
         let (a2, a1) = (two.aovs.as_ref().unwrap(), one.aovs.as_ref().unwrap());

@@ -316,12 +316,53 @@ fn save(path: &Path, contents: &str) {
     std::fs::rename(&tmp, path).unwrap();
 }
 
+/// A copy of the kernels in `dir`, to edit: its folder.
+fn kernels_copy(dir: &Path) -> PathBuf {
+    let glsl = dir.join("glsl");
+    copy_dir(&root().join("glsl"), &glsl);
+    glsl
+}
+
+/// Start the viewer `cmd` on the kernels in `glsl` (reloaded when they change), its screenshot
+/// to `shot`.
+fn spawn_live(
+    mut cmd: Command,
+    glsl: &Path,
+    shot: &Path,
+) -> (Running, Lines, std::thread::JoinHandle<String>) {
+    cmd.arg("--glsl-dir")
+        .arg(glsl)
+        .arg("--screenshot")
+        .arg(shot);
+    spawn_lines(cmd)
+}
+
+/// The viewer ended well (`status`, its `stderr` shown if not) and its screenshot `shot` is all
+/// magenta, the edited kernels' constant colour: the screenshot.
+fn assert_ends_magenta(
+    status: std::process::ExitStatus,
+    stderr: std::thread::JoinHandle<String>,
+    shot: &Path,
+) -> RgbImage {
+    assert!(
+        status.success(),
+        "viewer failed ({status}): {}",
+        stderr.join().unwrap()
+    );
+    let img = image::open(shot).unwrap().to_rgb8();
+    let off = img.pixels().filter(|p| p.0 != [255, 0, 255]).count();
+    assert_eq!(
+        off, 0,
+        "{off} pixels are not the edited kernel's constant colour"
+    );
+    img
+}
+
 #[test]
 fn kernel_edit_reloads_live() {
     let Some(xvfb) = xvfb_run() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let glsl = dir.path().join("glsl");
-    copy_dir(&root().join("glsl"), &glsl);
+    let glsl = kernels_copy(dir.path());
     let shading = glsl.join("mueller2015/shading.comp");
     let original = std::fs::read_to_string(&shading).unwrap();
 
@@ -347,7 +388,7 @@ fn kernel_edit_reloads_live() {
     );
 
     let shot = dir.path().join("after.png");
-    let mut cmd = view(
+    let cmd = view(
         &xvfb,
         &[
             "scenes/teapot1.toml",
@@ -363,11 +404,7 @@ fn kernel_edit_reloads_live() {
             "2",
         ],
     );
-    cmd.arg("--glsl-dir")
-        .arg(&glsl)
-        .arg("--screenshot")
-        .arg(&shot);
-    let (child, mut lines, stderr) = spawn_lines(cmd);
+    let (child, mut lines, stderr) = spawn_live(cmd, &glsl, &shot);
     let deadline = lines.deadline;
 
     lines.expect("watching ");
@@ -388,20 +425,8 @@ fn kernel_edit_reloads_live() {
     lines.expect("reload ok: mueller2015/shading.comp");
     let shot_line = lines.expect("screenshot: ");
     assert!(shot_line.contains("window framebuffer"), "{shot_line}");
-    let status = child.wait(deadline);
-    assert!(
-        status.success(),
-        "viewer failed ({status}): {}",
-        stderr.join().unwrap()
-    );
-
-    let img = image::open(&shot).unwrap().to_rgb8();
+    let img = assert_ends_magenta(child.wait(deadline), stderr, &shot);
     assert_eq!(img.dimensions(), (64, 64));
-    let off = img.pixels().filter(|p| p.0 != [255, 0, 255]).count();
-    assert_eq!(
-        off, 0,
-        "{off} pixels are not the edited kernel's constant colour"
-    );
 }
 
 /// With soft shadows shown, an edit of their quad kernel (`linespace_quad.frag`) is reloaded
@@ -410,8 +435,7 @@ fn kernel_edit_reloads_live() {
 fn soft_shadow_kernel_edit_reloads_live() {
     let Some(xvfb) = xvfb_run() else { return };
     let dir = tempfile::tempdir().unwrap();
-    let glsl = dir.path().join("glsl");
-    copy_dir(&root().join("glsl"), &glsl);
+    let glsl = kernels_copy(dir.path());
     let quad = glsl.join("klee2016/linespace_quad.frag");
     let original = std::fs::read_to_string(&quad).unwrap();
     let store = "fragColor = vec4(texture(colorTexture, texCoord).rgb, 1.0);";
@@ -423,7 +447,7 @@ fn soft_shadow_kernel_edit_reloads_live() {
     let magenta = original.replace(store, "fragColor = vec4(1.0, 0.0, 1.0, 1.0);");
 
     let shot = dir.path().join("after.png");
-    let mut cmd = view(
+    let cmd = view(
         &xvfb,
         &[
             "scenes/bunny_area.toml",
@@ -441,11 +465,7 @@ fn soft_shadow_kernel_edit_reloads_live() {
             "1",
         ],
     );
-    cmd.arg("--glsl-dir")
-        .arg(&glsl)
-        .arg("--screenshot")
-        .arg(&shot);
-    let (child, mut lines, stderr) = spawn_lines(cmd);
+    let (child, mut lines, stderr) = spawn_live(cmd, &glsl, &shot);
     let deadline = lines.deadline;
     lines.expect("watching ");
     lines.expect("frame 1: soft shadows linespace 2x2");
@@ -453,18 +473,7 @@ fn soft_shadow_kernel_edit_reloads_live() {
     let ok = lines.expect("reload ok: klee2016/linespace_quad.frag");
     assert!(ok.contains("soft shadows linespace 2x2"), "{ok}");
     lines.expect("screenshot: ");
-    let status = child.wait(deadline);
-    assert!(
-        status.success(),
-        "viewer failed ({status}): {}",
-        stderr.join().unwrap()
-    );
-    let img = image::open(&shot).unwrap().to_rgb8();
-    let off = img.pixels().filter(|p| p.0 != [255, 0, 255]).count();
-    assert_eq!(
-        off, 0,
-        "{off} pixels are not the edited kernel's constant colour"
-    );
+    assert_ends_magenta(child.wait(deadline), stderr, &shot);
 }
 
 #[test]

@@ -236,6 +236,10 @@ pub fn run(args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// The smallest Klee 2016 bench run: the N-tree reading A only (3 levels; reading B's tree takes
+/// minutes to build), at 16×16.
+pub const KLEE_TINY: [&str; 6] = ["--ntree-levels", "3", "--width", "16", "--height", "16"];
+
 /// The standard error of a run, as text.
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
@@ -282,6 +286,41 @@ pub fn stream(o: &RenderOptions) -> gpgpu_rt::design::Design {
         aovs: o.aovs,
         ..StreamOptions::new(o.width, o.height, o.refl_depth)
     })
+}
+
+/// Seed 004's streaming tracer at `size`² on the grid `dims`, with or without proximity clouds:
+/// eye rays only, 64 steps per call, AOVs kept.
+pub fn stream_options(
+    size: u32,
+    dims: [u32; 3],
+    proximity_clouds: bool,
+) -> gpgpu_rt::pipeline::stream::StreamOptions {
+    gpgpu_rt::pipeline::stream::StreamOptions {
+        width: size,
+        height: size,
+        refl_depth: 0,
+        dims: Some(dims),
+        proximity_clouds,
+        steps_per_call: 64,
+        max_calls: 10_000,
+        naive_shadows: false,
+        no_mask: false,
+        single_sided: false,
+        aovs: true,
+    }
+}
+
+/// The streaming tracer with the kernels built in, or with `STREAM_TEST_GLSL_DIR=DIR` those of
+/// DIR (a copy of `glsl/` with a planted bug: the stream tests were each seen to fail so).
+pub fn stream_renderer(
+    ctx: &GlContext,
+    scene: &Scene,
+    o: gpgpu_rt::pipeline::stream::StreamOptions,
+) -> gpgpu_rt::pipeline::stream::StreamRenderer {
+    let dir = std::env::var_os("STREAM_TEST_GLSL_DIR").map(Into::into);
+    let shaders = ShaderSource::from_dir(dir).expect("STREAM_TEST_GLSL_DIR");
+    gpgpu_rt::pipeline::stream::StreamRenderer::new(ctx.gl.clone(), &ctx.info, scene, &shaders, o)
+        .expect("stream tracer")
 }
 
 /// The renderer of `design` for `scene`, kernels built in.

@@ -20,13 +20,8 @@ use crate::bench::runner::config::{Config, GridVariant, Sizing, TracerSpec};
 use crate::bench::runner::Bench;
 
 /// The sparse scene (not in the paper): a small detailed object in a large empty room.
-pub const SPARSE: PaperScene = PaperScene {
-    file: "sparse_room.toml",
-    name: "Sparse room",
-    triangles: 1776,
-    grid: [32, 32, 32],
-    pc: true,
-};
+pub const SPARSE: PaperScene =
+    PaperScene::new("sparse_room.toml", "Sparse room", 1776, [32, 32, 32], true);
 
 /// Quick: image sides 64, 128, 192 (the paper's 256 : 512 : 768 scaled by ¼), the best of 5
 /// frames after 1 warm-up frame. Full: the paper's sides, the best of 10 frames after 2.

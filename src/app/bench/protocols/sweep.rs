@@ -6,6 +6,11 @@ use crate::bench::report::plots::{Chart, Series, Style};
 use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
 use crate::bench::runner::outcome::{Outcome, MEASURED_COLUMNS};
 
+/// The sizing of both resolution sweeps. Quick: 4 angles, 1 warm-up frame. Full: 36 angles
+/// (every 10°), 3 warm-up frames.
+pub const QUICK: Sizing = Sizing::quick(4, 1);
+pub const FULL: Sizing = Sizing::full(36, 3);
+
 /// Grid configurations for every variant × resolution of `scene`.
 pub fn grid_configs(
     scene: &str,

@@ -22,15 +22,12 @@ pub const PROTOCOL: Protocol = Protocol {
 };
 
 pub const SCENE: &str = "teapot6.toml";
-/// Quick: 4 angles, 1 warm-up frame. Full: 36 angles (every 10°), 3 warm-up frames.
-pub const QUICK: Sizing = Sizing::quick(4, 1);
-pub const FULL: Sizing = Sizing::full(36, 3);
 pub const QUICK_RESOLUTIONS: &[u32] = &[4, 8, 12, 16, 20, 24, 32, 40];
 pub const FULL_RESOLUTIONS: &[u32] = &[4, 8, 12, 16, 20, 24, 28, 32, 36, 40];
 
 fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     // configure: the base tracer, then every variant × resolution, reflection depth 1
-    let s = bench.sizing(QUICK, FULL);
+    let s = bench.sizing(sweep::QUICK, sweep::FULL);
     let resolutions = bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS);
     let variants = bench.variants();
     let mut configs = vec![Config::new(SCENE, TracerSpec::Base, 1, s)];

@@ -25,9 +25,6 @@ pub const PROTOCOL: Protocol = Protocol {
 
 pub const BUNNY: &str = "bunny.toml";
 pub const DRAGON: &str = "dragon.toml";
-/// Quick: 4 angles, 1 warm-up frame. Full: 36 angles (every 10°), 3 warm-up frames.
-pub const QUICK: Sizing = Sizing::quick(4, 1);
-pub const FULL: Sizing = Sizing::full(36, 3);
 pub const QUICK_RESOLUTIONS: &[u32] = &[8, 16, 24, 32];
 pub const FULL_RESOLUTIONS: &[u32] = &[8, 12, 16, 20, 24, 28, 32, 40];
 
@@ -42,7 +39,7 @@ struct Plan {
 
 fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let plan = Plan {
-        sizing: bench.sizing(QUICK, FULL),
+        sizing: bench.sizing(sweep::QUICK, sweep::FULL),
         resolutions: bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS),
         variants: bench.variants(),
         dragon_base: bench.scale() == Scale::Full,

@@ -28,34 +28,38 @@ pub struct PaperScene {
     pub pc: bool,
 }
 
-pub const KNIGHT: PaperScene = PaperScene {
-    file: "knight.toml",
-    name: "Knight",
-    triangles: 636,
-    grid: [14, 16, 14],
-    pc: true,
-};
-pub const TORUS_KNOT: PaperScene = PaperScene {
-    file: "torus_knot.toml",
-    name: "Torus knot",
-    triangles: 1024,
-    grid: [16, 16, 16],
-    pc: true,
-};
-pub const BUNNY: PaperScene = PaperScene {
-    file: "bunny_low.toml",
-    name: "Bunny",
-    triangles: 1764,
-    grid: [20, 20, 20],
-    pc: true,
-};
-pub const STANFORD_BUNNY: PaperScene = PaperScene {
-    file: "bunny.toml",
-    name: "Stanford Bunny",
-    triangles: 69451,
-    grid: [128, 128, 128],
-    pc: false,
-};
+impl PaperScene {
+    /// The scene of `file`, named `name`, of `triangles` triangles, measured with the grid
+    /// `grid`, with proximity clouds if `pc`.
+    pub const fn new(
+        file: &'static str,
+        name: &'static str,
+        triangles: usize,
+        grid: [u32; 3],
+        pc: bool,
+    ) -> Self {
+        PaperScene {
+            file,
+            name,
+            triangles,
+            grid,
+            pc,
+        }
+    }
+}
+
+pub const KNIGHT: PaperScene = PaperScene::new("knight.toml", "Knight", 636, [14, 16, 14], true);
+pub const TORUS_KNOT: PaperScene =
+    PaperScene::new("torus_knot.toml", "Torus knot", 1024, [16, 16, 16], true);
+pub const BUNNY: PaperScene = PaperScene::new("bunny_low.toml", "Bunny", 1764, [20, 20, 20], true);
+pub const STANFORD_BUNNY: PaperScene = PaperScene::new(
+    "bunny.toml",
+    "Stanford Bunny",
+    69451,
+    [128, 128, 128],
+    false,
+);
+
 /// The four scenes in the tables' order.
 pub const SCENES: [PaperScene; 4] = [KNIGHT, TORUS_KNOT, BUNNY, STANFORD_BUNNY];
 
