@@ -1,10 +1,10 @@
 // BVH traversal shared by glsl/bvh/intersect1.comp and intersect2.comp — ours, after Wagner
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
-// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (Bvh::traverse), same order and counts.
+// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (BvhTree::traverse), same order and counts.
 //
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), read as RGBA32UI texels of 4 words
-// (Bvh::gpu_words in src/reference/bvh/mod.rs):
+// (BvhTree::gpu_words in src/accel/bvh/layout.rs):
 //   a header of 8 words (BVH_HEADER_WORDS): the node count N, the grid's origin x, y, z, its
 //             steps x, y, z, 0 (plane q of axis a lies at origin[a] + q·step[a]);
 //   for each ray octant o (bit a set: the ray points down axis a) a copy of the N nodes in
@@ -20,7 +20,7 @@
 //             and a leaf's miss link is the next record;
 //   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0.
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh.rs. The header is two texels, not uniforms: llvmpipe's uniform loads
+// host, src/accel/bvh/mod.rs. The header is two texels, not uniforms: llvmpipe's uniform loads
 // cost more than texel loads, docs/design/bvh.md, step 23.) A node step reads one texel, a triangle
 // three (on llvmpipe each eight 128-bit loads, a transpose and a bounds check, where a 32-bit
 // word costs a gather with its bounds check). Ours: the copies per octant (twice the memory of
@@ -86,7 +86,7 @@ int triangleBase = 0;
 // twin's node counts with it, not the hits). In world units its rounding error is about 2^-23
 // of the root's extent plus the ray origin's distance from the grid — where (plane − ro)·inv
 // errs by 2^-24 of the distance to the plane — and the boxes' padding of 1e-5 of the scene's
-// extent (src/reference/bvh/build.rs) covers it for origins within some 80 extents of the scene
+// extent (src/accel/bvh/build.rs) covers it for origins within some 80 extents of the scene
 // (docs/design/bvh.md, step 23).
 //
 // Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
@@ -94,7 +94,7 @@ int triangleBase = 0;
 // one. For t >= +0 the bits are in the order of the floats; the entry distance is at least
 // tMin >= +0, and where an exit distance is negative so is the smallest of the bits: the box is
 // missed either way (an exit at exactly −0.0 too: a box the ray leaves at its origin). No
-// distance is NaN (safeInverse, and gridA and gridB clamped finite). The CPU twin (Bvh::enter,
+// distance is NaN (safeInverse, and gridA and gridB clamped finite). The CPU twin (BvhTree::enter,
 // RayGrid::t) computes the same bits.
 bool boxEntered(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit)
 {

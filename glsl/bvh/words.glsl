@@ -1,5 +1,5 @@
 // The SAH BVH's word buffer — ours, after Wagner 2018's three textures of Fig. 4.3 (ch. 4.2)
-// in one buffer (Bvh::gpu_words in src/reference/bvh/mod.rs; its layout: bvh/traverse.glsl),
+// in one buffer (BvhTree::gpu_words in src/accel/bvh/layout.rs; its layout: bvh/traverse.glsl),
 // read as RGBA32UI texels of 4 words, for bvh/traverse.glsl and bvh/hit_record.glsl.
 // (bvh/entry.comp defines BVH_WORDS_WRITABLE: it writes the blocks' entries, bvh/entries.glsl)
 #ifdef BVH_WORDS_WRITABLE
