@@ -4,23 +4,25 @@
 //
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), read as RGBA32UI texels of 4 words
-// (BvhTree::gpu_words in src/accel/bvh/layout.rs):
-//   a header of 8 words (BVH_HEADER_WORDS): the node count N, the grid's origin x, y, z, its
-//             steps x, y, z, 0 (plane q of axis a lies at origin[a] + q·step[a]);
+// (BvhTree::gpu_words; the types, field by field, in src/accel/bvh/layout.rs):
+//   Header, 8 words (BVH_HEADER_WORDS): node_count N, grid_origin x, y, z, grid_step x, y, z,
+//             zero (plane q of axis a lies at grid_origin[a] + q·grid_step[a]);
 //   for each ray octant o (bit a set: the ray points down axis a) a copy of the N nodes in
 //             that octant's depth-first order (the near child of every split first), one
-//             texel each (BVH_NODE_WORDS), octant o's from texel 2 + o·N on: the box as the
-//             planes where rays of the octant enter its slabs (near.xyz) and leave them
-//             (far.xyz), 16-bit step counts on the grid —
-//             near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth
-//             word: in an inner node its miss link (the texel of the record where a ray goes
-//             on when it misses the node; 2 + o·N + N: the walk is over), in a leaf
-//             −1 − (s·32 + count), its triangles from entry s of the leaf triangles on. An inner
-//             node's near child is the next record, its far child the near child's miss link,
-//             and a leaf's miss link is the next record;
-//   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0.
+//             NodeRecord each, one texel (BVH_NODE_WORDS), octant o's from texel 2 + o·N on:
+//             the box as the planes where rays of the octant enter its slabs (near) and leave
+//             them (far), 16-bit step counts on the grid — words near.x | near.y << 16,
+//             near.z | far.x << 16, far.y | far.z << 16 — and `reference`: in an inner node its
+//             miss link (the texel of the record where a ray goes on when it misses the node;
+//             2 + o·N + N: the walk is over), in a leaf −1 − (s·32 + count), its triangles from
+//             entry s of the leaf triangles on. An inner node's near child is the next record,
+//             its far child the near child's miss link, and a leaf's miss link is the next
+//             record;
+//   then a LeafTriangle per leaf entry, 12 words (BVH_TRIANGLE_WORDS): v0, id, edge1, zero1,
+//             edge2, zero2;
+//   then an EntryTexel per block of the image (bvh/entries.glsl).
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh/mod.rs. The header is two texels, not uniforms: llvmpipe's uniform loads
+// host, src/accel/bvh/mod.rs. The Header is two texels, not uniforms: llvmpipe's uniform loads
 // cost more than texel loads, docs/design/bvh.md, step 23.) A node step reads one texel, a triangle
 // three (on llvmpipe each eight 128-bit loads, a transpose and a bounds check, where a 32-bit
 // word costs a gather with its bounds check). Ours: the copies per octant (twice the memory of

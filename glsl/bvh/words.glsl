@@ -16,8 +16,9 @@ uvec4 bvhRecord(int texel) { return imageLoad(bvh, int(uint(texel) & BVH_TEXEL_I
 // The texel at word address `at` (a multiple of 4: the header, a leaf triangle).
 uvec4 bvhTexel(int at) { return bvhRecord(int(uint(at) >> 2u)); }
 
-// A node record's box: the planes where rays of its octant enter the slabs (near) and leave them
-// (far), 16-bit step counts on the grid (bvh/traverse.glsl).
+// A node record's box (NodeRecord in src/accel/bvh/layout.rs: near, far): the planes where rays
+// of its octant enter the slabs (near) and leave them (far), 16-bit step counts on the grid
+// (bvh/traverse.glsl).
 void recordPlanes(uvec4 record, out vec3 near, out vec3 far)
 {
     near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));

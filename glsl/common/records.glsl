@@ -15,9 +15,10 @@
 // (bvh/hit_record.glsl), −1 for none.
 int closestHitRecord = -1;
 
-// One record per pixel: xy its counts (packCounts), z its hit record (intersect1 only). One
-// store per invocation: on llvmpipe every store costs a loop over the 8 lanes per component
-// and about as much again for the store itself (docs/design/frame.md).
+// One record per pixel, a PixelRecord (src/pipeline/mueller2015/records.rs): xy its counts
+// (packCounts: tests_truncated, nodes_traced), z its hit record (hit; intersect1 only), w
+// unused. One store per invocation: on llvmpipe every store costs a loop over the 8 lanes per
+// component and about as much again for the store itself (docs/design/frame.md).
 layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordBuffer { uvec4 pixelRecord[]; };
 #if RECORD_STORE_64
 // The same records as two 64-bit words (GL_ARB_gpu_shader_int64, which the including kernel

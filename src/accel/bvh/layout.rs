@@ -8,17 +8,21 @@
 //!
 //! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
 //! words read as texels of four ([`BvhTree::gpu_words`]):
-//! - a header: the node count and the grid of the records' planes ([`Grid`], over the root's
-//!   box);
+//! - a [`Header`]: the node count and the grid of the records' planes ([`Grid`], over the
+//!   root's box);
 //! - for each of the 8 ray octants a copy of the nodes in that octant's depth-first order (the
-//!   near child of every split first), one 16-byte record each: the box as its near and far
+//!   near child of every split first), one 16-byte [`NodeRecord`] each: the box as its near and far
 //!   planes for rays of that octant, 16-bit step counts on the grid ([`BvhTree::planes`]), and in
 //!   an inner node its miss link for that octant (the record to go on with when the node is
 //!   missed), in a leaf the place and count of its triangles — an inner node's near child is
 //!   the record after it, its far child the near child's miss link, a leaf's miss link the
 //!   record after it;
-//! - after the records, per entry of [`BvhTree::tris`] (the triangle ids per leaf) the triangle as
-//!   v0 and its id, edge1, edge2 (12 words).
+//! - after the records, per entry of [`BvhTree::tris`] (the triangle ids per leaf) a
+//!   [`LeafTriangle`]: v0 and its id, edge1, edge2 (12 words);
+//! - after them (appended by the accelerator) an [`EntryTexel`] per block of the image.
+//!
+//! Each record is a `#[repr(C)]` type documented field by field, the GLSL naming it and its
+//! fields; [`BvhTree::gpu_words`] writes them through `bytemuck`.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -117,14 +121,95 @@ pub struct BvhTree {
     pub stats: BvhStats,
 }
 
-/// Words of the header of [`BvhTree::gpu_words`]: the node count and the grid's origin x, y, z; the
-/// grid's steps x, y, z and 0.
-pub const HEADER_WORDS: usize = 8;
-/// Words of one node record of one octant in [`BvhTree::gpu_words`]: one texel.
-pub const NODE_WORDS: usize = 4;
-/// Words of one leaf triangle in [`BvhTree::gpu_words`].
-pub const TRIANGLE_WORDS: usize = 12;
-/// Bits of a leaf record's triangle count in its reference word ([`BvhTree::gpu_words`]).
+/// The header of [`BvhTree::gpu_words`]: its first two texels, 32 bytes (`glsl/bvh/traverse.glsl`
+/// reads them as `header` and `bvhTexel(4)`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct Header {
+    /// bytes 0–3: N, the nodes of the tree (each octant's copy has N records)
+    pub node_count: u32,
+    /// bytes 4–15: the grid's origin x, y, z: plane q of axis a lies at
+    /// `grid_origin[a] + q·grid_step[a]` ([`Grid`])
+    pub grid_origin: [f32; 3],
+    /// bytes 16–27: the grid's steps x, y, z
+    pub grid_step: [f32; 3],
+    /// bytes 28–31: 0
+    pub zero: u32,
+}
+const _: () = assert!(std::mem::size_of::<Header>() == 32);
+
+/// A node record of one octant's copy of the nodes in [`BvhTree::gpu_words`]: one texel, 16
+/// bytes (`glsl/bvh/words.glsl`'s `recordPlanes` unpacks its planes, `glsl/bvh/traverse.glsl`'s
+/// `nodePass` reads `reference` as `int(record.w)`). The planes are the 16-bit step counts of
+/// [`BvhTree::planes`] on the grid; as words, `near.x | near.y << 16`, `near.z | far.x << 16`,
+/// `far.y | far.z << 16` (the host is little-endian: asserted below).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct NodeRecord {
+    /// bytes 0–5 (word 0, word 1 bits 0–15): the planes x, y, z where rays of the record's
+    /// octant enter the box's slabs — per axis the box's low plane, or its high plane where the
+    /// octant's rays point down the axis ([`octant_planes`])
+    pub near: [u16; 3],
+    /// bytes 6–11 (word 1 bits 16–31, word 2): the planes x, y, z where they leave them
+    pub far: [u16; 3],
+    /// bytes 12–15 (word 3): an inner node (≥ 0): its miss link, the texel of the record where a
+    /// ray of the octant goes on when it misses the node (the texel after the octant's last
+    /// record for [`END`]: the walk is over); a leaf (< 0): −1 − (s·2^[`LEAF_COUNT_BITS`] +
+    /// count), its count triangles from entry s of [`BvhTree::tris`] on
+    pub reference: i32,
+}
+const _: () = assert!(std::mem::size_of::<NodeRecord>() == 16);
+const _: () = assert!(
+    cfg!(target_endian = "little"),
+    "a record's 16-bit planes pack into its words low half first"
+);
+
+/// A leaf triangle in [`BvhTree::gpu_words`], one per entry of [`BvhTree::tris`]: three texels,
+/// 48 bytes (`glsl/bvh/traverse.glsl`'s `leafTriangles`, `glsl/bvh/hit_record.glsl`'s
+/// `hitFromRecord`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct LeafTriangle {
+    /// bytes 0–11: its first vertex
+    pub v0: [f32; 3],
+    /// bytes 12–15: its triangle id
+    pub id: u32,
+    /// bytes 16–27: v1 − v0, the first difference Algorithm 1 forms
+    pub edge1: [f32; 3],
+    /// bytes 28–31: 0
+    pub zero1: u32,
+    /// bytes 32–43: v2 − v0
+    pub edge2: [f32; 3],
+    /// bytes 44–47: 0
+    pub zero2: u32,
+}
+const _: () = assert!(std::mem::size_of::<LeafTriangle>() == 48);
+
+/// A block's entry point (`glsl/bvh/entries.glsl`): one texel, 16 bytes, per block of the
+/// image after the leaf triangles, which `glsl/bvh/entry.comp` writes every pass; the host
+/// uploads them zeroed (no entry).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct EntryTexel {
+    /// bytes 0–3: the octant of the block's rays + 1 (0: no entry, every ray walks from its
+    /// octant's root)
+    pub octant_plus_one: u32,
+    /// bytes 4–7: the texel of the record the block's rays of that octant walk from
+    pub node: u32,
+    /// bytes 8–11: the texel after the entry node's subtree, where their walk stops
+    pub end: u32,
+    /// bytes 12–15: 0
+    pub zero: u32,
+}
+const _: () = assert!(std::mem::size_of::<EntryTexel>() == 16);
+
+/// Words of the header of [`BvhTree::gpu_words`] ([`Header`]).
+pub const HEADER_WORDS: usize = std::mem::size_of::<Header>() / 4;
+/// Words of one node record of one octant in [`BvhTree::gpu_words`] ([`NodeRecord`]): one texel.
+pub const NODE_WORDS: usize = std::mem::size_of::<NodeRecord>() / 4;
+/// Words of one leaf triangle in [`BvhTree::gpu_words`] ([`LeafTriangle`]).
+pub const TRIANGLE_WORDS: usize = std::mem::size_of::<LeafTriangle>() / 4;
+/// Bits of a leaf's triangle count in its record's `reference` ([`NodeRecord`]).
 pub const LEAF_COUNT_BITS: u32 = 5;
 const _: () = assert!(
     MAX_LEAF < 1 << LEAF_COUNT_BITS,
@@ -166,50 +251,48 @@ impl BvhTree {
         }
     }
 
-    /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) read as
-    /// texels of 4 words (`glsl/bvh/traverse.glsl`):
-    /// - [`HEADER_WORDS`]: the node count N, the grid's origin x, y, z, its steps x, y, z, 0;
-    /// - for each octant o = 0..8, from texel [`BvhTree::root_texel`] on, the N nodes in the
-    ///   depth-first order of that octant (the order of [`BvhTree::links`]: the near child of every
-    ///   split first), one texel each ([`NODE_WORDS`]): the near planes x, y, z (for each axis
-    ///   the box's low plane, or its high plane where rays of the octant point down the axis)
-    ///   and the far planes x, y, z, as the 16-bit step counts of [`BvhTree::planes`] —
-    ///   near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth word:
-    ///   of an inner node its miss link (the texel of the record of `links[OCTANTS·n + o]`;
-    ///   [`END`]: the texel after the octant's last record), of a leaf −1 −
-    ///   (s·2^[`LEAF_COUNT_BITS`] + count) with s its first entry in [`BvhTree::tris`]. An inner
-    ///   node's near child is the next record; a leaf's miss link is always the next record
-    ///   (the octant's depth-first order goes on there after a subtree of one);
-    /// - from word [`BvhTree::triangle_base`] on, per entry of [`BvhTree::tris`] [`TRIANGLE_WORDS`]:
-    ///   v0 and the triangle id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences
-    ///   Algorithm 1 forms first.
+    /// The hierarchy as uploaded: one buffer of 32-bit words read as texels of 4 words
+    /// (`glsl/bvh/traverse.glsl`):
+    /// - a [`Header`];
+    /// - for each octant o = 0..8, from texel [`BvhTree::root_texel`] on, a [`NodeRecord`] of
+    ///   each of the N nodes in the depth-first order of that octant (the order of
+    ///   [`BvhTree::links`]: the near child of every split first). An inner node's near child is
+    ///   the next record; a leaf's miss link is always the next record (the octant's depth-first
+    ///   order goes on there after a subtree of one);
+    /// - from word [`BvhTree::triangle_base`] on, a [`LeafTriangle`] per entry of
+    ///   [`BvhTree::tris`].
     ///
-    /// (s < 2^26 always: `TextureBuffer::new` refuses a buffer of 2^31 bytes, and each entry
-    /// takes 48.)
+    /// (s < 2^26 always in a leaf's `reference`: `TextureBuffer::new` refuses a buffer of 2^31
+    /// bytes, and each entry takes 48.)
     pub fn gpu_words(&self) -> Vec<u32> {
         use rayon::prelude::*;
         let n = self.nodes.len();
-        let records = OCTANTS * NODE_WORDS * n;
         let mut out = vec![0u32; self.stats.bytes / 4];
         let (head, rest) = out.split_at_mut(HEADER_WORDS);
-        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-        head[0] = n as u32;
-        head[1..4].copy_from_slice(&bits(self.grid.origin));
-        head[4..7].copy_from_slice(&bits(self.grid.step));
-        let (octants, triangles) = rest.split_at_mut(records);
-        octants
-            .par_chunks_mut(NODE_WORDS * n)
+        let (octants, triangles) = rest.split_at_mut(OCTANTS * NODE_WORDS * n);
+        bytemuck::cast_slice_mut::<u32, Header>(head)[0] = Header {
+            node_count: n as u32,
+            grid_origin: self.grid.origin.to_array(),
+            grid_step: self.grid.step.to_array(),
+            zero: 0,
+        };
+        bytemuck::cast_slice_mut::<u32, NodeRecord>(octants)
+            .par_chunks_mut(n)
             .enumerate()
-            .for_each(|(o, w)| self.octant_records(o, w));
-        triangles
-            .par_chunks_mut(TRIANGLE_WORDS)
+            .for_each(|(o, records)| self.octant_records(o, records));
+        bytemuck::cast_slice_mut::<u32, LeafTriangle>(triangles)
+            .par_iter_mut()
             .zip(self.tris.par_iter())
-            .for_each(|(w, &id)| {
+            .for_each(|(t, &id)| {
                 let [v0, v1, v2] = self.triangles[id as usize];
-                w[0..3].copy_from_slice(&bits(v0));
-                w[3] = id;
-                w[4..7].copy_from_slice(&bits(v1 - v0));
-                w[8..11].copy_from_slice(&bits(v2 - v0));
+                *t = LeafTriangle {
+                    v0: v0.to_array(),
+                    id,
+                    edge1: (v1 - v0).to_array(),
+                    zero1: 0,
+                    edge2: (v2 - v0).to_array(),
+                    zero2: 0,
+                };
             });
         out
     }
@@ -249,21 +332,23 @@ impl BvhTree {
     }
 
     /// The node records of octant `o` ([`BvhTree::gpu_words`]) into `out`.
-    fn octant_records(&self, o: usize, out: &mut [u32]) {
+    fn octant_records(&self, o: usize, out: &mut [NodeRecord]) {
         let order = self.octant_order(o);
         let record = self.texels_in_order(o, &order);
         let end = record[self.nodes.len()];
-        for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
+        for (r, &k) in out.iter_mut().zip(&order) {
             let node = &self.nodes[k as usize];
             debug_assert!(node.first < 1 << (31 - LEAF_COUNT_BITS), "see gpu_words");
-            let [near, far] = octant_planes(&self.planes[k as usize], o).map(|p| p.map(u32::from));
-            w[0] = near[0] | near[1] << 16;
-            w[1] = near[2] | far[0] << 16;
-            w[2] = far[1] | far[2] << 16;
-            w[3] = match (node.is_leaf(), self.links[OCTANTS * k as usize + o]) {
-                (true, _) => (-1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32)) as u32,
-                (false, END) => end,
-                (false, l) => record[l as usize],
+            let [near, far] = octant_planes(&self.planes[k as usize], o);
+            let reference = match (node.is_leaf(), self.links[OCTANTS * k as usize + o]) {
+                (true, _) => -1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32),
+                (false, END) => end as i32,
+                (false, l) => record[l as usize] as i32,
+            };
+            *r = NodeRecord {
+                near,
+                far,
+                reference,
             };
         }
     }

@@ -10,6 +10,7 @@ use std::any::Any;
 use std::sync::Arc;
 
 use anyhow::{bail, Result};
+use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
 use serde_json::json;
 
@@ -28,9 +29,9 @@ mod build;
 pub mod layout;
 mod planes;
 pub use layout::{
-    block_of, octant_planes, Aabb, BvhStats, BvhTree, Node, BINS, BLOCK, END, HEADER_WORDS,
-    LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF, NODE_WORDS, OCTANTS, PARALLEL_BUILD,
-    SAH_DEPTH, TRIANGLE_WORDS,
+    block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
+    NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
+    NODE_WORDS, OCTANTS, PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
 };
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 
@@ -49,11 +50,12 @@ pub const ENTRY: Entry = Entry {
 /// addressed by texel and the triangles by word in the kernels' ints — which cannot overflow:
 /// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more (or beyond
 /// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
-/// `glsl/bvh/entry.comp` to write its entry point into (`glsl/bvh/entries.glsl`), 0 (no entry)
-/// until it does: the same image unit, so the BVH binds no more than GL 4.5's 8.
+/// `glsl/bvh/entry.comp` to write its entry point into ([`EntryTexel`]), 0 (no entry) until it
+/// does: the same image unit, so the BVH binds no more than GL 4.5's 8.
 fn upload(gl: &Arc<Gl>, bvh: &BvhTree, blocks: u32) -> Result<TextureBuffers> {
     let mut words = bvh.gpu_words();
-    words.resize(words.len() + 4 * blocks as usize, 0);
+    let entries = vec![EntryTexel::zeroed(); blocks as usize];
+    words.extend_from_slice(bytemuck::cast_slice(&entries));
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
