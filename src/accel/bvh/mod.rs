@@ -87,11 +87,12 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]), texel indices
 /// ([`TEXEL_INDEX_BITS`]) and its last texels, the entries of the image's blocks (columns ×
-/// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`), and they store hit records and per-pixel counts
-/// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
-/// 64-bit integers (`RECORD_STORE_64`); on llvmpipe intersect1 loads the next work group's rays
-/// ahead (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
-fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 11] {
+/// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`); the kernels store hit records and
+/// per-pixel counts (`Accelerator::records`, `glsl/bvh/records.glsl`), in one store of two 64-bit
+/// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); on llvmpipe
+/// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
+/// `glsl/bvh/intersect1_main.glsl`).
+fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 9] {
     [
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
@@ -102,8 +103,6 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
         ("BVH_LEAF_COUNT_BITS", LEAF_COUNT_BITS.to_string()),
         ("BVH_TRIANGLE_WORDS", TRIANGLE_WORDS.to_string()),
-        ("HIT_RECORDS", "1".into()),
-        ("PIXEL_COUNTS", "1".into()),
     ]
 }
 

@@ -1,9 +1,9 @@
-//! Hit records and per-pixel counts (ours, `glsl/common/records.glsl`): for an accelerator
+//! Hit records and per-pixel counts (ours, `glsl/bvh/records.glsl`): for an accelerator
 //! whose intersect1 only stores the closest hit of each pixel and whose intersection kernels
 //! store their work counts per pixel ([`crate::accel::Accelerator::records`], the SAH BVH).
-//! After its intersect1 the pipeline evaluates the hits (`glsl/common/evaluate_hit.comp`:
+//! After its intersect1 the pipeline evaluates the hits (`glsl/bvh/evaluate_hit.comp`:
 //! Listings 13 and 14, which the thesis runs inside intersect1) and after each intersection
-//! dispatch adds the counts to the 64-bit counters (`glsl/common/pixel_counts.comp`), both under
+//! dispatch adds the counts to the 64-bit counters (`glsl/bvh/pixel_counts.comp`), both under
 //! the same counter bank and ray kind. So `gpu_ms.intersect1` is the closest-hit search alone,
 //! as a ray-tracing kernel like Embree's `rtcIntersect1` measures it, and `evaluate_hit`,
 //! `pixel_counts` are timed apart.
@@ -17,7 +17,7 @@ use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 
-/// One pixel's record (`pixelRecord` in `glsl/common/records.glsl`, a uvec4): 16 bytes, which the
+/// One pixel's record (`pixelRecord` in `glsl/bvh/records.glsl`, a uvec4): 16 bytes, which the
 /// intersection kernels write (`packCounts`; intersect1 the hit record too) and `evaluate_hit`,
 /// `pixel_counts` read; the host only allocates them.
 #[repr(C)]
@@ -67,6 +67,8 @@ impl Records {
             .clone()
             .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
             .set("COUNT_GROUP", COUNT_GROUP)
+            // 32-bit stores only: these two kernels do not enable 64-bit integers
+            .set("RECORD_STORE_64", 0)
             .set(mask, mask_value);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
@@ -77,8 +79,8 @@ impl Records {
                 None,
                 max,
             )?,
-            evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
-            pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,
+            evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
+            pixel_counts: compute("bvh/pixel_counts.comp", "pixel_counts")?,
             pixels: w * h,
         })
     }
