@@ -98,7 +98,7 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
 }
 
 /// The GPU walk visits exactly the nodes its CPU twin visits, ray by ray summed over the frame,
-/// and every pixel's counts reach the statistics (`glsl/common/pixel_counts.comp`): the primary
+/// and every pixel's counts reach the statistics (`glsl/bvh/pixel_counts.comp`): the primary
 /// rays' node visits equal the twin's over the very same rays (the AOVs), and every pixel traced
 /// one primary ray, and so do the shadow feelers from their first hits (those that found an
 /// occluder included). Odd image sides leave a partial last block of `pixel_counts.comp`.
