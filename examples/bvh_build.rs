@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use gpgpu_rt::reference::bvh::Bvh;
+use gpgpu_rt::accel::bvh::BvhTree as Bvh;
 use gpgpu_rt::scene::Scene;
 
 fn main() -> anyhow::Result<()> {

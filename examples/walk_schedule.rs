@@ -34,8 +34,9 @@ use std::path::Path;
 
 use anyhow::{bail, ensure, Context, Result};
 use glam::Vec3;
+use gpgpu_rt::accel::bvh::{block_of, BvhTree as Bvh, END, LEAF_COUNT_BITS, TRIANGLE_WORDS};
 use gpgpu_rt::gl::PixelGrid;
-use gpgpu_rt::reference::bvh::{block_of, BlockEntry, Bvh, END, LEAF_COUNT_BITS, TRIANGLE_WORDS};
+use gpgpu_rt::reference::bvh::BlockEntry;
 use gpgpu_rt::reference::intersect_triangle;
 use gpgpu_rt::scene::Scene;
 

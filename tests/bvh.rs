@@ -3,7 +3,7 @@
 //! rebuilt (and an unmoved scene is not) and still gives the base tracer's image; the walks
 //! visit the twin's nodes; the kernels' paths for GL implementations without 64-bit integers or
 //! llvmpipe give the same frame. The builder's invariants are unit tests in
-//! `src/reference/bvh.rs`; the GPU against its CPU twin (test counts included) is in
+//! `src/accel/bvh/`; the GPU against its CPU twin (test counts included) is in
 //! `tests/accel.rs`.
 
 mod common;
@@ -98,7 +98,7 @@ fn moved_object_is_rebuilt_and_a_still_scene_is_not() {
 }
 
 /// The GPU walk visits exactly the nodes its CPU twin visits, ray by ray summed over the frame,
-/// and every pixel's counts reach the statistics (`glsl/common/pixel_counts.comp`): the primary
+/// and every pixel's counts reach the statistics (`glsl/bvh/pixel_counts.comp`): the primary
 /// rays' node visits equal the twin's over the very same rays (the AOVs), and every pixel traced
 /// one primary ray, and so do the shadow feelers from their first hits (those that found an
 /// occluder included). Odd image sides leave a partial last block of `pixel_counts.comp`.
@@ -141,7 +141,7 @@ fn walks_visit_the_twins_nodes_and_every_pixel_is_counted() {
     let head = "[camera]\nposition = [2.6, 2.7, 2.8]\nlook_at = [0.5, 0.5, 0.5]\nfov_y = 40.0\n\
                 [render]\nambient = [0.2, 0.2, 0.2]\n[[light]]\nposition = [3.0, 4.0, 2.0]\n";
     let corners = scene_of(dir.path(), head, &triangles.collect::<Vec<_>>());
-    let tree = gpgpu_rt::reference::bvh::Bvh::new(corners.world_triangles());
+    let tree = gpgpu_rt::accel::bvh::BvhTree::new(corners.world_triangles());
     assert_eq!(tree.nodes.len(), 3, "a root and two leaves");
     walks_match_the_twin(&ctx, &corners, (32, 32), false, true);
 }
@@ -153,7 +153,7 @@ fn walks_match_the_twin(
     some_blocked: bool,
     last_octant: bool,
 ) {
-    use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
+    use gpgpu_rt::accel::bvh::BvhTree as CpuBvh;
     use gpgpu_rt::reference::{closest_among, Feeler};
     use std::ops::ControlFlow;
     let frame = render_gpu(ctx, scene, bvh_options(w, h, 0));
@@ -182,7 +182,7 @@ fn walks_match_the_twin(
     let (mut nodes, mut tests) = (0u64, 0u64);
     for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
         let (ro, rd) = ray(x, y).unwrap();
-        let entry = entries[gpgpu_rt::reference::bvh::block_of(w, x, y)];
+        let entry = entries[gpgpu_rt::accel::bvh::block_of(w, x, y)];
         let mut best = None;
         nodes += twin.traverse_from(entry.as_ref(), ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
@@ -235,7 +235,7 @@ fn walks_match_the_twin(
 /// its float box, for every node of the bunny's hierarchy.
 #[test]
 fn the_grid_boxes_hold_every_triangle_of_their_subtree() {
-    use gpgpu_rt::reference::bvh::Bvh as CpuBvh;
+    use gpgpu_rt::accel::bvh::BvhTree as CpuBvh;
     let scene = load("bunny.toml");
     let bvh = CpuBvh::new(scene.world_triangles());
     let g = bvh.grid;

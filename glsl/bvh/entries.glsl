@@ -1,9 +1,9 @@
 // The entry point of each 8×8 block of intersect1's rays — ours (Reshetov, Soupikov and Hurley
 // 2005; bvh/entry.comp finds and writes them, bvh/intersect1.comp reads them): a texel per
-// block, (octant + 1, first record, end, 0), in the last BVH_ENTRY_TEXELS texels of the word
-// buffer (bvh/words.glsl; the host appends them, zeros, to Bvh::gpu_words), the blocks of the
-// image row by row as the CPU twin's Bvh::block_entries and block_of number them
-// (src/reference/bvh/entry.rs).
+// block, an EntryTexel (src/accel/bvh/layout.rs: octant_plus_one, node, end, zero), in the last
+// BVH_ENTRY_TEXELS texels of the word buffer (bvh/words.glsl; the host appends them, zeros, to
+// BvhTree::gpu_words), the blocks of the image row by row as block_of (src/accel/bvh/layout.rs) and the CPU twin's
+// BvhTree::block_entries (src/reference/bvh/entry.rs) number them.
 //
 // In the word buffer rather than an image of their own (ours): the BVH's kernels bind the
 // pipeline's ray-state images at units 0–6 and the word buffer at 7, the 8 image units GL 4.5

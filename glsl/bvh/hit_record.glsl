@@ -1,7 +1,8 @@
-// The SAH BVH's hit record (ours; common/records.glsl): intersect1 stores the word address of
-// the closest hit's leaf triangle in the BVH's buffer (−1: no hit), one word per pixel instead
+// The SAH BVH's hit record (ours; bvh/records.glsl): intersect1 stores the word address of
+// the closest hit's LeafTriangle in the BVH's buffer (−1: no hit; PixelRecord.hit in
+// src/pipeline/mueller2015/records.rs), one word per pixel instead
 // of (t, triangle id, u, v) — on llvmpipe each stored component is a loop over the 8 lanes —
-// and common/evaluate_hit.comp finds the hit again here: the same Algorithm 1 (intersectEdges of
+// and bvh/evaluate_hit.comp finds the hit again here: the same Algorithm 1 (intersectEdges of
 // common/intersect.glsl) on the same ray and the same words as the walk's triangleHit, so the
 // same t, u and v.
 #include "words.glsl"

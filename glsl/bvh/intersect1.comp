@@ -3,19 +3,19 @@
 // by an ordered traversal of the CPU-built BVH (bvh/traverse.glsl), from its block's entry
 // point (bvh/entry.comp, ours: Reshetov et al. 2005). Deviations: see there;
 // equal distances go to the lower triangle id, as in the base tracer's loop, so the image
-// equals the base tracer's. Listings 13, 14 of Müller 2015: common/intersect1_main.glsl.
+// equals the base tracer's. Listings 13, 14 of Müller 2015: bvh/evaluate_hit.comp
+// (bvh/intersect1_main.glsl).
 #if RECORD_STORE_64
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
+// the work counts stored per pixel (storePixelRecord), not added to the counters
+#define PIXEL_RECORDS
 #include "../common/intersect_head.glsl"
+#include "records.glsl"
 #include "traverse.glsl"
 
 // the entry point of each 8×8 block of rays (bvh/entry.comp, run before this kernel)
 #include "entries.glsl"
-
-#if !HIT_RECORDS
-#error "the BVH's intersect1 stores hit records (bvh/hit_record.glsl): it keeps no u, v"
-#endif
 
 // the ray and its closest hit so far, for triangleHit: its distance, triangle id and the word
 // address of its leaf triangle (the hit record; u and v are found again from it)
@@ -50,4 +50,4 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
     closestHitRecord = bestAt;
 }
 
-#include "../common/intersect1_main.glsl"
+#include "intersect1_main.glsl"

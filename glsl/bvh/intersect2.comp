@@ -7,7 +7,10 @@
 #if RECORD_STORE_64
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
+// the work counts stored per pixel (storePixelRecord), not added to the counters
+#define PIXEL_RECORDS
 #include "../common/intersect_head.glsl"
+#include "records.glsl"
 #include "traverse.glsl"
 
 // the feeler, for triangleHit

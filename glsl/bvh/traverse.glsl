@@ -1,26 +1,28 @@
 // BVH traversal shared by glsl/bvh/intersect1.comp and intersect2.comp — ours, after Wagner
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
-// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (Bvh::traverse), same order and counts.
+// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (BvhTree::traverse), same order and counts.
 //
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), read as RGBA32UI texels of 4 words
-// (Bvh::gpu_words in src/reference/bvh/mod.rs):
-//   a header of 8 words (BVH_HEADER_WORDS): the node count N, the grid's origin x, y, z, its
-//             steps x, y, z, 0 (plane q of axis a lies at origin[a] + q·step[a]);
+// (BvhTree::gpu_words; the types, field by field, in src/accel/bvh/layout.rs):
+//   Header, 8 words (BVH_HEADER_WORDS): node_count N, grid_origin x, y, z, grid_step x, y, z,
+//             zero (plane q of axis a lies at grid_origin[a] + q·grid_step[a]);
 //   for each ray octant o (bit a set: the ray points down axis a) a copy of the N nodes in
 //             that octant's depth-first order (the near child of every split first), one
-//             texel each (BVH_NODE_WORDS), octant o's from texel 2 + o·N on: the box as the
-//             planes where rays of the octant enter its slabs (near.xyz) and leave them
-//             (far.xyz), 16-bit step counts on the grid —
-//             near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth
-//             word: in an inner node its miss link (the texel of the record where a ray goes
-//             on when it misses the node; 2 + o·N + N: the walk is over), in a leaf
-//             −1 − (s·32 + count), its triangles from entry s of the leaf triangles on. An inner
-//             node's near child is the next record, its far child the near child's miss link,
-//             and a leaf's miss link is the next record;
-//   then per leaf triangle 12 words (BVH_TRIANGLE_WORDS): v0, triangle id, edge1, 0, edge2, 0.
+//             NodeRecord each, one texel (BVH_NODE_WORDS), octant o's from texel 2 + o·N on:
+//             the box as the planes where rays of the octant enter its slabs (near) and leave
+//             them (far), 16-bit step counts on the grid — words near.x | near.y << 16,
+//             near.z | far.x << 16, far.y | far.z << 16 — and `reference`: in an inner node its
+//             miss link (the texel of the record where a ray goes on when it misses the node;
+//             2 + o·N + N: the walk is over), in a leaf −1 − (s·32 + count), its triangles from
+//             entry s of the leaf triangles on. An inner node's near child is the next record,
+//             its far child the near child's miss link, and a leaf's miss link is the next
+//             record;
+//   then a LeafTriangle per leaf entry, 12 words (BVH_TRIANGLE_WORDS): v0, id, edge1, zero1,
+//             edge2, zero2;
+//   then an EntryTexel per block of the image (bvh/entries.glsl).
 // (BVH_HEADER_WORDS, BVH_NODE_WORDS, BVH_TRIANGLE_WORDS, BVH_LEAF_COUNT_BITS: #defines of the
-// host, src/accel/bvh.rs. The header is two texels, not uniforms: llvmpipe's uniform loads
+// host, src/accel/bvh/mod.rs. The Header is two texels, not uniforms: llvmpipe's uniform loads
 // cost more than texel loads, docs/design/bvh.md, step 23.) A node step reads one texel, a triangle
 // three (on llvmpipe each eight 128-bit loads, a transpose and a bounds check, where a 32-bit
 // word costs a gather with its bounds check). Ours: the copies per octant (twice the memory of
@@ -86,7 +88,7 @@ int triangleBase = 0;
 // twin's node counts with it, not the hits). In world units its rounding error is about 2^-23
 // of the root's extent plus the ray origin's distance from the grid — where (plane − ro)·inv
 // errs by 2^-24 of the distance to the plane — and the boxes' padding of 1e-5 of the scene's
-// extent (src/reference/bvh/build.rs) covers it for origins within some 80 extents of the scene
+// extent (src/accel/bvh/build.rs) covers it for origins within some 80 extents of the scene
 // (docs/design/bvh.md, step 23).
 //
 // Ours: the largest entry and the smallest exit distance by integer max and min of the floats'
@@ -94,7 +96,7 @@ int triangleBase = 0;
 // one. For t >= +0 the bits are in the order of the floats; the entry distance is at least
 // tMin >= +0, and where an exit distance is negative so is the smallest of the bits: the box is
 // missed either way (an exit at exactly −0.0 too: a box the ray leaves at its origin). No
-// distance is NaN (safeInverse, and gridA and gridB clamped finite). The CPU twin (Bvh::enter,
+// distance is NaN (safeInverse, and gridA and gridB clamped finite). The CPU twin (BvhTree::enter,
 // RayGrid::t) computes the same bits.
 bool boxEntered(uvec4 record, vec3 gridA, vec3 gridB, float tMin, float limit)
 {

@@ -1,5 +1,5 @@
 // The SAH BVH's word buffer — ours, after Wagner 2018's three textures of Fig. 4.3 (ch. 4.2)
-// in one buffer (Bvh::gpu_words in src/reference/bvh/mod.rs; its layout: bvh/traverse.glsl),
+// in one buffer (BvhTree::gpu_words in src/accel/bvh/layout.rs; its layout: bvh/traverse.glsl),
 // read as RGBA32UI texels of 4 words, for bvh/traverse.glsl and bvh/hit_record.glsl.
 // (bvh/entry.comp defines BVH_WORDS_WRITABLE: it writes the blocks' entries, bvh/entries.glsl)
 #ifdef BVH_WORDS_WRITABLE
@@ -16,8 +16,9 @@ uvec4 bvhRecord(int texel) { return imageLoad(bvh, int(uint(texel) & BVH_TEXEL_I
 // The texel at word address `at` (a multiple of 4: the header, a leaf triangle).
 uvec4 bvhTexel(int at) { return bvhRecord(int(uint(at) >> 2u)); }
 
-// A node record's box: the planes where rays of its octant enter the slabs (near) and leave them
-// (far), 16-bit step counts on the grid (bvh/traverse.glsl).
+// A node record's box (NodeRecord in src/accel/bvh/layout.rs: near, far): the planes where rays
+// of its octant enter the slabs (near) and leave them (far), 16-bit step counts on the grid
+// (bvh/traverse.glsl).
 void recordPlanes(uvec4 record, out vec3 near, out vec3 far)
 {
     near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));

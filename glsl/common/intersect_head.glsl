@@ -10,9 +10,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "images.glsl"
 #include "intersect.glsl"
 #include "counters.glsl"
-#if HIT_RECORDS || PIXEL_COUNTS
-#include "records.glsl"
-#endif
 
 uint tests = 0u;         // ray–triangle tests of this invocation
 uint truncated = 0u;     // 1 if a loop of this invocation ended early (see loopLimit)
@@ -33,37 +30,23 @@ uint raysTraced = 0u;    // 1 if this invocation traced its pixel's ray (ours: r
 // base tracer's intersect1: brute_force/intersect1.comp itself).
 void trace(ivec2 storePos);
 
+// Ours: a design whose intersection kernels store their work counts per pixel instead (the SAH
+// BVH: bvh/records.glsl, for bvh/pixel_counts.comp to add up) defines PIXEL_RECORDS before
+// including this file and storePixelRecord after it.
+#ifdef PIXEL_RECORDS
+void storePixelRecord(ivec2 storePos, int testsSlot);
+#endif
+
 // main() of every intersection kernel: trace this invocation's pixel, then add its work counts
 // to the 64-bit counters — its triangle tests to `testsSlot` (COUNTER_INTERSECT1 or 2) — or,
-// with PIXEL_COUNTS, store them for common/pixel_counts.comp (the other counts stay 0 there:
-// the designs that store per-pixel counts neither walk voxels nor jump clouds).
+// with PIXEL_RECORDS, store them.
 void traceAndCount(int testsSlot)
 {
-#if PIXEL_COUNTS
+#ifdef PIXEL_RECORDS
     ivec2 storePos = pixelPosition();
     if (insideImage(storePos)) {
         trace(storePos);
-        uvec2 counts = packCounts(tests, nodesVisited, truncated, raysTraced);
-        int at = pixelIndex(storePos);
-#if HIT_RECORDS
-        // (a constant condition: one of the two stores is compiled)
-        if (testsSlot == COUNTER_INTERSECT1) {
-#if RECORD_STORE_64
-            uint64_t record = uint64_t(uint(closestHitRecord));
-            pixelRecordWords[at] = u64vec2(packUint2x32(counts), record);
-#else
-            pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
-#endif
-        } else {
-#if RECORD_STORE_64
-            pixelRecordWords[at].x = packUint2x32(counts);
-#else
-            pixelRecord[at].xy = counts;
-#endif
-        }
-#else
-        pixelRecord[at].xy = counts;
-#endif
+        storePixelRecord(storePos, testsSlot);
     }
 #else
     countersBegin();

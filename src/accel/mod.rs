@@ -38,7 +38,7 @@ use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::reference::CpuAccelerator;
 use crate::scene::Scene;
 
-/// Pixels each invocation of `glsl/common/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
+/// Pixels each invocation of `glsl/bvh/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
 /// a #define of `pipeline::mueller2015::records`), for the accelerators whose kernels store
 /// per-pixel counts ([`Accelerator::records`]).
 pub const PIXELS_PER_INVOCATION: u32 = 16;
@@ -61,7 +61,7 @@ pub trait Accelerator {
     /// Add the design's facts (sizes, build time, settings) and events to the statistics.
     fn stats(&self, stats: &mut FrameStats);
     /// Whether the design's intersect1 stores hit records and its intersection kernels store
-    /// per-pixel counts (`HIT_RECORDS`, `PIXEL_COUNTS`: `glsl/common/records.glsl`), for the
+    /// per-pixel counts (`glsl/bvh/records.glsl`), for the
     /// pipeline to evaluate the hits and add the counts after them
     /// (`pipeline::mueller2015::records`). The thesis' designs evaluate and count in the kernel.
     fn records(&self) -> bool {

@@ -53,7 +53,7 @@ slot_table! {
         DIST_IN = 18,
         DIST_OUT = 19,
         /// Müller's pipeline, for the designs that keep the closest-hit search apart from the
-        /// hit's evaluation and count per pixel (glsl/common/records.glsl): per pixel its work
+        /// hit's evaluation and count per pixel (glsl/bvh/records.glsl): per pixel its work
         /// counts and hit record
         PIXEL_RECORDS = 21,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)

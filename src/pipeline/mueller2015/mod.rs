@@ -98,9 +98,8 @@ pub const COUNTERS: &[&str] = &[
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
 /// `#define`s every kernel gets: counter slots, the shadow-flag layout, the scene's triangle
-/// count (`glsl/common/scene.glsl`'s `triangleCount()`); the SAH BVH's kernels
-/// override the last three (`accel::bvh`: hit records, 64-bit record stores, the next work
-/// group's rays loaded ahead on llvmpipe).
+/// count (`glsl/common/scene.glsl`'s `triangleCount()`), the image size. (The SAH BVH's
+/// switches are its own: `accel::bvh`.)
 pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
     let mut d = Defines::new()
         .set(
@@ -111,13 +110,9 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
             "SHADOW_OFFSET",
             format!("{:?}", scene.settings.shadow_offset),
         )
-        // the image size (common/records.glsl); the designs that use records set these to 1
+        // the image size (bvh/records.glsl)
         .set("IMAGE_WIDTH", options.width)
         .set("IMAGE_HEIGHT", options.height)
-        .set("HIT_RECORDS", 0)
-        .set("PIXEL_COUNTS", 0)
-        .set("RECORD_STORE_64", 0)
-        .set("PREFETCH_RAYS", 0)
         .set("SCENE_TRIANGLES", scene.triangle_count());
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);

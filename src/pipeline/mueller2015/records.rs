@@ -1,20 +1,40 @@
-//! Hit records and per-pixel counts (ours, `glsl/common/records.glsl`): for an accelerator
+//! Hit records and per-pixel counts (ours, `glsl/bvh/records.glsl`): for an accelerator
 //! whose intersect1 only stores the closest hit of each pixel and whose intersection kernels
 //! store their work counts per pixel ([`crate::accel::Accelerator::records`], the SAH BVH).
-//! After its intersect1 the pipeline evaluates the hits (`glsl/common/evaluate_hit.comp`:
+//! After its intersect1 the pipeline evaluates the hits (`glsl/bvh/evaluate_hit.comp`:
 //! Listings 13 and 14, which the thesis runs inside intersect1) and after each intersection
-//! dispatch adds the counts to the 64-bit counters (`glsl/common/pixel_counts.comp`), both under
+//! dispatch adds the counts to the 64-bit counters (`glsl/bvh/pixel_counts.comp`), both under
 //! the same counter bank and ray kind. So `gpu_ms.intersect1` is the closest-hit search alone,
 //! as a ray-tracing kernel like Embree's `rtcIntersect1` measures it, and `evaluate_hit`,
 //! `pixel_counts` are timed apart.
 
 use anyhow::Result;
+use bytemuck::{Pod, Zeroable};
 
 use super::COUNTERS;
 use crate::accel::PIXELS_PER_INVOCATION;
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+
+/// One pixel's record (`pixelRecord` in `glsl/bvh/records.glsl`, a uvec4): 16 bytes, which the
+/// intersection kernels write (`packCounts`; intersect1 the hit record too) and `evaluate_hit`,
+/// `pixel_counts` read; the host only allocates them.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct PixelRecord {
+    /// bytes 0–3: the ray–triangle tests (bits 0–30) and whether a loop of the pixel's walk was
+    /// cut short (bit 31)
+    pub tests_truncated: u32,
+    /// bytes 4–7: the nodes visited (bits 0–30) and whether the pixel's ray was traced (bit 31)
+    pub nodes_traced: u32,
+    /// bytes 8–11 (intersect1 only): the hit record, the word address of the closest hit's
+    /// [`LeafTriangle`](crate::accel::bvh::LeafTriangle) in the BVH's word buffer (−1: no hit)
+    pub hit: i32,
+    /// bytes 12–15: unused
+    pub unused: u32,
+}
+const _: () = assert!(std::mem::size_of::<PixelRecord>() == 16);
 
 /// The work group size of `pixel_counts.comp` (its `COUNT_GROUP`).
 const COUNT_GROUP: u32 = 64;
@@ -47,13 +67,20 @@ impl Records {
             .clone()
             .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
             .set("COUNT_GROUP", COUNT_GROUP)
+            // 32-bit stores only: these two kernels do not enable 64-bit integers
+            .set("RECORD_STORE_64", 0)
             .set(mask, mask_value);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
-            // a uvec4 per pixel: two words of counts, the hit record (records.glsl)
-            records: Ssbo::new(gl, "pixel records", 16 * pixels, None, max)?,
-            evaluate_hit: compute("common/evaluate_hit.comp", "evaluate_hit")?,
-            pixel_counts: compute("common/pixel_counts.comp", "pixel_counts")?,
+            records: Ssbo::new(
+                gl,
+                "pixel records",
+                std::mem::size_of::<PixelRecord>() * pixels,
+                None,
+                max,
+            )?,
+            evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
+            pixel_counts: compute("bvh/pixel_counts.comp", "pixel_counts")?,
             pixels: w * h,
         })
     }

@@ -17,10 +17,8 @@
 
 use glam::Vec3;
 
-use super::{octant, octant_planes, safe_divisor, Bvh, END, OCTANTS};
-
-/// Pixels per side of a block: intersect1's work groups (`PIXEL_GROUP`).
-pub const BLOCK: u32 = 8;
+use super::{octant, safe_divisor};
+use crate::accel::bvh::{octant_planes, BvhTree, BLOCK, END, GRID_STEPS, OCTANTS};
 
 /// The rays of a block (all of one octant), bounded per axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,15 +60,15 @@ impl RayBounds {
     ///
     /// The margin, per axis, in world units: 4 grid steps and 2^-18 of the magnitudes of the
     /// grid's extent, its origin and the rays' origins, in distance at the bounds' largest
-    /// |1/d|. A ray's own test (`boxEntered`, [`RayGrid::t`](super::RayGrid::t)) and these bounds
+    /// |1/d|. A ray's own test (`boxEntered`, [`RayGrid::t`](crate::accel::bvh::RayGrid::t)) and these bounds
     /// each err by a few roundings of those magnitudes (about 2^-22 of them), so a box refused
     /// here is refused by the test of every ray of the bounds too; and being more than a step
     /// away from the box, no ray hits a triangle in it (the boxes hold their triangles).
-    pub fn may_enter(&self, bvh: &Bvh, planes: [[u16; 3]; 2]) -> bool {
+    pub fn may_enter(&self, bvh: &BvhTree, planes: [[u16; 3]; 2]) -> bool {
         let g = &bvh.grid;
         let q = |p: [u16; 3]| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
         let ro_size = self.ro_lo.abs().max(self.ro_hi.abs());
-        let scale = g.origin.abs() + g.step * super::GRID_STEPS as f32 + ro_size;
+        let scale = g.origin.abs() + g.step * GRID_STEPS as f32 + ro_size;
         let margin =
             (g.step * 4.0 + scale * (-18f32).exp2()) * self.inv_lo.abs().max(self.inv_hi.abs());
         // the distances to the planes at world coordinates w, bounded over the rays
@@ -104,7 +102,7 @@ pub struct BlockEntry {
     pub stop: i32,
 }
 
-impl Bvh {
+impl BvhTree {
     /// The entry point of rays bounded by `bounds`, as `glsl/bvh/entry.comp` finds it.
     pub fn block_entry(&self, bounds: &RayBounds) -> BlockEntry {
         let o = bounds.octant;
@@ -137,8 +135,9 @@ impl Bvh {
     }
 
     /// The entry point of every block of a `width`×`height` image, blocks row by row from the
-    /// low corner (GL's order: [`block_of`]), each from the rays `ray(x, y)` of its active pixels (`None`:
-    /// no ray); `None` for a block without a ray or with rays of more than one octant.
+    /// low corner (GL's order: [`block_of`](crate::accel::bvh::block_of)), each from the rays
+    /// `ray(x, y)` of its active pixels (`None`: no ray); `None` for a block without a ray or with
+    /// rays of more than one octant.
     pub fn block_entries(
         &self,
         (width, height): (u32, u32),
@@ -156,13 +155,6 @@ impl Bvh {
             })
             .collect()
     }
-}
-
-/// The index of the block of pixel (x, y) (GL's order, rows from the bottom) among the blocks
-/// of an image `width` pixels wide, as [`Bvh::block_entries`] lists them and intersect1 reads
-/// them (`storePos >> 3`).
-pub fn block_of(width: u32, x: u32, y: u32) -> usize {
-    ((y / BLOCK) * width.div_ceil(BLOCK) + x / BLOCK) as usize
 }
 
 /// Where a ray of `octant` walks from, and where it stops: `entry`'s node and stop if it is of
@@ -183,7 +175,7 @@ mod tests {
 
     /// The closest hit (id, t) of a walk from `entry`, and the nodes it visited.
     fn walk(
-        bvh: &Bvh,
+        bvh: &BvhTree,
         entry: Option<&BlockEntry>,
         (ro, rd): (Vec3, Vec3),
     ) -> (Option<(usize, f32)>, u64) {
@@ -200,7 +192,7 @@ mod tests {
     /// never more nodes. Returns the nodes visited both ways, the empty entries and the blocks
     /// without an entry (rays of more than one octant).
     fn check(
-        bvh: &Bvh,
+        bvh: &BvhTree,
         size: (u32, u32),
         ray: impl Fn(u32, u32) -> Option<(Vec3, Vec3)>,
     ) -> [u64; 4] {
@@ -241,7 +233,7 @@ mod tests {
 
     #[test]
     fn block_entries_keep_every_hit_and_skip_nodes() {
-        let bvh = Bvh::new(crate::reference::bvh::tests::soup());
+        let bvh = BvhTree::new(crate::accel::bvh::layout::tests::soup());
         // the soup fills [0, 10.3]³: a camera in front of it, its image's edges beside it, and
         // the rays' x and y turning sign at the image's middle (blocks of two octants there)
         let size = (52, 36);

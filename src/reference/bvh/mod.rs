@@ -1,26 +1,8 @@
-//! The SAH bounding volume hierarchy — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
-//! top-down, each node split where the simplified SAH of eq. 4.1 (half surface area times
-//! triangle count, summed over both children) is lowest, a leaf when it holds at most
-//! [`LEAF_SIZE`] triangles or no split beats the node's own SAH (Listings 4.3, 4.4). Where
-//! Wagner tries split distances one after another, we evaluate [`BINS`] bins per axis (binned
-//! SAH, Wald 2007, his [13]) and build the two children in parallel (rayon) above
-//! [`PARALLEL_BUILD`] triangles.
+//! The CPU twin of the SAH BVH's kernels (`glsl/bvh/`; the tree, its build and its GPU layout:
+//! [`crate::accel::bvh`]): the same walks in exactly the same order with the same counts, and the
+//! block entry points of `glsl/bvh/entry.comp` ([`entry`]).
 //!
-//! Layout for upload — after Wagner's three textures of Fig. 4.3, as one buffer of 32-bit
-//! words read as texels of four ([`Bvh::gpu_words`]):
-//! - a header: the node count and the grid of the records' planes ([`Grid`], over the root's
-//!   box);
-//! - for each of the 8 ray octants a copy of the nodes in that octant's depth-first order (the
-//!   near child of every split first), one 16-byte record each: the box as its near and far
-//!   planes for rays of that octant, 16-bit step counts on the grid ([`Bvh::planes`]), and in
-//!   an inner node its miss link for that octant (the record to go on with when the node is
-//!   missed), in a leaf the place and count of its triangles — an inner node's near child is
-//!   the record after it, its far child the near child's miss link, a leaf's miss link the
-//!   record after it;
-//! - after the records, per entry of [`Bvh::tris`] (the triangle ids per leaf) the triangle as
-//!   v0 and its id, edge1, edge2 (12 words).
-//!
-//! Traversal (the kernels in `glsl/bvh/traverse.glsl`, and [`Bvh::traverse`] here, their CPU
+//! Traversal (the kernels in `glsl/bvh/traverse.glsl`, and [`BvhTree::traverse`] here, their CPU
 //! twin, in exactly the same order with the same counts): stackless. A ray walks the nodes in
 //! depth-first order, taking at every inner node first the child on the near side of the split
 //! plane (the left unless the ray points down the split axis), and skipping a subtree by its
@@ -32,269 +14,15 @@
 
 use std::ops::ControlFlow;
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use super::{closest_among, CpuAccelerator, Feeler, Hit};
-pub use crate::accel::aabb::Aabb;
+use crate::accel::bvh::{octant_planes, BvhTree, RayGrid, OCTANTS};
 
-mod build;
 mod entry;
-mod planes;
-pub use entry::{block_of, BlockEntry, RayBounds, BLOCK};
-pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
+pub use entry::{BlockEntry, RayBounds};
 
-/// Bins per axis of the binned SAH.
-pub const BINS: usize = 16;
-/// Wagner's leaf size: a node of at most this many triangles is a leaf.
-pub const LEAF_SIZE: usize = 4;
-/// A node of more triangles is split even when the SAH says a split does not pay.
-pub const MAX_LEAF: usize = 16;
-/// Below this depth the SAH chooses the split; deeper, the triangles are halved (by centroid
-/// order on the widest axis), which bounds the depth by this plus log2(triangles).
-pub const SAH_DEPTH: u32 = 40;
-/// The deepest tree the build makes: [`SAH_DEPTH`] plus the halving below it.
-pub const MAX_DEPTH: u32 = SAH_DEPTH + 32;
-/// The miss link after the last node of a walk.
-pub const END: i32 = -1;
-/// Ray octants: bit a is set when the ray points down axis a.
-pub const OCTANTS: usize = 8;
-/// Subtrees of more triangles build their two children in parallel.
-pub const PARALLEL_BUILD: usize = 4096;
-
-/// One node: its bounds and integers (in [`Bvh::gpu_words`] as one record per octant).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct Node {
-    pub lo: [f32; 3],
-    /// Inner node: the left child (the right is `first + 1`); leaf: the first of its
-    /// triangles in [`Bvh::tris`].
-    pub first: u32,
-    pub hi: [f32; 3],
-    /// Leaf: the number of its triangles (> 0); inner node: −1 − the split axis.
-    pub meta: i32,
-}
-
-impl Node {
-    pub fn is_leaf(&self) -> bool {
-        self.meta > 0
-    }
-
-    /// A leaf's triangle count (0 for an inner node).
-    pub fn count(&self) -> u32 {
-        self.meta.max(0) as u32
-    }
-
-    /// An inner node's split axis: its left child lies on the low side.
-    pub fn axis(&self) -> usize {
-        (-1 - self.meta).clamp(0, 2) as usize
-    }
-
-    /// An inner node's near child for rays of `octant` (bit a set: the ray points down axis
-    /// a): the left one, on the low side of the split, unless the ray points down the axis.
-    pub fn near_child(&self, octant: usize) -> u32 {
-        self.first + ((octant >> self.axis()) & 1) as u32
-    }
-
-    /// The other child of an inner node for rays of `octant`.
-    pub fn far_child(&self, octant: usize) -> u32 {
-        2 * self.first + 1 - self.near_child(octant)
-    }
-}
-
-/// The facts of a build, for the statistics.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct BvhStats {
-    pub nodes: usize,
-    pub leaves: usize,
-    /// The deepest leaf (root: 0).
-    pub depth: u32,
-    /// SAH cost relative to the root: Σ inner A(n)/A(root) + Σ leaves A(l)/A(root)·N(l)
-    /// (A: surface area; one unit per node traversal and per triangle test).
-    pub sah_cost: f64,
-    /// Bytes as uploaded ([`Bvh::gpu_words`]).
-    pub bytes: usize,
-    pub build_ms: f64,
-}
-
-/// The hierarchy over a list of triangles, and the CPU twin of its kernels.
-pub struct Bvh {
-    triangles: Vec<[Vec3; 3]>,
-    pub nodes: Vec<Node>,
-    /// Miss links: `links[OCTANTS * n + octant]` is where a ray of that octant goes on after
-    /// node n ([`END`]: nowhere).
-    pub links: Vec<i32>,
-    /// Triangle ids in leaf order.
-    pub tris: Vec<u32>,
-    /// The grid over the root's box on which the records store the boxes.
-    pub grid: Grid,
-    /// Every node's box on the grid, as the kernels and [`Bvh::traverse`] test it.
-    pub planes: Vec<Planes>,
-    pub stats: BvhStats,
-}
-
-/// Words of the header of [`Bvh::gpu_words`]: the node count and the grid's origin x, y, z; the
-/// grid's steps x, y, z and 0.
-pub const HEADER_WORDS: usize = 8;
-/// Words of one node record of one octant in [`Bvh::gpu_words`]: one texel.
-pub const NODE_WORDS: usize = 4;
-/// Words of one leaf triangle in [`Bvh::gpu_words`].
-pub const TRIANGLE_WORDS: usize = 12;
-/// Bits of a leaf record's triangle count in its reference word ([`Bvh::gpu_words`]).
-pub const LEAF_COUNT_BITS: u32 = 5;
-const _: () = assert!(
-    MAX_LEAF < 1 << LEAF_COUNT_BITS,
-    "a leaf's count fits its bits"
-);
-
-impl Bvh {
-    /// Build the hierarchy over `triangles` (triangle id = index).
-    pub fn new(triangles: Vec<[Vec3; 3]>) -> Bvh {
-        let start = std::time::Instant::now();
-        let (tree, ids) = build::build(&triangles);
-        let mut nodes = vec![Node::zeroed()];
-        build::layout(&tree, 0, &mut nodes);
-        let links = miss_links(&nodes);
-        let grid = Grid::over(&Aabb {
-            lo: nodes[0].lo.into(),
-            hi: nodes[0].hi.into(),
-        });
-        let planes = {
-            use rayon::prelude::*;
-            nodes.par_iter().map(|n| grid.planes(n)).collect()
-        };
-        let mut stats = BvhStats {
-            nodes: nodes.len(),
-            leaves: nodes.iter().filter(|n| n.is_leaf()).count(),
-            bytes: 4 * (triangle_base(nodes.len()) + TRIANGLE_WORDS * ids.len()),
-            ..BvhStats::default()
-        };
-        build::measure(&tree, 0, tree.bounds().half_area() as f64, &mut stats);
-        stats.build_ms = start.elapsed().as_secs_f64() * 1e3;
-        Bvh {
-            triangles,
-            nodes,
-            links,
-            tris: ids,
-            grid,
-            planes,
-            stats,
-        }
-    }
-
-    /// The hierarchy as uploaded: one buffer of 32-bit words (the floats as bits) read as
-    /// texels of 4 words (`glsl/bvh/traverse.glsl`):
-    /// - [`HEADER_WORDS`]: the node count N, the grid's origin x, y, z, its steps x, y, z, 0;
-    /// - for each octant o = 0..8, from texel [`Bvh::root_texel`] on, the N nodes in the
-    ///   depth-first order of that octant (the order of [`Bvh::links`]: the near child of every
-    ///   split first), one texel each ([`NODE_WORDS`]): the near planes x, y, z (for each axis
-    ///   the box's low plane, or its high plane where rays of the octant point down the axis)
-    ///   and the far planes x, y, z, as the 16-bit step counts of [`Bvh::planes`] —
-    ///   near.x | near.y << 16, near.z | far.x << 16, far.y | far.z << 16 — and a fourth word:
-    ///   of an inner node its miss link (the texel of the record of `links[OCTANTS·n + o]`;
-    ///   [`END`]: the texel after the octant's last record), of a leaf −1 −
-    ///   (s·2^[`LEAF_COUNT_BITS`] + count) with s its first entry in [`Bvh::tris`]. An inner
-    ///   node's near child is the next record; a leaf's miss link is always the next record
-    ///   (the octant's depth-first order goes on there after a subtree of one);
-    /// - from word [`Bvh::triangle_base`] on, per entry of [`Bvh::tris`] [`TRIANGLE_WORDS`]:
-    ///   v0 and the triangle id, edge1 = v1 − v0 and 0, edge2 = v2 − v0 and 0 — the differences
-    ///   Algorithm 1 forms first.
-    ///
-    /// (s < 2^26 always: `TextureBuffer::new` refuses a buffer of 2^31 bytes, and each entry
-    /// takes 48.)
-    pub fn gpu_words(&self) -> Vec<u32> {
-        use rayon::prelude::*;
-        let n = self.nodes.len();
-        let records = OCTANTS * NODE_WORDS * n;
-        let mut out = vec![0u32; self.stats.bytes / 4];
-        let (head, rest) = out.split_at_mut(HEADER_WORDS);
-        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-        head[0] = n as u32;
-        head[1..4].copy_from_slice(&bits(self.grid.origin));
-        head[4..7].copy_from_slice(&bits(self.grid.step));
-        let (octants, triangles) = rest.split_at_mut(records);
-        octants
-            .par_chunks_mut(NODE_WORDS * n)
-            .enumerate()
-            .for_each(|(o, w)| self.octant_records(o, w));
-        triangles
-            .par_chunks_mut(TRIANGLE_WORDS)
-            .zip(self.tris.par_iter())
-            .for_each(|(w, &id)| {
-                let [v0, v1, v2] = self.triangles[id as usize];
-                w[0..3].copy_from_slice(&bits(v0));
-                w[3] = id;
-                w[4..7].copy_from_slice(&bits(v1 - v0));
-                w[8..11].copy_from_slice(&bits(v2 - v0));
-            });
-        out
-    }
-
-    /// The nodes in the depth-first order of octant `o` (its records' order in
-    /// [`Bvh::gpu_words`]), from its miss links: after an inner node its near child, after a
-    /// leaf (a subtree of one) its miss link.
-    fn octant_order(&self, o: usize) -> Vec<u32> {
-        let mut order = Vec::with_capacity(self.nodes.len());
-        let mut k = 0i32;
-        while k != END {
-            order.push(k as u32);
-            let node = &self.nodes[k as usize];
-            k = match node.is_leaf() {
-                true => self.links[OCTANTS * k as usize + o],
-                false => node.near_child(o) as i32,
-            };
-        }
-        order
-    }
-
-    /// The texel of every node's record in octant `o`'s copy ([`Bvh::gpu_words`]), and after
-    /// them the texel after the copy (where [`END`] points).
-    pub fn record_texels(&self, o: usize) -> Vec<u32> {
-        self.texels_in_order(o, &self.octant_order(o))
-    }
-
-    /// [`Bvh::record_texels`] of octant `o`, whose order is `order`.
-    fn texels_in_order(&self, o: usize, order: &[u32]) -> Vec<u32> {
-        let base = self.root_texel(o);
-        let mut record = vec![0u32; self.nodes.len() + 1];
-        for (i, &k) in order.iter().enumerate() {
-            record[k as usize] = (base + i) as u32;
-        }
-        record[self.nodes.len()] = (base + self.nodes.len()) as u32;
-        record
-    }
-
-    /// The node records of octant `o` ([`Bvh::gpu_words`]) into `out`.
-    fn octant_records(&self, o: usize, out: &mut [u32]) {
-        let order = self.octant_order(o);
-        let record = self.texels_in_order(o, &order);
-        let end = record[self.nodes.len()];
-        for (w, &k) in out.chunks_exact_mut(NODE_WORDS).zip(&order) {
-            let node = &self.nodes[k as usize];
-            debug_assert!(node.first < 1 << (31 - LEAF_COUNT_BITS), "see gpu_words");
-            let [near, far] = octant_planes(&self.planes[k as usize], o).map(|p| p.map(u32::from));
-            w[0] = near[0] | near[1] << 16;
-            w[1] = near[2] | far[0] << 16;
-            w[2] = far[1] | far[2] << 16;
-            w[3] = match (node.is_leaf(), self.links[OCTANTS * k as usize + o]) {
-                (true, _) => (-1 - ((node.first << LEAF_COUNT_BITS | node.count()) as i32)) as u32,
-                (false, END) => end,
-                (false, l) => record[l as usize],
-            };
-        }
-    }
-
-    /// The texel index of the root's record in octant `o`'s copy of the nodes
-    /// ([`Bvh::gpu_words`]).
-    pub fn root_texel(&self, o: usize) -> usize {
-        (HEADER_WORDS + o * self.nodes.len() * NODE_WORDS) / 4
-    }
-
-    /// The word address of the first leaf triangle in [`Bvh::gpu_words`].
-    pub fn triangle_base(&self) -> usize {
-        triangle_base(self.nodes.len())
-    }
-
+impl BvhTree {
     /// The shadow feeler's walk, as intersect2's: whether it is blocked, its triangle tests and
     /// its nodes visited. No hit before the offset counts, so neither do the boxes the feeler
     /// leaves before it.
@@ -303,7 +31,7 @@ impl Bvh {
         let (ro, rd) = (feeler.ro, feeler.rd);
         let nodes = self.traverse(ro, rd, feeler.offset, feeler.light_distance, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
-            blocked = feeler.blocked_among(&self.triangles, ids, &mut tests);
+            blocked = feeler.blocked_among(self.triangles(), ids, &mut tests);
             if blocked {
                 ControlFlow::Break(())
             } else {
@@ -311,11 +39,6 @@ impl Bvh {
             }
         });
         (blocked, tests, nodes)
-    }
-
-    /// The triangles it was built over.
-    pub fn triangles(&self) -> &[[Vec3; 3]] {
-        &self.triangles
     }
 
     /// Walk the nodes along ro + t·rd for `t_min` ≤ t ≤ `limit`, as `glsl/bvh/traverse.glsl`: every
@@ -332,7 +55,7 @@ impl Bvh {
         self.traverse_from(None, ro, rd, t_min, limit, leaf)
     }
 
-    /// [`Bvh::traverse`] from a block's entry point ([`Bvh::block_entry`], intersect1's walk):
+    /// [`BvhTree::traverse`] from a block's entry point ([`BvhTree::block_entry`], intersect1's walk):
     /// a ray of the entry's octant walks the entry node's subtree only, others the whole tree.
     pub fn traverse_from(
         &self,
@@ -372,9 +95,9 @@ impl Bvh {
 
     /// Whether the ray (of `octant`, with the grid factors `ray`) enters node `n`'s box at some
     /// `t_min` ≤ t ≤ `limit` (the slab test of Wagner 2018, Listing 4.5), bit for bit as
-    /// `boxEntered` in the kernels: the box on the grid ([`Bvh::planes`]), each slab's near
+    /// `boxEntered` in the kernels: the box on the grid ([`BvhTree::planes`]), each slab's near
     /// plane its low bound, or its high bound where the ray points down the axis (as the records
-    /// of [`Bvh::gpu_words`] store them), its distance q·a + b rounded twice ([`RayGrid::t`]),
+    /// of [`BvhTree::gpu_words`] store them), its distance q·a + b rounded twice ([`RayGrid::t`]),
     /// and the largest entry and the smallest exit distance taken by integer max and min of the
     /// floats' bits. For t ≥ +0 the order of the bits is the order of the floats; the entry distance is
     /// at least `t_min` ≥ +0, and where an exit distance is negative so is the smallest of the
@@ -387,24 +110,6 @@ impl Bvh {
         let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
         t_near <= t_far
     }
-}
-
-/// The word address of the first leaf triangle in [`Bvh::gpu_words`] of `n` nodes: after the
-/// header and the octants' records.
-fn triangle_base(n: usize) -> usize {
-    HEADER_WORDS + OCTANTS * NODE_WORDS * n
-}
-
-/// A box's near and far planes (step counts x, y, z) for rays of `octant`: per axis the low
-/// plane is the near one, unless the rays point down the axis.
-fn octant_planes(q: &Planes, octant: usize) -> [[u16; 3]; 2] {
-    let (mut near, mut far) = ([q[0], q[1], q[2]], [q[3], q[4], q[5]]);
-    for a in 0..3 {
-        if (octant >> a) & 1 == 1 {
-            std::mem::swap(&mut near[a], &mut far[a]);
-        }
-    }
-    [near, far]
 }
 
 /// The ray's octant: bit a set when it points down axis a (by the sign of 1/rd, as the kernels).
@@ -424,30 +129,12 @@ fn safe_divisor(rd: Vec3) -> Vec3 {
     Vec3::new(s(rd.x), s(rd.y), s(rd.z))
 }
 
-/// The miss links of every node for every octant (`links[OCTANTS·n + o]`): the depth-first
-/// order of octant o (every node before its subtree, the near child's subtree before the far
-/// child's) continues after a node's subtree at its miss link, [`END`] after the last. The
-/// near child's miss link is the far child, the far child's its parent's — in one pass down
-/// the nodes, as [`build::layout`] places every node's children after it.
-fn miss_links(nodes: &[Node]) -> Vec<i32> {
-    let mut links = vec![END; OCTANTS * nodes.len()];
-    for (k, node) in nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
-        debug_assert!(node.first as usize > k, "children after their parent");
-        for o in 0..OCTANTS {
-            let (near, far) = (node.near_child(o) as usize, node.far_child(o) as usize);
-            links[OCTANTS * near + o] = far as i32;
-            links[OCTANTS * far + o] = links[OCTANTS * k + o];
-        }
-    }
-    links
-}
-
-impl CpuAccelerator for Bvh {
+impl CpuAccelerator for BvhTree {
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64) {
         let (mut best, mut tests): (Option<Hit>, u64) = (None, 0);
         self.traverse(ro, rd, 0.0, f32::INFINITY, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
-            closest_among(&mut best, &self.triangles, ids, (ro, rd, last), &mut tests);
+            closest_among(&mut best, self.triangles(), ids, (ro, rd, last), &mut tests);
             ControlFlow::Continue(best.map_or(f32::INFINITY, |b| b.t))
         });
         (best, tests)
@@ -462,186 +149,12 @@ impl CpuAccelerator for Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A small deterministic triangle soup: a jittered grid of triangles, a few duplicates
-    /// (equal centroids) and a long sliver.
-    pub(super) fn soup() -> Vec<[Vec3; 3]> {
-        let mut out = Vec::new();
-        let mut s = 12345u32;
-        let mut rnd = || {
-            s = s.wrapping_mul(1664525).wrapping_add(1013904223);
-            (s >> 8) as f32 / (1u32 << 24) as f32
-        };
-        for _ in 0..3000 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 10.0;
-            let e = 0.3;
-            out.push([
-                c,
-                c + Vec3::new(rnd() * e, rnd() * e, 0.0),
-                c + Vec3::new(0.0, rnd() * e, rnd() * e),
-            ]);
-        }
-        let dup = out[7];
-        out.extend(std::iter::repeat_n(dup, 40));
-        out.push([
-            Vec3::ZERO,
-            Vec3::new(10.0, 0.0, 0.0),
-            Vec3::new(10.0, 0.01, 0.0),
-        ]);
-        out
-    }
-
-    #[test]
-    fn every_triangle_in_exactly_one_leaf_and_bounds_nest() {
-        let tris = soup();
-        let bvh = Bvh::new(tris.clone());
-        let mut seen = vec![0u32; tris.len()];
-        for n in &bvh.nodes {
-            let nb = Aabb {
-                lo: Vec3::from(n.lo),
-                hi: Vec3::from(n.hi),
-            };
-            if n.is_leaf() {
-                assert!(n.count() as usize <= MAX_LEAF);
-                for &t in &bvh.tris[n.first as usize..(n.first + n.count()) as usize] {
-                    seen[t as usize] += 1;
-                    for p in tris[t as usize] {
-                        assert!(nb.contains(&Aabb { lo: p, hi: p }), "triangle {t} outside");
-                    }
-                }
-            } else {
-                for c in [n.first, n.first + 1] {
-                    let c = &bvh.nodes[c as usize];
-                    let cb = Aabb {
-                        lo: Vec3::from(c.lo),
-                        hi: Vec3::from(c.hi),
-                    };
-                    assert!(nb.contains(&cb), "child outside its parent");
-                }
-            }
-        }
-        assert!(seen.iter().all(|&k| k == 1), "every triangle exactly once");
-        // every node but the root is some inner node's child, exactly once
-        let mut parents = vec![0u32; bvh.nodes.len()];
-        for n in bvh.nodes.iter().filter(|n| !n.is_leaf()) {
-            parents[n.first as usize] += 1;
-            parents[n.first as usize + 1] += 1;
-        }
-        assert_eq!(parents[0], 0);
-        assert!(parents[1..].iter().all(|&p| p == 1));
-        let s = bvh.stats;
-        assert_eq!(s.nodes, 2 * s.leaves - 1);
-        assert!(s.depth <= MAX_DEPTH, "depth {}", s.depth);
-        // far better than one leaf of everything
-        assert!(
-            s.sah_cost > 1.0 && s.sah_cost < tris.len() as f64 / 20.0,
-            "{s:?}"
-        );
-    }
-
-    #[test]
-    fn gpu_words_hold_every_node_and_leaf_triangle_at_its_address() {
-        let bvh = Bvh::new(soup());
-        let words = bvh.gpu_words();
-        let n = bvh.nodes.len();
-        let base = HEADER_WORDS + OCTANTS * NODE_WORDS * n;
-        assert_eq!(bvh.triangle_base(), base);
-        assert_eq!(words.len(), base + TRIANGLE_WORDS * bvh.tris.len());
-        assert_eq!(4 * words.len(), bvh.stats.bytes);
-        let f = |w: &[u32]| Vec3::from_array([0, 1, 2].map(|k| f32::from_bits(w[k])));
-        assert_eq!((words[0], f(&words[1..4])), (n as u32, bvh.grid.origin));
-        assert_eq!((f(&words[4..7]), words[7]), (bvh.grid.step, 0));
-        for octant in 0..OCTANTS {
-            // the octant's records, near child right after its parent: each node's texel
-            let mut at = vec![usize::MAX; n];
-            let root = HEADER_WORDS / 4 + octant * n;
-            let mut next = root;
-            let mut todo = vec![0usize];
-            while let Some(k) = todo.pop() {
-                at[k] = next;
-                next += 1;
-                let node = &bvh.nodes[k];
-                if !node.is_leaf() {
-                    let near = node.first as usize + ((octant >> node.axis()) & 1);
-                    todo.push(2 * node.first as usize + 1 - near);
-                    todo.push(near);
-                }
-            }
-            assert_eq!(next, root + n);
-            assert_eq!(bvh.root_texel(octant), root);
-            for (k, node) in bvh.nodes.iter().enumerate() {
-                let w = &words[4 * at[k]..4 * at[k] + NODE_WORDS];
-                // the planes where rays of the octant enter and leave the slabs, 16 bits each
-                let q = bvh.planes[k];
-                let (lo, hi) = ([q[0], q[1], q[2]], [q[3], q[4], q[5]]);
-                let down = |a: usize| (octant >> a) & 1 == 1;
-                let near = [0, 1, 2].map(|a| if down(a) { hi[a] } else { lo[a] } as u32);
-                let far = [0, 1, 2].map(|a| if down(a) { lo[a] } else { hi[a] } as u32);
-                let halves = w[..3].iter().flat_map(|&x| [x & 0xffff, x >> 16]);
-                assert_eq!(halves.collect::<Vec<_>>(), [near, far].concat());
-                if !node.is_leaf() {
-                    // the miss link: the texel of the octant's next record after the subtree
-                    let want = match bvh.links[OCTANTS * k + octant] {
-                        END => root + n,
-                        link => at[link as usize],
-                    };
-                    assert_eq!(w[3], want as u32, "miss link of node {k}, octant {octant}");
-                    continue;
-                }
-                // a leaf's miss link is the next record
-                assert_eq!(
-                    bvh.links[OCTANTS * k + octant],
-                    at.iter()
-                        .position(|&t| t == at[k] + 1)
-                        .map_or(END, |l| l as i32)
-                );
-                // the leaf's triangles: v0, id, edge1, 0, edge2, 0 each
-                let reference = -1 - w[3] as i32;
-                let count = reference & ((1 << LEAF_COUNT_BITS) - 1);
-                let first = (reference >> LEAF_COUNT_BITS) as usize;
-                assert_eq!((first, count as u32), (node.first as usize, node.count()));
-                for s in first..first + count as usize {
-                    let t = &words[base + TRIANGLE_WORDS * s..][..TRIANGLE_WORDS];
-                    let id = bvh.tris[s];
-                    let [v0, v1, v2] = bvh.triangles[id as usize];
-                    assert_eq!(
-                        (f(&t[0..3]), t[3], f(&t[4..7]), t[7], f(&t[8..11]), t[11]),
-                        (v0, id, v1 - v0, 0, v2 - v0, 0)
-                    );
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn miss_links_thread_every_node_once_per_octant() {
-        let bvh = Bvh::new(soup());
-        for octant in 0..OCTANTS {
-            // a walk that enters every box: the near child, else the miss link
-            let (mut node, mut order) = (0i32, Vec::new());
-            while node != END && order.len() <= bvh.nodes.len() {
-                order.push(node as usize);
-                let n = &bvh.nodes[node as usize];
-                node = if n.is_leaf() {
-                    bvh.links[OCTANTS * node as usize + octant]
-                } else {
-                    n.first as i32 + ((octant >> n.axis()) & 1) as i32
-                };
-            }
-            let mut seen = order.clone();
-            seen.sort_unstable();
-            seen.dedup();
-            assert_eq!(seen.len(), bvh.nodes.len(), "octant {octant}: every node");
-            assert_eq!(order.len(), bvh.nodes.len(), "octant {octant}: once");
-            // missing the root ends the walk
-            assert_eq!(bvh.links[octant], END);
-        }
-    }
+    use crate::accel::bvh::layout::tests::soup;
 
     #[test]
     fn traversal_finds_the_brute_force_hits() {
         let tris = soup();
-        let bvh = Bvh::new(tris.clone());
+        let bvh = BvhTree::new(tris.clone());
         let brute = super::super::brute_force::BruteForce::new(tris);
         let ro = Vec3::new(-2.0, 5.0, 5.0);
         let (mut hits, mut fewer) = (0, 0);

@@ -1,15 +1,15 @@
 // The per-pixel work counts of an intersection dispatch added to the 64-bit counters (ours;
-// common/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
+// bvh/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
 // counts — (ray–triangle tests, BVH nodes visited, loops cut short, rays traced) — and adds the
 // sums to the counter slots `countSlots` through common/counters.glsl (one global atomic per
 // work group and counter). A pixel's counts are below 2^32 / PIXELS_PER_INVOCATION, so the
 // sums fit: a ray visits each node and tests each leaf triangle at most once, and the host refuses
 // a structure with more of them (MAX_PIXEL_EVENTS in src/accel/mod.rs).
-// PIXELS_PER_INVOCATION and COUNT_GROUP: #defines of the host (src/pipeline/raytrace/records.rs)
+// PIXELS_PER_INVOCATION and COUNT_GROUP: #defines of the host (src/pipeline/mueller2015/records.rs)
 layout(local_size_x = COUNT_GROUP) in;
 
 #define COUNTER_SLOTS_PER_KERNEL 4
-#include "counters.glsl"
+#include "../common/counters.glsl"
 #include "records.glsl"
 
 // the global counter slot of each component

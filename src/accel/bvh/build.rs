@@ -1,4 +1,4 @@
-//! The binned SAH build of [`super::Bvh`] (Wald 2007, Wagner's [13]; the cost of eq. 4.1).
+//! The binned SAH build of [`super::BvhTree`] (Wald 2007, Wagner's [13]; the cost of eq. 4.1).
 //!
 //! Every node bins its triangles' centroids into [`BINS`] bins per axis (as many as it has
 //! triangles when they are fewer), all three axes in one
@@ -11,7 +11,7 @@
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
-use super::{Aabb, BvhStats, Node, BINS, LEAF_SIZE, MAX_LEAF, PARALLEL_BUILD, SAH_DEPTH};
+use super::layout::{Aabb, BvhStats, Node, BINS, LEAF_SIZE, MAX_LEAF, PARALLEL_BUILD, SAH_DEPTH};
 
 /// Nodes of more triangles bin in parallel chunks of [`BIN_CHUNK`].
 const PARALLEL_BINNING: usize = 1 << 15;

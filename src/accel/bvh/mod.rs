@@ -1,15 +1,16 @@
 //! The SAH BVH — ours, after Wagner 2018 ch. 3.2 and 4.2: built on the CPU
-//! (`reference::bvh`, binned SAH, rayon) and uploaded into one image buffer of 32-bit words
+//! (binned SAH, rayon: [`build`], [`layout`]) and uploaded into one image buffer of 32-bit words
 //! (a copy of the nodes for each ray octant, then the leaf triangles), traversed in the
 //! intersection kernels without a stack, near child first (`glsl/bvh/`). Objects move every
 //! frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model matrix changed
 //! since the last build, and not otherwise. Its image equals the base tracer's. CPU twin:
-//! `reference::bvh::Bvh`.
+//! `reference::bvh` (the walks of [`BvhTree`]).
 
 use std::any::Any;
 use std::sync::Arc;
 
 use anyhow::{bail, Result};
+use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
 use serde_json::json;
 
@@ -21,11 +22,18 @@ use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
-use crate::reference::bvh::{
-    Bvh as CpuBvh, BvhStats, BLOCK, HEADER_WORDS, LEAF_COUNT_BITS, NODE_WORDS, TRIANGLE_WORDS,
-};
 use crate::reference::CpuAccelerator;
 use crate::scene::{transform_triangles, Scene};
+
+mod build;
+pub mod layout;
+mod planes;
+pub use layout::{
+    block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
+    NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
+    NODE_WORDS, OCTANTS, PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
+};
+pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 
 pub const ENTRY: Entry = Entry {
     tracer: TracerKind::Bvh,
@@ -33,20 +41,21 @@ pub const ENTRY: Entry = Entry {
     label: "bvh",
     gpu: Bvh::create,
     cpu: |scene, _| -> Result<Box<dyn CpuAccelerator>> {
-        Ok(Box::new(CpuBvh::new(scene.world_triangles())))
+        Ok(Box::new(BvhTree::new(scene.world_triangles())))
     },
 };
 
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the node records of every octant and
-/// the leaf triangles in one image buffer of 32-bit words ([`CpuBvh::gpu_words`]), the records
+/// the leaf triangles in one image buffer of 32-bit words ([`BvhTree::gpu_words`]), the records
 /// addressed by texel and the triangles by word in the kernels' ints — which cannot overflow:
 /// `TextureBuffer::new` refuses a buffer of 2^31 bytes or more (or beyond
 /// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
-/// `glsl/bvh/entry.comp` to write its entry point into (`glsl/bvh/entries.glsl`), 0 (no entry)
-/// until it does: the same image unit, so the BVH binds no more than GL 4.5's 8.
-fn upload(gl: &Arc<Gl>, bvh: &CpuBvh, blocks: u32) -> Result<TextureBuffers> {
+/// `glsl/bvh/entry.comp` to write its entry point into ([`EntryTexel`]), 0 (no entry) until it
+/// does: the same image unit, so the BVH binds no more than GL 4.5's 8.
+fn upload(gl: &Arc<Gl>, bvh: &BvhTree, blocks: u32) -> Result<TextureBuffers> {
     let mut words = bvh.gpu_words();
-    words.resize(words.len() + 4 * blocks as usize, 0);
+    let entries = vec![EntryTexel::zeroed(); blocks as usize];
+    words.extend_from_slice(bytemuck::cast_slice(&entries));
     let data = TexelData::new;
     TextureBuffers::upload(
         gl,
@@ -78,11 +87,12 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]), texel indices
 /// ([`TEXEL_INDEX_BITS`]) and its last texels, the entries of the image's blocks (columns ×
-/// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`), and they store hit records and per-pixel counts
-/// (`Accelerator::records`), in one store of two 64-bit words where the GL implementation has
-/// 64-bit integers (`RECORD_STORE_64`); on llvmpipe intersect1 loads the next work group's rays
-/// ahead (`PREFETCH_RAYS`, `glsl/common/intersect1_main.glsl`).
-fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 11] {
+/// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`); the kernels store hit records and
+/// per-pixel counts (`Accelerator::records`, `glsl/bvh/records.glsl`), in one store of two 64-bit
+/// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); on llvmpipe
+/// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
+/// `glsl/bvh/intersect1_main.glsl`).
+fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 9] {
     [
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
@@ -93,8 +103,6 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
         ("BVH_LEAF_COUNT_BITS", LEAF_COUNT_BITS.to_string()),
         ("BVH_TRIANGLE_WORDS", TRIANGLE_WORDS.to_string()),
-        ("HIT_RECORDS", "1".into()),
-        ("PIXEL_COUNTS", "1".into()),
     ]
 }
 
@@ -176,7 +184,7 @@ impl Bvh {
     /// Build on the CPU and upload.
     fn rebuild(&mut self, models: &[Mat4]) -> Result<()> {
         let start = std::time::Instant::now();
-        let bvh = CpuBvh::new(transform_triangles(
+        let bvh = BvhTree::new(transform_triangles(
             self.objects
                 .iter()
                 .map(Vec::as_slice)

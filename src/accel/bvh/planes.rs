@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use super::{Aabb, Node};
+use super::layout::{Aabb, Node};
 
 /// Steps of the grid per axis: a plane is a step count 0..=GRID_STEPS (16 bits).
 pub const GRID_STEPS: u32 = u16::MAX as u32;

@@ -1,7 +1,7 @@
 // The evaluation of the closest hit as a kernel of its own (ours) — Müller 2015, ch. 4.1.2,
 // Listings 13 and 14, which the thesis runs at the end of intersect1 (evaluateHit in
-// common/intersect1_hit.glsl, unchanged). For the designs whose intersect1 stores hit records
-// (HIT_RECORDS, common/records.glsl): one invocation per pixel reads its ray from the
+// common/intersect1_hit.glsl, unchanged), for the SAH BVH, whose intersect1 stores hit records
+// (bvh/records.glsl): one invocation per pixel reads its ray from the
 // ray-state textures, finds its closest hit (t, triangle id, u, v) again from the hit record
 // (bvh/hit_record.glsl), and evaluates it exactly as the thesis' intersect1 does; an inactive
 // ray (rayState <= 0) gets an empty colour buffer. The host dispatches it right after
@@ -9,13 +9,13 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
-#include "scene.glsl"
-#include "images.glsl"
-#include "intersect.glsl"
+#include "../common/scene.glsl"
+#include "../common/images.glsl"
+#include "../common/intersect.glsl"
 #include "records.glsl"
-#include "intersect1_hit.glsl"
-// the hit records are the SAH BVH's (the one design that stores them): a leaf-triangle address
-#include "../bvh/hit_record.glsl"
+#include "../common/intersect1_hit.glsl"
+// a hit record: a leaf-triangle address
+#include "hit_record.glsl"
 
 void main()
 {
