@@ -48,7 +48,7 @@ fn every_accelerator_agrees_with_its_cpu_twin() {
                 entry.label
             );
         }
-        let twin = (entry.cpu)(&scene, &grid).expect("CPU twin");
+        let twin = gpgpu_rt::reference::twin(entry.tracer, &scene, &grid).expect("CPU twin");
         let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
         let c = compare(&gpu, &cpu);
         eprintln!("{}: {c:?}", entry.label);

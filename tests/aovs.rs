@@ -117,7 +117,8 @@ fn shadow_aov_is_the_share_of_unblocked_lights() {
         color: Vec3::splat(0.3),
     });
     let (w, h) = (48, 40);
-    let twin = (accel::bvh::ENTRY.cpu)(&scene, &GridOptions::default()).expect("CPU twin");
+    let twin = gpgpu_rt::reference::twin(accel::TracerKind::Bvh, &scene, &GridOptions::default())
+        .expect("CPU twin");
     let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
     let want = cpu
         .aovs

@@ -151,7 +151,7 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
         // held against its GPU side in tests/stream.rs, here only the GPU's ids are checked
         let cpu_ids: Vec<i32> = match (&design, row.accel) {
             (Design::Mueller2015(o), Some(e)) => {
-                let twin = (e.cpu)(&scene, &o.grid).unwrap();
+                let twin = gpgpu_rt::reference::twin(e.tracer, &scene, &o.grid).unwrap();
                 let cpu = Reference::with_accelerator(&scene, twin).render(
                     &scene.camera,
                     o.width,

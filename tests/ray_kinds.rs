@@ -70,7 +70,8 @@ fn every_kind_of_ray_is_counted_and_timed_apart() {
     );
     for (label, opts) in accelerators() {
         let entry = accel::entry(opts.tracer, &opts.grid);
-        let twin = (entry.cpu)(&scene, &opts.grid).expect("its CPU twin");
+        let twin =
+            gpgpu_rt::reference::twin(entry.tracer, &scene, &opts.grid).expect("its CPU twin");
         let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, SIZE, SIZE, 1);
         let f = render_gpu(&ctx, &scene, opts);
         let s = &f.stats;

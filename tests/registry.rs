@@ -68,7 +68,8 @@ fn each_accelerator_is_the_one_its_tracer_picks() {
         }
         // its twin is made over a scene (the oracle the tests compare its GPU side with)
         let scene = load("cow.toml");
-        (entry.cpu)(&scene, &grid).unwrap_or_else(|e| panic!("{row:?}: twin: {e:#}"));
+        gpgpu_rt::reference::twin(entry.tracer, &scene, &grid)
+            .unwrap_or_else(|e| panic!("{row:?}: twin: {e:#}"));
     }
 }
 

@@ -15,7 +15,6 @@ use anyhow::Result;
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
 use crate::frame::FrameStats;
 use crate::gl::{GlInfo, Kernel};
-use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 pub const ENTRY: Entry = Entry {
@@ -23,11 +22,6 @@ pub const ENTRY: Entry = Entry {
     grid_variant: None,
     label: "base",
     gpu: BruteForce::create,
-    cpu: |scene, _| -> Result<Box<dyn CpuAccelerator>> {
-        Ok(Box::new(reference::brute_force::BruteForce::new(
-            scene.world_triangles(),
-        )))
-    },
 };
 
 /// Triangles per dispatch where the implementation limits loops: below llvmpipe's 65535

@@ -20,7 +20,6 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
-use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 /// Largest resolution: the prefix sum handles 2048 blocks of 1024 voxels.
@@ -41,19 +40,6 @@ pub const ENTRY: Entry = Entry {
     grid_variant: Some(GridVariant::Exact),
     label: "grid-exact",
     gpu: ExactGrid::create,
-    cpu: |scene, options| -> Result<Box<dyn CpuAccelerator>> {
-        let n = resolution(scene, options, MAX_RESOLUTION)?;
-        let g = reference::exact_grid::ExactGrid::new(
-            scene.world_triangles(),
-            n,
-            GridMapping::of_scene(scene),
-        );
-        Ok(Box::new(if options.proximity_clouds {
-            g.with_proximity()
-        } else {
-            g
-        }))
-    },
 };
 
 /// The compact lists: voxelCount (references per voxel), voxelStart (their prefix sum),

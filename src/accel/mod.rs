@@ -35,7 +35,6 @@ use serde::Serialize;
 use crate::frame::FrameStats;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::reference::CpuAccelerator;
 use crate::scene::Scene;
 
 /// Pixels each invocation of `glsl/bvh/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
@@ -214,8 +213,6 @@ pub fn auto_resolution(triangles: usize) -> u32 {
 
 /// Makes the GPU side of an accelerator.
 pub type MakeGpu = fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>;
-/// Makes the CPU twin of an accelerator.
-pub type MakeCpu = fn(&Scene, &GridOptions) -> Result<Box<dyn CpuAccelerator>>;
 
 /// One accelerator of Müller 2015's pipeline: how the command line names it, and how its GPU
 /// side and CPU twin are made (its row in `design::REGISTRY` says what else belongs to it).
@@ -227,8 +224,6 @@ pub struct Entry {
     /// Its row's name in `design::REGISTRY`: "base", "grid-thesis", "grid-exact", "bvh".
     pub label: &'static str,
     pub gpu: MakeGpu,
-    /// The CPU twin over the scene as loaded.
-    pub cpu: MakeCpu,
 }
 
 /// The accelerator `--tracer tracer` with `options` selects; `design::REGISTRY` lists each in

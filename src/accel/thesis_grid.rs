@@ -21,7 +21,6 @@ use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
 use crate::gl::{Gl, Kernel};
-use crate::reference::{self, CpuAccelerator};
 use crate::scene::Scene;
 
 /// Largest resolution: the per-ray lists sort up to 3N crossings with BubbleSort (and
@@ -33,16 +32,6 @@ pub const ENTRY: Entry = Entry {
     grid_variant: Some(GridVariant::Thesis),
     label: "grid-thesis",
     gpu: ThesisGrid::create,
-    cpu: |scene, options| -> Result<Box<dyn CpuAccelerator>> {
-        let n = resolution(scene, options, MAX_RESOLUTION)?;
-        Ok(Box::new(reference::thesis_grid::ThesisGrid::new(
-            scene.world_triangles(),
-            n,
-            GridMapping::of_scene(scene),
-            options.voxel_array_length as usize,
-            options.ray_array_length.unwrap_or(3 * n) as usize,
-        )))
-    },
 };
 
 pub struct ThesisGrid {

@@ -17,6 +17,8 @@ pub mod wagner2018;
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
+use crate::accel::grid_frame::{resolution, GridMapping};
+use crate::accel::{self, bvh::BvhTree, GridOptions, GridVariant, TracerKind};
 use crate::frame::Aovs;
 use crate::scene::{Camera, Scene, WorldAttributes};
 
@@ -38,6 +40,39 @@ pub trait CpuAccelerator: Send + Sync {
     fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64);
     /// Whether the shadow feeler is blocked (Listing 15).
     fn occluded(&self, feeler: &Feeler) -> (bool, u64);
+}
+
+/// The CPU twin of the accelerator `--tracer tracer` with `options` (the grid's variant, its
+/// resolution, its lists) over the scene as loaded: the oracle its GPU side is held against.
+pub fn twin(
+    tracer: TracerKind,
+    scene: &Scene,
+    options: &GridOptions,
+) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    let triangles = scene.world_triangles();
+    Ok(match (tracer, options.variant) {
+        (TracerKind::Base, _) => Box::new(brute_force::BruteForce::new(triangles)),
+        (TracerKind::Grid, GridVariant::Thesis) => {
+            let n = resolution(scene, options, accel::thesis_grid::MAX_RESOLUTION)?;
+            Box::new(thesis_grid::ThesisGrid::new(
+                triangles,
+                n,
+                GridMapping::of_scene(scene),
+                options.voxel_array_length as usize,
+                options.ray_array_length.unwrap_or(3 * n) as usize,
+            ))
+        }
+        (TracerKind::Grid, GridVariant::Exact) => {
+            let n = resolution(scene, options, accel::exact_grid::MAX_RESOLUTION)?;
+            let g = exact_grid::ExactGrid::new(triangles, n, GridMapping::of_scene(scene));
+            Box::new(if options.proximity_clouds {
+                g.with_proximity()
+            } else {
+                g
+            })
+        }
+        (TracerKind::Bvh, _) => Box::new(BvhTree::new(triangles)),
+    })
 }
 
 /// A shadow feeler: blocked by a triangle other than `last` hit at `offset` < t <

@@ -22,7 +22,6 @@ use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
-use crate::reference::CpuAccelerator;
 use crate::scene::{transform_triangles, Scene};
 
 mod build;
@@ -40,9 +39,6 @@ pub const ENTRY: Entry = Entry {
     grid_variant: None,
     label: "bvh",
     gpu: Bvh::create,
-    cpu: |scene, _| -> Result<Box<dyn CpuAccelerator>> {
-        Ok(Box::new(BvhTree::new(scene.world_triangles())))
-    },
 };
 
 /// The hierarchy as uploaded (`glsl/bvh/traverse.glsl`): the node records of every octant and

@@ -40,7 +40,7 @@ impl Judge {
             ("CPU brute force", Reference::new(&unlit))
         } else {
             let grid = GridOptions::default();
-            let twin = (accel::bvh::ENTRY.cpu)(&unlit, &grid)?;
+            let twin = gpgpu_rt::reference::twin(accel::TracerKind::Bvh, &unlit, &grid)?;
             ("CPU SAH BVH", Reference::with_accelerator(&unlit, twin))
         };
         let f = reference.render(&scene.camera, width, height, 0);
