@@ -67,6 +67,19 @@ pub const COMMON_OPTIONS: &[&str] = &[
     "output", "width", "height", "aov-dir", "stats", "frames", "device", "glsl-dir", "driver",
 ];
 
+/// The defaults of the design options where the command line gives none, which
+/// [`Design::plain`] takes too.
+pub mod defaults {
+    /// `--tile`: dispatches of at most 256×256 pixels.
+    pub const TILE: u32 = 256;
+    /// `--light-samples`: U×V samples of the area light.
+    pub const LIGHT_SAMPLES: (u32, u32) = (4, 4);
+    /// `--ntree-n`: cells per axis of every N-tree node (the thesis' 10).
+    pub const NTREE_N: u32 = 10;
+    /// `--ntree-depth`: levels of the N-tree counting the root (reading A).
+    pub const NTREE_DEPTH: u32 = 3;
+}
+
 /// The options of Müller 2015's pipeline, whatever its accelerator.
 const MUELLER: &[&str] = &["tracer", "refl-depth", "shadow-flags", "tile"];
 
@@ -307,8 +320,8 @@ pub enum Design {
 
 impl Design {
     /// The design of `row` at `width`×`height` with `refl_depth` reflection passes where it
-    /// reflects, and its defaults otherwise: the grid's resolution from the triangle count,
-    /// 256² tiles, bitwise shadow flags, the line space with 4×4 light samples; no AOVs.
+    /// reflects, and the command line's [`defaults`] otherwise: the grid's resolution from the
+    /// triangle count, bitwise shadow flags, the line space; no AOVs.
     pub fn plain(row: &Row, width: u32, height: u32, refl_depth: u32) -> Design {
         match (row.pipeline, row.accel) {
             (Pipeline::Mueller2015, Some(entry)) => Design::Mueller2015(RenderOptions {
@@ -316,7 +329,7 @@ impl Design {
                 width,
                 height,
                 refl_depth,
-                tile: 256,
+                tile: defaults::TILE,
                 shadow_flags: ShadowFlags::Bits,
                 aovs: false,
                 grid: GridOptions {
@@ -328,19 +341,19 @@ impl Design {
             (Pipeline::Wagner2018, _) => Design::Wagner2018(WagnerOptions {
                 width,
                 height,
-                tile: 256,
+                tile: defaults::TILE,
                 aovs: false,
             }),
             (Pipeline::Stream, _) => Design::Stream(StreamOptions::new(width, height, refl_depth)),
             (Pipeline::Klee2016, _) => Design::Klee2016(SoftShadowOptions {
                 mode: ShadowMode::Linespace,
-                samples_u: 4,
-                samples_v: 4,
-                ntree_n: 10,
-                ntree_depth: 3,
+                samples_u: defaults::LIGHT_SAMPLES.0,
+                samples_v: defaults::LIGHT_SAMPLES.1,
+                ntree_n: defaults::NTREE_N,
+                ntree_depth: defaults::NTREE_DEPTH,
                 width,
                 height,
-                tile: 256,
+                tile: defaults::TILE,
                 shading: Default::default(),
             }),
             (Pipeline::Mueller2015, None) => {

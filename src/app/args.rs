@@ -9,7 +9,7 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Parser as _, ValueEnum};
 
 use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant};
-use gpgpu_rt::design::{self, Design, Pipeline, Row};
+use gpgpu_rt::design::{self, defaults, Design, Pipeline, Row};
 use gpgpu_rt::limits;
 use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions};
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
@@ -80,11 +80,11 @@ pub struct GridArgs {
     pub proximity_clouds: bool,
     /// --tracer stream: steps (one triangle test or one move to the next cell) per call of
     /// the traverse kernel, 1 to 4096.
-    #[arg(long, default_value_t = 64, value_name = "N", value_parser = limits::parser(limits::STREAM_STEPS))]
+    #[arg(long, default_value_t = StreamOptions::STEPS_PER_CALL, value_name = "N", value_parser = limits::parser(limits::STREAM_STEPS))]
     pub stream_steps: u32,
     /// --tracer stream: traverse calls per traversal at most, 1 to 1000000 (rays still
     /// walking then make the frame fail).
-    #[arg(long, default_value_t = 10_000, value_name = "N", value_parser = limits::parser(limits::STREAM_CALLS))]
+    #[arg(long, default_value_t = StreamOptions::MAX_CALLS, value_name = "N", value_parser = limits::parser(limits::STREAM_CALLS))]
     pub stream_max_calls: u32,
     /// --tracer stream: trace shadow rays naively — the closest hit anywhere along the ray,
     /// a blocker when it lies before the light — instead of the paper's any hit closer than
@@ -168,7 +168,7 @@ pub struct SoftShadowArgs {
     #[arg(long, value_parser = parse_samples, value_name = "UxV")]
     pub light_samples: Option<(u32, u32)>,
     /// Cells per axis of every N-tree node (N; 10 in the thesis).
-    #[arg(long, default_value_t = 10, value_name = "N")]
+    #[arg(long, default_value_t = defaults::NTREE_N, value_name = "N")]
     pub ntree_n: u32,
     /// Levels of the N-tree counting the root: 3 (reading A of the thesis' "maximale Tiefe von
     /// 3": root, nodes of 1/N, leaves of 1/N²; only one level of line spaces is asked, no
@@ -176,7 +176,7 @@ pub struct SoftShadowArgs {
     /// depths 0, 1, 2 below the root; leaves of 1/N³, a cascade of two line-space levels).
     /// The number counts levels with the root, not the thesis' depth index (docs/klee2016.md,
     /// "where we differ").
-    #[arg(long, default_value_t = 3, value_name = "LEVELS")]
+    #[arg(long, default_value_t = defaults::NTREE_DEPTH, value_name = "LEVELS")]
     pub ntree_depth: u32,
     /// How the shadow value s lights a pixel: `lit` (ours: diffuse · (ambient + light · s ·
     /// N·L)) or `fig7` (Klee 2016's Fig. 7: s · diffuse).
@@ -195,7 +195,7 @@ impl SoftShadowArgs {
 
     /// The light samples: the option, else 4x4.
     pub fn samples(&self) -> (u32, u32) {
-        self.light_samples.unwrap_or((4, 4))
+        self.light_samples.unwrap_or(defaults::LIGHT_SAMPLES)
     }
 
     pub fn options(
@@ -264,7 +264,7 @@ pub struct DesignArgs {
     pub shadow_flags: ShadowFlags,
     /// Split every dispatch into tiles of at most N×N pixels (multiple of 8; 0: no tiling),
     /// so that no dispatch runs long enough for a driver watchdog.
-    #[arg(long, default_value_t = 256, value_name = "N")]
+    #[arg(long, default_value_t = defaults::TILE, value_name = "N")]
     pub tile: u32,
     #[command(flatten)]
     pub grid: GridArgs,

@@ -76,9 +76,14 @@ pub struct StreamOptions {
 }
 
 impl StreamOptions {
+    /// Steps per traverse call unless `--stream-steps` says otherwise.
+    pub const STEPS_PER_CALL: u32 = 64;
+    /// Traverse calls per traversal at most unless `--stream-max-calls` says otherwise.
+    pub const MAX_CALLS: u32 = 10_000;
+
     /// A `width`×`height` image with `refl_depth` bounces and the command line's defaults: the
-    /// paper's ∛n grid, no proximity clouds, the paper's shadow optimisations, 64 steps per
-    /// call and at most 10 000 calls.
+    /// paper's ∛n grid, no proximity clouds, the paper's shadow optimisations,
+    /// [`Self::STEPS_PER_CALL`] steps per call and at most [`Self::MAX_CALLS`] calls.
     pub fn new(width: u32, height: u32, refl_depth: u32) -> StreamOptions {
         StreamOptions {
             width,
@@ -86,8 +91,8 @@ impl StreamOptions {
             refl_depth,
             dims: None,
             proximity_clouds: false,
-            steps_per_call: 64,
-            max_calls: 10_000,
+            steps_per_call: Self::STEPS_PER_CALL,
+            max_calls: Self::MAX_CALLS,
             naive_shadows: false,
             no_mask: false,
             single_sided: false,
