@@ -12,7 +12,10 @@ triangle-id order) and `gpgpu-rt info --json` (light positions, shadow offset). 
   with ties: ids differ but both hit at t within 1e-5 relative (a shared edge);
 - the shadow feelers of intersect2 (any hit) from o + t·d towards every point light, where
   N·L > 0 (the kernel does not trace the others), from the shadow offset to the light: Mrays/s
-  = feelers / seconds, ours = feelers / gpu_ms.intersect2; agreement with shadow.npy.
+  = feelers / seconds, ours = feelers / gpu_ms.intersect2; agreement with shadow.npy;
+- the whole frame: our GPU time of every kernel of the frame (`gpu_ms_total`: transform, eye
+  rays, searches, hit evaluation, counts, shading) against Embree's time for the primary rays
+  plus the feelers, with each kernel's share of ours.
 
 Threads: embreex's `run` loops over single rays (rtcIntersect1/rtcOccluded1, Embree's
 single-ray path; it binds no packet calls) on the calling thread with the GIL released, so
@@ -344,7 +347,24 @@ def measure(scene, a, work):
             m["ours_ms"] = median_of(runs, lambda s: s["gpu_ms"][kernel])
             m["kind_ms"] = median_of(runs, lambda s: kind_ms(s, *kinds))
             m["paired"] = paired(secs[kind][a.threads], runs, lambda s: s["gpu_ms"][kernel])
+        if "feelers" in r:
+            r["frame"] = frame(secs, a.threads, runs)
     return r
+
+
+def frame(secs, threads, runs):
+    """The whole frame: our GPU time of every kernel of the last frame (`gpu_ms_total`)
+    against Embree's time for the same primary rays plus feelers on `threads` processes, per
+    round (ours / Embree, the same round: > 1 is slower), and each kernel's share of ours."""
+    embree_ms = [(p + f) * 1e3 for p, f in zip(secs["primary"][threads], secs["feelers"][threads])]
+    per_round = [s["gpu_ms_total"] / e for s, e in zip(runs, embree_ms)]
+    total = statistics.median(s["gpu_ms_total"] for s in runs)
+    kernels = {k: statistics.median(s["gpu_ms"].get(k, 0.0) for s in runs)
+               for k in runs[0]["gpu_ms"]}
+    return {"ours_ms": total, "embree_ms": statistics.median(embree_ms),
+            "ratio": {"median": statistics.median(per_round), "min": min(per_round),
+                      "max": max(per_round)},
+            "kernel_ms": dict(sorted(kernels.items(), key=lambda kv: -kv[1]))}
 
 
 def rerun(a, scene, pipeline_args, d, k):
@@ -456,6 +476,7 @@ def report(results, a, command, load):
             m = r["feelers"]
             lines.append("| " + " | ".join([f"`{r['scene']}`", str(m["rays"]),
                                             *rate_cells(m, th), f"{m['agree_pct']:.4f}"]) + " |")
+    lines += frame_lines(results, th)
     lines += ["", "## Details", "",
               "| scene | Embree upload ms (embreex copy) | cores Embree got: build, "
               f"{th}-process rays (CPU / wall time) | Embree best Mrays/s ({th} processes) | ties "
@@ -474,6 +495,28 @@ def report(results, a, command, load):
               "of that edge by a rounding error and went on to a farther one. Neither test is "
               f"watertight: {ours_test} and Embree without its robust mode.", ""]
     return "\n".join(lines)
+
+
+def frame_lines(results, threads):
+    """The whole-frame table: ours against Embree's primary rays plus feelers."""
+    rows = [r for r in results if "frame" in r]
+    if not rows:
+        return []
+    lines = ["", "## The whole frame", "",
+             f"Ours: every kernel of the last frame (`gpu_ms_total`: transform, eye rays, the "
+             f"searches, hit evaluation, counts, shading); Embree: the same primary rays plus "
+             f"feelers on {threads} processes, nothing else (no shading). Time ratio ours / "
+             "Embree per round (> 1: ours slower); the shares are each kernel's part of ours.", "",
+             "| scene | ours ms | Embree ms (primary + feelers) | ours / Embree: median (range) "
+             "| kernels: ms (share) |", "|---|---:|---:|---:|---|"]
+    for r in rows:
+        f = r["frame"]
+        shares = ", ".join(f"{k} {ms:.1f} ({100 * ms / f['ours_ms']:.0f} %)"
+                           for k, ms in f["kernel_ms"].items() if ms > 0)
+        q = f["ratio"]
+        lines.append(f"| `{r['scene']}` | {f['ours_ms']:.1f} | {f['embree_ms']:.1f} | "
+                     f"{q['median']:.2f} ({q['min']:.2f}–{q['max']:.2f}) | {shares} |")
+    return lines
 
 
 def timing_bullets(a):
