@@ -171,8 +171,23 @@ fn moving_an_object_needs_only_its_model_matrix() {
     tracer.set_model(1, moved).unwrap();
     let after = tracer.render(&scene.camera).unwrap();
     assert_ne!(before.color, after.color);
+    assert!(after.stats.gpu_ms.contains_key("transform"));
     scene.objects[1].model = moved;
     assert_close(&after, &render_cpu(&scene, &opts), "moved teapot");
+    // nothing moved: no transform pass, the same buffers, the same image
+    let still = tracer.render(&scene.camera).unwrap();
+    assert!(
+        !still.stats.gpu_ms.contains_key("transform"),
+        "a static frame ran the transform pass"
+    );
+    assert_eq!(still.color, after.color);
+    // back to where it was: the pass writes the teapot again, the floor stays as written
+    let back =
+        Mat4::from_rotation_y(-0.7) * Mat4::from_translation(Vec3::new(-0.6, 0.0, 0.4)) * moved;
+    tracer.set_model(1, back).unwrap();
+    scene.objects[1].model = back;
+    let again = tracer.render(&scene.camera).unwrap();
+    assert_close(&again, &render_cpu(&scene, &opts), "teapot moved back");
 }
 
 #[test]

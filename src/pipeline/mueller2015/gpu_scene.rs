@@ -2,6 +2,12 @@
 //! attributes in VBOs (uploaded once), and the SSBOs the kernels read, filled every frame by
 //! the transform pass (`glsl/mueller2015/transform.vert`, rasterizer discarded) from the VBOs and each
 //! object's model and normal matrices. Materials, lights and textures live beside them.
+//!
+//! Deviation (ours): the thesis runs the transform pass over every object every frame; here a
+//! frame draws only the objects whose model matrix changed since their vertices were last
+//! written (the lights once), since the SSBOs keep what the pass wrote and the kernels only read
+//! them — the same buffers, without re-transforming a static scene every frame
+//! (`docs/design/frame.md`).
 
 use std::sync::Arc;
 
@@ -32,6 +38,8 @@ pub struct GpuScene {
     _rbo: Owned<glow::Renderbuffer>,
     textures: Owned<glow::Texture>,
     pub triangles: usize,
+    /// The model matrices the SSBOs were last written with (none before the first pass).
+    written: Option<Vec<Mat4>>,
 }
 
 fn upload_vbo(gl: &Arc<Gl>, data: &[u8]) -> Result<Owned<glow::Buffer>> {
@@ -282,6 +290,7 @@ impl GpuScene {
             _rbo: rbo,
             textures,
             triangles: scene.triangle_count(),
+            written: None,
         })
     }
 
@@ -301,9 +310,18 @@ impl GpuScene {
         }
     }
 
-    /// The transform pass: every object's vertices through its model matrix into the SSBOs,
-    /// then the lights. `models[i]` is object i's model matrix.
-    pub fn transform(&self, gl: &Gl, timers: &mut GpuTimers, models: &[Mat4]) {
+    /// The transform pass: the vertices of every object whose model matrix changed since the
+    /// SSBOs were written (every object the first time) through it into the SSBOs, and the
+    /// first time the lights. `models[i]` is object i's model matrix. No pass (and no
+    /// `transform` time) when nothing moved.
+    pub fn transform(&mut self, gl: &Gl, timers: &mut GpuTimers, models: &[Mat4]) {
+        let moved: Vec<usize> = (0..models.len())
+            .filter(|&i| self.written.as_ref().is_none_or(|w| w[i] != models[i]))
+            .collect();
+        let lights = self.written.is_none() && self.light_count > 0;
+        if moved.is_empty() && !lights {
+            return;
+        }
         self.bind(gl);
         let k = &self.transform;
         k.use_program();
@@ -319,13 +337,14 @@ impl GpuScene {
                 gl.enable(glow::RASTERIZER_DISCARD);
                 k.set_i32("transformLights", 0);
                 gl.bind_vertex_array(Some(self.vao.raw()));
-                for (&(first, count), model) in self.ranges.iter().zip(models) {
-                    let normal = Mat3::from_mat4(*model).inverse().transpose();
-                    k.set_mat4("modelMatrix", &model.to_cols_array());
+                for &i in &moved {
+                    let (first, count) = self.ranges[i];
+                    let normal = Mat3::from_mat4(models[i]).inverse().transpose();
+                    k.set_mat4("modelMatrix", &models[i].to_cols_array());
                     k.set_mat3("normalMatrix", &normal.to_cols_array());
                     gl.draw_arrays(glow::POINTS, first, count);
                 }
-                if self.light_count > 0 {
+                if lights {
                     k.set_i32("transformLights", 1);
                     k.set_mat4("modelMatrix", &Mat4::IDENTITY.to_cols_array());
                     gl.bind_vertex_array(Some(self.light_vao.raw()));
@@ -337,6 +356,7 @@ impl GpuScene {
             }
         });
         crate::gl::sync::barrier(gl);
+        self.written = Some(models.to_vec());
     }
 }
 

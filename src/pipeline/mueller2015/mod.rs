@@ -146,7 +146,7 @@ pub struct RayTracer {
     pixels: PixelGrid,
     lighting: Lighting,
     renderer: String,
-    /// Model matrix per object, applied by the transform pass every frame.
+    /// Model matrix per object, applied by the transform pass when it changed.
     models: Vec<Mat4>,
     entry: &'static Entry,
     accel: Box<dyn Accelerator>,
@@ -365,7 +365,7 @@ impl Renderer for RayTracer {
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let start = Instant::now();
         let gl = self.gl.clone();
-        // the scene data is transformed into the SSBOs at the start of every frame
+        // the objects that moved are transformed into the SSBOs at the start of the frame
         self.scene.transform(&gl, &mut self.timers, &self.models);
         self.scene.bind(&gl);
         self.counters.clear(&gl, &mut self.timers);
