@@ -9,7 +9,8 @@
 // reflected (Listing 14). A miss writes the background colour and ends the ray.
 
 uniform vec4 backgroundColor;
-// 1 in the first pass (primary rays): the first hit is also stored for the AOVs.
+// 1 in the first pass (primary rays): the first hit is also stored for the AOVs (ours; only
+// where the host keeps AOVs: STORE_AOVS).
 uniform int storePrimaryHit;
 layout(binding = SAMPLER_TEXTURES) uniform sampler2DArray textures;
 
@@ -24,50 +25,53 @@ void emptyColorBuffer(ivec2 storePos)
 void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
                  float t_min, int triID, float hit_u, float hit_v)
 {
+#if STORE_AOVS
     if (storePrimaryHit != 0)
         imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
+#endif
 
-    if (triID < 0) {
-        // no hit: the background colour with full weight; the ray leaves the scene
-        imageStore(colorBufferTexture, storePos, vec4(backgroundColor.rgb, 1.0));
-        imageStore(normalTexture, storePos, vec4(0.0));
-        imageStore(rayOriginTexture, storePos, vec4(ro, 0.0));
-        return;
-    }
-
-    // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
+    // Ours: a hit and a miss compute the same four texels and share one store per texture —
+    // llvmpipe runs both sides of a branch that any lane takes, and every store is a loop over
+    // the lanes (docs/design/frame.md). A miss: the background colour with full weight, and the
+    // ray leaves the scene (rayState 0); its direction is stored with triangle −1, which no kernel
+    // reads for an ended ray.
     vec3 direction = rd;
-    float w = 1.0 - hit_u - hit_v;
-    vec3 interpolated_normal = normalize(w * normals[3 * triID].xyz
-                                         + hit_u * normals[3 * triID + 1].xyz
-                                         + hit_v * normals[3 * triID + 2].xyz);
-    // ours: the normal faces the incoming ray (two-sided surfaces)
-    if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
+    vec3 interpolated_normal = vec3(0.0);
+    vec4 hitPoint = vec4(ro, 0.0);
+    vec4 colorWeight = vec4(backgroundColor.rgb, 1.0);
+    if (triID >= 0) {
+        // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
+        float w = 1.0 - hit_u - hit_v;
+        interpolated_normal = normalize(w * normals[3 * triID].xyz
+                                        + hit_u * normals[3 * triID + 1].xyz
+                                        + hit_v * normals[3 * triID + 2].xyz);
+        // ours: the normal faces the incoming ray (two-sided surfaces)
+        if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
 
-    vec4 mat = material[triMaterial[triID]];
-    vec3 color;
-    if (mat.w >= 0.0) {
-        // textured triangle: interpolated texture coordinates, sampled through the sampler
-        vec2 uv = w * texcoords[3 * triID] + hit_u * texcoords[3 * triID + 1]
-                + hit_v * texcoords[3 * triID + 2];
-        color = textureLod(textures, vec3(uv, mat.w), 0.0).rgb;
-    } else {
-        color = w * colors[3 * triID].rgb + hit_u * colors[3 * triID + 1].rgb
-              + hit_v * colors[3 * triID + 2].rgb;
+        vec4 mat = material[triMaterial[triID]];
+        vec3 color = w * colors[3 * triID].rgb + hit_u * colors[3 * triID + 1].rgb
+                   + hit_v * colors[3 * triID + 2].rgb;
+#if SCENE_TEXTURES
+        if (mat.w >= 0.0) {
+            // textured triangle: interpolated texture coordinates, sampled through the sampler
+            vec2 uv = w * texcoords[3 * triID] + hit_u * texcoords[3 * triID + 1]
+                    + hit_v * texcoords[3 * triID + 2];
+            color = textureLod(textures, vec3(uv, mat.w), 0.0).rgb;
+        }
+#endif
+
+        // Listing 14: reflection on the hit triangle?
+        float refl = mat.x;
+        if (refl > 0.0) {
+            rayState += 1.0;
+            direction = reflect(direction, interpolated_normal);
+        }
+        hitPoint = vec4(ro + t_min * rd, rayState);
+        // weight of the hit colour; the reflection gets the rest
+        colorWeight = vec4(color, 1.0 - refl);
     }
-
-    // Listing 14: reflection on the hit triangle?
-    float refl = mat.x;
-    if (refl > 0.0) {
-        rayState += 1.0;
-        direction = reflect(direction, interpolated_normal);
-    }
-    // weight of the hit colour; the reflection gets the rest
-    float weight = 1.0 - refl;
-
-    vec3 hitPoint = ro + t_min * rd;
-    imageStore(rayOriginTexture, storePos, vec4(hitPoint, rayState));
+    imageStore(rayOriginTexture, storePos, hitPoint);
     imageStore(rayDirTexture, storePos, vec4(direction, float(triID)));
     imageStore(normalTexture, storePos, vec4(interpolated_normal, 0.0));
-    imageStore(colorBufferTexture, storePos, vec4(color, weight));
+    imageStore(colorBufferTexture, storePos, colorWeight);
 }

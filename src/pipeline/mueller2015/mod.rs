@@ -98,7 +98,8 @@ pub const COUNTERS: &[&str] = &[
 pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
 /// `#define`s every kernel gets: counter slots, the shadow-flag layout, the scene's triangle
-/// count (`glsl/common/scene.glsl`'s `triangleCount()`), the image size. (The SAH BVH's
+/// count (`glsl/common/scene.glsl`'s `triangleCount()`), the image size, whether AOVs are kept
+/// and the scene has textures. (The SAH BVH's
 /// switches are its own: `accel::bvh`.)
 pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
     let mut d = Defines::new()
@@ -113,7 +114,11 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // the image size (bvh/records.glsl)
         .set("IMAGE_WIDTH", options.width)
         .set("IMAGE_HEIGHT", options.height)
-        .set("SCENE_TRIANGLES", scene.triangle_count());
+        .set("SCENE_TRIANGLES", scene.triangle_count())
+        // what the hit evaluation may skip (common/intersect1_hit.glsl): the first hits' store
+        // when no AOVs are asked, the texture lookup in a scene without textures
+        .set("STORE_AOVS", options.aovs as i32)
+        .set("SCENE_TEXTURES", !scene.textures.is_empty() as i32);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
