@@ -38,6 +38,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         aovs: true,
         grid: Default::default(),
         triangles_per_dispatch: None,
+        light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
     }
 }
 
