@@ -8,9 +8,7 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::{GridVariant, TracerKind};
 use gpgpu_rt::frame::{Frame, RAY_KINDS};
-use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::Scene;
@@ -19,37 +17,13 @@ const SIZE: (u32, u32) = (48, 36);
 /// Unequal U and V, so that a swap of the two shows.
 const SAMPLES: (u32, u32) = (3, 2);
 
-/// Every accelerator of the pipeline (the base tracer also split over several dispatches,
-/// whose flags carry an occluder found by an earlier dispatch): (label, options).
+/// Every accelerator of the pipeline, with the samples: (label, options).
 fn accelerators() -> Vec<(&'static str, RenderOptions)> {
-    let with = |tracer, variant, clouds: bool| {
-        let mut o = options(SIZE.0, SIZE.1, 1);
-        o.tracer = tracer;
-        o.grid.variant = variant;
-        o.grid.resolution = Some(12);
-        o.grid.proximity_clouds = clouds;
+    let mut all = pipeline_accelerators(SIZE.0, SIZE.1, 1, 12);
+    for (_, o) in &mut all {
         o.light_samples = SAMPLES;
-        o
-    };
-    let mut split = with(TracerKind::Base, GridVariant::Exact, false);
-    split.triangles_per_dispatch = Some(2000);
-    vec![
-        ("base", with(TracerKind::Base, GridVariant::Exact, false)),
-        ("base split", split),
-        (
-            "grid thesis",
-            with(TracerKind::Grid, GridVariant::Thesis, false),
-        ),
-        (
-            "grid exact",
-            with(TracerKind::Grid, GridVariant::Exact, false),
-        ),
-        (
-            "grid exact pc",
-            with(TracerKind::Grid, GridVariant::Exact, true),
-        ),
-        ("bvh sah", with(TracerKind::Bvh, GridVariant::Exact, false)),
-    ]
+    }
+    all
 }
 
 fn reference(scene: &Scene, o: &RenderOptions, samples: (u32, u32)) -> ReferenceFrame {
@@ -132,14 +106,7 @@ fn the_samples_change_the_primary_and_the_reflected_hits() {
 }
 
 fn tracer(scene: &Scene, opts: RenderOptions) -> anyhow::Result<RayTracer> {
-    let ctx = context();
-    RayTracer::new(
-        ctx.gl.clone(),
-        &ctx.info,
-        scene,
-        &ShaderSource::default(),
-        opts,
-    )
+    try_ray_tracer(&context(), scene, opts)
 }
 
 /// Area lights need a flag bit per sample: the thesis' RGBA layout, and more samples than the
