@@ -80,8 +80,15 @@ pub mod defaults {
     pub const NTREE_DEPTH: u32 = 3;
 }
 
-/// The options of Müller 2015's pipeline, whatever its accelerator.
-const MUELLER: &[&str] = &["tracer", "refl-depth", "shadow-flags", "tile"];
+/// The options of Müller 2015's pipeline, whatever its accelerator (`light-samples`: the
+/// feelers towards each area light, ours after Klee 2016).
+const MUELLER: &[&str] = &[
+    "tracer",
+    "refl-depth",
+    "shadow-flags",
+    "tile",
+    "light-samples",
+];
 
 /// One design of the registry.
 pub struct Row {
@@ -337,6 +344,7 @@ impl Design {
                     ..GridOptions::default()
                 },
                 triangles_per_dispatch: None,
+                light_samples: defaults::LIGHT_SAMPLES,
             }),
             (Pipeline::Wagner2018, _) => Design::Wagner2018(WagnerOptions {
                 width,
@@ -437,11 +445,16 @@ impl Design {
         }
         crate::frame::check_host(w, h, self.aovs()).map_err(anyhow::Error::msg)?;
         let row = self.row();
-        if row.pipeline != Pipeline::Klee2016 && !scene.area_lights.is_empty() {
+        // Müller 2015's pipeline casts feelers towards area-light samples (ours), Klee 2016's
+        // is made for them; the others light with point lights only
+        let lights_areas = matches!(row.pipeline, Pipeline::Mueller2015 | Pipeline::Klee2016);
+        if !lights_areas && !scene.area_lights.is_empty() {
             bail!(
-                "{}: the point-light ray tracers light with [[light]]s only; the scene's {} \
-                 [[area_light]](s) would be ignored (render it with --shadows)",
+                "{}: {} lights with [[light]]s only; the scene's {} [[area_light]](s) would be \
+                 ignored (render it with --shadows, or with Müller 2015's pipeline: --tracer \
+                 base|grid|bvh --bvh-variant sah)",
                 scene.path.display(),
+                row.title,
                 scene.area_lights.len()
             );
         }

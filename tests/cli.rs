@@ -413,7 +413,15 @@ fn options_of_the_other_pipeline_are_refused() {
         &["--grid, --refl-depth do not apply", "from --shadows"],
     );
     let cow = scene("cow.toml");
-    let mut a = vec!["render", cow.as_str(), "--light-samples", "3x3"];
+    // the light samples belong to Müller 2015's pipeline and Klee 2016's, not the stream's
+    let mut a = vec![
+        "render",
+        cow.as_str(),
+        "--light-samples",
+        "3x3",
+        "--tracer",
+        "stream",
+    ];
     a.extend_from_slice(&small);
     assert_fails(&run(&a), &["--light-samples does not apply", "--shadows"]);
     // the streaming tracer's switches, with another tracer

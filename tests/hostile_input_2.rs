@@ -548,9 +548,18 @@ fn inputs_a_design_would_ignore_are_refused() {
         "point.toml",
         &format!("{point}\n[[light]]\nposition = [0, 3, 0]\n"),
     );
+    // Müller 2015's pipeline lights area lights (tests/area_lights.rs); the streaming
+    // tracer does not
     let o = run_in(
         dir,
-        &["render", point.to_str().unwrap(), "-o", "o.png"],
+        &[
+            "render",
+            point.to_str().unwrap(),
+            "-o",
+            "o.png",
+            "--tracer",
+            "stream",
+        ],
         None,
         60,
     );

@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::{self, GridVariant, TracerKind};
+use gpgpu_rt::accel::{self, TracerKind};
 use gpgpu_rt::frame::{Frame, RAY_KINDS};
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::reference::Reference;
@@ -17,34 +17,7 @@ const SIZE: u32 = 24;
 
 /// The pipeline's accelerators: (label, options).
 fn accelerators() -> Vec<(&'static str, RenderOptions)> {
-    let with = |tracer, variant, clouds: bool| {
-        let mut o = options(SIZE, SIZE, 1);
-        o.tracer = tracer;
-        o.grid.variant = variant;
-        o.grid.resolution = Some(16);
-        o.grid.proximity_clouds = clouds;
-        o
-    };
-    // the base tracer with its triangles split over 4 dispatches: a ray is counted once
-    let mut split = with(TracerKind::Base, GridVariant::Exact, false);
-    split.triangles_per_dispatch = Some(2000);
-    vec![
-        ("base", with(TracerKind::Base, GridVariant::Exact, false)),
-        ("base split", split),
-        (
-            "grid thesis",
-            with(TracerKind::Grid, GridVariant::Thesis, false),
-        ),
-        (
-            "grid exact",
-            with(TracerKind::Grid, GridVariant::Exact, false),
-        ),
-        (
-            "grid exact pc",
-            with(TracerKind::Grid, GridVariant::Exact, true),
-        ),
-        ("bvh sah", with(TracerKind::Bvh, GridVariant::Exact, false)),
-    ]
+    pipeline_accelerators(SIZE, SIZE, 1, 16)
 }
 
 /// A counter of a kind of `f`, 0 where the kind or the counter is absent.

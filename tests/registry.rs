@@ -216,3 +216,35 @@ fn every_row_renders() {
         assert!(lit > 16, "{row:?}: {lit} lit pixels");
     }
 }
+
+/// The designs that light an area light are those that take `--light-samples` (Müller 2015's
+/// pipeline, with its feelers per sample, and Klee 2016's); the others refuse such a scene by
+/// name rather than ignore the light.
+#[test]
+fn area_lights_are_lit_by_the_rows_that_take_light_samples() {
+    let ctx = context();
+    // the area light alone (Klee 2016's pipeline refuses point lights beside it)
+    let mut area = load("cow_area.toml");
+    area.lights.clear();
+    for row in REGISTRY {
+        let design = Design::plain(row, 16, 16, 0);
+        let made = design.renderer(ctx.gl.clone(), &ctx.info, &area, &Default::default());
+        match (row.takes("light-samples"), made) {
+            (true, Ok(mut r)) => {
+                let f = r
+                    .render(&area.camera)
+                    .unwrap_or_else(|e| panic!("{row:?}: {e:#}"));
+                assert!(f.stats.total_triangle_tests() > 0, "{row:?}");
+            }
+            (true, Err(e)) => panic!("{row:?} takes --light-samples but refuses: {e:#}"),
+            (false, Ok(_)) => panic!("{row:?} would ignore the area light"),
+            (false, Err(e)) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains("[[area_light]]") && msg.contains("ignored"),
+                    "{msg}"
+                );
+            }
+        }
+    }
+}

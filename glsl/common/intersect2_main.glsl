@@ -5,7 +5,9 @@
 // (true if a triangle other than lastTriID is hit with SHADOW_OFFSET < t < lightDistance).
 //
 // Dispatched once per light source (uniform lightSource). One shadow feeler per pixel from
-// the hit point of intersect1 towards the light. Early out: N·L <= 0 means the light is behind
+// the hit point of intersect1 towards the light. Ours: an area light is dispatched once per
+// light sample, each dispatch's feelers towards that sample setting the sample's own flag bit
+// (common/light_target.glsl); the shading kernel weights the light by the share of unset bits. Early out: N·L <= 0 means the light is behind
 // the surface — shadow without a test. The 0.02 offset (SHADOW_OFFSET) is the thesis'
 // correction for smoother transitions between the shadow and the lighting. The flag goes into
 // the shadow texture: one RGBA channel per light (the thesis, lights 0..3) or one bit per
@@ -14,7 +16,7 @@
 // textures once a frame, which would let a reflection pass inherit the flags of the pass
 // before it); see RayTracer::pass in src/pipeline/raytrace/mod.rs.
 
-uniform int lightSource;
+#include "light_target.glsl"
 
 // Is this light's shadow flag already set at storePos? (For a kernel that splits its search
 // over several dispatches: brute_force/intersect2.comp.)
@@ -46,7 +48,7 @@ void trace(ivec2 storePos)
     vec4 shadows = imageLoad(shadowTexture, storePos);
 #endif
     vec3 ro = originState.xyz;
-    vec3 toLight = lightPos[lightSource].xyz - ro;
+    vec3 toLight = feelerTarget() - ro;
     float lightDistance = length(toLight);
     vec3 rd = toLight / lightDistance;
 

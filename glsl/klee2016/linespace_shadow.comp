@@ -41,6 +41,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #define N NTREE_N
 #define COUNTER_SLOTS_PER_KERNEL 5
 #include "../common/counters.glsl"
+#include "../common/light_samples.glsl"
 
 #define GEOMETRY_BIT 1u
 #define CHILDREN_BIT 2u
@@ -137,10 +138,7 @@ int k = 0, u = 1, v = 2, dir = 1; // traversal axis, the other two, direction al
 
 vec3 samplePoint(int r)
 {
-    int i = r / SAMPLES_V;
-    int j = r - i * SAMPLES_V;
-    return lightCorner + (float(i) + 0.5) / float(SAMPLES_U) * lightEdgeU
-                       + (float(j) + 0.5) / float(SAMPLES_V) * lightEdgeV;
+    return lightSamplePoint(lightCorner, lightEdgeU, lightEdgeV, r, SAMPLES_U, SAMPLES_V);
 }
 
 // Algorithm 1 (preparation, first part): the shadow rays of one surface point from the offset

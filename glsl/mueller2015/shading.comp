@@ -5,6 +5,9 @@
 //     final = weight * final + (1 - weight) * temp;   final.w = weight + (1 - weight) * pColor.w
 // A ray that missed (rayState 0, colour buffer not empty) adds the background the same way.
 // Finally the rayState is decremented.
+// Ours, after Klee 2016: AREA_LIGHTS rectangular area lights, each lit as a point light at its
+// centre weighted by the share of its SAMPLES_U × SAMPLES_V feelers that intersect2 found
+// unblocked (the sample bits after the point lights' bits; docs/mueller2015.md, "Area lights").
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
@@ -14,6 +17,13 @@ layout(local_size_x = 8, local_size_y = 8) in;
 uniform vec4 camPosition;
 uniform vec4 ambientColor;
 uniform int lightCount;
+#if AREA_LIGHTS > 0 && !SHADOW_BITS
+#error "area lights need the bitwise shadow flags (a bit per light sample)"
+#endif
+#if AREA_LIGHTS > 0
+// per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
+uniform vec4 areaLight[4 * AREA_LIGHTS];
+#endif
 
 bool inShadow(ivec2 storePos, int l)
 {
@@ -23,6 +33,31 @@ bool inShadow(ivec2 storePos, int l)
 #else
     return imageLoad(shadowTexture, storePos)[l] > 0.5;
 #endif
+}
+
+#if AREA_LIGHTS > 0
+// The share of area light a's feelers at storePos that no triangle blocked: its sample bits
+// are lightCount + a·U·V … + U·V − 1 (a sample behind the surface counts as blocked, as
+// Listing 15 treats a point light behind it).
+float unblockedShare(ivec2 storePos, int a)
+{
+    const int samples = SAMPLES_U * SAMPLES_V;
+    uvec4 flags = imageLoad(shadowTexture, storePos);
+    int first = lightCount + a * samples;
+    int blocked = 0;
+    for (int s = first; s < first + samples; s++)
+        blocked += int((flags[s >> 5] >> uint(s & 31)) & 1u);
+    return float(samples - blocked) / float(samples);
+}
+#endif
+
+// The Phong terms of Listing 16's loop for a light from direction L.
+vec3 phong(vec3 n, vec3 L, vec3 view, vec4 mat, vec3 albedo)
+{
+    float diffuse = max(dot(n, L), 0.0);
+    vec3 R = reflect(-L, n);
+    float specular = mat.y * pow(max(dot(R, view), 0.0), mat.z);
+    return diffuse * albedo + vec3(specular);
 }
 
 void main()
@@ -47,11 +82,18 @@ void main()
         for (int l = 0; l < lightCount; l++) {
             if (inShadow(storePos, l)) continue;
             vec3 L = normalize(lightPos[l].xyz - p);
-            float diffuse = max(dot(n, L), 0.0);
-            vec3 R = reflect(-L, n);
-            float specular = mat.y * pow(max(dot(R, view), 0.0), mat.z);
-            temp_color += lightColor[l].rgb * (diffuse * pColor.rgb + vec3(specular));
+            temp_color += lightColor[l].rgb * phong(n, L, view, mat, pColor.rgb);
         }
+#if AREA_LIGHTS > 0
+        for (int a = 0; a < AREA_LIGHTS; a++) {
+            float share = unblockedShare(storePos, a);
+            if (share <= 0.0) continue;
+            vec3 centre = areaLight[4 * a].xyz
+                        + 0.5 * (areaLight[4 * a + 1].xyz + areaLight[4 * a + 2].xyz);
+            vec3 L = normalize(centre - p);
+            temp_color += share * areaLight[4 * a + 3].rgb * phong(n, L, view, mat, pColor.rgb);
+        }
+#endif
     } else {
         // the ray left the scene in this pass: the background colour
         temp_color = pColor.rgb;

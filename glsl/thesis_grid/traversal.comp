@@ -4,7 +4,8 @@
 // kernel's edges) and the ids of the non-empty voxels it passes are stored in traversal order
 // in its section of rayslist (ray_array_length entries), the count in raycontains.
 // traversalMode 0: the eye / reflected rays of the ray-state textures; 1: the shadow feelers
-// towards light lightSource (the thesis traverses both, ch. 3.2.4).
+// towards light lightSource (the thesis traverses both, ch. 3.2.4), or ours, towards one sample
+// of an area light (common/light_target.glsl).
 // Ours: the ray is first clipped to the grid box (the thesis' rays start inside [-1, 1)³).
 // A full list drops the remaining voxels: ray_list_overflows counts them.
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -15,6 +16,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/images.glsl"
 #include "../common/counters.glsl"
 #include "../common/grid.glsl"
+#include "../common/light_target.glsl"
 
 // The thesis' block names (Listing 19), though VerticesInVoxel holds triangle ids (N³ lists of
 // voxel_array_length) and ContainedVertices the fill level of each voxel's list.
@@ -23,7 +25,6 @@ layout(std430, binding = SSBO_RAYSLIST) writeonly buffer RaysList { int rayslist
 layout(std430, binding = SSBO_RAYCONTAINS) writeonly buffer RayContains { int raycontains[]; };
 
 uniform int traversalMode;
-uniform int lightSource;
 
 int start = 0;          // first position of this ray's list
 int voxelListCounter = 0;
@@ -70,7 +71,7 @@ void walkRay(ivec2 storePos)
         rd = imageLoad(rayDirTexture, storePos).xyz;
         tEnd = 1.0 / 0.0;
     } else {
-        vec3 toLight = lightPos[lightSource].xyz - ro;
+        vec3 toLight = feelerTarget() - ro;
         tEnd = length(toLight);
         rd = toLight / tEnd;
         // the light behind the surface: intersect2 sets the shadow without a test

@@ -12,7 +12,7 @@ use std::any::Any;
 
 use anyhow::Result;
 
-use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind};
+use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, LightTarget, TracerKind};
 use crate::frame::FrameStats;
 use crate::gl::{GlInfo, Kernel};
 use crate::scene::Scene;
@@ -104,10 +104,10 @@ impl Accelerator for BruteForce {
         &self.intersect1
     }
 
-    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, target: &LightTarget) -> &Kernel {
         self.intersect2.use_program();
         // the dispatches before the last need the light now
-        self.intersect2.set_i32("lightSource", light as i32);
+        target.set_uniforms(&self.intersect2);
         Self::split(&self.intersect2, &self.ranges, f);
         &self.intersect2
     }

@@ -15,7 +15,9 @@ use serde_json::json;
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
 use super::TracerKind;
-use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
+use super::{
+    Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant, LightTarget,
+};
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
@@ -273,7 +275,7 @@ impl Accelerator for ExactGrid {
         &self.intersect1
     }
 
-    fn occluded(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, _target: &LightTarget) -> &Kernel {
         self.lists.bind(f.gl);
         self.intersect2.use_program();
         self.frame.set_uniforms(&self.intersect2);

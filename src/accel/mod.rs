@@ -32,7 +32,7 @@ use std::any::Any;
 use std::sync::Arc;
 
 use anyhow::Result;
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use serde::Serialize;
 
 use crate::frame::FrameStats;
@@ -58,8 +58,10 @@ pub trait Accelerator {
     /// design's uniforms set, and return it. The pipeline sets the shared uniforms and
     /// dispatches it over the image.
     fn closest_hit(&mut self, f: &mut FrameContext, pass: u32) -> &Kernel;
-    /// The same for intersect2, the shadow feelers towards light `light` (any hit).
-    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel;
+    /// The same for intersect2, the shadow feelers towards `target` (any hit): a point light,
+    /// or one sample of an area light. A design that dispatches before returning (a traversal
+    /// pass, the base tracer's split) sets the target's uniforms on its kernels first.
+    fn occluded(&mut self, f: &mut FrameContext, target: &LightTarget) -> &Kernel;
     /// Add the design's facts (sizes, build time, settings) and events to the statistics.
     fn stats(&self, stats: &mut FrameStats);
     /// Whether the design's intersect1 stores hit records and its intersection kernels store
@@ -71,6 +73,45 @@ pub trait Accelerator {
     }
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
+}
+
+/// What the shadow feelers of one intersect2 dispatch aim at (`glsl/common/light_target.glsl`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightTarget {
+    /// Point light `0` (Listing 15): its flag is its index.
+    Point(usize),
+    /// Ours, after Klee 2016: sample `sample` of the area light `corner`, `edges`; its flag is
+    /// bit `slot` of the shadow flags.
+    AreaSample {
+        slot: usize,
+        sample: u32,
+        corner: Vec3,
+        edges: [Vec3; 2],
+    },
+}
+
+impl LightTarget {
+    /// Its uniforms, on `kernel` (in use).
+    pub fn set_uniforms(&self, kernel: &Kernel) {
+        match *self {
+            LightTarget::Point(light) => {
+                kernel.set_i32("lightSource", light as i32);
+                kernel.set_i32("lightSample", -1);
+            }
+            LightTarget::AreaSample {
+                slot,
+                sample,
+                corner,
+                edges,
+            } => {
+                kernel.set_i32("lightSource", slot as i32);
+                kernel.set_i32("lightSample", sample as i32);
+                kernel.set_vec3("areaCorner", corner.to_array());
+                kernel.set_vec3("areaEdgeU", edges[0].to_array());
+                kernel.set_vec3("areaEdgeV", edges[1].to_array());
+            }
+        }
+    }
 }
 
 /// What an accelerator gets from the pipeline during a frame.

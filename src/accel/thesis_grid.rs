@@ -16,7 +16,9 @@ use serde_json::json;
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
 use super::TracerKind;
-use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant};
+use super::{
+    Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant, LightTarget,
+};
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
@@ -101,13 +103,13 @@ impl ThesisGrid {
 
     /// The traversal kernel (Listing 21): every ray's non-empty voxels into `rayslist` — the
     /// primary or reflected rays (mode 0) or the shadow feelers towards `light` (mode 1).
-    fn traverse(&self, f: &mut FrameContext, light: Option<usize>) {
+    fn traverse(&self, f: &mut FrameContext, feelers: Option<&LightTarget>) {
         self.bind(f);
         let k = &self.traversal;
         k.use_program();
         self.frame.set_uniforms(k);
-        k.set_i32("traversalMode", light.is_some() as i32);
-        k.set_i32("lightSource", light.unwrap_or(0) as i32);
+        k.set_i32("traversalMode", feelers.is_some() as i32);
+        feelers.unwrap_or(&LightTarget::Point(0)).set_uniforms(k);
         k.dispatch_pixels(f.timers, f.pixels);
     }
 
@@ -163,8 +165,8 @@ impl Accelerator for ThesisGrid {
         &self.intersect1
     }
 
-    fn occluded(&mut self, f: &mut FrameContext, light: usize) -> &Kernel {
-        self.traverse(f, Some(light));
+    fn occluded(&mut self, f: &mut FrameContext, target: &LightTarget) -> &Kernel {
+        self.traverse(f, Some(target));
         self.intersect2.use_program();
         self.frame.set_uniforms(&self.intersect2);
         &self.intersect2

@@ -335,7 +335,12 @@ impl DesignArgs {
             ));
         }
         let refl_depth = self.refl_depth.unwrap_or(scene.settings.refl_depth);
-        Ok(self.tracer_design(row, size, refl_depth, aovs))
+        // the scene's light samples where the command line gives none
+        let this = DesignArgs {
+            soft,
+            ..self.clone()
+        };
+        Ok(this.tracer_design(row, size, refl_depth, aovs))
     }
 
     /// The point-light design `row` with these options.
@@ -367,6 +372,7 @@ impl DesignArgs {
                 aovs,
                 grid: self.grid.options(),
                 triangles_per_dispatch: None,
+                light_samples: self.soft.samples(),
             }),
         }
     }

@@ -208,6 +208,11 @@ impl Kernel {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_4_f32(self.loc(name), v[0], v[1], v[2], w) };
     }
+    pub fn set_vec4_slice(&self, name: &str, v: &[[f32; 4]]) {
+        let flat: Vec<f32> = v.iter().flatten().copied().collect();
+        // SAFETY: a uniform vec4 array of the program in use, of at least v.len() elements.
+        unsafe { self.gl.uniform_4_f32_slice(self.loc(name), &flat) };
+    }
     pub fn set_mat3(&self, name: &str, m: &[f32; 9]) {
         // SAFETY: a uniform of the program in use.
         unsafe { self.gl.uniform_matrix_3_f32_slice(self.loc(name), false, m) };

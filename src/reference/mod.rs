@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use crate::accel::grid_frame::{resolution, GridMapping};
 use crate::accel::{self, bvh::BvhTree, GridOptions, GridVariant, TracerKind};
 use crate::frame::Aovs;
-use crate::scene::{Camera, Scene, WorldAttributes};
+use crate::scene::{AreaLight, Camera, Scene, WorldAttributes};
 
 /// A closest hit: ray parameter, triangle id and barycentric (u, v).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,6 +147,10 @@ pub struct Reference {
     attributes: WorldAttributes,
     materials: Vec<Vec4>,
     lights: Vec<(Vec3, Vec3)>,
+    /// Per area light: its sample points (Klee's, [`linespace::light_samples`]), centre and
+    /// colour; the samples as [`Reference::with_light_samples`] says.
+    area_lights: Vec<(Vec<Vec3>, Vec3, Vec3)>,
+    area_defs: Vec<AreaLight>,
     layers: (u32, u32, Vec<image::RgbaImage>),
     background: Vec3,
     ambient: Vec3,
@@ -226,11 +230,24 @@ impl Reference {
                 })
                 .collect(),
             lights: scene.lights.iter().map(|l| (l.position, l.color)).collect(),
+            area_lights: Vec::new(),
+            area_defs: scene.area_lights.clone(),
             layers: scene.texture_layers(16384),
             background: Vec3::from(scene.settings.background),
             ambient: Vec3::from(scene.settings.ambient),
             shadow_offset: scene.settings.shadow_offset,
         }
+        .with_light_samples(crate::design::defaults::LIGHT_SAMPLES)
+    }
+
+    /// The reference with `su`×`sv` feelers towards every area light (`--light-samples`).
+    pub fn with_light_samples(mut self, (su, sv): (u32, u32)) -> Reference {
+        self.area_lights = self
+            .area_defs
+            .iter()
+            .map(|a| (linespace::light_samples(a, su, sv), a.center(), a.color))
+            .collect();
+        self
     }
 
     /// Bilinear lookup with repeat wrapping, as GL_LINEAR / GL_REPEAT on RGBA8 at level 0.
@@ -263,6 +280,46 @@ impl Reference {
                 (shadow, tests, true)
             }
         }
+    }
+
+    /// The shading kernel at a hit (Listing 16's loop), after the shadow feelers of
+    /// intersect2 towards every point light and every sample of every area light: the colour
+    /// and the lit share (the shadow AOV: an area light counts with its unblocked share).
+    fn shade(&self, s: &Surface, out: &mut PixelResult) -> (Vec3, f32) {
+        let phong = |l: Vec3| {
+            let diffuse = s.n.dot(l).max(0.0);
+            let r = reflect(-l, s.n);
+            let specular = s.mat.y * r.dot(s.view).max(0.0).powf(s.mat.z);
+            diffuse * s.color + Vec3::splat(specular)
+        };
+        let mut temp = self.ambient * s.color;
+        let mut lit = 0.0;
+        let mut feeler = |light: usize, target: Vec3| {
+            let (shadow, tests, traced) = self.shadowed(s.p, s.n, s.id, target);
+            out.tests2 += tests;
+            if traced {
+                out.rays[if light == 0 { 1 } else { 2 }] += 1;
+            }
+            shadow
+        };
+        for (light, &(lp, lc)) in self.lights.iter().enumerate() {
+            if feeler(light, lp) {
+                continue;
+            }
+            lit += 1.0;
+            temp += lc * phong((lp - s.p).normalize());
+        }
+        for (a, (samples, centre, lc)) in self.area_lights.iter().enumerate() {
+            let light = self.lights.len() + a;
+            let open = samples.iter().filter(|&&q| !feeler(light, q)).count();
+            let share = open as f32 / samples.len() as f32;
+            lit += share;
+            if share > 0.0 {
+                temp += share * *lc * phong((*centre - s.p).normalize());
+            }
+        }
+        let all = self.lights.len() + self.area_lights.len();
+        (temp, if all == 0 { 1.0 } else { lit / all as f32 })
     }
 
     /// Trace one pixel through `refl_depth + 1` passes, as the kernels do.
@@ -320,26 +377,17 @@ impl Reference {
                     }
                     // shadow feelers and shading at p
                     let view = (camera_pos - p).normalize();
-                    let mut temp = self.ambient * color;
-                    let mut unblocked = 0;
-                    for (light, &(lp, lc)) in self.lights.iter().enumerate() {
-                        let (shadow, tests, traced) = self.shadowed(p, n, id, lp);
-                        out.tests2 += tests;
-                        if traced {
-                            out.rays[if light == 0 { 1 } else { 2 }] += 1;
-                        }
-                        if shadow {
-                            continue;
-                        }
-                        unblocked += 1;
-                        let l = (lp - p).normalize();
-                        let diffuse = n.dot(l).max(0.0);
-                        let r = reflect(-l, n);
-                        let specular = mat.y * r.dot(view).max(0.0).powf(mat.z);
-                        temp += lc * (diffuse * color + Vec3::splat(specular));
-                    }
-                    if pass == 0 && !self.lights.is_empty() {
-                        out.lit = unblocked as f32 / self.lights.len() as f32;
+                    let surface = Surface {
+                        p,
+                        n,
+                        id,
+                        mat,
+                        color,
+                        view,
+                    };
+                    let (temp, lit) = self.shade(&surface, &mut out);
+                    if pass == 0 {
+                        out.lit = lit;
                     }
                     ro = p;
                     last = id as i32;
@@ -407,6 +455,16 @@ impl Reference {
         }
         frame
     }
+}
+
+/// A hit point as the shading kernel sees it.
+struct Surface {
+    p: Vec3,
+    n: Vec3,
+    id: usize,
+    mat: Vec4,
+    color: Vec3,
+    view: Vec3,
 }
 
 #[derive(Default)]

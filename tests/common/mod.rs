@@ -38,11 +38,21 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         aovs: true,
         grid: Default::default(),
         triangles_per_dispatch: None,
+        light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
     }
 }
 
 /// The ray tracer with the accelerator `opts.tracer` for `scene`, kernels built in.
 pub fn ray_tracer(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> RayTracer {
+    try_ray_tracer(ctx, scene, opts).expect("tracer")
+}
+
+/// [`ray_tracer`], or why it is refused.
+pub fn try_ray_tracer(
+    ctx: &GlContext,
+    scene: &Scene,
+    opts: RenderOptions,
+) -> anyhow::Result<RayTracer> {
     RayTracer::new(
         ctx.gl.clone(),
         &ctx.info,
@@ -50,7 +60,45 @@ pub fn ray_tracer(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> RayTra
         &ShaderSource::default(),
         opts,
     )
-    .expect("tracer")
+}
+
+/// Every accelerator of Müller 2015's pipeline at `w`×`h` with `refl_depth` reflection passes
+/// and grids of `n`³, the base tracer also with its triangles split over dispatches of 2000
+/// (a ray counted once, a found occluder carried in the flag): (label, options).
+pub fn pipeline_accelerators(
+    w: u32,
+    h: u32,
+    refl_depth: u32,
+    n: u32,
+) -> Vec<(&'static str, RenderOptions)> {
+    use gpgpu_rt::accel::GridVariant;
+    let with = |tracer, variant, clouds: bool| {
+        let mut o = options(w, h, refl_depth);
+        o.tracer = tracer;
+        o.grid.variant = variant;
+        o.grid.resolution = Some(n);
+        o.grid.proximity_clouds = clouds;
+        o
+    };
+    let mut split = with(TracerKind::Base, GridVariant::Exact, false);
+    split.triangles_per_dispatch = Some(2000);
+    vec![
+        ("base", with(TracerKind::Base, GridVariant::Exact, false)),
+        ("base split", split),
+        (
+            "grid thesis",
+            with(TracerKind::Grid, GridVariant::Thesis, false),
+        ),
+        (
+            "grid exact",
+            with(TracerKind::Grid, GridVariant::Exact, false),
+        ),
+        (
+            "grid exact pc",
+            with(TracerKind::Grid, GridVariant::Exact, true),
+        ),
+        ("bvh sah", with(TracerKind::Bvh, GridVariant::Exact, false)),
+    ]
 }
 
 pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {

@@ -15,7 +15,8 @@ use glam::{Mat4, Vec3};
 use serde_json::json;
 
 use super::{
-    Accelerator, BuildContext, Entry, FrameContext, GridOptions, TracerKind, MAX_PIXEL_EVENTS,
+    Accelerator, BuildContext, Entry, FrameContext, GridOptions, LightTarget, TracerKind,
+    MAX_PIXEL_EVENTS,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
@@ -244,7 +245,7 @@ impl Accelerator for Bvh {
         &self.intersect1
     }
 
-    fn occluded(&mut self, f: &mut FrameContext, _light: usize) -> &Kernel {
+    fn occluded(&mut self, f: &mut FrameContext, _target: &LightTarget) -> &Kernel {
         self.bind(f.gl, glow::READ_ONLY);
         self.intersect2.use_program();
         &self.intersect2

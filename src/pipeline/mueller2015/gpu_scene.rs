@@ -105,7 +105,7 @@ impl VertexData {
 
 /// What the transform pass needs of the device, and a warning for a scene without lights.
 fn check_device(info: &GlInfo, scene: &Scene) -> Result<()> {
-    if scene.lights.is_empty() {
+    if scene.lights.is_empty() && scene.area_lights.is_empty() {
         log::warn!(
             "{}: the scene has no lights; only ambient light",
             scene.path.display()

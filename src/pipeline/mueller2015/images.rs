@@ -73,7 +73,8 @@ pub struct AovImages {
     normal: Image2d,
     shadow: Image2d,
     flags: ShadowFlags,
-    lights: usize,
+    /// Point lights, area lights, samples per area light (see [`super::shadow_slots`]).
+    lights: (usize, usize, usize),
 }
 
 impl AovImages {
@@ -82,7 +83,7 @@ impl AovImages {
         w: u32,
         h: u32,
         flags: ShadowFlags,
-        lights: usize,
+        lights: (usize, usize, usize),
     ) -> Result<AovImages> {
         Ok(AovImages {
             ray_origin: Image2d::new(gl, w, h, glow::RGBA32F)?,
@@ -106,35 +107,33 @@ impl AovImages {
         self.shadow.copy_from(gl, &images.shadow);
     }
 
-    /// Per pixel, the share of the point lights whose shadow feeler of the first pass was not
-    /// blocked (a light behind the surface counts as blocked, as Listing 15 treats it); 1 where
-    /// the primary ray missed (no feelers) or the scene has no lights. GL row order.
+    /// Per pixel, the share of the lights whose shadow feeler of the first pass was not
+    /// blocked (a light behind the surface counts as blocked, as Listing 15 treats it), an
+    /// area light counting with the share of its samples' feelers unblocked; 1 where the
+    /// primary ray missed (no feelers) or the scene has no lights. GL row order.
     fn lit_share(&self, gl: &Gl) -> Vec<f32> {
-        let n = self.lights;
-        let blocked: Vec<usize> = match self.flags {
+        let (n, areas, samples) = self.lights;
+        match self.flags {
             ShadowFlags::Bits => self
                 .shadow
                 .read_u32(gl)
                 .iter()
-                .map(|f| f.iter().map(|w| w.count_ones() as usize).sum())
+                .map(|f| lit_share_of_bits(f, n, areas, samples))
                 .collect(),
             ShadowFlags::Rgba => self
                 .shadow
                 .read_f32(gl)
                 .iter()
-                .map(|f| f[..n.min(4)].iter().filter(|&&c| c > 0.5).count())
+                .map(|f| {
+                    let blocked = f[..n.min(4)].iter().filter(|&&c| c > 0.5).count();
+                    if n == 0 {
+                        1.0
+                    } else {
+                        (n - blocked) as f32 / n as f32
+                    }
+                })
                 .collect(),
-        };
-        blocked
-            .iter()
-            .map(|&b| {
-                if n == 0 {
-                    1.0
-                } else {
-                    (n - b) as f32 / n as f32
-                }
-            })
-            .collect()
+        }
     }
 
     /// The AOVs of the last frame, row 0 = the top image row.
@@ -149,5 +148,23 @@ impl AovImages {
             normal: flip_xyz(&self.normal.read_f32(gl), w, h),
             shadow: Some(flip_rows(&self.lit_share(gl), w, h)),
         }
+    }
+}
+
+/// The lit share of one pixel's bitwise flags: `lights` point lights with a bit each, then
+/// `areas` area lights with `samples` bits each (`super::shadow_slots`).
+pub fn lit_share_of_bits(flags: &[u32; 4], lights: usize, areas: usize, samples: usize) -> f32 {
+    let set = |s: usize| flags[s >> 5] >> (s & 31) & 1 == 1;
+    let points = (0..lights).filter(|&l| !set(l)).count() as f32;
+    let area_share: f32 = (0..areas)
+        .map(|a| {
+            let first = lights + a * samples;
+            let open = (first..first + samples).filter(|&s| !set(s)).count();
+            open as f32 / samples as f32
+        })
+        .sum();
+    match lights + areas {
+        0 => 1.0,
+        all => (points + area_share) / all as f32,
     }
 }

@@ -22,12 +22,13 @@ use self::records::Records;
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
-    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, TracerKind,
+    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, LightTarget,
+    TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::scene::{Camera, CameraRays, Scene};
+use crate::scene::{AreaLight, Camera, CameraRays, Scene};
 
 /// How the shadow flags of intersect2 are stored (Müller 2015, Listing 15 and ch. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
@@ -76,6 +77,9 @@ pub struct RenderOptions {
     /// The base tracer's triangles per dispatch (`accel::BuildContext`); `None`: as the GL
     /// implementation needs.
     pub triangles_per_dispatch: Option<u32>,
+    /// `--light-samples` U×V: the feelers towards each area light per hit point (ours, after
+    /// Klee 2016; the scene's point lights get one each, as Listing 15).
+    pub light_samples: (u32, u32),
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -118,7 +122,11 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // what the hit evaluation may skip (common/intersect1_hit.glsl): the first hits' store
         // when no AOVs are asked, the texture lookup in a scene without textures
         .set("STORE_AOVS", options.aovs as i32)
-        .set("SCENE_TEXTURES", !scene.textures.is_empty() as i32);
+        .set("SCENE_TEXTURES", !scene.textures.is_empty() as i32)
+        // the area lights' samples (common/light_target.glsl, shading.comp)
+        .set("SAMPLES_U", options.light_samples.0)
+        .set("SAMPLES_V", options.light_samples.1)
+        .set("AREA_LIGHTS", scene.area_lights.len());
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -134,8 +142,50 @@ struct Kernels {
 /// The scene's lighting and background, as the kernels' uniforms take them.
 struct Lighting {
     lights: usize,
+    area_lights: Vec<AreaLight>,
     background: [f32; 3],
     ambient: [f32; 3],
+}
+
+impl Lighting {
+    /// The shading kernel's `areaLight` array: corner, edge u, edge v, colour per area light.
+    fn area_uniform(&self) -> Vec<[f32; 4]> {
+        self.area_lights
+            .iter()
+            .flat_map(|a| [a.corner, a.edge_u, a.edge_v, a.color].map(|v| v.extend(0.0).into()))
+            .collect()
+    }
+}
+
+/// The shadow flags' bits (ours, after Klee 2016, for area lights): point light `l` has bit
+/// `l` (Listing 15, the bitwise flags of ch. 5); then every area light U·V bits, one per
+/// sample in Klee's sample order. The feelers of one intersect2 dispatch set one bit; the
+/// shading kernel weights an area light by the share of its bits left unset.
+pub fn shadow_slots(scene: &Scene, (su, sv): (u32, u32)) -> usize {
+    scene.lights.len() + scene.area_lights.len() * (su * sv) as usize
+}
+
+/// The intersect2 dispatches of a pass, in order: each with the light it counts under
+/// ([`Bank::occluded`]: point lights first, then the area lights) and its feelers' target.
+pub fn light_targets(
+    lights: usize,
+    area_lights: &[AreaLight],
+    (su, sv): (u32, u32),
+) -> Vec<(usize, LightTarget)> {
+    let samples = (su * sv) as usize;
+    let points = (0..lights).map(|l| (l, LightTarget::Point(l)));
+    let areas = area_lights.iter().enumerate().flat_map(move |(a, area)| {
+        (0..samples).map(move |r| {
+            let target = LightTarget::AreaSample {
+                slot: lights + a * samples + r,
+                sample: r as u32,
+                corner: area.corner,
+                edges: [area.edge_u, area.edge_v],
+            };
+            (lights + a, target)
+        })
+    });
+    points.chain(areas).collect()
 }
 
 /// The ray tracer: Müller 2015's pipeline with one accelerator.
@@ -165,12 +215,40 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
     if scene.lights.len() > options.shadow_flags.max_lights() {
         bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
+    check_area_lights(scene, options)?;
     let max_tex = info.max_texture_size as u32;
     let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > max_tex || h > max_tex {
         bail!("image size {w}x{h} outside 1..={max_tex} (GL_MAX_TEXTURE_SIZE)");
     }
     PixelGrid::new(w, h, options.tile, info.dispatch_threads())
+}
+
+/// Area lights need a flag bit per sample: the bitwise layout, with room for every sample.
+fn check_area_lights(scene: &Scene, options: &RenderOptions) -> Result<()> {
+    let areas = scene.area_lights.len();
+    if areas == 0 {
+        return Ok(());
+    }
+    let (su, sv) = options.light_samples;
+    let path = scene.path.display();
+    if options.shadow_flags != ShadowFlags::Bits {
+        bail!(
+            "{path}: {areas} [[area_light]](s) need --shadow-flags bits (a flag bit per light \
+             sample); --shadow-flags rgba holds one flag per point light"
+        );
+    }
+    let slots = shadow_slots(scene, options.light_samples);
+    let most = ShadowFlags::Bits.max_lights();
+    if slots > most {
+        bail!(
+            "{path}: {} point light(s) and {areas} area light(s) at --light-samples {su}x{sv} \
+             need {slots} shadow flag bits, but --shadow-flags bits holds {most}: use fewer \
+             samples or lights",
+            scene.lights.len()
+        );
+    }
+    Ok(())
 }
 
 /// The error for more lights than `flags` holds: it suggests the bitwise layout only where
@@ -235,7 +313,11 @@ impl RayTracer {
             images: RayImages::new(&gl, w, h, options.shadow_flags)?,
             aov_images: options
                 .aovs
-                .then(|| AovImages::new(&gl, w, h, options.shadow_flags, scene.lights.len()))
+                .then(|| {
+                    let samples = (options.light_samples.0 * options.light_samples.1) as usize;
+                    let lights = (scene.lights.len(), scene.area_lights.len(), samples);
+                    AovImages::new(&gl, w, h, options.shadow_flags, lights)
+                })
                 .transpose()?,
             scene: gpu_scene,
             kernels,
@@ -243,6 +325,7 @@ impl RayTracer {
             timers: GpuTimers::new(&gl),
             lighting: Lighting {
                 lights: scene.lights.len(),
+                area_lights: scene.area_lights.clone(),
                 background: scene.settings.background,
                 ambient: scene.settings.ambient,
             },
@@ -309,10 +392,11 @@ impl RayTracer {
         // clears the textures once a frame; intersect2 only sets flags, so a reflection pass
         // would inherit the flags of the pass before it)
         self.images.shadow.clear(&self.gl);
-        for light in 0..self.lighting.lights {
+        let l = &self.lighting;
+        for (light, target) in light_targets(l.lights, &l.area_lights, self.options.light_samples) {
             self.counters.bind(f.gl, f.timers, Bank::occluded(light));
-            let k = self.accel.occluded(&mut f, light);
-            k.set_i32("lightSource", light as i32);
+            let k = self.accel.occluded(&mut f, &target);
+            target.set_uniforms(k);
             k.dispatch_pixels(f.timers, f.pixels);
             if let Some(r) = &self.records {
                 r.add_counts(f.timers, "intersect2");
@@ -324,7 +408,21 @@ impl RayTracer {
         k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
         k.set_vec4("ambientColor", self.lighting.ambient, 1.0);
         k.set_i32("lightCount", self.lighting.lights as i32);
+        k.set_vec4_slice("areaLight", &self.lighting.area_uniform());
         k.dispatch_pixels(&mut self.timers, self.pixels);
+    }
+
+    /// The area lights and their samples, for the settings (none without area lights).
+    fn area_settings(&self) -> Vec<(&'static str, serde_json::Value)> {
+        let areas = self.lighting.area_lights.len();
+        let (su, sv) = self.options.light_samples;
+        match areas {
+            0 => vec![],
+            _ => vec![
+                ("area_lights", json!(areas)),
+                ("light_samples", json!(format!("{su}x{sv}"))),
+            ],
+        }
     }
 
     /// The counters and timers of the frame, with the accelerator's facts.
@@ -448,6 +546,7 @@ impl Renderer for RayTracer {
         ]
         .into_iter()
         .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
+        .chain(self.area_settings())
         .map(|(k, v)| (k.to_string(), v))
         .collect()
     }

@@ -74,6 +74,7 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
             aovs,
             grid,
             triangles_per_dispatch: None,
+            light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
         })
     };
     match c.tracer {
