@@ -19,8 +19,8 @@
 //                              walks, the nodes away from the origin first (phase 0: cheap
 //                              line-space hits), then the nodes near it (phase 1: exact tests)
 //                              for the rays still unblocked; a leaf's triangles are taken one
-//                              by one for all its rays, and one whose plane has the origin and
-//                              the light's four corners on one side is skipped for the packet.
+//                              by one for all its rays, and one that no ray of the packet can
+//                              cross (packetMisses: plane, light pyramid) is skipped for all.
 // NEAR_ORIGIN_RULE and BIT_IS_HIT come from the host (ShadowMode::near_origin_rule, bit_is_hit).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
@@ -144,6 +144,8 @@ struct Shaft {
 } shaft;
 
 int active_rays = 0;    // the number of active rays
+#define RAY_WORDS ((NUM_RAYS + 31) / 32)
+uint activeBits[RAY_WORDS]; // shaft.active_rays as bits, for linespace-fast's loops over them
 vec3 originWorld = vec3(0.0); // the shadow rays' common origin in world space
 int k = 0, u = 1, v = 2, dir = 1; // traversal axis, the other two, direction along k (+1 / -1)
 
@@ -163,12 +165,14 @@ void initShaft(vec3 pos, vec3 normal)
 {
     originWorld = pos + normal * shadowOffset;
     active_rays = 0;
+    for (int w = 0; w < RAY_WORDS; w++) activeBits[w] = 0u;
     for (int r = 0; r < NUM_RAYS; r++) {
         // samples behind the surface are blocked by it (N·L <= 0)
         vec3 l = samplePoint(r);
         bool front = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
         shaft.active_rays[r] = uint(front);
         if (front) active_rays++;
+        if (front) activeBits[r >> 5] |= 1u << uint(r & 31);
         shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
     }
     // initialise the shaft: transform into the N-tree coordinate system
@@ -279,6 +283,13 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
     return ((entry >> uint(bit_position)) & 1u) != 0u;
 }
 
+void deactivateRay(int r)
+{
+    shaft.active_rays[r] = 0u;
+    activeBits[r >> 5] &= ~(1u << uint(r & 31));
+    active_rays--;
+}
+
 void countLookups(int depth, uint n)
 {
     if (depth == 0) lookupsDepth0 += n; else lookupsDepth1 += n;
@@ -294,11 +305,27 @@ bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
     if (!getEntry(node, sf, sd, ef, ed)) return false;
     if (deactivate) {
-        shaft.active_rays[r] = 0u;
-        active_rays--;
+        deactivateRay(r);
         raysBlockedLinespace++;
     }
     return true;
+}
+
+// linespace-fast: Algorithm 2 at the last line-space depth over the active rays alone (their
+// bits), so a packet with few rays left costs few loop iterations; the same rays in the same
+// order as the loop of isIntersection
+bool isIntersectionActive(uvec2 node, vec3 childStart, float te)
+{
+    bool found = false;
+    for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
+        uint bits = activeBits[w];
+        while (bits != 0u && WITHIN_BUDGET) {
+            int r = 32 * w + findLSB(bits);
+            bits &= bits - 1u;
+            found = lineSpaceRay(r, node, childStart, te, true) || found;
+        }
+    }
+    return found;
 }
 
 // Algorithm 2: isIntersection. deactivate: at the last depth with line spaces a set bit is a
@@ -308,10 +335,14 @@ bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
     bool found_intersection = false;
     float te = tEnd(level);
     uint before = linespaceLookups;
-    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
-        bool found = lineSpaceRay(r, node, childStart, te, deactivate);
-        if (found && !deactivate) { found_intersection = true; break; }
-        found_intersection = found_intersection || found;
+    if (FAST_PATH == 1 && deactivate) {
+        found_intersection = isIntersectionActive(node, childStart, te);
+    } else {
+        for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
+            bool found = lineSpaceRay(r, node, childStart, te, deactivate);
+            if (found && !deactivate) { found_intersection = true; break; }
+            found_intersection = found_intersection || found;
+        }
     }
     countLookups(level - 1, linespaceLookups - before);
     return found_intersection;
@@ -350,8 +381,7 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     uint count = node.g;
     for (uint i = 0u; i < count && WITHIN_BUDGET; i++) {
         if (occludes(leafTriangles[off + i], originWorld, rd)) {
-            shaft.active_rays[r] = 0u;
-            active_rays--;
+            deactivateRay(r);
             raysBlockedTriangle++;
             return;
         }
@@ -397,22 +427,24 @@ bool packetMisses(uint t)
         && s * dot(n, lightCorners[2] - v0) > eps && s * dot(n, lightCorners[3] - v0) > eps;
 }
 
-#define RAY_WORDS ((NUM_RAYS + 31) / 32)
-
 // linespace-fast: the active rays that cross a leaf (Kay–Kajiya), a bit each; their number
 int crossingRays(vec3 childStart, float te, out uint crossing[RAY_WORDS])
 {
     int n = 0;
-    for (int w = 0; w < RAY_WORDS; w++) crossing[w] = 0u;
-    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
-        int sf, ef;
-        ivec2 sd, ed;
-        if (shaft.active_rays[r] == 0u
-            || !isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed))
-            continue;
-        crossing[r >> 5] |= 1u << uint(r & 31);
-        n++;
-        leafRays++;
+    for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
+        crossing[w] = 0u;
+        uint bits = activeBits[w];
+        while (bits != 0u && WITHIN_BUDGET) {
+            int r = 32 * w + findLSB(bits);
+            bits &= bits - 1u;
+            int sf, ef;
+            ivec2 sd, ed;
+            if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed))
+                continue;
+            crossing[w] |= 1u << uint(r & 31);
+            n++;
+            leafRays++;
+        }
     }
     return n;
 }
@@ -430,15 +462,14 @@ void leafTestsPacket(uvec2 node, vec3 childStart, int level)
         uint t = leafTriangles[off + i];
         if (packetMisses(t)) { trianglesCulled++; continue; }
         if (left < 0) left = crossingRays(childStart, tEnd(level), crossing);
-        for (int w = 0; w < RAY_WORDS; w++) {
+        for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
             uint bits = crossing[w];
             while (bits != 0u && WITHIN_BUDGET) {
                 int r = 32 * w + findLSB(bits);
                 bits &= bits - 1u;
                 if (!occludes(t, originWorld, samplePoint(r) - originWorld)) continue;
                 crossing[w] &= ~(1u << uint(r & 31));
-                shaft.active_rays[r] = 0u;
-                active_rays--;
+                deactivateRay(r);
                 left--;
                 raysBlockedTriangle++;
             }
