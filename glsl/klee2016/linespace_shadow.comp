@@ -15,6 +15,12 @@
 //                              near-origin rule (NEAR_ORIGIN_RULE 0).
 //   SHADOW_MODE 4 (variant2):  Table 2's "Variante 2" as defined: mode 1 without it — the
 //                              deepest level is never visited, no triangle is tested.
+//   SHADOW_MODE 5 (linespace-fast, FAST_PATH 1): ours, mode 1's answer for less work — two
+//                              walks, the nodes away from the origin first (phase 0: cheap
+//                              line-space hits), then the nodes near it (phase 1: exact tests)
+//                              for the rays still unblocked; a leaf's triangles are taken one
+//                              by one for all its rays, and one that no ray of the packet can
+//                              cross (packetMisses: plane, light pyramid) is skipped for all.
 // NEAR_ORIGIN_RULE and BIT_IS_HIT come from the host (ShadowMode::near_origin_rule, bit_is_hit).
 // The node containing the rays' common origin has no entry side, hence no line-space entry:
 // it is always descended and its leaves are tested exactly (not said in the thesis; without
@@ -39,7 +45,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
-#define COUNTER_SLOTS_PER_KERNEL 5
+#define COUNTER_SLOTS_PER_KERNEL 15
 #include "../common/counters.glsl"
 #include "../common/light_samples.glsl"
 
@@ -86,6 +92,12 @@ uint nodesVisited = 0u;
 uint truncated = 0u;
 uint packetFailures = 0u;
 uint loopIterations = 0u;
+// where the time goes (shadow_pass::COUNTERS)
+uint lookupsDepth0 = 0u, lookupsDepth1 = 0u;
+uint descentsNear = 0u, descentsLinespace = 0u;
+uint leafRays = 0u, raysBlockedLinespace = 0u, raysBlockedTriangle = 0u, trianglesCulled = 0u;
+int phase = 0;          // linespace-fast: 0 the nodes away from the origin, 1 those near it
+vec3 lightCorners[4];   // world space, Listing 2's corner order
 
 // false once the invocation has used up its loop budget
 bool loopStep()
@@ -133,6 +145,8 @@ struct Shaft {
 } shaft;
 
 int active_rays = 0;    // the number of active rays
+#define RAY_WORDS ((NUM_RAYS + 31) / 32)
+uint activeBits[RAY_WORDS]; // shaft.active_rays as bits, for linespace-fast's loops over them
 vec3 originWorld = vec3(0.0); // the shadow rays' common origin in world space
 int k = 0, u = 1, v = 2, dir = 1; // traversal axis, the other two, direction along k (+1 / -1)
 
@@ -149,12 +163,14 @@ void initShaft(vec3 pos, vec3 normal)
 {
     originWorld = pos + normal * shadowOffset;
     active_rays = 0;
+    for (int w = 0; w < RAY_WORDS; w++) activeBits[w] = 0u;
     for (int r = 0; r < NUM_RAYS; r++) {
         // samples behind the surface are blocked by it (N·L <= 0)
         vec3 l = samplePoint(r);
         bool front = r >= rayBegin && r < rayEnd && dot(normal, l - pos) > 0.0;
         shaft.active_rays[r] = uint(front);
         if (front) active_rays++;
+        if (front) activeBits[r >> 5] |= 1u << uint(r & 31);
         shaft.ray_direction[r] = (l - originWorld) * invNodeSize;
     }
     // initialise the shaft: transform into the N-tree coordinate system
@@ -265,6 +281,18 @@ bool getEntry(uvec2 node, int startFace, ivec2 startDim, int endFace, ivec2 endD
     return ((entry >> uint(bit_position)) & 1u) != 0u;
 }
 
+void deactivateRay(int r)
+{
+    shaft.active_rays[r] = 0u;
+    activeBits[r >> 5] &= ~(1u << uint(r & 31));
+    active_rays--;
+}
+
+void countLookups(int depth, uint n)
+{
+    if (depth == 0) lookupsDepth0 += n; else lookupsDepth1 += n;
+}
+
 // Algorithm 2, one ray: true if the ray crosses the node and its line-space bit is set; at
 // the last depth with line spaces (deactivate) the ray is then deactivated.
 bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
@@ -275,10 +303,27 @@ bool lineSpaceRay(int r, uvec2 node, vec3 childStart, float te, bool deactivate)
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return false;
     if (!getEntry(node, sf, sd, ef, ed)) return false;
     if (deactivate) {
-        shaft.active_rays[r] = 0u;
-        active_rays--;
+        deactivateRay(r);
+        raysBlockedLinespace++;
     }
     return true;
+}
+
+// linespace-fast: Algorithm 2 at the last line-space depth over the active rays alone (their
+// bits), so a packet with few rays left costs few loop iterations; the same rays in the same
+// order as the loop of isIntersection
+bool isIntersectionActive(uvec2 node, vec3 childStart, float te)
+{
+    bool found = false;
+    for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
+        uint bits = activeBits[w];
+        while (bits != 0u && WITHIN_BUDGET) {
+            int r = 32 * w + findLSB(bits);
+            bits &= bits - 1u;
+            found = lineSpaceRay(r, node, childStart, te, true) || found;
+        }
+    }
+    return found;
 }
 
 // Algorithm 2: isIntersection. deactivate: at the last depth with line spaces a set bit is a
@@ -287,11 +332,17 @@ bool isIntersection(uvec2 node, vec3 childStart, int level, bool deactivate)
 {
     bool found_intersection = false;
     float te = tEnd(level);
-    for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
-        bool found = lineSpaceRay(r, node, childStart, te, deactivate);
-        if (found && !deactivate) return true;
-        found_intersection = found_intersection || found;
+    uint before = linespaceLookups;
+    if (FAST_PATH == 1 && deactivate) {
+        found_intersection = isIntersectionActive(node, childStart, te);
+    } else {
+        for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) {
+            bool found = lineSpaceRay(r, node, childStart, te, deactivate);
+            if (found && !deactivate) { found_intersection = true; break; }
+            found_intersection = found_intersection || found;
+        }
     }
+    countLookups(level - 1, linespaceLookups - before);
     return found_intersection;
 }
 
@@ -322,14 +373,104 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
     int sf, ef;
     ivec2 sd, ed;
     if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed)) return;
+    leafRays++;
     vec3 rd = samplePoint(r) - originWorld;
     uint off = node.r >> 2;
     uint count = node.g;
     for (uint i = 0u; i < count && WITHIN_BUDGET; i++) {
         if (occludes(leafTriangles[off + i], originWorld, rd)) {
-            shaft.active_rays[r] = 0u;
-            active_rays--;
+            deactivateRay(r);
+            raysBlockedTriangle++;
             return;
+        }
+    }
+}
+
+// linespace-fast: the packet's rays lie in the pyramid from the origin to the (convex) light:
+// its four side planes, unit normals pointing out (set by initPyramid)
+vec3 sideNormal[4];
+
+void initPyramid()
+{
+    // the light's corners in cyclic order (lightCorners is Listing 2's order)
+    vec3 ring[4] = vec3[4](lightCorners[0], lightCorners[1], lightCorners[3], lightCorners[2]);
+    vec3 centre = 0.25 * (ring[0] + ring[1] + ring[2] + ring[3]);
+    for (int e = 0; e < 4; e++) {
+        vec3 n = normalize(cross(ring[e] - originWorld, ring[(e + 1) & 3] - originWorld));
+        sideNormal[e] = dot(n, centre - originWorld) > 0.0 ? -n : n;
+    }
+}
+
+// linespace-fast: true when no ray of the packet can cross triangle t — the origin and the
+// light's four corners lie on one side of the triangle's plane, or the triangle lies outside
+// one side plane of the pyramid (initPyramid): every segment from the origin to a sample of
+// the light stays clear of it. The margins (1e-5 world units, against Möller–Trumbore's
+// rounding) keep the skip conservative: a triangle the exact test could hit is tested.
+bool packetMisses(uint t)
+{
+    vec3 v0 = triVertex[3u * t].xyz;
+    vec3 v1 = triVertex[3u * t + 1u].xyz;
+    vec3 v2 = triVertex[3u * t + 2u].xyz;
+    for (int e = 0; e < 4; e++) {
+        vec3 n = sideNormal[e];
+        if (dot(n, v0 - originWorld) > 1e-5 && dot(n, v1 - originWorld) > 1e-5
+            && dot(n, v2 - originWorld) > 1e-5) return true;
+    }
+    vec3 n = cross(v1 - v0, v2 - v0);
+    float eps = 1e-5 * length(n);
+    float side = dot(n, originWorld - v0);
+    if (abs(side) <= eps) return false;
+    float s = sign(side);
+    return s * dot(n, lightCorners[0] - v0) > eps && s * dot(n, lightCorners[1] - v0) > eps
+        && s * dot(n, lightCorners[2] - v0) > eps && s * dot(n, lightCorners[3] - v0) > eps;
+}
+
+// linespace-fast: the active rays that cross a leaf (Kay–Kajiya), a bit each; their number
+int crossingRays(vec3 childStart, float te, out uint crossing[RAY_WORDS])
+{
+    int n = 0;
+    for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
+        crossing[w] = 0u;
+        uint bits = activeBits[w];
+        while (bits != 0u && WITHIN_BUDGET) {
+            int r = 32 * w + findLSB(bits);
+            bits &= bits - 1u;
+            int sf, ef;
+            ivec2 sd, ed;
+            if (!isNodeIntersection(childStart, shaft.ray_direction[r], te, sf, sd, ef, ed))
+                continue;
+            crossing[w] |= 1u << uint(r & 31);
+            n++;
+            leafRays++;
+        }
+    }
+    return n;
+}
+
+// linespace-fast: a leaf's triangles one by one, each first against the whole packet
+// (packetMisses), then for the active rays that cross the leaf (a bit per ray, found at the
+// first triangle not skipped). A ray meets the leaf's triangles in the same order as in leafRay
+// and stops at the same one, so the values and the tests of the unskipped triangles are mode 1's.
+void leafTestsPacket(uvec2 node, vec3 childStart, int level)
+{
+    uint crossing[RAY_WORDS];
+    int left = -1; // the rays crossing the leaf still active; -1: not yet found
+    uint off = node.r >> 2;
+    for (uint i = 0u; i < node.g && left != 0 && WITHIN_BUDGET; i++) {
+        uint t = leafTriangles[off + i];
+        if (packetMisses(t)) { trianglesCulled++; continue; }
+        if (left < 0) left = crossingRays(childStart, tEnd(level), crossing);
+        for (int w = 0; w < RAY_WORDS && WITHIN_BUDGET; w++) {
+            uint bits = crossing[w];
+            while (bits != 0u && WITHIN_BUDGET) {
+                int r = 32 * w + findLSB(bits);
+                bits &= bits - 1u;
+                if (!occludes(t, originWorld, samplePoint(r) - originWorld)) continue;
+                crossing[w] &= ~(1u << uint(r & 31));
+                deactivateRay(r);
+                left--;
+                raysBlockedTriangle++;
+            }
         }
     }
 }
@@ -337,8 +478,26 @@ void leafRay(int r, uvec2 node, vec3 childStart, float te)
 // the exact triangle tests of a leaf for every active ray crossing it
 void leafTests(uvec2 node, vec3 childStart, int level)
 {
+    if (FAST_PATH == 1) { leafTestsPacket(node, childStart, level); return; }
     float te = tEnd(level);
     for (int r = rayBegin; r < rayEnd && WITHIN_BUDGET; r++) leafRay(r, node, childStart, te);
+}
+
+// linespace-fast: does the node at stack depth 0 belong to the other phase's walk? Near the
+// origin (nearOrigin) is phase 1's, the rest phase 0's; depths below follow their parent.
+bool phaseSkips(int depth, vec3 childStart)
+{
+    if (FAST_PATH == 0 || depth > 0) return false;
+    return nearOrigin(childStart) != (phase == 1);
+}
+
+// linespace-fast, phase 1: the slices at depth 0 past the origin's neighbourhood hold no near
+// node (the walk goes away from the origin, so it ends there)
+bool phaseEnds(int depth, int slice)
+{
+    if (FAST_PATH == 0 || depth > 0 || phase == 0) return false;
+    float kc = (shaft.ray_start[0][k] - float(slice)) * float(N);
+    return kc < -NEAR_MARGIN || kc > float(N) + NEAR_MARGIN;
 }
 
 // the slices [first, last] the packet crosses in a node at stack depth d
@@ -418,6 +577,7 @@ int traverse()
         // for all slices of the node, from current_slice on (the loop ends at last_slice or
         // when a child is to be traversed: next_depth)
         for (int slice = stack[depth].current_slice; WITHIN_BUDGET; slice += dir) {
+            if (phaseEnds(depth, slice)) break;
             if (stack[depth].traverse_chilids == 0u) {
                 sliceUV(depth, slice);
                 int cu0 = max(int(floor(stack[depth].u_min)), 0);
@@ -429,6 +589,8 @@ int traverse()
                     for (int cv = cv0; cv <= cv1 && WITHIN_BUDGET; cv++) {
                         ivec3 c;
                         c[k] = slice; c[u] = cu; c[v] = cv;
+                        // linespace-fast: the other walk's cell
+                        if (phaseSkips(depth, (shaft.ray_start[0] - vec3(c)) * fN)) continue;
                         uvec2 node = fetchNode(stack[depth].parent_node.r >> 2, c);
                         // Algorithm 1 line 24 lists nodes with geometry *and* children; ours
                         // lists leaves too (their triangles are tested below), and the list is
@@ -463,11 +625,13 @@ int traverse()
                     bool descend;
                     if (inside) {
                         descend = true;
+                        descentsNear++;
                     } else if (BIT_IS_HIT == 1 && depth == LAST_LS_DEPTH) {
                         isIntersection(node, childStart, depth + 1, true);
                         descend = false;
                     } else {
                         descend = isIntersection(node, childStart, depth + 1, false);
+                        if (descend) descentsLinespace++;
                     }
                     if (descend && depth + 1 < NUM_MAX_DEPTH) {
                         shaft.ray_start[depth + 1] = childStart;
@@ -557,19 +721,26 @@ bool ddaBlocked(int r)
         if ((node.r & CHILDREN_BIT) == 0u) {
             uint off = node.r >> 2;
             for (uint i = 0u; i < node.g && WITHIN_BUDGET; i++) {
-                if (occludes(leafTriangles[off + i], originWorld, rd)) return true;
+                if (occludes(leafTriangles[off + i], originWorld, rd)) {
+                    raysBlockedTriangle++;
+                    return true;
+                }
             }
             continue;
         }
         bool inside = nearOrigin(childStart);
         bool descend = inside;
+        if (inside) descentsNear++;
         if (!inside) {
             int sf, ef;
             ivec2 sd, ed;
-            if (isNodeIntersection(childStart, direction, te, sf, sd, ef, ed)
-                && getEntry(node, sf, sd, ef, ed)) {
-                if (depth == LAST_LS_DEPTH) return true;
-                descend = true;
+            if (isNodeIntersection(childStart, direction, te, sf, sd, ef, ed)) {
+                uint before = linespaceLookups;
+                bool set = getEntry(node, sf, sd, ef, ed);
+                countLookups(depth, linespaceLookups - before);
+                if (set && depth == LAST_LS_DEPTH) { raysBlockedLinespace++; return true; }
+                if (set) descentsLinespace++;
+                descend = set;
             }
         }
         if (descend && depth + 1 < NUM_MAX_DEPTH) {
@@ -593,9 +764,11 @@ int litRays(vec3 pos, vec3 normal)
         }
         return lit;
     }
-    vec3 corners[4] = vec3[4](lightCorner, lightCorner + lightEdgeV, lightCorner + lightEdgeU,
-                              lightCorner + lightEdgeU + lightEdgeV);
-    for (int c = 0; c < 4; c++) shaft.corner_dir[c] = (corners[c] - originWorld) * invNodeSize;
+    lightCorners = vec3[4](lightCorner, lightCorner + lightEdgeV, lightCorner + lightEdgeU,
+                           lightCorner + lightEdgeU + lightEdgeV);
+    for (int c = 0; c < 4; c++) {
+        shaft.corner_dir[c] = (lightCorners[c] - originWorld) * invNodeSize;
+    }
     // the traversal axis k: the dominant axis of the light vector, if all four corner rays go
     // the same way along it; else the axis along which they do with the largest minimum
     vec3 lv = abs(centre - originWorld);
@@ -621,6 +794,14 @@ int litRays(vec3 pos, vec3 normal)
     ivec2 uvAxes = faceAxes(k);
     u = uvAxes.x; v = uvAxes.y;
     dir = shaft.corner_dir[0][k] > 0.0 ? 1 : -1;
+    if (FAST_PATH == 1) {
+        // linespace-fast: first the nodes away from the origin, then, for the rays they left
+        // unblocked, those near it
+        initPyramid();
+        phase = 0;
+        if (traverse() == 0) return 0;
+        phase = 1;
+    }
     return traverse();
 }
 
@@ -658,9 +839,29 @@ void main()
     countAdd(COUNTER_NODES_VISITED, nodesVisited);
     countAdd(COUNTER_TRUNCATED, truncated);
     countAdd(COUNTER_PACKET_FAILURES, packetFailures);
+    countAdd(COUNTER_LOOKUPS_DEPTH0, lookupsDepth0);
+    countAdd(COUNTER_LOOKUPS_DEPTH1, lookupsDepth1);
+    countAdd(COUNTER_DESCENTS_NEAR, descentsNear);
+    countAdd(COUNTER_DESCENTS_LINESPACE, descentsLinespace);
+    countAdd(COUNTER_LEAF_RAYS, leafRays);
+    countAdd(COUNTER_RAYS_BLOCKED_LINESPACE, raysBlockedLinespace);
+    countAdd(COUNTER_RAYS_BLOCKED_TRIANGLE, raysBlockedTriangle);
+    countAdd(COUNTER_TRIANGLES_CULLED, trianglesCulled);
+    countAdd(COUNTER_LOOP_ITERATIONS, loopIterations);
+    if (loopIterations > 0u) atomicMax(groupCount[COUNTER_LOOP_ITERATIONS_GROUP_MAX], loopIterations);
     countersEnd(COUNTER_TRIANGLE_TESTS, COUNTER_TRIANGLE_TESTS);
     countersEnd(COUNTER_LINESPACE_LOOKUPS, COUNTER_LINESPACE_LOOKUPS);
     countersEnd(COUNTER_NODES_VISITED, COUNTER_NODES_VISITED);
     countersEnd(COUNTER_TRUNCATED, COUNTER_TRUNCATED);
     countersEnd(COUNTER_PACKET_FAILURES, COUNTER_PACKET_FAILURES);
+    countersEnd(COUNTER_LOOKUPS_DEPTH0, COUNTER_LOOKUPS_DEPTH0);
+    countersEnd(COUNTER_LOOKUPS_DEPTH1, COUNTER_LOOKUPS_DEPTH1);
+    countersEnd(COUNTER_DESCENTS_NEAR, COUNTER_DESCENTS_NEAR);
+    countersEnd(COUNTER_DESCENTS_LINESPACE, COUNTER_DESCENTS_LINESPACE);
+    countersEnd(COUNTER_LEAF_RAYS, COUNTER_LEAF_RAYS);
+    countersEnd(COUNTER_RAYS_BLOCKED_LINESPACE, COUNTER_RAYS_BLOCKED_LINESPACE);
+    countersEnd(COUNTER_RAYS_BLOCKED_TRIANGLE, COUNTER_RAYS_BLOCKED_TRIANGLE);
+    countersEnd(COUNTER_TRIANGLES_CULLED, COUNTER_TRIANGLES_CULLED);
+    countersEnd(COUNTER_LOOP_ITERATIONS, COUNTER_LOOP_ITERATIONS);
+    countersEnd(COUNTER_LOOP_ITERATIONS_GROUP_MAX, COUNTER_LOOP_ITERATIONS_GROUP_MAX);
 }

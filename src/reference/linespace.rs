@@ -14,6 +14,10 @@
 //!   triangles (Table 2's "Schnitttests mit Dreiecken"); the reference.
 //! * [`ShadowMode::Variant1`], [`ShadowMode::Variant2`]: Table 2's "Variante 1" and "Variante
 //!   2" as the thesis defines them: `Exact` and `Linespace` without the near-origin rule below.
+//! * [`ShadowMode::LinespaceFast`] (ours): `Linespace`'s values for less work — the nodes away
+//!   from the origin walked first, the near ones after for the rays still unblocked, and a
+//!   leaf's triangle skipped for the packet when the origin and the light's corners lie on one
+//!   side of its plane ([`packet_misses`]).
 //!
 //! Where the thesis is silent we do this (and the kernel the same): the node that contains the
 //! rays' common origin has no entry side, so no line-space entry; it is always descended, and
@@ -37,6 +41,8 @@ pub struct ShadowCounts {
     pub nodes_visited: u64,
     /// Pixels whose light corners do not all lie on one side of an axis (no packet): lit.
     pub packet_failures: u64,
+    /// Triangles skipped for a whole packet by [`packet_misses`] (`LinespaceFast`).
+    pub triangles_culled: u64,
     /// Line-space lookups per stack depth (0: the root's children, as the thesis counts
     /// "Tiefe null"): the cascade shows as lookups at more than one depth.
     pub lookups_by_depth: [u64; 3],
@@ -48,6 +54,7 @@ impl std::ops::AddAssign for ShadowCounts {
         self.linespace_lookups += o.linespace_lookups;
         self.nodes_visited += o.nodes_visited;
         self.packet_failures += o.packet_failures;
+        self.triangles_culled += o.triangles_culled;
         for (a, b) in self.lookups_by_depth.iter_mut().zip(o.lookups_by_depth) {
             *a += b;
         }
@@ -142,6 +149,51 @@ fn node_intersection(
     let (su, sv) = cell(start_vec, start_face);
     let (eu, ev) = cell(end_vec, end_face);
     Some((start_face, su, sv, end_face, eu, ev))
+}
+
+/// `LinespaceFast`: the packet's rays lie in the pyramid from the origin to the (convex)
+/// light; its four side planes' unit normals, pointing out (the kernel's `initPyramid`).
+pub fn pyramid_sides(origin: Vec3, corners: &[Vec3; 4]) -> [Vec3; 4] {
+    // the corners in cyclic order (Listing 2's order is (0, 0), (0, 1), (1, 0), (1, 1))
+    let ring = [corners[0], corners[1], corners[3], corners[2]];
+    let centre = 0.25 * (ring[0] + ring[1] + ring[2] + ring[3]);
+    std::array::from_fn(|e| {
+        let n = (ring[e] - origin)
+            .cross(ring[(e + 1) & 3] - origin)
+            .normalize();
+        if n.dot(centre - origin) > 0.0 {
+            -n
+        } else {
+            n
+        }
+    })
+}
+
+/// `LinespaceFast`: no segment from `origin` to a point of the light (given by its `corners`
+/// and the pyramid's `sides`, [`pyramid_sides`]) can cross triangle `tri` when the origin and
+/// the four corners lie on one side of its plane, or the triangle lies outside a side plane.
+/// The margins (1e-5 world units, against Möller–Trumbore's rounding) keep the skip
+/// conservative. The kernel's `packetMisses`.
+pub fn packet_misses(
+    tri: &[Vec3; 3],
+    origin: Vec3,
+    corners: &[Vec3; 4],
+    sides: &[Vec3; 4],
+) -> bool {
+    if sides
+        .iter()
+        .any(|n| tri.iter().all(|v| n.dot(*v - origin) > 1e-5))
+    {
+        return true;
+    }
+    let n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    let eps = 1e-5 * n.length();
+    let side = n.dot(origin - tri[0]);
+    if side.abs() <= eps {
+        return false;
+    }
+    let s = side.signum();
+    corners.iter().all(|c| s * n.dot(*c - tri[0]) > eps)
 }
 
 /// Margin, in child cells, around a node within which the rays' origin counts as "in the
@@ -294,6 +346,10 @@ struct Shaft {
     light_points: Vec<Vec3>,
     active_rays: Vec<bool>,
     active_count: usize,
+    /// `LinespaceFast`: two walks, packet tests of the leaves
+    fast: bool,
+    /// `LinespaceFast`'s walk: 0 the nodes away from the origin, 1 those near it.
+    phase: u8,
 }
 
 impl<'a> LinespaceShadows<'a> {
@@ -430,8 +486,16 @@ impl<'a> LinespaceShadows<'a> {
                     light_points,
                     active_rays,
                     active_count,
+                    fast: mode.fast_path(),
+                    phase: 0,
                 };
                 shaft.ray_start[0] = o;
+                // LinespaceFast: the walk away from the origin first, then the near one for
+                // the rays it left unblocked
+                if shaft.fast && self.cgt(mode, &mut shaft, &mut counts) == 0 {
+                    return (0, counts);
+                }
+                shaft.phase = 1;
                 self.cgt(mode, &mut shaft, &mut counts)
             }
         };
@@ -560,6 +624,9 @@ impl<'a> LinespaceShadows<'a> {
         level: usize,
         counts: &mut ShadowCounts,
     ) {
+        if s.fast {
+            return self.leaf_tests_packet(s, node, child_start, level, counts);
+        }
         let te = self.t_end(level);
         let off = (node[0] >> 2) as usize;
         let tris = &self.tree.leaf_triangles[off..off + node[1] as usize];
@@ -586,6 +653,71 @@ impl<'a> LinespaceShadows<'a> {
         }
     }
 
+    /// `LinespaceFast`: a leaf's triangles one by one, each first against the whole packet
+    /// ([`packet_misses`]), then for the active rays that cross the leaf (found at the first
+    /// triangle not skipped); a ray meets the triangles in [`Self::leaf_tests`]' order and stops
+    /// at the same one (the kernel's `leafTestsPacket`).
+    fn leaf_tests_packet(
+        &self,
+        s: &mut Shaft,
+        node: [u32; 2],
+        child_start: Vec3,
+        level: usize,
+        counts: &mut ShadowCounts,
+    ) {
+        let te = self.t_end(level);
+        let mut crossing: Option<Vec<usize>> = None;
+        let corners = light_corners(&self.light);
+        let sides = pyramid_sides(s.origin_world, &corners);
+        let off = (node[0] >> 2) as usize;
+        for &t in &self.tree.leaf_triangles[off..off + node[1] as usize] {
+            if crossing.as_ref().is_some_and(|c| c.is_empty()) {
+                break;
+            }
+            let tri = &self.triangles[t as usize];
+            if packet_misses(tri, s.origin_world, &corners, &sides) {
+                counts.triangles_culled += 1;
+                continue;
+            }
+            let rays = crossing.get_or_insert_with(|| {
+                (0..s.ray_direction.len())
+                    .filter(|&r| {
+                        s.active_rays[r]
+                            && node_intersection(self.tree.n, child_start, s.ray_direction[r], te)
+                                .is_some()
+                    })
+                    .collect()
+            });
+            rays.retain(|&r| {
+                counts.triangle_tests += 1;
+                let rd = s.light_points[r] - s.origin_world;
+                let hit = intersect_triangle(s.origin_world, rd, tri[0], tri[1], tri[2])
+                    .is_some_and(|(tt, _, _)| tt < 1.0);
+                if hit {
+                    s.active_rays[r] = false;
+                    s.active_count -= 1;
+                }
+                !hit
+            });
+        }
+    }
+
+    /// `LinespaceFast`: does the cell `c` at stack depth `d` belong to the other walk? Near
+    /// the origin ([`near_origin`]) is walk 1's, the rest walk 0's; deeper cells follow their
+    /// parent (the kernel's `phaseSkips`).
+    fn phase_skips(&self, s: &Shaft, d: usize, c: IVec3) -> bool {
+        let nf = self.tree.n as f32;
+        s.fast && d == 0 && near_origin((s.ray_start[0] - c.as_vec3()) * nf, nf) != (s.phase == 1)
+    }
+
+    /// `LinespaceFast`, walk 1: the slices at depth 0 past the origin's neighbourhood hold no
+    /// near cell (the kernel's `phaseEnds`).
+    fn phase_ends(&self, s: &Shaft, d: usize, slice: i32) -> bool {
+        let nf = self.tree.n as f32;
+        let kc = (s.ray_start[0][s.k] - slice as f32) * nf;
+        s.fast && d == 0 && s.phase == 1 && (kc < -NEAR_MARGIN || kc > nf + NEAR_MARGIN)
+    }
+
     /// Algorithm 1 (continuation): the slice-by-slice traversal with the explicit stack.
     /// Returns the number of rays still active (lit).
     fn cgt(&self, mode: ShadowMode, s: &mut Shaft, counts: &mut ShadowCounts) -> usize {
@@ -609,6 +741,9 @@ impl<'a> LinespaceShadows<'a> {
             let mut lvl = level;
             let mut slice = lvl.current_slice;
             loop {
+                if self.phase_ends(s, d, slice) {
+                    break;
+                }
                 if !lvl.traverse_childs {
                     // examine the slice: nodes with geometry inside u/v_min/max
                     let uv = self.slice_uv(s, d, slice);
@@ -623,6 +758,10 @@ impl<'a> LinespaceShadows<'a> {
                             c[s.k] = slice;
                             c[s.u] = cu;
                             c[s.v] = cv;
+                            // LinespaceFast: the other walk's cell
+                            if self.phase_skips(s, d, c) {
+                                continue;
+                            }
                             counts.nodes_visited += 1;
                             let node = self.node(lvl.parent_group, c);
                             if node[0] & GEOMETRY_BIT != 0 {

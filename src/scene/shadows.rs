@@ -26,6 +26,12 @@ pub enum ShadowMode {
     /// holding the origin included; the deepest level is never visited, no triangle is tested
     /// ("die tiefste Ebene des N-tree [muss] nicht traversiert werden").
     Variant2,
+    /// Ours, the fast path: `linespace`'s answer (the same shadow values) for less work — the
+    /// nodes away from the origin (line-space lookups) are walked first and the nodes near it
+    /// (exact triangle tests) only for the rays still unblocked, and a leaf's triangle is
+    /// skipped for the whole packet when the origin and the light's four corners lie on one
+    /// side of its plane (no ray of the packet can cross it).
+    LinespaceFast,
 }
 
 impl ShadowMode {
@@ -37,6 +43,7 @@ impl ShadowMode {
             ShadowMode::LinespaceDda => 2,
             ShadowMode::Variant1 => 3,
             ShadowMode::Variant2 => 4,
+            ShadowMode::LinespaceFast => 5,
         }
     }
     pub fn name(self) -> &'static str {
@@ -46,6 +53,7 @@ impl ShadowMode {
             ShadowMode::LinespaceDda => "linespace-dda",
             ShadowMode::Variant1 => "variant1",
             ShadowMode::Variant2 => "variant2",
+            ShadowMode::LinespaceFast => "linespace-fast",
         }
     }
     /// Does the mode descend (and test exactly) the nodes near the rays' origin instead of
@@ -56,7 +64,15 @@ impl ShadowMode {
     }
     /// Does a set line-space bit at the last depth with line spaces count as a hit?
     pub fn bit_is_hit(self) -> bool {
-        matches!(self, ShadowMode::Linespace | ShadowMode::Variant2)
+        matches!(
+            self,
+            ShadowMode::Linespace | ShadowMode::Variant2 | ShadowMode::LinespaceFast
+        )
+    }
+    /// Does the mode walk the nodes away from the origin first and cull triangles per packet
+    /// (`linespace-fast`)?
+    pub fn fast_path(self) -> bool {
+        self == ShadowMode::LinespaceFast
     }
 }
 

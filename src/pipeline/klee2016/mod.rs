@@ -346,6 +346,9 @@ impl SoftShadowRenderer {
         for e in ["linespace_lookups", "nodes_visited", "packet_failures"] {
             stats.events.insert(e.into(), counts.get(e));
         }
+        for e in &shadow_pass::COUNTERS[shadow_pass::EVENTS] {
+            stats.events.insert((*e).into(), counts.get(e));
+        }
         stats.facts = self.facts();
         Ok((stats, truncated))
     }

@@ -19,14 +19,32 @@ use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::scene::{AreaLight, ShadowMode};
 
-/// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`.
-pub const COUNTERS: [&str; 5] = [
+/// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`. After the
+/// first five, where the time goes (docs/design/linespace.md): lookups per stack depth, the
+/// descents by the near-origin rule and by a set bit, the (ray, leaf) pairs whose triangles are
+/// tested, what blocked the rays, the triangles a packet's plane test skipped
+/// (`linespace-fast`), and the loop iterations: their sum, and the sum over work groups of the
+/// group's largest (a SIMD vector iterates while any lane does: the ratio is the divergence).
+pub const COUNTERS: [&str; 15] = [
     "triangle_tests",
     "linespace_lookups",
     "nodes_visited",
     "truncated",
     "packet_failures",
+    "lookups_depth0",
+    "lookups_depth1",
+    "descents_near",
+    "descents_linespace",
+    "leaf_rays",
+    "rays_blocked_linespace",
+    "rays_blocked_triangle",
+    "triangles_culled",
+    "loop_iterations",
+    "loop_iterations_group_max",
 ];
+
+/// The counters `render --stats` reports as events (all but the ones reported elsewhere).
+pub const EVENTS: std::ops::Range<usize> = 5..15;
 
 /// The shadow kernel for a mode and a number of samples (the defines of Algorithm 1).
 pub fn shadow_kernel(
@@ -50,6 +68,7 @@ pub fn shadow_kernel(
         .set("SHADOW_MODE", mode.kernel_mode())
         .set("NEAR_ORIGIN_RULE", mode.near_origin_rule() as u32)
         .set("BIT_IS_HIT", mode.bit_is_hit() as u32)
+        .set("FAST_PATH", mode.fast_path() as u32)
         .set("LOOP_BUDGET", format!("{}u", loop_budget(limit, su * sv)));
     for (i, c) in COUNTERS.iter().enumerate() {
         defines = defines.set(&format!("COUNTER_{}", c.to_uppercase()), i);
@@ -60,6 +79,7 @@ pub fn shadow_kernel(
         ShadowMode::LinespaceDda => "shadow_linespace_dda",
         ShadowMode::Variant1 => "shadow_variant1",
         ShadowMode::Variant2 => "shadow_variant2",
+        ShadowMode::LinespaceFast => "shadow_linespace_fast",
     };
     Kernel::compute(
         gl,
@@ -78,7 +98,7 @@ pub fn loop_budget(limit: Option<LoopLimit>, rays: u32) -> u32 {
 }
 
 /// The counts of one shadow pass.
-pub struct ShadowCounts(pub [u64; 5]);
+pub struct ShadowCounts(pub [u64; COUNTERS.len()]);
 
 impl ShadowCounts {
     pub fn get(&self, name: &str) -> u64 {
