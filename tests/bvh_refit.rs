@@ -9,10 +9,7 @@ mod common;
 
 use common::*;
 use glam::{Mat4, Vec3};
-use gpgpu_rt::accel::bvh::{
-    Bvh, BvhTree, Grid, NodeRecord, NODE_WORDS, OCTANTS,
-    REBUILD_GROWTH,
-};
+use gpgpu_rt::accel::bvh::{Bvh, BvhTree, Grid, NodeRecord, NODE_WORDS, OCTANTS, REBUILD_GROWTH};
 use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
@@ -27,7 +24,10 @@ fn bvh_options(w: u32, h: u32) -> RenderOptions {
 }
 
 fn bvh(t: &RayTracer) -> &Bvh {
-    t.accelerator().as_any().downcast_ref::<Bvh>().expect("a BVH tracer")
+    t.accelerator()
+        .as_any()
+        .downcast_ref::<Bvh>()
+        .expect("a BVH tracer")
 }
 
 /// Object `object` of `scene` turned by `degrees` about its vertical axis.
@@ -107,7 +107,9 @@ fn the_refitted_records_hold_the_turned_triangles() {
     };
     for (k, node) in twin.nodes.iter().enumerate() {
         let mut b = gpgpu_rt::accel::bvh::Aabb::EMPTY;
-        subtree_triangles(&twin, k, &mut |id| tris[id].iter().for_each(|&p| b.grow_point(p)));
+        subtree_triangles(&twin, k, &mut |id| {
+            tris[id].iter().for_each(|&p| b.grow_point(p))
+        });
         for o in 0..OCTANTS {
             let texel = twin.record_texels(o)[k] as usize;
             let r: NodeRecord = bytemuck::pod_read_unaligned(bytemuck::cast_slice(
@@ -174,5 +176,99 @@ fn a_refit_past_the_threshold_makes_the_next_move_rebuild() {
             assert_eq!((b.builds(), b.refits()), (2, 0));
             assert_eq!(b.sah_growth(), 1.0);
         }
+    }
+}
+
+/// The measurement behind `REBUILD_GROWTH` (`docs/design/bvh.md`, "Moving objects"): the SAH
+/// cost of the refitted tree over the built tree's, as the scene turns about the vertical axis
+/// through its centre (the bench's `--rotate objects`) in steps of 15°, refitted by the CPU twin
+/// (whose words are the GPU refit's, above) and never rebuilt; and a fresh build's cost at each
+/// angle. Run: `cargo test --release --test bvh_refit -- --ignored --nocapture growth`.
+#[test]
+#[ignore = "a measurement, not a check: prints a table"]
+fn sah_growth_over_a_full_turn() {
+    for name in ["bunny.toml", "dragon.toml"] {
+        let scene = load(name);
+        let tris = world_triangles(&scene);
+        let mut b = gpgpu_rt::accel::bvh::Aabb::EMPTY;
+        tris.iter().flatten().for_each(|&p| b.grow_point(p));
+        let c = 0.5 * (b.lo + b.hi);
+        let mut tree = BvhTree::new(tris.clone());
+        let built = tree.stats.sah_cost;
+        eprintln!("{name}: built SAH cost {built:.2}; degrees, refitted/built, fresh/built");
+        for step in 1..=24 {
+            let deg = 15.0 * step as f32;
+            let r = Mat4::from_translation(c)
+                * Mat4::from_rotation_y(deg.to_radians())
+                * Mat4::from_translation(-c);
+            let turned: Vec<_> = tris
+                .iter()
+                .map(|t| t.map(|p| r.transform_point3(p)))
+                .collect();
+            tree.refit(turned.clone());
+            let fresh = BvhTree::new(turned).stats.sah_cost;
+            eprintln!(
+                "  {deg:5.0}  {:.3}  {:.3}",
+                tree.stats.sah_cost / built,
+                fresh / built
+            );
+        }
+    }
+}
+
+/// The measurement of a turning frame against a still one (`docs/design/bvh.md`, "Moving
+/// objects"): `scene` at 512², no reflections, every object turned about the scene's vertical
+/// axis through its centre (the bench's `--rotate objects`) by 3° on every other frame, so that
+/// refitted and still frames alternate; their GPU time (every kernel, `gpu_ms_total`) and the
+/// refit's. Run: `cargo test --release --test bvh_refit -- --ignored --nocapture turning`.
+#[test]
+#[ignore = "a measurement, not a check: prints a table"]
+fn turning_frames_against_still_ones() {
+    let ctx = context();
+    for name in ["bunny.toml", "dragon.toml"] {
+        let scene = load(name);
+        let mut b = gpgpu_rt::accel::bvh::Aabb::EMPTY;
+        world_triangles(&scene)
+            .iter()
+            .flatten()
+            .for_each(|&p| b.grow_point(p));
+        let c = 0.5 * (b.lo + b.hi);
+        let mut tracer = ray_tracer(
+            &ctx,
+            &scene,
+            RenderOptions {
+                refl_depth: 0,
+                ..bvh_options(512, 512)
+            },
+        );
+        tracer.render(&scene.camera).unwrap();
+        let (mut still, mut turning, mut refit) = (Vec::new(), Vec::new(), Vec::new());
+        for frame in 1..=10 {
+            if frame % 2 == 0 {
+                let r = Mat4::from_translation(c)
+                    * Mat4::from_rotation_y((3.0 * frame as f32).to_radians())
+                    * Mat4::from_translation(-c);
+                for (i, o) in scene.objects.iter().enumerate() {
+                    tracer.set_model(i, r * o.model).unwrap();
+                }
+            }
+            let s = tracer.render(&scene.camera).unwrap().stats;
+            let total: f64 = s.gpu_ms.values().sum();
+            match frame % 2 {
+                0 => turning.push(total),
+                _ => still.push(total),
+            }
+            refit.push(s.facts["bvh_refit_ms"].as_f64().unwrap());
+            assert_eq!(s.facts["bvh_rebuilt"], json!(false));
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let refit: Vec<f64> = refit.into_iter().filter(|&m| m > 0.0).collect();
+        eprintln!(
+            "{name}: still {:.1} ms, turning {:.1} ms (ratio {:.3}), refit {:.1} ms; still {still:.1?}, turning {turning:.1?}",
+            mean(&still),
+            mean(&turning),
+            mean(&turning) / mean(&still),
+            mean(&refit)
+        );
     }
 }

@@ -144,6 +144,19 @@ fn image_units_suffice(max_image_units: i32) -> Result<()> {
     Ok(())
 }
 
+/// The refit of the last build's tree ([`refit`]) and what the rebuild policy knows of it.
+struct Moving {
+    kernels: RefitKernels,
+    /// the last build's refit buffers
+    refit: Option<Refit>,
+    /// refits since the last build
+    refits: u64,
+    /// the SAH cost of the tree as the last refit left it (the last build's after a build)
+    cost: f64,
+    /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
+    max_block: i64,
+}
+
 pub struct Bvh {
     gl: Arc<Gl>,
     /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into the
@@ -165,15 +178,8 @@ pub struct Bvh {
     builds: u64,
     /// whether the last frame rebuilt
     rebuilt: bool,
-    refit_kernels: RefitKernels,
-    /// the last build's refit buffers
-    refit: Option<Refit>,
-    /// refits since the last build
-    refits: u64,
-    /// the SAH cost of the tree as the last refit left it (the last build's after a build)
-    refit_cost: f64,
-    /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
-    max_block: i64,
+    /// the GPU refit for frames in which objects moved
+    moving: Moving,
     /// the last build's world transform, words (octant records, leaf triangles) and upload, ms
     upload_ms: f64,
 }
@@ -194,11 +200,13 @@ impl Bvh {
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
-            refit_kernels: refit_kernels(b, &defs)?,
-            refit: None,
-            refits: 0,
-            refit_cost: 0.0,
-            max_block: b.info.max_ssbo_block_size,
+            moving: Moving {
+                kernels: refit_kernels(b, &defs)?,
+                refit: None,
+                refits: 0,
+                cost: 0.0,
+                max_block: b.info.max_ssbo_block_size,
+            },
             objects: scene
                 .objects
                 .iter()
@@ -232,11 +240,11 @@ impl Bvh {
             );
         }
         let buffers = upload(&self.gl, &bvh, self.blocks)?;
-        let refit = Refit::new(&self.gl, &bvh, self.max_block)?;
+        let refit = Refit::new(&self.gl, &bvh, self.moving.max_block)?;
         // the old buffers (if any) drop after the new ones are made, as before
         self.buffers = Some(buffers);
-        self.refit = Some(refit);
-        (self.refits, self.refit_cost) = (0, bvh.stats.sah_cost);
+        self.moving.refit = Some(refit);
+        (self.moving.refits, self.moving.cost) = (0, bvh.stats.sah_cost);
         self.stats = bvh.stats;
         // the rest: the world transform, the words (octant records, leaf triangles), the upload
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
@@ -264,24 +272,24 @@ impl Bvh {
 
     /// The number of refits since the last build.
     pub fn refits(&self) -> u64 {
-        self.refits
+        self.moving.refits
     }
 
     /// The SAH cost of the tree as the last refit left it over the last build's (1 after a
     /// build): past [`REBUILD_GROWTH`], the next frame that moves an object rebuilds.
     pub fn sah_growth(&self) -> f64 {
-        self.refit_cost / self.stats.sah_cost
+        self.moving.cost / self.stats.sah_cost
     }
 
     /// Refit the tree on the GPU to this frame's world-space vertices (the scene's `vertex` SSBO,
     /// bound), and read the refitted tree's SAH cost.
     fn refit(&mut self, f: &mut FrameContext) -> Result<()> {
-        let refit = self.refit.as_ref().expect("a tree to refit");
+        let refit = self.moving.refit.as_ref().expect("a tree to refit");
         self.bind(f.gl, glow::READ_WRITE);
-        refit.run(f.gl, f.timers, &self.refit_kernels);
-        self.refit_cost = refit.sah_cost(f.gl)?;
+        refit.run(f.gl, f.timers, &self.moving.kernels);
+        self.moving.cost = refit.sah_cost(f.gl)?;
         self.built_for = Some(f.models.to_vec());
-        self.refits += 1;
+        self.moving.refits += 1;
         Ok(())
     }
 
@@ -300,7 +308,7 @@ impl Accelerator for Bvh {
         if self.built_for.as_deref() == Some(f.models) {
             return Ok(());
         }
-        if self.refit.is_some() && self.sah_growth() <= REBUILD_GROWTH {
+        if self.moving.refit.is_some() && self.sah_growth() <= REBUILD_GROWTH {
             return self.refit(f);
         }
         self.rebuilt = true;
@@ -333,9 +341,9 @@ impl Accelerator for Bvh {
         f.insert("bvh_leaves".into(), json!(s.leaves));
         f.insert("bvh_depth".into(), json!(s.depth));
         f.insert("bvh_bytes".into(), json!(s.bytes));
-        f.insert("bvh_sah_cost".into(), json!(self.refit_cost));
+        f.insert("bvh_sah_cost".into(), json!(self.moving.cost));
         f.insert("bvh_build_sah_cost".into(), json!(s.sah_cost));
-        f.insert("bvh_refits".into(), json!(self.refits));
+        f.insert("bvh_refits".into(), json!(self.moving.refits));
         let refit_ms = stats.gpu_ms.get(REFIT_TIMER).copied().unwrap_or(0.0);
         f.insert("bvh_refit_ms".into(), json!(refit_ms));
     }

@@ -34,7 +34,7 @@ use crate::gl::{sync, Gl, Kernel};
 
 /// Rebuild on the CPU when the refitted tree's SAH cost exceeds the last build's by this factor
 /// (measured on the turning dragon and bunny: `docs/design/bvh.md`, "Moving objects").
-pub const REBUILD_GROWTH: f64 = 1.5;
+pub const REBUILD_GROWTH: f64 = 1.3;
 
 /// Invocations of a work group of the refit's kernels (`REFIT_GROUP`).
 pub const REFIT_GROUP: u32 = 64;
@@ -48,7 +48,11 @@ impl BvhTree {
     /// by the build's [`BvhTree::pad`]; an inner node's: its children's union), the grid over the
     /// new root box, the planes on it, and the SAH cost of the refitted tree.
     pub fn refit(&mut self, triangles: Vec<[Vec3; 3]>) {
-        assert_eq!(triangles.len(), self.triangles.len(), "a refit keeps the triangles");
+        assert_eq!(
+            triangles.len(),
+            self.triangles.len(),
+            "a refit keeps the triangles"
+        );
         self.triangles = triangles;
         let pad = Vec3::splat(self.pad);
         for k in (0..self.nodes.len()).rev() {
@@ -165,7 +169,13 @@ impl Refit {
         let words = bytemuck::cast_slice(&t.words);
         let n = tree.nodes.len();
         Ok(Refit {
-            topology: Ssbo::new(gl, "bvh refit topology", words.len(), Some(words), max_block)?,
+            topology: Ssbo::new(
+                gl,
+                "bvh refit topology",
+                words.len(),
+                Some(words),
+                max_block,
+            )?,
             boxes: Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?,
             passes: t.passes,
             nodes: n as u32,
@@ -292,7 +302,11 @@ mod tests {
             }
         }
         for (k, node) in bvh.nodes.iter().enumerate() {
-            assert_eq!(node.is_leaf(), pass_of[k] == 0, "the leaves' pass is the first");
+            assert_eq!(
+                node.is_leaf(),
+                pass_of[k] == 0,
+                "the leaves' pass is the first"
+            );
             if !node.is_leaf() {
                 let c = node.first as usize;
                 assert!(pass_of[c] < pass_of[k] && pass_of[c + 1] < pass_of[k]);
