@@ -459,6 +459,19 @@ impl TextureBuffers {
             t.bind_image(gl, *unit, access);
         }
     }
+
+    /// For tests: the 32-bit words of buffer `index` (in upload order), as kernels left them.
+    pub fn read_u32(&self, gl: &Gl, index: usize) -> Vec<u32> {
+        let t = &self.0[index].0;
+        let mut bytes = vec![0u8; t.bytes];
+        // SAFETY: reading `t.bytes` bytes of our own buffer, which holds at least as many.
+        unsafe {
+            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(t.buffer.raw()));
+            gl.get_buffer_sub_data(glow::TEXTURE_BUFFER, 0, &mut bytes);
+            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+        }
+        bytemuck::pod_collect_to_vec(&bytes)
+    }
 }
 
 /// A 32-bit float depth renderbuffer of `w`×`h` (the depth test of a pass that rasterises the

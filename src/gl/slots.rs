@@ -56,6 +56,11 @@ slot_table! {
         /// hit's evaluation and count per pixel (glsl/bvh/records.glsl): per pixel its work
         /// counts and hit record
         PIXEL_RECORDS = 21,
+        // the SAH BVH's GPU refit (glsl/bvh/refit.glsl): the tree's topology as the host lays
+        // it out once per build (src/accel/bvh/refit.rs), and every node's float box and
+        // subtree SAH cost as the refit's passes write them
+        REFIT_TOPOLOGY = 10,
+        REFIT_BOXES = 11,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,

@@ -255,14 +255,7 @@ fn best_split(bins: &Bins, binning: &Binning) -> Option<Split> {
 /// to the scene so that rounding in the slab test (and ulp differences of the GPU's
 /// transformed vertices) never loses a triangle that touches its box.
 fn prims_of(triangles: &[[Vec3; 3]]) -> Vec<Prim> {
-    let mut scene = Aabb::EMPTY;
-    for t in triangles {
-        t.iter().for_each(|&p| scene.grow_point(p));
-    }
-    let extent = (scene.hi - scene.lo)
-        .max_element()
-        .max(scene.hi.abs().max_element());
-    let pad = Vec3A::splat(1e-5 * extent.max(1e-20));
+    let pad = Vec3A::splat(pad(triangles));
     triangles
         .par_iter()
         .enumerate()
@@ -278,6 +271,20 @@ fn prims_of(triangles: &[[Vec3; 3]]) -> Vec<Prim> {
             }
         })
         .collect()
+}
+
+/// The margin every triangle's bounds are widened by ([`prims_of`]): 10^-5 of the scene's
+/// extent (its largest side or coordinate). The GPU refit widens by the last build's margin
+/// (`accel::bvh::refit`).
+pub(super) fn pad(triangles: &[[Vec3; 3]]) -> f32 {
+    let mut scene = Aabb::EMPTY;
+    for t in triangles {
+        t.iter().for_each(|&p| scene.grow_point(p));
+    }
+    let extent = (scene.hi - scene.lo)
+        .max_element()
+        .max(scene.hi.abs().max_element());
+    1e-5 * extent.max(1e-20)
 }
 
 /// Build the hierarchy over `triangles`; the tree and the triangle ids in leaf order.

@@ -107,7 +107,7 @@ pub struct BvhStats {
 /// The hierarchy over a list of triangles, as built and uploaded (its kernels' CPU twin:
 /// `reference::bvh`).
 pub struct BvhTree {
-    triangles: Vec<[Vec3; 3]>,
+    pub(super) triangles: Vec<[Vec3; 3]>,
     pub nodes: Vec<Node>,
     /// Miss links: `links[OCTANTS * n + octant]` is where a ray of that octant goes on after
     /// node n ([`END`]: nowhere).
@@ -119,6 +119,9 @@ pub struct BvhTree {
     /// Every node's box on the grid, as the kernels and [`BvhTree::traverse`] test it.
     pub planes: Vec<Planes>,
     pub stats: BvhStats,
+    /// The margin of every triangle's bounds in the node boxes (`build::pad`): 10^-5 of the
+    /// extent of the scene it was built over, kept by a refit ([`BvhTree::refit`]).
+    pub pad: f32,
 }
 
 /// The header of [`BvhTree::gpu_words`]: its first two texels, 32 bytes (`glsl/bvh/traverse.glsl`
@@ -220,6 +223,7 @@ impl BvhTree {
     /// Build the hierarchy over `triangles` (triangle id = index).
     pub fn new(triangles: Vec<[Vec3; 3]>) -> BvhTree {
         let start = std::time::Instant::now();
+        let pad = build::pad(&triangles);
         let (tree, ids) = build::build(&triangles);
         let mut nodes = vec![Node::zeroed()];
         build::layout(&tree, 0, &mut nodes);
@@ -248,6 +252,7 @@ impl BvhTree {
             grid,
             planes,
             stats,
+            pad,
         }
     }
 

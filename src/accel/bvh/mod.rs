@@ -2,8 +2,10 @@
 //! (binned SAH, rayon: [`build`], [`layout`]) and uploaded into one image buffer of 32-bit words
 //! (a copy of the nodes for each ray octant, then the leaf triangles), traversed in the
 //! intersection kernels without a stack, near child first (`glsl/bvh/`). Objects move every
-//! frame in the bench protocols: the BVH is rebuilt on the CPU whenever a model matrix changed
-//! since the last build, and not otherwise. Its image equals the base tracer's. CPU twin:
+//! frame in the bench protocols: whenever a model matrix changed since the last frame, the BVH
+//! is refitted on the GPU ([`refit`]: the build's topology, new boxes), or rebuilt on the CPU
+//! where the last refit had grown its SAH cost past [`REBUILD_GROWTH`] times the last build's;
+//! a still scene keeps its tree. Its image equals the base tracer's. CPU twin:
 //! `reference::bvh` (the walks of [`BvhTree`]).
 
 use std::any::Any;
@@ -28,12 +30,14 @@ use crate::scene::{transform_triangles, Scene};
 mod build;
 pub mod layout;
 mod planes;
+pub mod refit;
 pub use layout::{
     block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
     NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
     NODE_WORDS, OCTANTS, PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
 };
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
+pub use refit::{Refit, RefitKernels, REBUILD_GROWTH, REFIT_GROUP, REFIT_TIMER};
 
 pub const ENTRY: Entry = Entry {
     tracer: TracerKind::Bvh,
@@ -103,6 +107,22 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
     ]
 }
 
+/// The refit's kernels (`glsl/bvh/refit_*.comp`), with the BVH's defines, timed together
+/// ([`Refit::run`]).
+fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<RefitKernels> {
+    let extra = [
+        ("REFIT_GROUP", REFIT_GROUP.to_string()),
+        ("BVH_GRID_STEPS", GRID_STEPS.to_string()),
+    ];
+    let defs = [defs, &extra[..]].concat();
+    let kernel = |file| b.kernel(file, &defs, REFIT_TIMER);
+    Ok(RefitKernels {
+        leaves: kernel("bvh/refit_leaves.comp")?,
+        nodes: kernel("bvh/refit_nodes.comp")?,
+        records: kernel("bvh/refit_records.comp")?,
+    })
+}
+
 /// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
 const ENTRY_GROUP: u32 = 64;
 const _: () = assert!(
@@ -125,6 +145,19 @@ fn image_units_suffice(max_image_units: i32) -> Result<()> {
     Ok(())
 }
 
+/// The refit of the last build's tree ([`refit`]) and what the rebuild policy knows of it.
+struct Moving {
+    kernels: RefitKernels,
+    /// the last build's refit buffers
+    refit: Option<Refit>,
+    /// refits since the last build
+    refits: u64,
+    /// the SAH cost of the tree as the last refit left it (the last build's after a build)
+    cost: f64,
+    /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
+    max_block: i64,
+}
+
 pub struct Bvh {
     gl: Arc<Gl>,
     /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into the
@@ -136,14 +169,18 @@ pub struct Bvh {
     intersect2: Kernel,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
-    /// the model matrices of the last build (`None`: not built yet)
+    /// the model matrices of the tree as uploaded, built or refitted (`None`: not built yet)
     built_for: Option<Vec<Mat4>>,
     buffers: Option<TextureBuffers>,
+    /// the last build's facts (its SAH cost: the refits' yardstick)
     stats: BvhStats,
-    /// builds so far (the first and one per frame in which something moved)
+    /// builds so far (the first, and one per frame after a refit that grew the SAH cost past
+    /// [`REBUILD_GROWTH`])
     builds: u64,
     /// whether the last frame rebuilt
     rebuilt: bool,
+    /// the GPU refit for frames in which objects moved
+    moving: Moving,
     /// the last build's world transform, words (octant records, leaf triangles) and upload, ms
     upload_ms: f64,
 }
@@ -164,6 +201,13 @@ impl Bvh {
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
+            moving: Moving {
+                kernels: refit_kernels(b, &defs)?,
+                refit: None,
+                refits: 0,
+                cost: 0.0,
+                max_block: b.info.max_ssbo_block_size,
+            },
             objects: scene
                 .objects
                 .iter()
@@ -197,8 +241,11 @@ impl Bvh {
             );
         }
         let buffers = upload(&self.gl, &bvh, self.blocks)?;
+        let refit = Refit::new(&self.gl, &bvh, self.moving.max_block)?;
         // the old buffers (if any) drop after the new ones are made, as before
         self.buffers = Some(buffers);
+        self.moving.refit = Some(refit);
+        (self.moving.refits, self.moving.cost) = (0, bvh.stats.sah_cost);
         self.stats = bvh.stats;
         // the rest: the world transform, the words (octant records, leaf triangles), the upload
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
@@ -217,6 +264,36 @@ impl Bvh {
         self.builds
     }
 
+    /// For tests: the word buffer as the GPU holds it ([`BvhTree::gpu_words`], then the block
+    /// entries), empty before the first build.
+    pub fn words(&self) -> Vec<u32> {
+        let b = self.buffers.as_ref();
+        b.map(|b| b.read_u32(&self.gl, 0)).unwrap_or_default()
+    }
+
+    /// The number of refits since the last build.
+    pub fn refits(&self) -> u64 {
+        self.moving.refits
+    }
+
+    /// The SAH cost of the tree as the last refit left it over the last build's (1 after a
+    /// build): past [`REBUILD_GROWTH`], the next frame that moves an object rebuilds.
+    pub fn sah_growth(&self) -> f64 {
+        self.moving.cost / self.stats.sah_cost
+    }
+
+    /// Refit the tree on the GPU to this frame's world-space vertices (the scene's `vertex` SSBO,
+    /// bound), and read the refitted tree's SAH cost.
+    fn refit(&mut self, f: &mut FrameContext) -> Result<()> {
+        let refit = self.moving.refit.as_ref().expect("a tree to refit");
+        self.bind(f.gl, glow::READ_WRITE);
+        refit.run(f.gl, f.timers, &self.moving.kernels);
+        self.moving.cost = refit.sah_cost(f.gl)?;
+        self.built_for = Some(f.models.to_vec());
+        self.moving.refits += 1;
+        Ok(())
+    }
+
     /// Bind the word buffer with `access`: the entry kernel writes its last texels
     /// (`glow::READ_WRITE`), the others only read it (`glow::READ_ONLY`).
     fn bind(&self, gl: &Gl, access: u32) {
@@ -228,11 +305,15 @@ impl Bvh {
 
 impl Accelerator for Bvh {
     fn build(&mut self, f: &mut FrameContext) -> Result<()> {
-        self.rebuilt = self.built_for.as_deref() != Some(f.models);
-        if self.rebuilt {
-            self.rebuild(f.models)?;
+        self.rebuilt = false;
+        if self.built_for.as_deref() == Some(f.models) {
+            return Ok(());
         }
-        Ok(())
+        if self.moving.refit.is_some() && self.sah_growth() <= REBUILD_GROWTH {
+            return self.refit(f);
+        }
+        self.rebuilt = true;
+        self.rebuild(f.models)
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
@@ -261,7 +342,11 @@ impl Accelerator for Bvh {
         f.insert("bvh_leaves".into(), json!(s.leaves));
         f.insert("bvh_depth".into(), json!(s.depth));
         f.insert("bvh_bytes".into(), json!(s.bytes));
-        f.insert("bvh_sah_cost".into(), json!(s.sah_cost));
+        f.insert("bvh_sah_cost".into(), json!(self.moving.cost));
+        f.insert("bvh_build_sah_cost".into(), json!(s.sah_cost));
+        f.insert("bvh_refits".into(), json!(self.moving.refits));
+        let refit_ms = stats.gpu_ms.get(REFIT_TIMER).copied().unwrap_or(0.0);
+        f.insert("bvh_refit_ms".into(), json!(refit_ms));
     }
 
     fn records(&self) -> bool {

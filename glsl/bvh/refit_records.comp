@@ -1,0 +1,73 @@
+// The refit's last pass — ours (bvh/refit.glsl: after Wald et al. 2007's refit): one invocation
+// per node. Each finds the grid of the records' planes over the root's new box (Grid::over in
+// src/accel/bvh/planes.rs), quantises its node's box onto it conservatively (Grid::planes: the
+// low planes rounded down, the high ones up, so that the record still holds its subtree) and
+// writes its record in every octant's copy (NodeRecord, BvhTree::octant_records in
+// src/accel/bvh/layout.rs), keeping the record's `reference` (miss link or leaf triangles: the
+// topology is the build's); node 0's invocation writes the Header's grid. In doubles as the host
+// computes them: a plane origin + q·step is exact in a double (q has 16 bits, step 24), so the
+// planes are the host's, bit for bit.
+#include "refit.glsl"
+
+const double GRID_MAX = double(BVH_GRID_STEPS);
+
+vec3 gridOrigin = vec3(0.0), gridStep = vec3(1.0);
+
+// Grid::over: the root's low corner and per axis the smallest float step whose BVH_GRID_STEPS
+// steps reach the high side, no smaller than 2^-40 of the axis's coordinates; the unit grid at 0
+// for a root that is no box.
+void gridOver(vec3 lo, vec3 hi)
+{
+    if (any(isnan(lo)) || any(isinf(lo)) || any(isnan(hi)) || any(isinf(hi))
+            || any(greaterThan(lo, hi))) return;
+    gridOrigin = lo;
+    for (int a = 0; a < 3; a++) {
+        double extent = double(hi[a]) - double(lo[a]);
+        float spacing = max(abs(lo[a]), abs(hi[a])) * uintBitsToFloat(uint(127 - 40) << 23);
+        float s = max(float(extent / GRID_MAX), max(spacing, uintBitsToFloat(0x00800000u)));
+        while (double(s) * GRID_MAX < extent) s = uintBitsToFloat(floatBitsToUint(s) + 1u);
+        gridStep[a] = s;
+    }
+}
+
+double plane(int a, double q) { return double(gridOrigin[a]) + q * double(gridStep[a]); }
+
+// Grid::planes for one axis: the tightest planes (low, high) that hold [lo, hi]
+uvec2 axisPlanes(int a, float lo, float hi)
+{
+    double o = double(gridOrigin[a]), s = double(gridStep[a]);
+    double l = clamp(floor((double(lo) - o) / s), 0.0LF, GRID_MAX);
+    while (l > 0.0LF && plane(a, l) > double(lo)) l -= 1.0LF;
+    while (l < GRID_MAX && plane(a, l + 1.0LF) <= double(lo)) l += 1.0LF;
+    double h = clamp(ceil((double(hi) - o) / s), 0.0LF, GRID_MAX);
+    while (h < GRID_MAX && plane(a, h) < double(hi)) h += 1.0LF;
+    while (h > 0.0LF && plane(a, h - 1.0LF) >= double(hi)) h -= 1.0LF;
+    return uvec2(uint(l), uint(h));
+}
+
+void main()
+{
+    int k = passNode();
+    if (k < 0) return;
+    gridOver(boxes[0].xyz, boxes[1].xyz);
+    if (k == 0) {
+        imageStore(bvh, 0, uvec4(uint(nodeCount), floatBitsToUint(gridOrigin)));
+        imageStore(bvh, 1, uvec4(floatBitsToUint(gridStep), 0u));
+    }
+    vec3 lo = boxes[2 * k].xyz, hi = boxes[2 * k + 1].xyz;
+    uvec3 low, high;
+    for (int a = 0; a < 3; a++) {
+        uvec2 q = axisPlanes(a, lo[a], hi[a]);
+        low[a] = q.x;
+        high[a] = q.y;
+    }
+    for (int o = 0; o < 8; o++) {
+        // octant_planes: the near plane is the low one unless the octant's rays point down
+        bvec3 down = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
+        uvec3 near = mix(low, high, down), far = mix(high, low, down);
+        int texel = recordTexel(k, o);
+        uint reference = imageLoad(bvh, texel).w;
+        imageStore(bvh, texel, uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
+                                     far.y | far.z << 16u, reference));
+    }
+}

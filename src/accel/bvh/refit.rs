@@ -1,0 +1,316 @@
+//! Moving objects without a CPU rebuild — ours: the BVH's boxes refitted bottom-up on the GPU
+//! every frame in which a model matrix changed, the topology of the last CPU build kept (Wald,
+//! Boulos and Shirley 2007, "Ray tracing deformable scenes using dynamic bounding volume
+//! hierarchies"; Kopta et al. 2012, "Fast, effective BVH updates for animated scenes"), one
+//! dispatch per level of the tree (`glsl/bvh/refit.glsl`), and a CPU rebuild when the refitted
+//! tree's SAH cost has grown past [`REBUILD_GROWTH`] times the last build's
+//! (`docs/design/bvh.md`, "Moving objects").
+//!
+//! Where each part of [`BvhTree::gpu_words`] comes from, after a build and after a refit:
+//!
+//! | words | after a CPU build ([`BvhTree::new`]) | after a GPU refit | CPU twin of the refit |
+//! |---|---|---|---|
+//! | [`Header`](super::Header): node count | `gpu_words` | `refit_records.comp` (node 0): unchanged | — |
+//! | Header: grid origin, step | `Grid::over` the root's box | `refit_records.comp` (`gridOver`, every invocation; node 0 stores it) | [`BvhTree::refit`] |
+//! | [`NodeRecord`](super::NodeRecord) planes, every octant | `Grid::planes` of the built boxes | `refit_records.comp` (`axisPlanes`) of the refitted boxes | [`BvhTree::refit`] |
+//! | NodeRecord `reference` (miss link, leaf triangles) | `octant_records` | kept (read and written back) | — |
+//! | [`LeafTriangle`](super::LeafTriangle) v0, id, edges | `gpu_words` from the CPU's world transform | `refit_leaves.comp` from the transform pass' `vertex` SSBO | [`BvhTree::refit`] |
+//! | node boxes (not uploaded) | the build, padded by `build::pad` | `refit_leaves.comp`, `refit_nodes.comp` (SSBO `REFIT_BOXES`), padded by the build's pad | [`BvhTree::refit`] |
+//!
+//! The block entries after the leaf triangles are `glsl/bvh/entry.comp`'s every pass, either way.
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
+use glam::Vec3;
+use glow::HasContext;
+use rayon::prelude::*;
+
+use super::layout::{Aabb, BvhTree, Node, OCTANTS};
+use super::planes::Grid;
+use crate::gl::resources::{GpuTimers, Ssbo};
+use crate::gl::slots::ssbo;
+use crate::gl::{sync, Gl, Kernel};
+
+/// Rebuild on the CPU when the refitted tree's SAH cost exceeds the last build's by this factor
+/// (measured on the turning dragon and bunny: `docs/design/bvh.md`, "Moving objects").
+pub const REBUILD_GROWTH: f64 = 1.3;
+
+/// Invocations of a work group of the refit's kernels (`REFIT_GROUP`).
+pub const REFIT_GROUP: u32 = 64;
+
+/// The timer of the refit's passes, all together (`bvh_refit_ms` in the statistics).
+pub const REFIT_TIMER: &str = "bvh_refit";
+
+impl BvhTree {
+    /// The CPU twin of the GPU refit: the same topology over `triangles` (moved: same count,
+    /// same ids), every node's box made again bottom-up (a leaf's: its triangles' bounds widened
+    /// by the build's [`BvhTree::pad`]; an inner node's: its children's union), the grid over the
+    /// new root box, the planes on it, and the SAH cost of the refitted tree.
+    pub fn refit(&mut self, triangles: Vec<[Vec3; 3]>) {
+        assert_eq!(
+            triangles.len(),
+            self.triangles.len(),
+            "a refit keeps the triangles"
+        );
+        self.triangles = triangles;
+        let pad = Vec3::splat(self.pad);
+        for k in (0..self.nodes.len()).rev() {
+            let node = self.nodes[k];
+            let b = if node.is_leaf() {
+                let mut b = Aabb::EMPTY;
+                let entries = node.first as usize..(node.first + node.count()) as usize;
+                for &id in &self.tris[entries] {
+                    self.triangles[id as usize]
+                        .iter()
+                        .for_each(|&p| b.grow_point(p));
+                }
+                Aabb {
+                    lo: b.lo - pad,
+                    hi: b.hi + pad,
+                }
+            } else {
+                let mut b = aabb(&self.nodes[node.first as usize]);
+                b.grow(&aabb(&self.nodes[node.first as usize + 1]));
+                b
+            };
+            (self.nodes[k].lo, self.nodes[k].hi) = (b.lo.to_array(), b.hi.to_array());
+        }
+        self.grid = Grid::over(&aabb(&self.nodes[0]));
+        let grid = self.grid;
+        self.planes = self.nodes.par_iter().map(|n| grid.planes(n)).collect();
+        self.stats.sah_cost = sah_cost(&self.nodes);
+    }
+}
+
+fn aabb(n: &Node) -> Aabb {
+    Aabb {
+        lo: n.lo.into(),
+        hi: n.hi.into(),
+    }
+}
+
+/// The SAH cost of `nodes` relative to the root ([`super::BvhStats::sah_cost`]).
+pub fn sah_cost(nodes: &[Node]) -> f64 {
+    let root = aabb(&nodes[0]).half_area() as f64;
+    let cost = |n: &Node| {
+        let rel = match root > 0.0 {
+            true => aabb(n).half_area() as f64 / root,
+            false => 1.0,
+        };
+        rel * n.count().max(1) as f64
+    };
+    nodes.iter().map(cost).sum()
+}
+
+/// The tree's topology as the refit's kernels read it (`glsl/bvh/refit.glsl` lays the words out),
+/// and its passes: the leaves, then the inner nodes level by level, the deepest first.
+pub struct Topology {
+    pub words: Vec<u32>,
+    /// (first, count) of each pass in the order of the nodes
+    pub passes: Vec<(u32, u32)>,
+}
+
+impl Topology {
+    pub fn of(tree: &BvhTree) -> Topology {
+        let nodes = &tree.nodes;
+        let n = nodes.len();
+        let mut depth = vec![0usize; n];
+        let mut levels: Vec<Vec<u32>> = Vec::new();
+        let mut leaves = Vec::new();
+        for (k, node) in nodes.iter().enumerate() {
+            if node.is_leaf() {
+                leaves.push(k as u32);
+                continue;
+            }
+            let first = node.first as usize;
+            (depth[first], depth[first + 1]) = (depth[k] + 1, depth[k] + 1);
+            levels.resize_with(levels.len().max(depth[k] + 1), Vec::new);
+            levels[depth[k]].push(k as u32);
+        }
+        let mut passes = vec![(0, leaves.len() as u32)];
+        let mut order = leaves;
+        for level in levels.iter().rev() {
+            passes.push((order.len() as u32, level.len() as u32));
+            order.extend(level);
+        }
+        let mut words: Vec<u32> = nodes
+            .iter()
+            .flat_map(|n| [n.first, n.meta as u32])
+            .collect();
+        words.extend(order);
+        let texels: Vec<Vec<u32>> = (0..OCTANTS).map(|o| tree.record_texels(o)).collect();
+        words.extend((0..n).flat_map(|k| texels.iter().map(move |t| t[k])));
+        words.extend(&tree.tris);
+        Topology { words, passes }
+    }
+}
+
+/// The refit's three kernels (`glsl/bvh/refit_*.comp`).
+pub struct RefitKernels {
+    pub leaves: Kernel,
+    pub nodes: Kernel,
+    pub records: Kernel,
+}
+
+/// The refit of one build: its topology and the node boxes, on the GPU.
+pub struct Refit {
+    topology: Ssbo,
+    boxes: Ssbo,
+    passes: Vec<(u32, u32)>,
+    nodes: u32,
+    pad: f32,
+}
+
+impl Refit {
+    /// The buffers of `tree`'s refit.
+    pub fn new(gl: &Arc<Gl>, tree: &BvhTree, max_block: i64) -> Result<Refit> {
+        let t = Topology::of(tree);
+        let words = bytemuck::cast_slice(&t.words);
+        let n = tree.nodes.len();
+        Ok(Refit {
+            topology: Ssbo::new(
+                gl,
+                "bvh refit topology",
+                words.len(),
+                Some(words),
+                max_block,
+            )?,
+            boxes: Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?,
+            passes: t.passes,
+            nodes: n as u32,
+            pad: tree.pad,
+        })
+    }
+
+    /// Run the refit's passes (the BVH's word buffer bound for reading and writing, the scene's
+    /// `vertex` SSBO holding this frame's world-space vertices), a barrier after each: a level
+    /// reads the boxes the pass before wrote (GL 4.6 §7.13), the records' pass the root's box.
+    /// Timed together as [`REFIT_TIMER`].
+    pub fn run(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels) {
+        self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
+        self.boxes.bind(gl, ssbo::REFIT_BOXES);
+        sync::barrier(gl);
+        let n = self.nodes as i32;
+        timers.time(gl, REFIT_TIMER, || {
+            let all = (0, self.nodes);
+            let passes = self.passes.iter().enumerate().map(|(i, &p)| match i {
+                0 => (&k.leaves, p),
+                _ => (&k.nodes, p),
+            });
+            for (kernel, (start, count)) in passes.chain([(&k.records, all)]) {
+                kernel.use_program();
+                kernel.set_i32("nodeCount", n);
+                kernel.set_i32("orderStart", start as i32);
+                kernel.set_i32("orderCount", count as i32);
+                if std::ptr::eq(kernel, &k.leaves) {
+                    kernel.set_f32("pad", self.pad);
+                }
+                // SAFETY: dispatch of the program in use.
+                unsafe { gl.dispatch_compute(count.div_ceil(REFIT_GROUP).max(1), 1, 1) };
+                sync::barrier(gl);
+            }
+        });
+    }
+
+    /// The SAH cost of the refitted tree (after [`Refit::run`]): the root's subtree cost over
+    /// its half area, as the refit's passes found them (`glsl/bvh/refit.glsl`).
+    pub fn sah_cost(&self, gl: &Gl) -> Result<f64> {
+        let mut bytes = [0u8; 32];
+        // SAFETY: reading the first 32 bytes of our own buffer, which has at least 32.
+        unsafe {
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.boxes.buffer.raw()));
+            gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
+            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
+        }
+        let f: [f32; 8] = bytemuck::cast(bytes);
+        let root = Aabb {
+            lo: Vec3::new(f[0], f[1], f[2]),
+            hi: Vec3::new(f[4], f[5], f[6]),
+        };
+        let area = root.half_area() as f64;
+        if !f[3].is_finite() {
+            return Err(anyhow!("the refit's SAH cost is {}", f[3]));
+        }
+        Ok(match area > 0.0 {
+            true => f[3] as f64 / area,
+            false => 1.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::layout::tests::soup;
+    use super::*;
+    use glam::Mat4;
+
+    #[test]
+    fn a_refit_of_unmoved_triangles_gives_the_build_s_words() {
+        let tris = soup();
+        let mut bvh = BvhTree::new(tris.clone());
+        let (words, cost) = (bvh.gpu_words(), bvh.stats.sah_cost);
+        bvh.refit(tris);
+        assert_eq!(bvh.gpu_words(), words);
+        assert!((bvh.stats.sah_cost - cost).abs() < 1e-9 * cost, "{cost}");
+    }
+
+    #[test]
+    fn a_refit_holds_every_moved_triangle_in_its_leaves_boxes() {
+        let tris = soup();
+        let mut bvh = BvhTree::new(tris.clone());
+        let turn = Mat4::from_rotation_y(0.7) * Mat4::from_rotation_x(0.3);
+        let moved: Vec<_> = tris
+            .iter()
+            .map(|t| t.map(|p| turn.transform_point3(p)))
+            .collect();
+        bvh.refit(moved.clone());
+        for n in &bvh.nodes {
+            let q = bvh.grid.planes(n);
+            let b = aabb(n);
+            let on_grid = |p: Vec3| {
+                (0..3).all(|a| {
+                    bvh.grid.plane(a, q[a]) <= p[a] as f64
+                        && p[a] as f64 <= bvh.grid.plane(a, q[3 + a])
+                })
+            };
+            let entries = n.first as usize..(n.first + n.count()) as usize;
+            for &id in bvh.tris.get(entries).filter(|_| n.is_leaf()).unwrap_or(&[]) {
+                for p in moved[id as usize] {
+                    assert!(b.contains(&Aabb { lo: p, hi: p }) && on_grid(p));
+                }
+            }
+        }
+        // the build's boxes, turned, are looser than a fresh build's over the turned triangles
+        assert!(bvh.stats.sah_cost > BvhTree::new(moved).stats.sah_cost);
+    }
+
+    #[test]
+    fn the_passes_take_every_node_once_after_its_children() {
+        let bvh = BvhTree::new(soup());
+        let t = Topology::of(&bvh);
+        let n = bvh.nodes.len();
+        let order = &t.words[2 * n..3 * n];
+        let mut pass_of = vec![usize::MAX; n];
+        let mut next = 0;
+        for (i, &(start, count)) in t.passes.iter().enumerate() {
+            assert_eq!(start, next);
+            next += count;
+            for &k in &order[start as usize..(start + count) as usize] {
+                assert_eq!(pass_of[k as usize], usize::MAX, "node {k} twice");
+                pass_of[k as usize] = i;
+            }
+        }
+        for (k, node) in bvh.nodes.iter().enumerate() {
+            assert_eq!(
+                node.is_leaf(),
+                pass_of[k] == 0,
+                "the leaves' pass is the first"
+            );
+            if !node.is_leaf() {
+                let c = node.first as usize;
+                assert!(pass_of[c] < pass_of[k] && pass_of[c + 1] < pass_of[k]);
+            }
+        }
+    }
+}
