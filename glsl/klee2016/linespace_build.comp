@@ -28,6 +28,9 @@ layout(local_size_x = 64) in;
 // occupancy[ls · N² + y + N·z]: bit x set when child (x, y, z) of line space ls's node has
 // geometry (made on the host from the node pool)
 layout(std430, binding = SSBO_LS_OCCUPANCY) readonly buffer Occupancy { uint occupancy[]; };
+// sat[ls · (N+1)³ + x + (N+1)·(y + (N+1)·z)]: the filled children with all coordinates below
+// (x, y, z) (a summed-volume table of the same flags), to skip boxes of cells without any
+layout(std430, binding = SSBO_LS_SAT) readonly buffer Sat { uint sat[]; };
 layout(r32ui, binding = IMAGE_LINESPACE) uniform writeonly uimage3D linespaceTexture;
 
 uniform int lsBegin;         // this dispatch's line spaces: lsBegin <= ls < lsEnd
@@ -89,10 +92,23 @@ bool shaftHitsCell(ivec3 alo, ivec3 ahi, ivec3 blo, ivec3 bhi, ivec3 c)
     return t.x * t.w < t.z * t.y;
 }
 
+#define M1 (N + 1)
+// Filled children in the cells c0..c1 (inclusive; c0 <= c1) of the node whose table starts at
+// satBase.
+uint filledIn(uint satBase, ivec3 c0, ivec3 c1)
+{
+    ivec3 h = c1 + ivec3(1);
+#define S(x, y, z) sat[satBase + uint(x + M1 * (y + M1 * (z)))]
+    return S(h.x, h.y, h.z) - S(c0.x, h.y, h.z) - S(h.x, c0.y, h.z) - S(h.x, h.y, c0.z)
+        + S(c0.x, c0.y, h.z) + S(c0.x, h.y, c0.z) + S(h.x, c0.y, c0.z) - S(c0.x, c0.y, c0.z);
+#undef S
+}
+
 // Fig. 5: is there a child with geometry in the shaft between A and B? (See the header for
 // the candidates.)
 bool shaftBlocked(uint base, ivec3 alo, ivec3 ahi, ivec3 blo, ivec3 bhi)
 {
+    uint satBase = base / uint(NN) * uint(M1 * M1 * M1);
     for (int j = 0; j < N; j++) {
         // the boxes at t = j/N and (j+1)/N, scaled by N: integers
         ivec3 lo0 = (N - j) * alo + j * blo;
@@ -102,7 +118,7 @@ bool shaftBlocked(uint base, ivec3 alo, ivec3 ahi, ivec3 blo, ivec3 bhi)
         // cells m with m < max(hi)/N and m + 1 > min(lo)/N (interiors; all values >= 0)
         ivec3 c0 = min(lo0, lo1) / N;
         ivec3 c1 = min((max(hi0, hi1) + (N - 1)) / N - 1, ivec3(N - 1));
-        if (c1.x < c0.x) continue;
+        if (any(lessThan(c1, c0)) || filledIn(satBase, c0, c1) == 0u) continue;
         uint xs = ((1u << uint(c1.x - c0.x + 1)) - 1u) << uint(c0.x);
         for (int z = c0.z; z <= c1.z; z++) {
             for (int y = c0.y; y <= c1.y; y++) {

@@ -62,6 +62,8 @@ slot_table! {
         /// Klee 2016's line-space build (glsl/klee2016/linespace_build.comp): per inner node
         /// its children's geometry flags, one N-bit row per (y, z)
         LS_OCCUPANCY = 2,
+        /// and their summed-volume tables
+        LS_SAT = 3,
     }
 }
 

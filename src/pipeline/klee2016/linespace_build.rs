@@ -15,6 +15,31 @@ use crate::gl::resources::{GpuTimers, Owned, Ssbo};
 use crate::gl::slots::{image, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
 
+/// `--linespace-build`: where the line spaces are computed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LinespaceBuild {
+    /// The GPU on a hardware GPU, the CPU on a software rasteriser (llvmpipe, or zink over
+    /// lavapipe), whose compute kernels run on the same cores and where the CPU build is
+    /// faster (docs/design/linespace.md).
+    #[default]
+    Auto,
+    /// The CPU build (`NTree::build_linespaces_cpu`), uploaded.
+    Cpu,
+    /// The GPU build (`glsl/klee2016/linespace_build.comp`).
+    Gpu,
+}
+
+impl LinespaceBuild {
+    /// Whether the GPU builds the line spaces on the GL implementation `info`.
+    pub fn on_gpu(self, info: &GlInfo) -> bool {
+        match self {
+            LinespaceBuild::Auto => !info.is_llvmpipe(),
+            LinespaceBuild::Cpu => false,
+            LinespaceBuild::Gpu => true,
+        }
+    }
+}
+
 /// Invocations of a work group (the kernel's `local_size_x`).
 const GROUP: u32 = 64;
 /// Work groups of one dispatch at most (GL guarantees 65535 per dimension).
@@ -57,7 +82,7 @@ fn linespaces_per_dispatch(words: u32) -> u32 {
 }
 
 /// Build `tree`'s line spaces on the GPU into a new texture with Listing 3's layout (at most
-/// `GL_MAX_3D_TEXTURE_SIZE`, capped at 2048, per axis), read them back into `tree.linespaces`
+/// `max_dim` texels per axis), read them back into `tree.linespaces`
 /// and the layout's texels, and set `tree.linespace_build_ms` to the whole step's wall time
 /// (occupancy rows, dispatches, read-back).
 pub fn build(
@@ -65,10 +90,10 @@ pub fn build(
     info: &GlInfo,
     shaders: &ShaderSource,
     tree: &mut NTree,
+    max_dim: u32,
 ) -> Result<GpuLinespaces> {
     let t0 = std::time::Instant::now();
     let words = ntree::linespace_words(tree.n) as u32;
-    let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
     let mut packed = ntree::linespace_layout(words as usize, tree.linespace_count, max_dim)?;
     let texture = r32ui_texture_3d(gl, &packed)?;
     let rows = tree.occupancy_rows();
@@ -77,6 +102,14 @@ pub fn build(
         "linespaceOccupancy",
         4 * rows.len(),
         Some(bytemuck::cast_slice(&rows)),
+        info.max_ssbo_block_size,
+    )?;
+    let sat = tree.occupancy_sat(&rows);
+    let sat = Ssbo::new(
+        gl,
+        "linespaceSat",
+        4 * sat.len(),
+        Some(bytemuck::cast_slice(&sat)),
         info.max_ssbo_block_size,
     )?;
     let defines = Defines::new().set("NTREE_N", tree.n);
@@ -94,6 +127,7 @@ pub fn build(
     kernel.set_i32("tex_y_res", packed.tex_y_res as i32);
     kernel.set_i32("ls_y_size", packed.ls_y_size as i32);
     occupancy.bind(gl, ssbo::LS_OCCUPANCY);
+    sat.bind(gl, ssbo::LS_SAT);
     // SAFETY: binding our texture to its image unit.
     unsafe {
         let (t, wo) = (Some(texture.raw()), glow::WRITE_ONLY);

@@ -40,6 +40,7 @@ use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
 pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 
+pub use self::linespace_build::LinespaceBuild;
 pub use crate::scene::shadows::parse_samples;
 
 /// Options of the soft-shadow renderer.
@@ -58,6 +59,8 @@ pub struct SoftShadowOptions {
     pub tile: u32,
     /// How the shadow value lights a pixel (ours, or Fig. 7's product).
     pub shading: KleeShading,
+    /// Where the line spaces are computed (GPU or CPU).
+    pub linespace_build: LinespaceBuild,
 }
 
 /// The scene's single area light (the thesis lights with one).
@@ -156,13 +159,13 @@ fn linespaces(
     shaders: &ShaderSource,
     tree: &mut NTree,
 ) -> Result<(Owned<glow::Texture>, PackedLinespaces)> {
+    let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
     let (texture, packed) = if tree.linespaces.is_empty() {
-        let built = linespace_build::build(gl, info, shaders, tree)?;
+        let built = linespace_build::build(gl, info, shaders, tree, max_dim)?;
         tree.linespace_gpu_ms = Some(built.gpu_ms);
         (built.texture, built.packed)
     } else {
         let words = ntree::linespace_words(tree.n);
-        let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
         let count = tree.linespace_count;
         let packed = ntree::pack_linespaces(&tree.linespaces, words, count, max_dim)?;
         (shadow_pass::linespace_texture(gl, &packed)?, packed)
@@ -192,11 +195,14 @@ impl SoftShadowRenderer {
         scene_light(scene)?;
         crate::scene::validate::scene(scene)
             .map_err(|m| anyhow::anyhow!("{}: {m}", scene.path.display()))?;
-        let tree = NTree::build_nodes(
+        let mut tree = NTree::build_nodes(
             &scene.world_triangles(),
             options.ntree_n,
             options.ntree_depth,
         )?;
+        if !options.linespace_build.on_gpu(info) {
+            tree.build_linespaces_cpu();
+        }
         Self::with_tree(gl, info, scene, shaders, options, tree)
     }
 

@@ -661,6 +661,34 @@ impl NTree {
         self.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
     }
 
+    /// Per line space (in order) the summed-volume table of its children's geometry flags:
+    /// (N+1)³ counts, entry x + (N+1)·(y + (N+1)·z) = filled children below (x, y, z) on
+    /// every axis.
+    pub fn occupancy_sat(&self, rows: &[u32]) -> Vec<u32> {
+        let n = self.n as usize;
+        let m = n + 1;
+        let mut sat = vec![0u32; self.linespace_count * m * m * m];
+        for (ls, table) in sat.chunks_mut(m * m * m).enumerate() {
+            for z in 1..m {
+                for y in 1..m {
+                    for x in 1..m {
+                        let f = (rows[ls * n * n + (y - 1) + n * (z - 1)] >> (x - 1)) & 1;
+                        let at = |x: usize, y: usize, z: usize| x + m * (y + m * z);
+                        table[at(x, y, z)] = f
+                            + table[at(x - 1, y, z)]
+                            + table[at(x, y - 1, z)]
+                            + table[at(x, y, z - 1)]
+                            - table[at(x - 1, y - 1, z)]
+                            - table[at(x - 1, y, z - 1)]
+                            - table[at(x, y - 1, z - 1)]
+                            + table[at(x - 1, y - 1, z - 1)];
+                    }
+                }
+            }
+        }
+        sat
+    }
+
     /// The geometry flags of every inner node's children as the GPU build reads them: per line
     /// space (in order) N² rows, row y + N·z with bit x set when child (x, y, z) has geometry.
     pub fn occupancy_rows(&self) -> Vec<u32> {
