@@ -363,6 +363,7 @@ impl Design {
                 height,
                 tile: defaults::TILE,
                 shading: Default::default(),
+                linespace_build: Default::default(),
             }),
             (Pipeline::Mueller2015, None) => {
                 unreachable!("Müller 2015's rows name their accelerator")

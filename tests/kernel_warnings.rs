@@ -90,6 +90,7 @@ fn every_kernel_compiles_without_warnings() {
             ntree_n: 10,
             ntree_depth: 3,
             shading: Default::default(),
+            linespace_build: Default::default(),
             width: 8,
             height: 8,
             tile: 0,

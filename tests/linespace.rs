@@ -226,6 +226,7 @@ fn opts(mode: ShadowMode, s: u32, w: u32) -> SoftShadowOptions {
         ntree_n: 10,
         ntree_depth: 3,
         shading: Default::default(),
+        linespace_build: Default::default(),
         width: w,
         height: w,
         tile: 32,

@@ -11,7 +11,7 @@ use clap::{ArgMatches, Parser as _, ValueEnum};
 use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant};
 use gpgpu_rt::design::{self, defaults, Design, Pipeline, Row};
 use gpgpu_rt::limits;
-use gpgpu_rt::pipeline::klee2016::{KleeShading, SoftShadowOptions};
+use gpgpu_rt::pipeline::klee2016::{KleeShading, LinespaceBuild, SoftShadowOptions};
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::stream::StreamOptions;
 use gpgpu_rt::pipeline::wagner2018::WagnerOptions;
@@ -182,6 +182,10 @@ pub struct SoftShadowArgs {
     /// N·L)) or `fig7` (Klee 2016's Fig. 7: s · diffuse).
     #[arg(long, value_enum, default_value_t = KleeShading::Lit)]
     pub klee_shading: KleeShading,
+    /// Where the N-tree's line spaces are computed: `gpu` (a compute kernel), `cpu`, or
+    /// `auto` (the GPU unless GL is a software rasteriser, where the CPU build is faster).
+    #[arg(long, value_enum, default_value_t = LinespaceBuild::Auto)]
+    pub linespace_build: LinespaceBuild,
 }
 
 impl SoftShadowArgs {
@@ -212,6 +216,7 @@ impl SoftShadowArgs {
             ntree_n: self.ntree_n,
             ntree_depth: self.ntree_depth,
             shading: self.klee_shading,
+            linespace_build: self.linespace_build,
             width,
             height,
             tile,

@@ -199,6 +199,7 @@ fn soft_renderer<'a>(
                 ntree_n: 10,
                 ntree_depth: 3,
                 shading: Default::default(),
+                linespace_build: Default::default(),
                 width: size,
                 height: size,
                 tile: 0,

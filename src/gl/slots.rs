@@ -64,6 +64,11 @@ slot_table! {
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,
+        /// Klee 2016's line-space build (glsl/klee2016/linespace_build.comp): per inner node
+        /// its children's geometry flags, one N-bit row per (y, z)
+        LS_OCCUPANCY = 2,
+        /// and their summed-volume tables
+        LS_SAT = 3,
     }
 }
 

@@ -15,6 +15,7 @@
 //! buffer (RG32UI), the line spaces into a 3D R32UI texture laid out as Listing 3.
 
 pub mod gbuffer;
+pub mod linespace_build;
 pub mod ntree;
 pub mod present;
 pub mod shadow_pass;
@@ -34,11 +35,12 @@ use self::shadow_pass::{shadow_kernel, ShadowPass, ShadowUniforms};
 use super::Renderer;
 use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
 use crate::gl::context::LoopLimit;
-use crate::gl::resources::GpuTimers;
+use crate::gl::resources::{GpuTimers, Owned};
 use crate::gl::{Gl, GlInfo, PixelGrid, ShaderSource};
 pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 
+pub use self::linespace_build::LinespaceBuild;
 pub use crate::scene::shadows::parse_samples;
 
 /// Options of the soft-shadow renderer.
@@ -57,6 +59,8 @@ pub struct SoftShadowOptions {
     pub tile: u32,
     /// How the shadow value lights a pixel (ours, or Fig. 7's product).
     pub shading: KleeShading,
+    /// Where the line spaces are computed (GPU or CPU).
+    pub linespace_build: LinespaceBuild,
 }
 
 /// The scene's single area light (the thesis lights with one).
@@ -146,12 +150,26 @@ pub struct SoftShadowRenderer {
     last: Option<(Camera, FrameStats)>,
 }
 
-/// Pack the tree's line spaces into the 3D texture layout of Listing 3 (the node pool's
-/// texture buffer checks its own limit when it is made).
-fn pack(info: &GlInfo, tree: &NTree) -> Result<PackedLinespaces> {
-    let words = ntree::linespace_words(tree.n);
+/// The tree's line spaces in the 3D texture layout of Listing 3: built on the GPU when the
+/// tree comes without them ([`NTree::build_nodes`]), uploaded when the CPU built them (the node
+/// pool's texture buffer checks its own limit when it is made).
+fn linespaces(
+    gl: &Arc<Gl>,
+    info: &GlInfo,
+    shaders: &ShaderSource,
+    tree: &mut NTree,
+) -> Result<(Owned<glow::Texture>, PackedLinespaces)> {
     let max_dim = (info.max_3d_texture_size.max(1) as u32).min(2048);
-    let packed = ntree::pack_linespaces(&tree.linespaces, words, tree.linespace_count, max_dim)?;
+    let (texture, packed) = if tree.linespaces.is_empty() {
+        let built = linespace_build::build(gl, info, shaders, tree, max_dim)?;
+        tree.linespace_gpu_ms = Some(built.gpu_ms);
+        (built.texture, built.packed)
+    } else {
+        let words = ntree::linespace_words(tree.n);
+        let count = tree.linespace_count;
+        let packed = ntree::pack_linespaces(&tree.linespaces, words, count, max_dim)?;
+        (shadow_pass::linespace_texture(gl, &packed)?, packed)
+    };
     log::info!(
         "N-tree N={} depth={}: {} node groups, {} leaves, {} line spaces ({} bytes), built in {:.0} + {:.0} ms",
         tree.n,
@@ -163,7 +181,7 @@ fn pack(info: &GlInfo, tree: &NTree) -> Result<PackedLinespaces> {
         tree.build_ms,
         tree.linespace_build_ms
     );
-    Ok(packed)
+    Ok((texture, packed))
 }
 
 impl SoftShadowRenderer {
@@ -177,11 +195,14 @@ impl SoftShadowRenderer {
         scene_light(scene)?;
         crate::scene::validate::scene(scene)
             .map_err(|m| anyhow::anyhow!("{}: {m}", scene.path.display()))?;
-        let tree = NTree::build(
+        let mut tree = NTree::build_nodes(
             &scene.world_triangles(),
             options.ntree_n,
             options.ntree_depth,
         )?;
+        if !options.linespace_build.on_gpu(info) {
+            tree.build_linespaces_cpu();
+        }
         Self::with_tree(gl, info, scene, shaders, options, tree)
     }
 
@@ -208,13 +229,15 @@ impl SoftShadowRenderer {
             options.tile,
             info.dispatch_threads(),
         )?;
-        let packed = pack(info, &tree)?;
+        let mut tree = tree;
+        let (linespace_texture, packed) = linespaces(&gl, info, shaders, &mut tree)?;
         let samples = (options.samples_u, options.samples_v);
         let limit = info.loop_limit();
         let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples, limit)?;
         let (w, h) = (options.width, options.height);
         let triangles = scene.world_triangles();
-        let shadow = ShadowPass::new(&gl, info, kernel, &tree, &packed, &triangles, &options)?;
+        let ls = (linespace_texture, &packed);
+        let shadow = ShadowPass::new(&gl, info, kernel, &tree, ls, &triangles, &options)?;
         Ok(SoftShadowRenderer {
             gbuffer: GBuffer::new(&gl, shaders, scene, w, h)?,
             present: Present::new(&gl, shaders, w, h)?,
@@ -422,6 +445,10 @@ impl SoftShadowRenderer {
             (
                 "linespace_build_ms",
                 json!(self.scene.tree.linespace_build_ms),
+            ),
+            (
+                "linespace_build_gpu_ms",
+                json!(self.scene.tree.linespace_gpu_ms),
             ),
             (
                 "linespace_texture",

@@ -160,6 +160,46 @@ pub fn shaft_hits_box(a: &Aabb, b: &Aabb, c: &Aabb) -> bool {
     tl < th
 }
 
+/// [`shaft_hits_box`] for the unit cell `c` (lower corner) with every coordinate on the
+/// integer lattice, in integers: the bounds of t kept as fractions (numerator, denominator > 0)
+/// and compared crosswise — the twin of `shaftHitsCell` in glsl/klee2016/linespace_build.comp.
+/// The same answers as the f64 test: its quotients are of integers within ±(N + 1), which f64
+/// rounds monotonically and keeps apart (two different ones differ by at least 1/(N + 1)²), so
+/// every comparison comes out as it does for the fractions (`tests/linespace_build.rs` checks
+/// every shaft and cell for small N).
+pub fn shaft_hits_cell(a: ([i32; 3], [i32; 3]), b: ([i32; 3], [i32; 3]), c: [i32; 3]) -> bool {
+    // (tl, th) as (numerator, denominator) pairs
+    let (mut tl, mut th) = ((0i32, 1i32), (1i32, 1i32));
+    // α + β t < γ
+    let mut constrain = |alpha: i32, beta: i32, gamma: i32| -> bool {
+        if beta == 0 {
+            return alpha < gamma;
+        }
+        if beta > 0 {
+            let num = gamma - alpha;
+            if num * th.1 < th.0 * beta {
+                th = (num, beta);
+            }
+        } else {
+            let num = alpha - gamma;
+            if num * tl.1 > tl.0 * -beta {
+                tl = (num, -beta);
+            }
+        }
+        true
+    };
+    let ((alo, ahi), (blo, bhi)) = (a, b);
+    for i in 0..3 {
+        if !constrain(alo[i], blo[i] - alo[i], c[i] + 1) {
+            return false;
+        }
+        if !constrain(-ahi[i], -(bhi[i] - ahi[i]), -c[i]) {
+            return false;
+        }
+    }
+    tl.0 * th.1 < th.0 * tl.1
+}
+
 /// The boxes of the filled ones of N³ children (index x + N(y + Nz)), in index order.
 fn filled_cells(n: u32, filled: &[bool]) -> Vec<Aabb> {
     let nn = n as usize;
@@ -347,17 +387,16 @@ impl PackedLinespaces {
     pub fn bytes(&self) -> usize {
         4 * self.texels.len()
     }
+
+    /// Texels of the layout: x · y · z.
+    pub fn texel_count(&self) -> usize {
+        self.tex_x_res as usize * self.tex_y_res as usize * self.tex_z_res as usize
+    }
 }
 
-/// Pack `count` line spaces of `words_per` words each (concatenated in `words`) into the 3D
-/// texture layout of Listing 3 with at most `max_dim` texels per axis.
-pub fn pack_linespaces(
-    words: &[u32],
-    words_per: usize,
-    count: usize,
-    max_dim: u32,
-) -> Result<PackedLinespaces> {
-    assert_eq!(words.len(), words_per * count);
+/// The 3D texture layout of Listing 3 for `count` line spaces of `words_per` words each with at
+/// most `max_dim` texels per axis (no texels yet).
+pub fn linespace_layout(words_per: usize, count: usize, max_dim: u32) -> Result<PackedLinespaces> {
     let tex_x_res = (words_per as u32).clamp(1, max_dim);
     let ls_y_size = (words_per as u32).div_ceil(tex_x_res);
     let rows = (count as u64 * ls_y_size as u64).max(1);
@@ -370,15 +409,27 @@ pub fn pack_linespaces(
              --ntree-n or --ntree-depth"
         );
     }
-    let mut p = PackedLinespaces {
+    Ok(PackedLinespaces {
         tex_x_res,
         tex_y_res,
         tex_z_res: tex_z_res as u32,
         ls_y_size,
         words_per_linespace: words_per as u32,
         texels: Vec::new(),
-    };
-    p.texels = vec![0u32; tex_x_res as usize * tex_y_res as usize * tex_z_res as usize];
+    })
+}
+
+/// Pack `count` line spaces of `words_per` words each (concatenated in `words`) into the 3D
+/// texture layout of Listing 3 with at most `max_dim` texels per axis.
+pub fn pack_linespaces(
+    words: &[u32],
+    words_per: usize,
+    count: usize,
+    max_dim: u32,
+) -> Result<PackedLinespaces> {
+    assert_eq!(words.len(), words_per * count);
+    let mut p = linespace_layout(words_per, count, max_dim)?;
+    p.texels = vec![0u32; p.texel_count()];
     for ls in 0..count {
         for w in 0..words_per {
             let o = p.offset(p.texel(ls as u32, w as u32));
@@ -408,7 +459,10 @@ pub struct NTree {
     pub leaf_triangles: Vec<u32>,
     pub leaf_count: usize,
     pub build_ms: f64,
+    /// Wall time of the line spaces' build (CPU, or GPU with its set-up and read-back).
     pub linespace_build_ms: f64,
+    /// GPU time of the line spaces' build when the GPU built them (timer queries).
+    pub linespace_gpu_ms: Option<f64>,
     /// The host bytes the build estimated, step by step, before allocating them.
     pub estimated_bytes: u64,
 }
@@ -446,8 +500,18 @@ impl NTree {
 
     /// Build the N-tree over `triangles` (world space): geometry by exact triangle/box overlap
     /// (separating axes), children down to level depth − 1, then one line space per node with
-    /// children (the root's included, as line space 0).
+    /// children (the root's included, as line space 0) on the CPU — the twin of the GPU build
+    /// (`linespace_build`).
     pub fn build(triangles: &[[Vec3; 3]], n: u32, depth: u32) -> Result<NTree> {
+        let mut tree = Self::build_nodes(triangles, n, depth)?;
+        tree.build_linespaces_cpu();
+        Ok(tree)
+    }
+
+    /// The N-tree's nodes and leaves without its line spaces (`linespace_count` says how many
+    /// there will be; `linespaces` stays empty until [`NTree::build_linespaces_cpu`] or the GPU
+    /// build fills it).
+    pub fn build_nodes(triangles: &[[Vec3; 3]], n: u32, depth: u32) -> Result<NTree> {
         if !(2..=16).contains(&n) {
             bail!("--ntree-n {n}: must lie in 2..=16");
         }
@@ -495,6 +559,7 @@ impl NTree {
             leaf_count: 0,
             build_ms: 0.0,
             linespace_build_ms: 0.0,
+            linespace_gpu_ms: None,
             estimated_bytes: 0,
         };
         let tris: Vec<[DVec3; 3]> = triangles.iter().map(|t| t.map(|p| p.as_dvec3())).collect();
@@ -575,19 +640,68 @@ impl NTree {
             bail!("more than 2^30 node groups");
         }
         tree.build_ms = t0.elapsed().as_secs_f64() * 1e3;
+        tree.linespace_count = inner_groups.len();
+        tree.estimated_bytes = budget.total();
+        Ok(tree)
+    }
+
+    /// The line spaces of every inner node on the CPU ([`build_linespace`], in line-space
+    /// order), timed into `linespace_build_ms`.
+    pub fn build_linespaces_cpu(&mut self) {
         let t1 = std::time::Instant::now();
-        let progress = Progress::new("line spaces", inner_groups.len() as u64, 1000);
-        let spaces: Vec<Vec<u32>> = inner_groups
+        let groups = self.inner_groups();
+        let progress = Progress::new("line spaces", groups.len() as u64, 1000);
+        let spaces: Vec<Vec<u32>> = groups
             .par_iter()
-            .map(|&g| build_linespace(n, &tree.group_filled(g)))
+            .map(|&g| build_linespace(self.n, &self.group_filled(g)))
             .inspect(|_| progress.inc(1))
             .collect();
         drop(progress);
-        tree.linespace_count = spaces.len();
-        tree.linespaces = spaces.concat();
-        tree.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
-        tree.estimated_bytes = budget.total();
-        Ok(tree)
+        self.linespaces = spaces.concat();
+        self.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// Per line space (in order) the summed-volume table of its children's geometry flags:
+    /// (N+1)³ counts, entry x + (N+1)·(y + (N+1)·z) = filled children below (x, y, z) on
+    /// every axis.
+    pub fn occupancy_sat(&self, rows: &[u32]) -> Vec<u32> {
+        let n = self.n as usize;
+        let m = n + 1;
+        let mut sat = vec![0u32; self.linespace_count * m * m * m];
+        for (ls, table) in sat.chunks_mut(m * m * m).enumerate() {
+            for z in 1..m {
+                for y in 1..m {
+                    for x in 1..m {
+                        let f = (rows[ls * n * n + (y - 1) + n * (z - 1)] >> (x - 1)) & 1;
+                        let at = |x: usize, y: usize, z: usize| x + m * (y + m * z);
+                        table[at(x, y, z)] = f
+                            + table[at(x - 1, y, z)]
+                            + table[at(x, y - 1, z)]
+                            + table[at(x, y, z - 1)]
+                            - table[at(x - 1, y - 1, z)]
+                            - table[at(x - 1, y, z - 1)]
+                            - table[at(x, y - 1, z - 1)]
+                            + table[at(x - 1, y - 1, z - 1)];
+                    }
+                }
+            }
+        }
+        sat
+    }
+
+    /// The geometry flags of every inner node's children as the GPU build reads them: per line
+    /// space (in order) N² rows, row y + N·z with bit x set when child (x, y, z) has geometry.
+    pub fn occupancy_rows(&self) -> Vec<u32> {
+        let n = self.n as usize;
+        let mut rows = vec![0u32; self.linespace_count * n * n];
+        for (ls, g) in self.inner_groups().into_iter().enumerate() {
+            for (i, filled) in self.group_filled(g).into_iter().enumerate() {
+                if filled {
+                    rows[ls * n * n + i / n] |= 1 << (i % n);
+                }
+            }
+        }
+        rows
     }
 
     /// Line space `i` as words.

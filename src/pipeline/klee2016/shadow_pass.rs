@@ -6,11 +6,12 @@
 
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use glam::Vec3;
 use glow::HasContext;
 
 use super::gbuffer::rgba32f_texture;
+use super::linespace_build::{r32ui_texture_3d, read_texture_3d};
 use super::ntree::{NTree, PackedLinespaces};
 use super::{KleeShading, SoftShadowOptions};
 use crate::gl::context::LoopLimit;
@@ -132,28 +133,24 @@ pub struct ShadowPass {
     texture_layout: [u32; 3],
 }
 
-/// The line spaces as a 3D R32UI texture laid out as Listing 3.
-fn linespace_texture(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owned<glow::Texture>> {
+/// The line spaces as a 3D R32UI texture laid out as Listing 3, uploaded from the CPU build.
+pub fn linespace_texture(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owned<glow::Texture>> {
+    let t = r32ui_texture_3d(gl, packed)?;
     let (x, y, z) = (
         packed.tex_x_res as i32,
         packed.tex_y_res as i32,
         packed.tex_z_res as i32,
     );
-    // SAFETY: texture creation and upload; the slice holds x·y·z texels.
+    // SAFETY: upload into our texture; the slice holds x·y·z texels.
     unsafe {
-        let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
         gl.bind_texture(glow::TEXTURE_3D, Some(t.raw()));
-        gl.tex_storage_3d(glow::TEXTURE_3D, 1, glow::R32UI, x, y, z);
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
         let texels = glow::PixelUnpackData::Slice(Some(bytemuck::cast_slice(&packed.texels)));
         let (red, uint) = (glow::RED_INTEGER, glow::UNSIGNED_INT);
         gl.tex_sub_image_3d(glow::TEXTURE_3D, 0, 0, 0, 0, x, y, z, red, uint, texels);
-        for p in [glow::TEXTURE_MIN_FILTER, glow::TEXTURE_MAG_FILTER] {
-            gl.tex_parameter_i32(glow::TEXTURE_3D, p, glow::NEAREST as i32);
-        }
         gl.bind_texture(glow::TEXTURE_3D, None);
-        Ok(t)
     }
+    Ok(t)
 }
 
 impl ShadowPass {
@@ -162,7 +159,7 @@ impl ShadowPass {
         info: &GlInfo,
         kernel: Kernel,
         tree: &NTree,
-        packed: &PackedLinespaces,
+        (linespaces, packed): (Owned<glow::Texture>, &PackedLinespaces),
         triangles: &[[Vec3; 3]],
         options: &SoftShadowOptions,
     ) -> Result<ShadowPass> {
@@ -196,7 +193,7 @@ impl ShadowPass {
             kernel,
             shadow_texture: rgba32f_texture(gl, options.width, options.height)?,
             node_pool,
-            linespace_texture: linespace_texture(gl, packed)?,
+            linespace_texture: linespaces,
             buffers,
             min_bound: tree.min_bound,
             inv_node_size: tree.inv_node_size(),
@@ -281,21 +278,6 @@ impl ShadowPass {
 
     /// Read the 3D line-space texture back (`texels` of them; the round-trip test).
     pub fn read_linespace_texture(&self, texels: usize) -> Vec<u32> {
-        let gl = &self.gl;
-        let mut data = vec![0u32; texels];
-        // SAFETY: the slice holds all texels of the texture.
-        unsafe {
-            gl.bind_texture(glow::TEXTURE_3D, Some(self.linespace_texture.raw()));
-            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
-            gl.get_tex_image(
-                glow::TEXTURE_3D,
-                0,
-                glow::RED_INTEGER,
-                glow::UNSIGNED_INT,
-                glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
-            );
-            gl.bind_texture(glow::TEXTURE_3D, None);
-        }
-        data
+        read_texture_3d(&self.gl, self.linespace_texture.raw(), texels)
     }
 }

@@ -190,6 +190,7 @@ impl SoftShadows {
             ntree_n: 10,
             ntree_depth: levels,
             shading: Default::default(),
+            linespace_build: Default::default(),
             width: s.width,
             height: s.height,
             tile,
