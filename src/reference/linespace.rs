@@ -422,10 +422,9 @@ impl<'a> LinespaceShadows<'a> {
         let o = self.tree.to_ntree(origin);
         let ray_direction: Vec<Vec3> = light_points.iter().map(|l| (*l - origin) * inv).collect();
         let lit = match mode {
-            ShadowMode::LinespaceDda => {
-                let mut lit = 0;
-                for r in 0..num_rays {
-                    if active_rays[r]
+            ShadowMode::LinespaceDda => (0..num_rays)
+                .filter(|&r| {
+                    active_rays[r]
                         && !self.dda_blocked(
                             o,
                             ray_direction[r],
@@ -433,42 +432,11 @@ impl<'a> LinespaceShadows<'a> {
                             light_points[r],
                             &mut counts,
                         )
-                    {
-                        lit += 1;
-                    }
-                }
-                lit
-            }
+                })
+                .count(),
             _ => {
                 let corner_dir = light_corners(&self.light).map(|c| (c - origin) * inv);
-                // Algorithm 1: the traversal axis k, the dominant axis of the light vector —
-                // valid when all four corner rays go the same way along it
-                let centre = self.light.center() - origin;
-                let valid = |a: usize| {
-                    corner_dir.iter().all(|c| c[a] > 0.0) || corner_dir.iter().all(|c| c[a] < 0.0)
-                };
-                let lv = centre.abs();
-                let dominant = if lv.x >= lv.y && lv.x >= lv.z {
-                    0
-                } else if lv.y >= lv.z {
-                    1
-                } else {
-                    2
-                };
-                let k = if valid(dominant) {
-                    Some(dominant)
-                } else {
-                    (0..3).filter(|&a| valid(a)).max_by(|&a, &b| {
-                        let m = |a: usize| {
-                            corner_dir
-                                .iter()
-                                .map(|c| c[a].abs())
-                                .fold(f32::INFINITY, f32::min)
-                        };
-                        m(a).total_cmp(&m(b))
-                    })
-                };
-                let Some(k) = k else {
+                let Some(k) = traversal_axis(&corner_dir, self.light.center() - origin) else {
                     // no packet: lit, counted once per pixel
                     counts.packet_failures += (batch.start == 0) as u64;
                     return (batch.len(), counts);
@@ -718,12 +686,71 @@ impl<'a> LinespaceShadows<'a> {
         s.fast && d == 0 && s.phase == 1 && (kc < -NEAR_MARGIN || kc > nf + NEAR_MARGIN)
     }
 
+    /// Examine slice `slice` of the node at stack depth `d`: its children with geometry inside
+    /// the packet's u/v_min/max into the level's node list.
+    fn examine_slice(
+        &self,
+        s: &Shaft,
+        d: usize,
+        slice: i32,
+        lvl: &mut StackLevel,
+        counts: &mut ShadowCounts,
+    ) {
+        let n = self.tree.n as i32;
+        let uv = self.slice_uv(s, d, slice);
+        let cu0 = (uv[0].floor() as i32).max(0);
+        let cu1 = (uv[1].floor() as i32).min(n - 1);
+        let cv0 = (uv[2].floor() as i32).max(0);
+        let cv1 = (uv[3].floor() as i32).min(n - 1);
+        lvl.nodelist.clear();
+        for cu in cu0..=cu1 {
+            for cv in cv0..=cv1 {
+                let mut c = IVec3::ZERO;
+                c[s.k] = slice;
+                c[s.u] = cu;
+                c[s.v] = cv;
+                // LinespaceFast: the other walk's cell
+                if self.phase_skips(s, d, c) {
+                    continue;
+                }
+                counts.nodes_visited += 1;
+                let node = self.node(lvl.parent_group, c);
+                if node[0] & GEOMETRY_BIT != 0 {
+                    lvl.nodelist.push((node, c));
+                }
+            }
+        }
+        lvl.nodelist_index = lvl.nodelist.len();
+    }
+
+    /// Whether the packet descends into inner node `node`, a child of the node at stack depth
+    /// `d` (its rays from `child_start`, in the node's units): ours, a node near the origin is
+    /// descended; else its line space decides (at the last line-space depth, `bit_is_hit`
+    /// variants take a set bit as a hit and never descend).
+    fn descends(
+        &self,
+        mode: ShadowMode,
+        s: &mut Shaft,
+        node: [u32; 2],
+        child_start: Vec3,
+        d: usize,
+        counts: &mut ShadowCounts,
+    ) -> bool {
+        let level_of_node = d + 1;
+        if mode.near_origin_rule() && near_origin(child_start, self.tree.n as f32) {
+            return true;
+        }
+        if mode.bit_is_hit() && d as i32 == self.tree.last_linespace_depth() {
+            self.is_intersection(s, node, child_start, level_of_node, true, counts);
+            return false;
+        }
+        self.is_intersection(s, node, child_start, level_of_node, false, counts)
+    }
+
     /// Algorithm 1 (continuation): the slice-by-slice traversal with the explicit stack.
     /// Returns the number of rays still active (lit).
     fn cgt(&self, mode: ShadowMode, s: &mut Shaft, counts: &mut ShadowCounts) -> usize {
-        let n = self.tree.n as i32;
-        let nf = n as f32;
-        let last_ls_depth = self.tree.last_linespace_depth();
+        let nf = self.tree.n as f32;
         let max_depth = self.tree.depth as usize - 1;
         let mut stack: Vec<Option<StackLevel>> = vec![None; max_depth];
         stack[0] = self.init_level(s, 0, 0);
@@ -745,31 +772,7 @@ impl<'a> LinespaceShadows<'a> {
                     break;
                 }
                 if !lvl.traverse_childs {
-                    // examine the slice: nodes with geometry inside u/v_min/max
-                    let uv = self.slice_uv(s, d, slice);
-                    let cu0 = (uv[0].floor() as i32).max(0);
-                    let cu1 = (uv[1].floor() as i32).min(n - 1);
-                    let cv0 = (uv[2].floor() as i32).max(0);
-                    let cv1 = (uv[3].floor() as i32).min(n - 1);
-                    lvl.nodelist.clear();
-                    for cu in cu0..=cu1 {
-                        for cv in cv0..=cv1 {
-                            let mut c = IVec3::ZERO;
-                            c[s.k] = slice;
-                            c[s.u] = cu;
-                            c[s.v] = cv;
-                            // LinespaceFast: the other walk's cell
-                            if self.phase_skips(s, d, c) {
-                                continue;
-                            }
-                            counts.nodes_visited += 1;
-                            let node = self.node(lvl.parent_group, c);
-                            if node[0] & GEOMETRY_BIT != 0 {
-                                lvl.nodelist.push((node, c));
-                            }
-                        }
-                    }
-                    lvl.nodelist_index = lvl.nodelist.len();
+                    self.examine_slice(s, d, slice, &mut lvl, counts);
                 }
                 while lvl.nodelist_index > 0 {
                     lvl.nodelist_index -= 1;
@@ -779,17 +782,7 @@ impl<'a> LinespaceShadows<'a> {
                     if node[0] & CHILDREN_BIT == 0 {
                         self.leaf_tests(s, node, child_start, level_of_node, counts);
                     } else {
-                        // ours: a node near the origin is descended; the variants ask it too
-                        let inside = mode.near_origin_rule() && near_origin(child_start, nf);
-                        let descend = if inside {
-                            true
-                        } else if mode.bit_is_hit() && d as i32 == last_ls_depth {
-                            self.is_intersection(s, node, child_start, level_of_node, true, counts);
-                            false
-                        } else {
-                            self.is_intersection(s, node, child_start, level_of_node, false, counts)
-                        };
-                        if descend {
+                        if self.descends(mode, s, node, child_start, d, counts) {
                             s.ray_start[d + 1] = child_start;
                             if let Some(next) = self.init_level(s, d + 1, node[0] >> 2) {
                                 lvl.traverse_childs = true;
@@ -992,4 +985,32 @@ impl<'a> LinespaceShadows<'a> {
             .count();
         lit as f32 / pts.len() as f32
     }
+}
+
+/// Algorithm 1: the traversal axis k, the dominant axis of the light vector `centre` (from the
+/// origin to the light's centre) — valid when all four corner rays `corner_dir` go the same way
+/// along it; else the valid axis along which the corner rays go fastest; none if no axis is valid.
+fn traversal_axis(corner_dir: &[Vec3; 4], centre: Vec3) -> Option<usize> {
+    let valid =
+        |a: usize| corner_dir.iter().all(|c| c[a] > 0.0) || corner_dir.iter().all(|c| c[a] < 0.0);
+    let lv = centre.abs();
+    let dominant = if lv.x >= lv.y && lv.x >= lv.z {
+        0
+    } else if lv.y >= lv.z {
+        1
+    } else {
+        2
+    };
+    if valid(dominant) {
+        return Some(dominant);
+    }
+    let slowest = |a: usize| {
+        corner_dir
+            .iter()
+            .map(|c| c[a].abs())
+            .fold(f32::INFINITY, f32::min)
+    };
+    (0..3)
+        .filter(|&a| valid(a))
+        .max_by(|&a, &b| slowest(a).total_cmp(&slowest(b)))
 }
