@@ -11,7 +11,7 @@ use gpgpu_rt::accel::{GridOptions, GridVariant};
 use gpgpu_rt::design::{accelerators, Design};
 use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, GlContext, ShaderSource};
-use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
+use gpgpu_rt::pipeline::klee2016::{LinespaceBuild, SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::stream::StreamOptions;
 use gpgpu_rt::pipeline::wagner2018::WagnerOptions;
@@ -74,11 +74,13 @@ fn every_kernel_compiles_without_warnings() {
     };
     one_frame(&ctx, &scene, Design::Stream(opts));
 
-    // the soft shadows: G-buffer, the five shadow modes, the quad
+    // the soft shadows: G-buffer, the six shadow modes, the quad; the line spaces built on the
+    // GPU once (glsl/klee2016/linespace_build.comp)
     let area = common::load("bunny_area.toml");
     for mode in [
         ShadowMode::Exact,
         ShadowMode::Linespace,
+        ShadowMode::LinespaceFast,
         ShadowMode::LinespaceDda,
         ShadowMode::Variant1,
         ShadowMode::Variant2,
@@ -90,7 +92,11 @@ fn every_kernel_compiles_without_warnings() {
             ntree_n: 10,
             ntree_depth: 3,
             shading: Default::default(),
-            linespace_build: Default::default(),
+            linespace_build: if mode == ShadowMode::Linespace {
+                LinespaceBuild::Gpu
+            } else {
+                LinespaceBuild::Cpu
+            },
             width: 8,
             height: 8,
             tile: 0,
