@@ -157,7 +157,8 @@ pub struct SoftShadowArgs {
     /// Soft shadows from the scene's `[[area_light]]` with the Cascaded Line Space (Klee 2016):
     /// G-buffer, shadow compute pass, screen-filling quad. `exact`: triangle tests (the
     /// reference); `linespace`: packet traversal, the line-space bit decides a hit;
-    /// `linespace-dda`: one 3D-DDA per ray with the same line-space termination; `variant1`,
+    /// `linespace-fast`: linespace's values, far nodes first and triangles culled per packet
+    /// (ours, the fast one); `linespace-dda`: one 3D-DDA per ray with the same line-space termination; `variant1`,
     /// `variant2`: Table 2's "Variante 1/2" as defined (exact / linespace without our
     /// near-origin rule).
     /// [default: the scene's render.shadows, else the point-light ray tracer]
