@@ -1,5 +1,5 @@
 //! The scene on the GPU, as Müller 2015 ch. 3.1.2 keeps it: the object-space vertex
-//! attributes in VBOs (uploaded once), and the SSBOs the kernels read, filled every frame by
+//! attributes in VBOs (uploaded once), and the SSBOs the kernels read, filled by
 //! the transform pass (`glsl/mueller2015/transform.vert`, rasterizer discarded) from the VBOs and each
 //! object's model and normal matrices. Materials, lights and textures live beside them.
 //!
