@@ -54,7 +54,7 @@ pub struct GpuLinespaces {
     pub gpu_ms: f64,
 }
 
-/// An empty 3D R32UI texture of `packed`'s layout.
+/// A 3D R32UI texture of `packed`'s layout, all zeros.
 pub fn r32ui_texture_3d(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owned<glow::Texture>> {
     let (x, y, z) = (
         packed.tex_x_res as i32,
@@ -70,6 +70,10 @@ pub fn r32ui_texture_3d(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owned
             gl.tex_parameter_i32(glow::TEXTURE_3D, p, glow::NEAREST as i32);
         }
         gl.bind_texture(glow::TEXTURE_3D, None);
+        // zeros: glTexStorage3D leaves the contents undefined, and the build stores only the
+        // line spaces' words, not the padding after the last one (zink over lavapipe left
+        // other values there, which a read-back compared with the CPU's zeros)
+        gl.clear_tex_u32(t.raw(), glow::RED_INTEGER, [0; 4]);
         let bytes = 4 * packed.texel_count() as u64;
         crate::gl::check_alloc(gl, "the 3D line-space texture", bytes)?;
         Ok(t)
