@@ -4,8 +4,8 @@
 // uint into the 3D R32UI texture the shadow kernel reads). The thesis builds the line spaces on
 // the CPU; this GPU build is ours, and so is everything below that the thesis does not print:
 // - One invocation per 32-bit word of a line space (32 shafts, one after the other): the word
-//   is stored whole with imageStore, so no atomics and no clearing of the texture are needed,
-//   and the words of padding after a line space's last entry come out 0 like the CPU's.
+//   is stored whole with imageStore, so no atomics are needed; its bits past the line space's
+//   last entry come out 0 like the CPU's (the host zeroes the texels after the last one).
 // - The entry layout of src/pipeline/klee2016/ntree.rs (`entry_index`): the 15 pairs of sides
 //   s < e, `entry = pair(s, e)·N⁴ + cell_s·N² + cell_e`, cells u + N·v.
 // - The shaft test is exact in integers: every box involved (the two boundary cells, the

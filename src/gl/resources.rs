@@ -496,20 +496,36 @@ pub fn depth_renderbuffer(gl: &Arc<Gl>, w: u32, h: u32) -> Result<Owned<glow::Re
 /// row 0 = the bottom row (GL order).
 pub fn read_texture_rgba32f(gl: &Gl, texture: glow::Texture, w: u32, h: u32) -> Vec<[f32; 4]> {
     let mut data = vec![[0f32; 4]; (w * h) as usize];
-    // SAFETY: the slice holds w·h RGBA floats.
+    read_tex_image(
+        gl,
+        texture,
+        (glow::TEXTURE_2D, glow::RGBA, glow::FLOAT),
+        &mut data,
+    );
+    data
+}
+
+/// `glGetTexImage` of level 0 of `texture` into `data`, which must hold every texel of it:
+/// `(target, format, type)` as GL names them, rows packed without padding.
+pub fn read_tex_image<T: bytemuck::Pod>(
+    gl: &Gl,
+    texture: glow::Texture,
+    (target, format, ty): (u32, u32, u32),
+    data: &mut [T],
+) {
+    // SAFETY: the caller's slice holds the whole level; the texture is unbound again.
     unsafe {
-        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+        gl.bind_texture(target, Some(texture));
         gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
         gl.get_tex_image(
-            glow::TEXTURE_2D,
+            target,
             0,
-            glow::RGBA,
-            glow::FLOAT,
-            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
+            format,
+            ty,
+            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(data))),
         );
-        gl.bind_texture(glow::TEXTURE_2D, None);
+        gl.bind_texture(target, None);
     }
-    data
 }
 
 /// GPU time per kernel from GL timer queries: a `GL_TIMESTAMP` query (`glQueryCounter`)

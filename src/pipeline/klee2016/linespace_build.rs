@@ -100,22 +100,13 @@ pub fn build(
     let words = ntree::linespace_words(tree.n) as u32;
     let mut packed = ntree::linespace_layout(words as usize, tree.linespace_count, max_dim)?;
     let texture = r32ui_texture_3d(gl, &packed)?;
+    let upload = |name, words: &[u32]| {
+        let bytes = bytemuck::cast_slice(words);
+        Ssbo::new(gl, name, bytes.len(), Some(bytes), info.max_ssbo_block_size)
+    };
     let rows = tree.occupancy_rows();
-    let occupancy = Ssbo::new(
-        gl,
-        "linespaceOccupancy",
-        4 * rows.len(),
-        Some(bytemuck::cast_slice(&rows)),
-        info.max_ssbo_block_size,
-    )?;
-    let sat = tree.occupancy_sat(&rows);
-    let sat = Ssbo::new(
-        gl,
-        "linespaceSat",
-        4 * sat.len(),
-        Some(bytemuck::cast_slice(&sat)),
-        info.max_ssbo_block_size,
-    )?;
+    let occupancy = upload("linespaceOccupancy", &rows)?;
+    let sat = upload("linespaceSat", &tree.occupancy_sat(&rows))?;
     let defines = Defines::new().set("NTREE_N", tree.n);
     let kernel = Kernel::compute(
         gl,
@@ -160,18 +151,7 @@ pub fn build(
 /// Read the `texels` R32UI texels of a 3D texture back.
 pub fn read_texture_3d(gl: &Gl, texture: glow::Texture, texels: usize) -> Vec<u32> {
     let mut data = vec![0u32; texels];
-    // SAFETY: the slice holds all texels of the texture.
-    unsafe {
-        gl.bind_texture(glow::TEXTURE_3D, Some(texture));
-        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
-        gl.get_tex_image(
-            glow::TEXTURE_3D,
-            0,
-            glow::RED_INTEGER,
-            glow::UNSIGNED_INT,
-            glow::PixelPackData::Slice(Some(bytemuck::cast_slice_mut(&mut data))),
-        );
-        gl.bind_texture(glow::TEXTURE_3D, None);
-    }
+    let layout = (glow::TEXTURE_3D, glow::RED_INTEGER, glow::UNSIGNED_INT);
+    crate::gl::resources::read_tex_image(gl, texture, layout, &mut data);
     data
 }
