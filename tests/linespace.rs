@@ -25,6 +25,8 @@ struct SoftFrame {
     gbuffer_normal: Vec<[f32; 4]>,
     aovs: Aovs,
     stats: FrameStats,
+    /// per pixel the first rays of the batches the GPU traced its shadow rays in (bit r)
+    batch_starts: Vec<[u32; 4]>,
 }
 
 fn render(r: &mut SoftShadowRenderer, camera: &Camera) -> anyhow::Result<SoftFrame> {
@@ -38,7 +40,19 @@ fn render(r: &mut SoftShadowRenderer, camera: &Camera) -> anyhow::Result<SoftFra
         gbuffer_normal,
         aovs,
         stats: f.stats,
+        batch_starts: r.read_batch_starts(),
     })
+}
+
+/// The first rays of the batches pixel `i`'s shadow rays were traced in on the GPU (ascending;
+/// the first is ray 0): a pixel whose batch hit llvmpipe's loop limit went on in smaller ones.
+fn batch_starts(f: &SoftFrame, i: usize) -> Vec<usize> {
+    let mask = f.batch_starts[i];
+    let starts: Vec<usize> = (0..128)
+        .filter(|r| mask[r / 32] & (1 << (r % 32)) != 0)
+        .collect();
+    assert_eq!(starts.first(), Some(&0), "pixel {i}: batches {mask:?}");
+    starts
 }
 
 /// A small deterministic generator (xorshift).
@@ -245,7 +259,6 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
         r.reconfigure(&shaders, mode, 3, 3).unwrap();
         let f = render(&mut r, &scene.camera).unwrap();
         let cpu = r.cpu();
-        let batches = f.stats.facts["ray_batches"].as_u64().unwrap() as usize;
         let (mut hits, mut off, mut cpu_tests) = (0usize, 0usize, 0u64);
         for (i, p) in f.gbuffer_position.iter().enumerate() {
             if p[3] <= 0.0 {
@@ -255,11 +268,11 @@ fn gpu_agrees_with_cpu_and_linespace_differs_from_exact_only_by_conservative_sha
             }
             hits += 1;
             let nrm = f.gbuffer_normal[i];
-            let (s, c) = cpu.shadow_in_batches(
+            let (s, c) = cpu.shadow_in_ranges(
                 mode,
                 Vec3::new(p[0], p[1], p[2]),
                 Vec3::new(nrm[0], nrm[1], nrm[2]).normalize(),
-                batches,
+                &batch_starts(&f, i),
             );
             cpu_tests += c.triangle_tests;
             if (s - f.shadow[i]).abs() > 1e-6 {
@@ -704,18 +717,17 @@ fn cpu_frame(
     hit: &[usize],
 ) -> (Vec<f32>, ShadowCounts) {
     let cpu = r.cpu();
-    // the rays in as many packets as the GPU split them into (its loop budget)
-    let batches = f.stats.facts["ray_batches"].as_u64().unwrap() as usize;
     let mut counts = ShadowCounts::default();
     let values = hit
         .iter()
         .map(|&i| {
             let (p, n) = (f.gbuffer_position[i], f.gbuffer_normal[i]);
-            let (s, c) = cpu.shadow_in_batches(
+            // the rays in the packets the GPU split them into (its loop budget)
+            let (s, c) = cpu.shadow_in_ranges(
                 mode,
                 Vec3::new(p[0], p[1], p[2]),
                 Vec3::new(n[0], n[1], n[2]).normalize(),
-                batches,
+                &batch_starts(f, i),
             );
             counts += c;
             s

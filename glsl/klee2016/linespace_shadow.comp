@@ -37,11 +37,15 @@
 // ended early if the limit had been reached, proved no guard: on zink the traversal's loops
 // were cut while the sentinel still ran whole, and 174 of 2,294 pixels of the bunny at 10x10
 // rays came out too light, unreported — docs/drivers.md.) A pixel past its budget is counted
-// as truncated, and the host renders the frame again with the pixel's rays split into
-// batches (rayBegin..rayEnd, one dispatch each, the lit counts summed in shadowTexture.g),
-// halving the batch until no pixel is truncated; a frame truncated with one ray per batch is
-// refused. A ray's result does not depend on the other rays of its packet, so batches give
-// the same image (ours; the thesis' GPU had no such limit).
+// as truncated: its batch's lit count is not kept, nor are its counts added to the counters,
+// and shadowTexture marks where the pixel goes on (.b: the batch's first ray, .a: the next
+// attempt). The host then runs the pass again for the marked pixels alone (attempt 1, 2, …;
+// the others return at once), each from its first ray not done, in batches of half as many
+// rays (batchRays; one dispatch per batch, the lit counts summed in shadowTexture.g), until no
+// pixel is truncated; a pixel truncated with one ray per batch is refused. A ray's result does
+// not depend on the other rays of its packet, so the batches give the same image, and every
+// ray's work is counted once, in the batch that completes it (ours; the thesis' GPU had no
+// such limit).
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
@@ -57,8 +61,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = IMAGE_GBUFFER_POSITION) uniform readonly image2D positionTexture;
 layout(rgba32f, binding = IMAGE_GBUFFER_NORMAL) uniform readonly image2D normalTexture;
 layout(rgba32f, binding = IMAGE_GBUFFER_DIFFUSE) uniform image2D diffuseTexture;
-// r: shadow value, g: lit rays
+// r: shadow value, g: lit rays, b and a: where a truncated pixel goes on (main)
 layout(rgba32f, binding = IMAGE_SHADOW_VALUE) uniform image2D shadowTexture;
+// bit r (of 128) set where a batch that completed a pixel with geometry began at ray r: how
+// its rays were split, which the CPU twin follows to count as the GPU did
+layout(rgba32ui, binding = IMAGE_SHADOW_BATCHES) uniform uimage2D batchTexture;
 // the line spaces, packed as Listing 3
 layout(r32ui, binding = IMAGE_LINESPACE) uniform readonly uimage3D linespaceTexture;
 // The node pool (Fig. 8–9): texture buffer, red = flags | child group << 2, green = line space.
@@ -81,10 +88,11 @@ uniform int tex_x_res;
 uniform int tex_y_res;
 uniform int ls_y_size;
 uniform ivec2 tileOffset;
-uniform int rayBegin;        // this dispatch's rays: rayBegin <= r < rayEnd (0, NUM_RAYS: all)
-uniform int rayEnd;
-uniform bool accumulate;     // add to the lit count of the batches before
-uniform bool lastBatch;      // the last batch: write the shaded colour
+uniform int batchRays;       // the rays of a batch (NUM_RAYS: the whole packet at once)
+uniform int batchIndex;      // this dispatch's batch of the attempt, from the pixel's first ray
+uniform int attempt;         // 0: every pixel; a > 0: the pixels truncated in attempt a − 1
+// this invocation's rays: rayBegin <= r < rayEnd (shadePixel)
+int rayBegin = 0, rayEnd = NUM_RAYS;
 
 uint triangleTests = 0u;
 uint linespaceLookups = 0u;
@@ -805,33 +813,64 @@ int litRays(vec3 pos, vec3 normal)
     return traverse();
 }
 
+// The shadow pass of one pixel for its rays rayBegin..rayEnd, `before` its state: the lit
+// count of its rays before rayBegin in .g, the first ray of its attempt in .b. Stored: the lit
+// count with this batch's (.g) — or, where the batch was truncated, the count before it, the
+// batch's first ray (.b) and the next attempt (.a); the shaded colour after the pixel's last ray.
+void shadePixel(ivec2 storePos, vec4 pos, vec4 before)
+{
+    vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
+    float lit = float(litRays(pos.xyz, n));
+    if (truncated != 0u) {
+        imageStore(shadowTexture, storePos,
+                   vec4(0.0, before.g, float(rayBegin), float(attempt + 1)));
+        return;
+    }
+    lit += before.g;
+    float s = lit / float(NUM_RAYS);
+    imageStore(shadowTexture, storePos, vec4(s, lit, before.b, float(attempt)));
+    uvec4 starts = rayBegin == 0 ? uvec4(0u) : imageLoad(batchTexture, storePos);
+    starts[rayBegin >> 5] |= 1u << uint(rayBegin & 31);
+    imageStore(batchTexture, storePos, starts);
+    if (rayEnd == NUM_RAYS) {
+        // Fig. 7 multiplies the shadow value into the diffuse colour (fig7Shading); ours, the
+        // default, lights it with the light's colour and N·L plus the ambient light:
+        // diffuse · (ambient + light · s · max(N·L, 0)). Back into the diffuse texture either
+        // way
+        vec4 diffuse = imageLoad(diffuseTexture, storePos);
+        vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
+        vec3 c = fig7Shading != 0
+            ? s * diffuse.rgb
+            : diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
+        imageStore(diffuseTexture, storePos, vec4(c, 1.0));
+    }
+}
+
 void main()
 {
     countersBegin();
     ivec2 storePos = ivec2(gl_GlobalInvocationID.xy) + tileOffset;
-    if (all(lessThan(storePos, imageSize(positionTexture)))) {
+    bool inside = all(lessThan(storePos, imageSize(positionTexture)));
+    // the pixel's state (nothing yet before the first batch of attempt 0)
+    bool first = attempt == 0 && batchIndex == 0;
+    vec4 before = inside && !first ? imageLoad(shadowTexture, storePos) : vec4(0.0);
+    rayBegin = int(before.b) + batchIndex * batchRays;
+    rayEnd = min(rayBegin + batchRays, NUM_RAYS);
+    // a pixel of this attempt (.a; a truncated batch moved it to the next) with rays left
+    if (inside && before.a == float(attempt) && rayBegin < NUM_RAYS) {
         vec4 pos = imageLoad(positionTexture, storePos);
         if (pos.w > 0.0) {
-            vec3 n = normalize(imageLoad(normalTexture, storePos).xyz);
-            float lit = float(litRays(pos.xyz, n));
-            if (accumulate) lit += imageLoad(shadowTexture, storePos).g;
-            float s = lit / float(NUM_RAYS);
-            imageStore(shadowTexture, storePos, vec4(s, lit, 0.0, 1.0));
-            if (lastBatch) {
-                // Fig. 7 multiplies the shadow value into the diffuse colour (fig7Shading);
-                // ours, the default, lights it with the light's colour and N·L plus the ambient
-                // light: diffuse · (ambient + light · s · max(N·L, 0)). Back into the diffuse
-                // texture either way
-                vec4 diffuse = imageLoad(diffuseTexture, storePos);
-                vec3 l = normalize(lightCorner + 0.5 * (lightEdgeU + lightEdgeV) - pos.xyz);
-                vec3 c = fig7Shading != 0
-                    ? s * diffuse.rgb
-                    : diffuse.rgb * (ambient + lightColor * s * max(dot(n, l), 0.0));
-                imageStore(diffuseTexture, storePos, vec4(c, 1.0));
-            }
-        } else {
-            imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 1.0));
+            shadePixel(storePos, pos, before);
+        } else if (first) {
+            imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 0.0));
         }
+    }
+    // a truncated batch's counts are dropped: the batches that complete its rays count them
+    if (truncated != 0u) {
+        triangleTests = 0u; linespaceLookups = 0u; nodesVisited = 0u; packetFailures = 0u;
+        lookupsDepth0 = 0u; lookupsDepth1 = 0u; descentsNear = 0u; descentsLinespace = 0u;
+        leafRays = 0u; raysBlockedLinespace = 0u; raysBlockedTriangle = 0u;
+        trianglesCulled = 0u; loopIterations = 0u;
     }
     // the kernel's counters, named by the host (shadow_pass::COUNTERS): local slot = global slot
     countAdd(COUNTER_TRIANGLE_TESTS, triangleTests);

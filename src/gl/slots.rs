@@ -89,6 +89,8 @@ slot_table! {
         GBUFFER_DIFFUSE = 2,
         SHADOW_VALUE = 3,
         LINESPACE = 4,
+        /// the first ray of every batch that completed a pixel's rays, a bit per ray (128)
+        SHADOW_BATCHES = 5,
         // Wagner 2018's kernel (glsl/wagner2018/raytrace.comp): the image it renders (ch. 4.3's
         // surface), and ours for the AOVs: the first hit (t, triangle id, u, v), the primary
         // ray's direction, the normal at the hit (w: 1 lit, 0 in shadow)

@@ -385,10 +385,27 @@ impl<'a> LinespaceShadows<'a> {
     ) -> (f32, ShadowCounts) {
         let rays = (self.samples_u * self.samples_v) as usize;
         let per_batch = rays.div_ceil(batches.clamp(1, rays));
+        let starts: Vec<usize> = (0..rays).step_by(per_batch).collect();
+        self.shadow_in_ranges(mode, p, normal, &starts)
+    }
+
+    /// [`Self::shadow`] with the rays split into packets at `starts` (ascending, from 0): the
+    /// packets `starts[i]..starts[i + 1]` and the last one to the last ray, as the GPU's shadow
+    /// pass traced a pixel whose batches hit llvmpipe's loop limit (its batch starts,
+    /// `SoftShadowRenderer::read_batch_starts`).
+    pub fn shadow_in_ranges(
+        &self,
+        mode: ShadowMode,
+        p: Vec3,
+        normal: Vec3,
+        starts: &[usize],
+    ) -> (f32, ShadowCounts) {
+        let rays = (self.samples_u * self.samples_v) as usize;
         let mut counts = ShadowCounts::default();
         let mut lit = 0;
-        for begin in (0..rays).step_by(per_batch) {
-            let (l, c) = self.lit_rays(mode, p, normal, begin..(begin + per_batch).min(rays));
+        let ends = starts.iter().skip(1).copied().chain([rays]);
+        for (&begin, end) in starts.iter().zip(ends) {
+            let (l, c) = self.lit_rays(mode, p, normal, begin..end);
             lit += l;
             counts += c;
         }

@@ -140,10 +140,13 @@ pub struct SoftShadowRenderer {
     timers: GpuTimers,
     /// The image and the tiles of the shadow pass's dispatches.
     pixels: PixelGrid,
-    /// Dispatches the shadow rays of a pixel are split into (1: the whole packet at once).
-    /// Doubled when a frame hits llvmpipe's loop limit, kept for the next frames, back to 1
-    /// when the mode or the samples change.
+    /// Dispatches the shadow rays of a pixel are split into in the first attempt of a frame
+    /// (1: the whole packet at once; more only by `set_ray_batches`); back to 1 when the mode
+    /// or the samples change.
     ray_batches: u32,
+    /// The batches of the last frame's last attempt (more than `ray_batches` where pixels hit
+    /// llvmpipe's loop limit and were computed again).
+    last_batches: u32,
     /// The GL implementation's loop limit (the shadow kernel's budget follows from it).
     loop_limit: Option<LoopLimit>,
     /// The camera and the statistics of the last frame drawn.
@@ -260,6 +263,7 @@ impl SoftShadowRenderer {
             timers: GpuTimers::new(&gl),
             pixels,
             ray_batches: 1,
+            last_batches: 1,
             loop_limit: limit,
             last: None,
             gl,
@@ -313,8 +317,9 @@ impl SoftShadowRenderer {
             .read_linespace_texture(self.scene.packed.texels.len())
     }
 
-    /// Dispatch the shadow rays of every pixel in `n` batches from the next frame on (normally
-    /// automatic: see [`SoftShadowRenderer::draw`]); clamped to 1..=rays.
+    /// Dispatch the shadow rays of every pixel in `n` batches in the first attempt of the next
+    /// frames (normally 1: only the pixels that hit the loop limit get more, see
+    /// `ShadowPass::run`); clamped to 1..=rays.
     pub fn set_ray_batches(&mut self, n: u32) {
         self.ray_batches = n.clamp(1, self.rays());
     }
@@ -333,9 +338,17 @@ impl SoftShadowRenderer {
         )
     }
 
-    /// One attempt at a frame with `ray_batches` dispatches of the shadow pass per tile: the
-    /// statistics and the number of truncated pixels (then the image is incomplete).
-    fn draw_once(&mut self, camera: &Camera) -> Result<(FrameStats, u64)> {
+    /// Per pixel of the last frame (row 0 = the top image row) the first rays of the batches
+    /// its shadow rays were traced in, a bit per ray (bit r of word r / 32): the split the
+    /// CPU twin needs to count as the GPU did (`LinespaceCpu::shadow_in_ranges`).
+    pub fn read_batch_starts(&self) -> Vec<[u32; 4]> {
+        let (w, h) = self.size();
+        flip_rows(&self.shadow.read_batch_starts(w, h), w, h)
+    }
+
+    /// A frame: the G-buffer, the shadow pass (`ray_batches` dispatches per tile, more for the
+    /// pixels that hit llvmpipe's loop limit: `ShadowPass::run`) and the quad; its statistics.
+    fn draw_once(&mut self, camera: &Camera) -> Result<FrameStats> {
         let (w, h) = self.size();
         let (lo, hi) = self.scene.bounds;
         let vp = view_projection(camera, w, h, lo, hi);
@@ -345,23 +358,25 @@ impl SoftShadowRenderer {
         crate::gl::check_error(&self.gl, "the G-buffer pass")?;
         let pixels = self.pixels;
         let batches = (self.rays(), self.ray_batches);
-        let counts = self.shadow.run(
+        let (counts, last_batches) = self.shadow.run(
             &mut self.timers,
             pixels,
             &self.gbuffer.textures(),
             &self.uniforms,
             batches,
-        );
+        )?;
+        self.last_batches = last_batches;
         crate::gl::check_error(&self.gl, "the shadow pass")?;
         self.present
             .draw(&mut self.timers, self.gbuffer.textures()[2]);
         crate::gl::check_error(&self.gl, "the screen-filling quad")?;
-        let truncated = counts.get("truncated");
+        // every truncated pixel was computed again in more batches: the frame is complete
         let mut stats = FrameStats {
             gpu_ms: self.timers.resolve(&self.gl),
-            truncated_rays: truncated,
             ..Default::default()
         };
+        let retried = counts.get("truncated");
+        stats.events.insert("retried_pixels".into(), retried);
         let kernel = self.shadow.kernel.timer().to_string();
         stats
             .triangle_tests
@@ -373,7 +388,7 @@ impl SoftShadowRenderer {
             stats.events.insert((*e).into(), counts.get(e));
         }
         stats.facts = self.facts();
-        Ok((stats, truncated))
+        Ok(stats)
     }
 
     /// The AOVs of the base tracer from the G-buffer: primary rays from the camera, hits from
@@ -419,7 +434,7 @@ impl SoftShadowRenderer {
     fn facts(&self) -> BTreeMap<String, serde_json::Value> {
         [
             ("shadows", json!(self.options.mode)),
-            ("ray_batches", json!(self.ray_batches)),
+            ("ray_batches", json!(self.last_batches)),
             (
                 "light_samples",
                 json!(format!(
@@ -488,33 +503,13 @@ impl Renderer for SoftShadowRenderer {
     }
 
     /// Render one frame (G-buffer, shadow pass, screen-filling quad into the output texture)
-    /// and read back only the counters and the timers. A frame that hit llvmpipe's loop limit
-    /// is rendered again with each pixel's shadow rays split into twice as many dispatches
-    /// (`ray_batches` in the facts), until none does; with one ray per dispatch it is refused.
+    /// and read back only the counters and the timers.
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
-        let rays = self.rays();
-        loop {
-            let (mut stats, truncated) = self.draw_once(camera)?;
-            if truncated == 0 {
-                stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-                self.last = Some((*camera, stats.clone()));
-                return Ok(stats);
-            }
-            if self.ray_batches >= rays {
-                bail!(
-                    "{truncated} pixels of the shadow pass hit the loop budget even with one shadow ray per \
-                     dispatch (llvmpipe ends loops after 65535 iterations); use a coarser N-tree or the \
-                     linespace mode"
-                );
-            }
-            // llvmpipe's loop limit: the same frame again with half as many rays per dispatch
-            self.ray_batches = (self.ray_batches * 2).min(rays);
-            log::info!(
-                "{truncated} pixels hit the loop budget: the shadow rays in {} batches per pixel",
-                self.ray_batches
-            );
-        }
+        let mut stats = self.draw_once(camera)?;
+        stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        self.last = Some((*camera, stats.clone()));
+        Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {

@@ -15,7 +15,7 @@ use super::linespace_build::{r32ui_texture_3d, read_texture_3d};
 use super::ntree::{NTree, PackedLinespaces};
 use super::{KleeShading, SoftShadowOptions};
 use crate::gl::context::LoopLimit;
-use crate::gl::resources::{GpuTimers, Owned, Ssbo, TextureBuffer};
+use crate::gl::resources::{read_tex_image, GpuTimers, Image2d, Owned, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::scene::{AreaLight, ShadowMode};
@@ -121,8 +121,11 @@ pub struct ShadowUniforms {
 pub struct ShadowPass {
     gl: Arc<Gl>,
     pub kernel: Kernel,
-    /// r: shadow value, g: lit rays (summed over batches)
+    /// r: shadow value, g: lit rays (summed over batches); b, a: where a truncated pixel goes
+    /// on (its first ray not done, the attempt)
     shadow_texture: Owned<glow::Texture>,
+    /// RGBA32UI: bit r set where a batch that completed began at ray r
+    batch_texture: Owned<glow::Texture>,
     /// the node pool (Fig. 8–9), RG32UI texels
     node_pool: TextureBuffer,
     linespace_texture: Owned<glow::Texture>,
@@ -192,6 +195,7 @@ impl ShadowPass {
             gl: gl.clone(),
             kernel,
             shadow_texture: rgba32f_texture(gl, options.width, options.height)?,
+            batch_texture: Image2d::new(gl, options.width, options.height, glow::RGBA32UI)?.texture,
             node_pool,
             linespace_texture: linespaces,
             buffers,
@@ -233,6 +237,7 @@ impl ShadowPass {
             img(image::GBUFFER_NORMAL, gbuffer[1], ro, f);
             img(image::GBUFFER_DIFFUSE, gbuffer[2], rw, f);
             img(image::SHADOW_VALUE, self.shadow_texture.raw(), rw, f);
+            img(image::SHADOW_BATCHES, self.batch_texture.raw(), rw, glow::RGBA32UI);
             let ls = Some(self.linespace_texture.raw());
             gl.bind_image_texture(image::LINESPACE, ls, 0, true, 0, ro, glow::R32UI);
         }
@@ -243,7 +248,11 @@ impl ShadowPass {
     }
 
     /// The shadow pass over the image, each pixel's `rays` shadow rays in `batches`
-    /// dispatches per tile (llvmpipe's loop limit: see `SoftShadowRenderer::draw`).
+    /// dispatches per tile; then, while a batch was truncated (llvmpipe's loop limit: the
+    /// kernel's header), the pixels it left alone again, each from that batch's first ray on,
+    /// in batches of half as many rays — an attempt each, the other pixels untouched. The
+    /// counts (`truncated`: the batches truncated) and the batches of the last attempt; an
+    /// error where a batch of one ray is truncated.
     pub fn run(
         &self,
         timers: &mut GpuTimers,
@@ -251,21 +260,57 @@ impl ShadowPass {
         gbuffer: &[glow::Texture; 3],
         uniforms: &ShadowUniforms,
         (rays, batches): (u32, u32),
-    ) -> ShadowCounts {
-        let counters = &self.buffers[2];
-        counters.clear_u32(&self.gl, 0);
+    ) -> Result<(ShadowCounts, u32)> {
+        self.buffers[2].clear_u32(&self.gl, 0);
         self.bind(gbuffer, uniforms);
+        let mut batch_rays = rays.div_ceil(batches.clamp(1, rays));
+        let mut retried = 0;
+        for attempt in 0.. {
+            self.dispatch_batches(timers, pixels, rays, batch_rays, attempt);
+            let counts = self.counts();
+            let truncated = counts.get("truncated") - retried;
+            if truncated == 0 {
+                return Ok((counts, rays.div_ceil(batch_rays)));
+            }
+            if batch_rays == 1 {
+                bail!(
+                    "{truncated} pixels of the shadow pass hit the loop budget even with one shadow \
+                     ray per dispatch (llvmpipe ends loops after 65535 iterations); use a coarser \
+                     N-tree or the linespace mode"
+                );
+            }
+            batch_rays = batch_rays.div_ceil(2);
+            log::info!(
+                "{truncated} pixels hit the loop budget: their shadow rays go on in batches of {batch_rays}"
+            );
+            retried += truncated;
+        }
+        unreachable!("the attempts end by returning")
+    }
+
+    /// One attempt of the shadow pass: batches of `batch_rays` rays per pixel, one dispatch per
+    /// tile each, for every pixel (attempt 0) or those the attempt before left truncated (from
+    /// their first ray not done: at most `rays` of them).
+    fn dispatch_batches(
+        &self,
+        timers: &mut GpuTimers,
+        pixels: PixelGrid,
+        rays: u32,
+        batch_rays: u32,
+        attempt: u32,
+    ) {
         let k = &self.kernel;
-        let per_batch = rays.div_ceil(batches.clamp(1, rays));
-        for begin in (0..rays).step_by(per_batch as usize) {
-            let end = (begin + per_batch).min(rays);
-            k.set_i32("rayBegin", begin as i32);
-            k.set_i32("rayEnd", end as i32);
-            k.set_i32("accumulate", (begin > 0) as i32);
-            k.set_i32("lastBatch", (end == rays) as i32);
+        k.set_i32("attempt", attempt as i32);
+        k.set_i32("batchRays", batch_rays as i32);
+        for batch in 0..rays.div_ceil(batch_rays) {
+            k.set_i32("batchIndex", batch as i32);
             k.dispatch_pixels(timers, pixels);
         }
-        let raw = counters.read_u32(&self.gl);
+    }
+
+    /// The counters read back (the GPU waits for the pass).
+    fn counts(&self) -> ShadowCounts {
+        let raw = self.buffers[2].read_u32(&self.gl);
         ShadowCounts(std::array::from_fn(|i| {
             crate::pipeline::counter_value(&raw, i)
         }))
@@ -274,6 +319,15 @@ impl ShadowPass {
     /// The shadow texture (r: shadow value, g: lit rays).
     pub fn shadow_texture(&self) -> glow::Texture {
         self.shadow_texture.raw()
+    }
+
+    /// Per pixel (GL rows, bottom first) the first rays of the batches its shadow rays were
+    /// traced in: bit r of the 128 set where one began at ray r.
+    pub fn read_batch_starts(&self, w: u32, h: u32) -> Vec<[u32; 4]> {
+        let mut data = vec![[0u32; 4]; (w * h) as usize];
+        let layout = (glow::TEXTURE_2D, glow::RGBA_INTEGER, glow::UNSIGNED_INT);
+        read_tex_image(&self.gl, self.batch_texture.raw(), layout, &mut data);
+        data
     }
 
     /// Read the 3D line-space texture back (`texels` of them; the round-trip test).
