@@ -24,11 +24,9 @@
 //!   words along x, continued on the next y row, line spaces one after the other along y,
 //!   continued along z, at most 2048 (GL_MAX_3D_TEXTURE_SIZE) per axis.
 
-use crate::progress::Progress;
 use crate::scene::budget;
 use anyhow::{bail, Result};
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 
 /// Red-channel flag: the node contains geometry.
 pub const GEOMETRY_BIT: u32 = 1;
@@ -645,19 +643,17 @@ impl NTree {
         Ok(tree)
     }
 
-    /// The line spaces of every inner node on the CPU ([`build_linespace`], in line-space
-    /// order), timed into `linespace_build_ms`.
+    /// The line spaces of every inner node on the CPU, in line-space order: one mask per
+    /// child position OR-ed ([`super::linespace_cpu::build_linespaces`], the same bits as
+    /// [`build_linespace`]), timed into `linespace_build_ms`.
     pub fn build_linespaces_cpu(&mut self) {
         let t1 = std::time::Instant::now();
-        let groups = self.inner_groups();
-        let progress = Progress::new("line spaces", groups.len() as u64, 1000);
-        let spaces: Vec<Vec<u32>> = groups
-            .par_iter()
-            .map(|&g| build_linespace(self.n, &self.group_filled(g)))
-            .inspect(|_| progress.inc(1))
+        let filled: Vec<Vec<bool>> = self
+            .inner_groups()
+            .into_iter()
+            .map(|g| self.group_filled(g))
             .collect();
-        drop(progress);
-        self.linespaces = spaces.concat();
+        self.linespaces = super::linespace_cpu::build_linespaces(self.n, &filled);
         self.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
     }
 
