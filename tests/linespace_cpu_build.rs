@@ -25,7 +25,8 @@ fn cell_masks_hold_exactly_the_shafts_that_cut_the_cell() {
             for s in 0..FACES {
                 for e in s + 1..FACES {
                     for i in 0..n.pow(4) {
-                        let (su, sv, eu, ev) = (i % n, (i / n) % n, (i / (n * n)) % n, i / n.pow(3));
+                        let (su, sv, eu, ev) =
+                            (i % n, (i / n) % n, (i / (n * n)) % n, i / n.pow(3));
                         let a = lattice(&face_rect(n, s, su, su + 1, sv, sv + 1));
                         let b = lattice(&face_rect(n, e, eu, eu + 1, ev, ev + 1));
                         let idx = entry_index(n, s, su, sv, e, eu, ev).unwrap();

@@ -1,6 +1,7 @@
-//! The CPU build of the line spaces, output-sensitive — Klee 2016, ch. 3.3 (Fig. 5: "für jedes
-//! Kind mit Geometrie wird eine Maske der Schäfte, die es schneidet, in den Linespace
-//! ver-odert"), after Keul et al. \[KLM\].
+//! The CPU build of the line spaces, output-sensitive — Klee 2016, ch. 3.3, Fig. 5: "Dies
+//! geschieht mittels einer Bitmaske, die für jeden gefüllten Unterknoten erstellt wird […]. Die
+//! Binärmasken der einzelnen Unterknoten werden durch die binäre OR-Operation zusammengefügt",
+//! after Keul et al. \[KLM\].
 //!
 //! A line space depends only on which of its node's N³ children hold geometry, and the shafts a
 //! child cuts depend only on its position in the node. So the mask of every position that some
@@ -50,13 +51,11 @@ fn constrain(t: &mut (f64, f64), alpha: i32, beta: i32, gamma: i32) {
 /// The largest (`max`) or smallest value of base + num / t over t ∈ `t` (0 ≤ t.0 ≤ t.1): it is
 /// monotone in t, so one of the ends; at t = 0 it is ±∞ by the sign of num.
 fn extreme(base: i32, num: i32, t: (f64, f64), max: bool) -> f64 {
-    let at = |t: f64| {
-        match (t > 0.0, num.signum()) {
-            (true, _) => base as f64 + num as f64 / t,
-            (false, 0) => base as f64,
-            (false, 1) => f64::INFINITY,
-            _ => f64::NEG_INFINITY,
-        }
+    let at = |t: f64| match (t > 0.0, num.signum()) {
+        (true, _) => base as f64 + num as f64 / t,
+        (false, 0) => base as f64,
+        (false, 1) => f64::INFINITY,
+        _ => f64::NEG_INFINITY,
     };
     let (v0, v1) = (at(t.0), at(t.1));
     if max {
@@ -78,6 +77,17 @@ fn end_range(n: i32, a: ([i32; 3], [i32; 3]), c: [i32; 3], i: usize, t: (f64, f6
     (lo as i32, hi as i32)
 }
 
+/// The distinct mirror images of position `c` with the axes flipped for each (bit k: axis k);
+/// a flip that leaves the middle cell of an odd N in place is left out.
+fn mirrors(n: u32, c: [u32; 3]) -> impl Iterator<Item = (u32, [u32; 3])> {
+    (0..8u32)
+        .filter(move |fl| (0..3).all(|k| fl >> k & 1 == 0 || 2 * c[k] + 1 != n))
+        .map(move |fl| {
+            let flip = |k: usize| if fl >> k & 1 != 0 { n - 1 - c[k] } else { c[k] };
+            (fl, [flip(0), flip(1), flip(2)])
+        })
+}
+
 /// The masks of one position's mirror images (Fig. 5's mask per child, for the position and
 /// its reflections in the node's middle planes): `flips` bit k set mirrors axis k.
 struct Orbit {
@@ -86,16 +96,11 @@ struct Orbit {
 }
 
 impl Orbit {
-    /// The distinct mirror images of position `c` (one per set of flipped axes, a flip that
-    /// leaves the middle cell of an odd N in place left out), their masks empty.
+    /// The mirror images of position `c` ([`mirrors`]), their masks empty.
     fn new(n: u32, c: [u32; 3]) -> Orbit {
         let words = linespace_words(n);
-        let masks = (0..8u32)
-            .filter(|fl| (0..3).all(|k| fl >> k & 1 == 0 || 2 * c[k] + 1 != n))
-            .map(|fl| {
-                let cell = std::array::from_fn(|k| if fl >> k & 1 != 0 { n - 1 - c[k] } else { c[k] });
-                (fl, cell, vec![0u32; words])
-            })
+        let masks = mirrors(n, c)
+            .map(|(fl, cell)| (fl, cell, vec![0u32; words]))
             .collect();
         Orbit { n: n as i32, masks }
     }
@@ -168,7 +173,11 @@ fn orbit_masks(n: u32, c: [u32; 3]) -> Vec<([u32; 3], Vec<u32>)> {
 pub fn cell_mask(n: u32, c: [u32; 3]) -> Vec<u32> {
     let canon = c.map(|v| v.min(n - 1 - v));
     let orbit = orbit_masks(n, canon);
-    orbit.into_iter().find(|(cell, _)| *cell == c).expect("c is in its orbit").1
+    orbit
+        .into_iter()
+        .find(|(cell, _)| *cell == c)
+        .expect("c is in its orbit")
+        .1
 }
 
 /// The line spaces of nodes whose children's geometry flags (N³ each, index x + N(y + Nz)) are
@@ -180,17 +189,21 @@ pub fn build_linespaces(n: u32, filled: &[Vec<bool>]) -> Vec<u32> {
     let nn = n as usize;
     let half = n.div_ceil(2);
     let index = |c: [u32; 3]| c[0] as usize + nn * (c[1] as usize + nn * c[2] as usize);
-    let used: Vec<bool> = (0..nn * nn * nn).map(|i| filled.iter().any(|f| f[i])).collect();
+    let used: Vec<bool> = (0..nn * nn * nn)
+        .map(|i| filled.iter().any(|f| f[i]))
+        .collect();
     let mut out = vec![0u32; filled.len() * words];
     for z in 0..half {
         let masks: Vec<(usize, Vec<u32>)> = (0..half * half)
             .into_par_iter()
             .flat_map_iter(|j| {
                 let c = [j % half, j / half, z];
-                let mirrors = Orbit::new(n, c).masks;
-                let any = mirrors.iter().any(|(_, cell, _)| used[index(*cell)]);
+                let any = mirrors(n, c).any(|(_, cell)| used[index(cell)]);
                 let masks = if any { orbit_masks(n, c) } else { Vec::new() };
-                masks.into_iter().map(|(c, m)| (index(c), m)).filter(|(i, _)| used[*i])
+                masks
+                    .into_iter()
+                    .map(|(c, m)| (index(c), m))
+                    .filter(|(i, _)| used[*i])
             })
             .collect();
         out.par_chunks_mut(words)
