@@ -16,6 +16,7 @@
 
 pub mod gbuffer;
 pub mod linespace_build;
+pub mod linespace_cpu;
 pub mod ntree;
 pub mod present;
 pub mod shadow_pass;

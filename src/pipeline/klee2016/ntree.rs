@@ -24,7 +24,6 @@
 //!   words along x, continued on the next y row, line spaces one after the other along y,
 //!   continued along z, at most 2048 (GL_MAX_3D_TEXTURE_SIZE) per axis.
 
-use crate::progress::Progress;
 use crate::scene::budget;
 use anyhow::{bail, Result};
 use glam::{DVec3, Vec3};
@@ -528,10 +527,12 @@ impl NTree {
         let t0 = std::time::Instant::now();
         let what = format!("the N-tree of N = {n}, depth {depth}");
         let mut budget = budget::Tracker::new(&what, "--ntree-n with --ntree-depth");
-        let tri_bytes = std::mem::size_of::<[DVec3; 3]>() + 2 * 4; // the f64 copy, the id lists
-                                                                   // and what any build takes: the work lists, the thread pool, a line space in progress
-                                                                   // per thread
-        let fixed = 64 << 10;
+        // the f64 copy, the id lists
+        let tri_bytes = std::mem::size_of::<[DVec3; 3]>() + 2 * 4;
+        // and what any build takes: the work lists, the thread pool, and the CPU line-space
+        // build's masks of two layers of child positions (`linespace_cpu`)
+        let masks = 2 * 4 * (n as u64).pow(2) * linespace_words(n) as u64;
+        let fixed = (64 << 10) + masks;
         budget
             .add(fixed + triangles.len() as u64 * tri_bytes as u64)
             .map_err(anyhow::Error::msg)?;
@@ -574,65 +575,54 @@ impl NTree {
         budget.add(group_bytes).map_err(anyhow::Error::msg)?;
         tree.nodes.resize((n as usize).pow(3), [0, 0]);
         let mut work = vec![(0u32, 1u32, min_bound.as_dvec3(), edge as f64, all)];
-        while let Some((group, level, origin, size, ids)) = work.pop() {
-            let cell = size / n as f64;
-            let nn = n as usize;
-            budget
-                .add(24 * (nn * nn * nn) as u64)
-                .map_err(anyhow::Error::msg)?;
-            let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nn * nn * nn];
-            for &id in &ids {
-                let t = &tris[id as usize];
-                let tlo = t[0].min(t[1]).min(t[2]);
-                let thi = t[0].max(t[1]).max(t[2]);
-                let c0 = ((tlo - origin) / cell)
-                    .floor()
-                    .as_ivec3()
-                    .clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
-                let c1 = ((thi - origin) / cell)
-                    .floor()
-                    .as_ivec3()
-                    .clamp(glam::IVec3::ZERO, glam::IVec3::splat(n as i32 - 1));
-                for z in c0.z..=c1.z {
-                    for y in c0.y..=c1.y {
-                        for x in c0.x..=c1.x {
-                            let bmin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
-                            let eps = cell * 1e-6;
-                            if tri_box_overlap(bmin - eps, bmin + DVec3::splat(cell) + eps, t) {
-                                buckets[x as usize + nn * (y as usize + nn * z as usize)].push(id);
-                            }
-                        }
-                    }
-                }
+        let nn = n as usize;
+        while let Some(top) = work.pop() {
+            // the groups on top of the stack whose children are leaves push no work, so their
+            // triangles are sorted in parallel and applied in the order they would be popped
+            let mut batch = vec![top];
+            while batch[0].1 == depth - 1 && work.last().is_some_and(|w| w.1 == depth - 1) {
+                batch.push(work.pop().expect("checked"));
             }
-            // the children's id lists (grown by doubling: up to twice their length), counted
-            // as they are made; they are a group's references, never more than a level's
-            let refs: usize = buckets.iter().map(Vec::len).sum();
-            budget.add(8 * refs as u64).map_err(anyhow::Error::msg)?;
-            for (i, b) in buckets.into_iter().enumerate() {
-                if b.is_empty() {
-                    continue;
-                }
-                let slot = group as usize * nn * nn * nn + i;
-                if level < depth - 1 {
-                    budget.add(group_bytes).map_err(anyhow::Error::msg)?;
-                    let child_group = (tree.nodes.len() / (nn * nn * nn)) as u32;
-                    tree.nodes.resize(tree.nodes.len() + nn * nn * nn, [0, 0]);
-                    let ls = inner_groups.len() as u32;
-                    inner_groups.push(child_group);
-                    tree.nodes[slot] = [GEOMETRY_BIT | CHILDREN_BIT | (child_group << 2), ls];
-                    let (x, y, z) = (i % nn, (i / nn) % nn, i / (nn * nn));
-                    let child_origin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
-                    work.push((child_group, level + 1, child_origin, cell, b));
-                } else {
-                    let off = tree.leaf_triangles.len() as u32;
-                    if off >= 1 << 30 {
-                        bail!("more than 2^30 leaf triangle references");
+            for _ in &batch {
+                budget
+                    .add(24 * (nn * nn * nn) as u64)
+                    .map_err(anyhow::Error::msg)?;
+            }
+            let sorted: Vec<Vec<Vec<u32>>> = batch
+                .par_iter()
+                .map(|(_, _, origin, size, ids)| bucket_triangles(&tris, ids, *origin, *size, n))
+                .collect();
+            for ((group, level, origin, size, _), buckets) in batch.into_iter().zip(sorted) {
+                let cell = size / n as f64;
+                // the children's id lists (grown by doubling: up to twice their length), counted
+                // as they are made; they are a group's references, never more than a level's
+                let refs: usize = buckets.iter().map(Vec::len).sum();
+                budget.add(8 * refs as u64).map_err(anyhow::Error::msg)?;
+                for (i, b) in buckets.into_iter().enumerate() {
+                    if b.is_empty() {
+                        continue;
                     }
-                    budget.add(4 * b.len() as u64).map_err(anyhow::Error::msg)?;
-                    tree.nodes[slot] = [GEOMETRY_BIT | (off << 2), b.len() as u32];
-                    tree.leaf_triangles.extend_from_slice(&b);
-                    tree.leaf_count += 1;
+                    let slot = group as usize * nn * nn * nn + i;
+                    if level < depth - 1 {
+                        budget.add(group_bytes).map_err(anyhow::Error::msg)?;
+                        let child_group = (tree.nodes.len() / (nn * nn * nn)) as u32;
+                        tree.nodes.resize(tree.nodes.len() + nn * nn * nn, [0, 0]);
+                        let ls = inner_groups.len() as u32;
+                        inner_groups.push(child_group);
+                        tree.nodes[slot] = [GEOMETRY_BIT | CHILDREN_BIT | (child_group << 2), ls];
+                        let (x, y, z) = (i % nn, (i / nn) % nn, i / (nn * nn));
+                        let child_origin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
+                        work.push((child_group, level + 1, child_origin, cell, b));
+                    } else {
+                        let off = tree.leaf_triangles.len() as u32;
+                        if off >= 1 << 30 {
+                            bail!("more than 2^30 leaf triangle references");
+                        }
+                        budget.add(4 * b.len() as u64).map_err(anyhow::Error::msg)?;
+                        tree.nodes[slot] = [GEOMETRY_BIT | (off << 2), b.len() as u32];
+                        tree.leaf_triangles.extend_from_slice(&b);
+                        tree.leaf_count += 1;
+                    }
                 }
             }
         }
@@ -645,19 +635,17 @@ impl NTree {
         Ok(tree)
     }
 
-    /// The line spaces of every inner node on the CPU ([`build_linespace`], in line-space
-    /// order), timed into `linespace_build_ms`.
+    /// The line spaces of every inner node on the CPU, in line-space order: one mask per
+    /// child position OR-ed ([`super::linespace_cpu::build_linespaces`], the same bits as
+    /// [`build_linespace`]), timed into `linespace_build_ms`.
     pub fn build_linespaces_cpu(&mut self) {
         let t1 = std::time::Instant::now();
-        let groups = self.inner_groups();
-        let progress = Progress::new("line spaces", groups.len() as u64, 1000);
-        let spaces: Vec<Vec<u32>> = groups
-            .par_iter()
-            .map(|&g| build_linespace(self.n, &self.group_filled(g)))
-            .inspect(|_| progress.inc(1))
+        let filled: Vec<Vec<bool>> = self
+            .inner_groups()
+            .into_iter()
+            .map(|g| self.group_filled(g))
             .collect();
-        drop(progress);
-        self.linespaces = spaces.concat();
+        self.linespaces = super::linespace_cpu::build_linespaces(self.n, &filled);
         self.linespace_build_ms = t1.elapsed().as_secs_f64() * 1e3;
     }
 
@@ -720,6 +708,47 @@ impl NTree {
         }
         g
     }
+}
+
+/// The triangles `ids` sorted into the N³ children (edge `size / N`, index x + N(y + Nz)) of the
+/// node at `origin`: a triangle goes to every child its box overlaps (exact, separating axes,
+/// the child widened by 10⁻⁶ of its edge), in the order of `ids`.
+fn bucket_triangles(
+    tris: &[[DVec3; 3]],
+    ids: &[u32],
+    origin: DVec3,
+    size: f64,
+    n: u32,
+) -> Vec<Vec<u32>> {
+    let cell = size / n as f64;
+    let nn = n as usize;
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); nn * nn * nn];
+    let last = glam::IVec3::splat(n as i32 - 1);
+    for &id in ids {
+        let t = &tris[id as usize];
+        let tlo = t[0].min(t[1]).min(t[2]);
+        let thi = t[0].max(t[1]).max(t[2]);
+        let c0 = ((tlo - origin) / cell)
+            .floor()
+            .as_ivec3()
+            .clamp(glam::IVec3::ZERO, last);
+        let c1 = ((thi - origin) / cell)
+            .floor()
+            .as_ivec3()
+            .clamp(glam::IVec3::ZERO, last);
+        for z in c0.z..=c1.z {
+            for y in c0.y..=c1.y {
+                for x in c0.x..=c1.x {
+                    let bmin = origin + DVec3::new(x as f64, y as f64, z as f64) * cell;
+                    let eps = cell * 1e-6;
+                    if tri_box_overlap(bmin - eps, bmin + DVec3::splat(cell) + eps, t) {
+                        buckets[x as usize + nn * (y as usize + nn * z as usize)].push(id);
+                    }
+                }
+            }
+        }
+    }
+    buckets
 }
 
 /// Triangle/box overlap by separating axes (Akenine-Möller 2001): the box's 3 axes, the
