@@ -42,7 +42,8 @@
 // attempt). The host then runs the pass again for the marked pixels alone (attempt 1, 2, …;
 // the others return at once), each from its first ray not done, in batches of half as many
 // rays (batchRays; one dispatch per batch, the lit counts summed in shadowTexture.g), until no
-// pixel is truncated; a pixel truncated with one ray per batch is refused. A ray's result does
+// pixel is truncated; a pixel truncated with one ray per batch is refused. The next frame
+// starts each pixel in the attempt that completed it (a static view: no batch truncated again). A ray's result does
 // not depend on the other rays of its packet, so the batches give the same image, and every
 // ray's work is counted once, in the batch that completes it (ours; the thesis' GPU had no
 // such limit).
@@ -851,9 +852,14 @@ void main()
     countersBegin();
     ivec2 storePos = ivec2(gl_GlobalInvocationID.xy) + tileOffset;
     bool inside = all(lessThan(storePos, imageSize(positionTexture)));
-    // the pixel's state (nothing yet before the first batch of attempt 0)
+    // the pixel's state; at the frame's first dispatch the pixel starts from ray 0 with nothing
+    // lit, in the attempt that completed it in the last frame (.a; 0 after the host forgot it:
+    // ShadowPass::forget_attempts) — one whose batches were truncated then starts with smaller
+    // ones now, without the truncated work
     bool first = attempt == 0 && batchIndex == 0;
-    vec4 before = inside && !first ? imageLoad(shadowTexture, storePos) : vec4(0.0);
+    vec4 before = inside ? imageLoad(shadowTexture, storePos) : vec4(0.0);
+    if (first) before = vec4(0.0, 0.0, 0.0, before.a);
+    if (first && inside && before.a > 0.0) imageStore(shadowTexture, storePos, before);
     rayBegin = int(before.b) + batchIndex * batchRays;
     rayEnd = min(rayBegin + batchRays, NUM_RAYS);
     // a pixel of this attempt (.a; a truncated batch moved it to the next) with rays left
@@ -861,7 +867,7 @@ void main()
         vec4 pos = imageLoad(positionTexture, storePos);
         if (pos.w > 0.0) {
             shadePixel(storePos, pos, before);
-        } else if (first) {
+        } else {
             imageStore(shadowTexture, storePos, vec4(1.0, float(NUM_RAYS), 0.0, 0.0));
         }
     }

@@ -286,6 +286,7 @@ impl SoftShadowRenderer {
         self.options.samples_u = su;
         self.options.samples_v = sv;
         self.ray_batches = 1;
+        self.shadow.forget_attempts();
         Ok(())
     }
 
@@ -323,6 +324,7 @@ impl SoftShadowRenderer {
     /// `ShadowPass::run`); clamped to 1..=rays.
     pub fn set_ray_batches(&mut self, n: u32) {
         self.ray_batches = n.clamp(1, self.rays());
+        self.shadow.forget_attempts();
     }
 
     fn rays(&self) -> u32 {

@@ -10,7 +10,6 @@ use anyhow::{bail, Result};
 use glam::Vec3;
 use glow::HasContext;
 
-use super::gbuffer::rgba32f_texture;
 use super::linespace_build::{r32ui_texture_3d, read_texture_3d};
 use super::ntree::{NTree, PackedLinespaces};
 use super::{KleeShading, SoftShadowOptions};
@@ -122,8 +121,12 @@ pub struct ShadowPass {
     gl: Arc<Gl>,
     pub kernel: Kernel,
     /// r: shadow value, g: lit rays (summed over batches); b, a: where a truncated pixel goes
-    /// on (its first ray not done, the attempt)
-    shadow_texture: Owned<glow::Texture>,
+    /// on (its first ray not done, the attempt) — after a frame, a: the attempt that completed
+    /// the pixel, where the next frame starts it
+    shadow_texture: Image2d,
+    /// the attempts of the last frame (the next one runs at least as many); 0: none remembered
+    /// (the texture then holds zeros)
+    remembered_attempts: u32,
     /// RGBA32UI: bit r set where a batch that completed began at ray r
     batch_texture: Owned<glow::Texture>,
     /// the node pool (Fig. 8–9), RG32UI texels
@@ -191,10 +194,11 @@ impl ShadowPass {
         ];
         let pool = bytemuck::cast_slice(&tree.nodes);
         let node_pool = TextureBuffer::new(gl, "nodePool", glow::RG32UI, 8, pool)?;
-        let pass = ShadowPass {
+        let mut pass = ShadowPass {
             gl: gl.clone(),
             kernel,
-            shadow_texture: rgba32f_texture(gl, options.width, options.height)?,
+            shadow_texture: Image2d::new(gl, options.width, options.height, glow::RGBA32F)?,
+            remembered_attempts: 0,
             batch_texture: Image2d::new(gl, options.width, options.height, glow::RGBA32UI)?.texture,
             node_pool,
             linespace_texture: linespaces,
@@ -204,6 +208,7 @@ impl ShadowPass {
             texture_layout: [packed.tex_x_res, packed.tex_y_res, packed.ls_y_size],
         };
         crate::gl::check_error(gl, "uploading the N-tree and the line spaces")?;
+        pass.forget_attempts();
         Ok(pass)
     }
 
@@ -236,8 +241,18 @@ impl ShadowPass {
             img(image::GBUFFER_POSITION, gbuffer[0], ro, f);
             img(image::GBUFFER_NORMAL, gbuffer[1], ro, f);
             img(image::GBUFFER_DIFFUSE, gbuffer[2], rw, f);
-            img(image::SHADOW_VALUE, self.shadow_texture.raw(), rw, f);
-            img(image::SHADOW_BATCHES, self.batch_texture.raw(), rw, glow::RGBA32UI);
+            img(
+                image::SHADOW_VALUE,
+                self.shadow_texture.texture.raw(),
+                rw,
+                f,
+            );
+            img(
+                image::SHADOW_BATCHES,
+                self.batch_texture.raw(),
+                rw,
+                glow::RGBA32UI,
+            );
             let ls = Some(self.linespace_texture.raw());
             gl.bind_image_texture(image::LINESPACE, ls, 0, true, 0, ro, glow::R32UI);
         }
@@ -254,7 +269,7 @@ impl ShadowPass {
     /// counts (`truncated`: the batches truncated) and the batches of the last attempt; an
     /// error where a batch of one ray is truncated.
     pub fn run(
-        &self,
+        &mut self,
         timers: &mut GpuTimers,
         pixels: PixelGrid,
         gbuffer: &[glow::Texture; 3],
@@ -269,7 +284,10 @@ impl ShadowPass {
             self.dispatch_batches(timers, pixels, rays, batch_rays, attempt);
             let counts = self.counts();
             let truncated = counts.get("truncated") - retried;
-            if truncated == 0 {
+            // the pixels the last frame completed in a later attempt start there
+            let remembered = attempt + 1 < self.remembered_attempts;
+            if truncated == 0 && !remembered {
+                self.remembered_attempts = attempt + 1;
                 return Ok((counts, rays.div_ceil(batch_rays)));
             }
             if batch_rays == 1 {
@@ -280,9 +298,11 @@ impl ShadowPass {
                 );
             }
             batch_rays = batch_rays.div_ceil(2);
-            log::info!(
-                "{truncated} pixels hit the loop budget: their shadow rays go on in batches of {batch_rays}"
-            );
+            if truncated > 0 {
+                log::info!(
+                    "{truncated} pixels hit the loop budget: their shadow rays go on in batches of {batch_rays}"
+                );
+            }
             retried += truncated;
         }
         unreachable!("the attempts end by returning")
@@ -318,7 +338,14 @@ impl ShadowPass {
 
     /// The shadow texture (r: shadow value, g: lit rays).
     pub fn shadow_texture(&self) -> glow::Texture {
-        self.shadow_texture.raw()
+        self.shadow_texture.texture.raw()
+    }
+
+    /// Forget the attempts that completed each pixel (a new mode, new samples, new batches:
+    /// the last frame's split says nothing about the next): every pixel starts in attempt 0.
+    pub fn forget_attempts(&mut self) {
+        self.shadow_texture.clear(&self.gl);
+        self.remembered_attempts = 0;
     }
 
     /// Per pixel (GL rows, bottom first) the first rays of the batches its shadow rays were

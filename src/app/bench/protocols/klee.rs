@@ -262,7 +262,13 @@ fn table2_gap(savings: &[Savings]) -> String {
     if let [a, b] = savings {
         let gap = published - a.linespace;
         let share = |x: f64| pct(x / gap);
-        let closes = |x: f64| format!("{} points ({})", pp(x - a.linespace), share(x - a.linespace));
+        let closes = |x: f64| {
+            format!(
+                "{} points ({})",
+                pp(x - a.linespace),
+                share(x - a.linespace)
+            )
+        };
         text += &format!(
             "\nOf the gap between `linespace` at reading A and the published saving ({} points), \
              the depth reading (A → B, `linespace` vs `exact`) closes {}, the variants as defined \
