@@ -45,13 +45,15 @@ void main()
     if (k < 0) return;
     leafBox(k);
     for (int p = nodeParent(k); p >= 0; p = nodeParent(p)) {
-        // release: this child's box is written before its arrival is counted (GL 4.6 §7.12.1:
-        // coherent stores, then memoryBarrierBuffer, are visible to the invocation that sees the
-        // count)
-        memoryBarrierBuffer();
+        // release: this child's box is written before its arrival is counted (GLSL 4.60
+        // §4.10: coherent stores, then a memory barrier, are visible to the invocation that sees
+        // the count). memoryBarrier(), which orders buffer accesses as memoryBarrierBuffer()
+        // does and more: Mesa 22.3's zink on lavapipe counted no arrival past a
+        // memoryBarrierBuffer() in this divergent loop (tests/bvh_refit.rs failed there).
+        memoryBarrier();
         if ((atomicAdd(arrivals[p], 1u) & 1u) == 0u) return;
         // acquire: the sibling's box is read after its arrival was seen
-        memoryBarrierBuffer();
+        memoryBarrier();
         int c = nodeFirst(p);
         vec4 leftLo = boxes[2 * c], leftHi = boxes[2 * c + 1];
         vec4 rightLo = boxes[2 * c + 2], rightHi = boxes[2 * c + 3];
