@@ -13,9 +13,9 @@ use std::cell::Cell;
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Result};
-use glow::HasContext;
 use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
+use glow::HasContext;
 use serde_json::json;
 
 use super::{
@@ -318,7 +318,11 @@ impl Bvh {
         }
         // SAFETY: as above.
         unsafe { self.gl.delete_sync(fence) };
-        let refit = self.moving.refit.as_ref().expect("a refit before its fence");
+        let refit = self
+            .moving
+            .refit
+            .as_ref()
+            .expect("a refit before its fence");
         self.moving.cost.set(refit.sah_cost(&self.gl)?);
         Ok(())
     }
@@ -340,7 +344,9 @@ impl Bvh {
         self.drop_pending();
         // SAFETY: a fence on a current context; deleted in read_cost or drop_pending.
         let fence = unsafe { f.gl.fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0) };
-        self.moving.pending.set(Some(fence.map_err(|e| anyhow!("glFenceSync: {e}"))?));
+        self.moving
+            .pending
+            .set(Some(fence.map_err(|e| anyhow!("glFenceSync: {e}"))?));
         self.built_for = Some(f.models.to_vec());
         self.moving.refits += 1;
         Ok(())

@@ -123,7 +123,10 @@ impl Topology {
         for (k, node) in nodes.iter().enumerate() {
             match node.is_leaf() {
                 true => leaves.push(k as u32),
-                false => (parent[node.first as usize], parent[node.first as usize + 1]) = (k as u32, k as u32),
+                false => {
+                    (parent[node.first as usize], parent[node.first as usize + 1]) =
+                        (k as u32, k as u32)
+                }
             }
         }
         let count = leaves.len() as u32;
@@ -308,7 +311,9 @@ mod tests {
         }
         let mut leaves = t.words[3 * n..3 * n + t.leaves as usize].to_vec();
         leaves.sort_unstable();
-        let want: Vec<u32> = (0..n as u32).filter(|&k| bvh.nodes[k as usize].is_leaf()).collect();
+        let want: Vec<u32> = (0..n as u32)
+            .filter(|&k| bvh.nodes[k as usize].is_leaf())
+            .collect();
         assert_eq!(leaves, want);
         let words = bvh.gpu_words();
         for k in 0..n {
