@@ -170,10 +170,23 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 
-    let frames = read_csv(&out.join("thesis-5.1.csv"));
-    assert_eq!(frames.len(), 3 * 2, "three scenes, two angles each");
+    let all = read_csv(&out.join("thesis-5.1.csv"));
+    assert_eq!(
+        all.len(),
+        2 * 3 * 2,
+        "base and BVH, three scenes, two angles each"
+    );
+    let (frames, bvh): (Vec<_>, Vec<_>) = all.iter().cloned().partition(|r| r["tracer"] == "base");
     let triangles: HashMap<&str, u64> =
         [("teapot1", 14592), ("teapot3", 27392), ("teapot6", 46592)].into();
+    // the SAH BVH beside the base tracer (issue 34): the same scenes and frames, fewer tests,
+    // and with the objects turned on the second angle a refit, not a rebuild
+    assert_eq!(bvh.len(), 3 * 2);
+    for r in &bvh {
+        assert_eq!(r["tracer"], "bvh");
+        assert_eq!(u(r, "triangles"), triangles[r["scene"].as_str()]);
+        assert!(u(r, "triangle_tests") < 16 * 16 * u(r, "triangles"));
+    }
     for r in &frames {
         let t = triangles[r["scene"].as_str()];
         assert_eq!(u(r, "triangles"), t);
@@ -218,8 +231,8 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
     assert!(tests_of("teapot1") < tests_of("teapot3") && tests_of("teapot3") < tests_of("teapot6"));
 
     let summary = read_csv(&out.join("thesis-5.1_summary.csv"));
-    assert_eq!(summary.len(), 3);
-    check_summary_against_frames(&frames, &summary);
+    assert_eq!(summary.len(), 2 * 3);
+    check_summary_against_frames(&all, &summary);
 
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     for needle in [
@@ -230,6 +243,8 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
         "Fig. 19",
         "Fig. 20",
         "14,592 / 14,592",
+        "The SAH BVH beside them",
+        "BVH refit ms",
         "16×16",
         "512×512",
     ] {
@@ -266,8 +281,8 @@ fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
     let frames = read_csv(&out.join("thesis-5.3.csv"));
     let summary = read_csv(&out.join("thesis-5.3_summary.csv"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    // bunny base + 2 variants × 2 resolutions; dragon 2 variants × 28³
-    assert_eq!(summary.len(), 1 + 4 + 2, "{err}");
+    // bunny base + 2 variants × 2 resolutions; dragon 2 variants × 28³; the BVH on both
+    assert_eq!(summary.len(), 1 + 4 + 2 + 2, "{err}");
 
     // no reflection on the bunny: intersect1 is exactly W·H·T, intersect2 at most that
     let base: Vec<_> = frames
@@ -322,7 +337,10 @@ fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
                 );
             }
         }
-        let dragon: Vec<_> = frames.iter().filter(|r| r["scene"] == "dragon").collect();
+        let dragon: Vec<_> = frames
+            .iter()
+            .filter(|r| r["scene"] == "dragon" && r["tracer"] == "grid")
+            .collect();
         assert_eq!(dragon.len(), 2 * 2);
         assert!(dragon
             .iter()

@@ -1,21 +1,24 @@
 // The SAH BVH's refit on the GPU — ours: the bottom-up refit of Wald, Boulos and Shirley 2007
 // ("Ray tracing deformable scenes using dynamic bounding volume hierarchies", ACM TOG 26(1)),
 // as Kopta et al. 2012 ("Fast, effective BVH updates for animated scenes", I3D) run it every
-// frame between rebuilds, here with one dispatch per level of the tree (the host's passes:
-// src/accel/bvh/refit.rs) instead of atomics: the topology of the last CPU build is kept, the
-// boxes, the leaf triangles, the grid of the records' planes and every octant's records are made
-// again from the world-space vertices the transform pass wrote (common/scene.glsl). Shared by
-// bvh/refit_leaves.comp, bvh/refit_nodes.comp and bvh/refit_records.comp, one dispatch each
-// per pass, a barrier between them (src/gl/sync.rs).
+// frame between rebuilds, in two dispatches (the host's passes: src/accel/bvh/refit.rs): the
+// leaves and, through an arrival counter per inner node, every inner node (Karras 2012,
+// "Maximizing parallelism in the construction of BVHs, octrees, and k-d trees", HPG, §4: the
+// second child to arrive makes the parent), then the records. The topology of the last CPU
+// build is kept; the boxes, the leaf triangles, the grid of the records' planes and every
+// octant's records are made again from the world-space vertices the transform pass wrote
+// (common/scene.glsl). Shared by bvh/refit_leaves.comp and bvh/refit_records.comp, a barrier
+// between them (src/gl/sync.rs).
 //
 // The topology, as 32-bit words (Topology::of in src/accel/bvh/refit.rs; N = nodeCount):
 //   words 0 .. 2N:    per node k its Node integers (src/accel/bvh/layout.rs): first (an inner
 //                     node: its left child, the right is first + 1; a leaf: its first entry of
 //                     the leaf triangles) and meta (a leaf: its count > 0; inner: < 0);
-//   words 2N .. 3N:   the nodes in the passes' order: the leaves, then the inner nodes level by
-//                     level, the deepest first; a pass takes orderCount of them from orderStart;
-//   words 3N .. 11N:  per node k and octant o the texel of its record in octant o's copy;
-//   words 11N ..:     per entry s of the leaf triangles its triangle id.
+//   words 2N .. 3N:   per node k its parent (the root: -1);
+//   words 3N .. 4N:   the leaves, orderCount of them (the rest unused);
+//   words 4N .. 20N:  per node k and octant o the texel of its record in octant o's copy and
+//                     the record's `reference` (miss link or leaf triangles, the build's);
+//   words 20N ..:     per entry s of the leaf triangles its triangle id.
 // The boxes: per node k, boxes[2k] = (lo, the subtree's SAH cost), boxes[2k + 1] = (hi, 0): a
 // leaf's cost is its half area times its count, an inner node's its half area plus its
 // children's, so the root's cost over its half area is BvhStats::sah_cost.
@@ -25,22 +28,31 @@ layout(local_size_x = REFIT_GROUP) in;
 #include "words.glsl"
 
 layout(std430, binding = SSBO_REFIT_TOPOLOGY) readonly buffer RefitTopology { uint topology[]; };
-layout(std430, binding = SSBO_REFIT_BOXES) buffer RefitBoxes { vec4 boxes[]; };
+// coherent: the boxes pass reads the boxes other invocations of its dispatch wrote (GL 4.6
+// §7.12.1; refit_leaves.comp)
+layout(std430, binding = SSBO_REFIT_BOXES) coherent buffer RefitBoxes { vec4 boxes[]; };
 
 uniform int nodeCount;
-uniform int orderStart;
 uniform int orderCount;
 
 int nodeFirst(int k) { return int(topology[2 * k]); }
 int nodeMeta(int k) { return int(topology[2 * k + 1]); }
-// the node of this invocation in its pass, or -1 beyond the pass
-int passNode()
+int nodeParent(int k) { return int(topology[2 * nodeCount + k]); }
+// the node of this invocation: a leaf in the boxes' pass, any node in the records' pass; -1
+// beyond the pass
+int passNode(bool leaves)
 {
     int i = int(gl_GlobalInvocationID.x);
-    return i < orderCount ? int(topology[2 * nodeCount + orderStart + i]) : -1;
+    if (i >= orderCount) return -1;
+    return leaves ? int(topology[3 * nodeCount + i]) : i;
 }
-int recordTexel(int k, int octant) { return int(topology[3 * nodeCount + 8 * k + octant]); }
-int leafTriangleId(int s) { return int(topology[11 * nodeCount + s]); }
+// (texel, reference) of node k's record in octant o's copy
+uvec2 recordSlot(int k, int octant)
+{
+    int at = 4 * nodeCount + 2 * (8 * k + octant);
+    return uvec2(topology[at], topology[at + 1]);
+}
+int leafTriangleId(int s) { return int(topology[20 * nodeCount + s]); }
 
 // Aabb::half_area: xdim·ydim + ydim·zdim + zdim·xdim
 float halfArea(vec3 lo, vec3 hi)

@@ -3,10 +3,11 @@
 // src/accel/bvh/planes.rs), quantises its node's box onto it conservatively (Grid::planes: the
 // low planes rounded down, the high ones up, so that the record still holds its subtree) and
 // writes its record in every octant's copy (NodeRecord, BvhTree::octant_records in
-// src/accel/bvh/layout.rs), keeping the record's `reference` (miss link or leaf triangles: the
-// topology is the build's); node 0's invocation writes the Header's grid. In doubles as the host
-// computes them: a plane origin + q·step is exact in a double (q has 16 bits, step 24), so the
-// planes are the host's, bit for bit.
+// src/accel/bvh/layout.rs) with the record's `reference` from the topology (miss link or leaf
+// triangles: the build's, so no texel is read); node 0's invocation writes the Header's grid.
+// The planes are the host's, bit for bit: a first guess in floats (a step count off by a few at
+// most), then the host's test in doubles, where a plane origin + q·step is exact (q has 16 bits,
+// step 24), moves it to the tightest plane that holds the box.
 #include "refit.glsl"
 
 const double GRID_MAX = double(BVH_GRID_STEPS);
@@ -32,14 +33,15 @@ void gridOver(vec3 lo, vec3 hi)
 
 double plane(int a, double q) { return double(gridOrigin[a]) + q * double(gridStep[a]); }
 
-// Grid::planes for one axis: the tightest planes (low, high) that hold [lo, hi]
+// Grid::planes for one axis: the tightest planes (low, high) that hold [lo, hi]. The guesses
+// come from floats; the loops, in doubles, make them exact whatever the guesses were.
 uvec2 axisPlanes(int a, float lo, float hi)
 {
-    double o = double(gridOrigin[a]), s = double(gridStep[a]);
-    double l = clamp(floor((double(lo) - o) / s), 0.0LF, GRID_MAX);
+    float o = gridOrigin[a], s = gridStep[a], top = float(BVH_GRID_STEPS);
+    double l = double(clamp(floor((lo - o) / s), 0.0, top));
     while (l > 0.0LF && plane(a, l) > double(lo)) l -= 1.0LF;
     while (l < GRID_MAX && plane(a, l + 1.0LF) <= double(lo)) l += 1.0LF;
-    double h = clamp(ceil((double(hi) - o) / s), 0.0LF, GRID_MAX);
+    double h = double(clamp(ceil((hi - o) / s), 0.0, top));
     while (h < GRID_MAX && plane(a, h) < double(hi)) h += 1.0LF;
     while (h > 0.0LF && plane(a, h - 1.0LF) >= double(hi)) h -= 1.0LF;
     return uvec2(uint(l), uint(h));
@@ -47,7 +49,7 @@ uvec2 axisPlanes(int a, float lo, float hi)
 
 void main()
 {
-    int k = passNode();
+    int k = passNode(false);
     if (k < 0) return;
     gridOver(boxes[0].xyz, boxes[1].xyz);
     if (k == 0) {
@@ -65,9 +67,8 @@ void main()
         // octant_planes: the near plane is the low one unless the octant's rays point down
         bvec3 down = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
         uvec3 near = mix(low, high, down), far = mix(high, low, down);
-        int texel = recordTexel(k, o);
-        uint reference = imageLoad(bvh, texel).w;
-        imageStore(bvh, texel, uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
-                                     far.y | far.z << 16u, reference));
+        uvec2 slot = recordSlot(k, o);
+        imageStore(bvh, int(slot.x), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
+                                     far.y | far.z << 16u, slot.y));
     }
 }

@@ -8,11 +8,14 @@ use clap::ArgMatches;
 use serde_json::json;
 
 use crate::args::{DesignArgs, GpuArgs};
+use crate::bench::runner::args::Rotation;
+use crate::bench::runner::{rotation_center, turn_about};
 use gpgpu_rt::design::Design;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output::{Format, Staging, Target};
 use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::scene::Camera;
 use gpgpu_rt::scene::Scene;
 use gpgpu_rt::{limits, output};
 
@@ -39,6 +42,20 @@ pub struct RenderArgs {
     /// warm up: shader compilation on first use, caches).
     #[arg(long, default_value_t = 1, value_name = "N", value_parser = limits::parser(limits::FRAMES))]
     frames: u32,
+    /// Turn the scene from frame to frame, `--turn` degrees a frame (the first frame already
+    /// turned once): every object about the vertical axis through the scene's centre
+    /// (`objects`, moving objects as `bench --rotate objects` does) or the camera around it.
+    #[arg(long, value_enum, value_name = "HOW")]
+    rotate: Option<Rotation>,
+    /// Degrees the scene turns a frame with `--rotate`.
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "DEG",
+        requires = "rotate",
+        allow_negative_numbers = true
+    )]
+    turn: f32,
     #[command(flatten)]
     design: DesignArgs,
     #[command(flatten)]
@@ -174,13 +191,33 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let ctx = GlContext::headless(args.gpu.device)?;
     let mut r = design.renderer(ctx.gl.clone(), &ctx.info, &scene, &shaders)?;
     // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
-    for _ in 1..args.frames {
-        r.draw(&scene.camera)?;
+    for i in 1..args.frames {
+        let camera = turn(&args, &scene, r.as_mut(), i)?;
+        r.draw(&camera)?;
     }
-    let frame = r.render(&scene.camera)?;
+    let camera = turn(&args, &scene, r.as_mut(), args.frames)?;
+    let frame = r.render(&camera)?;
     write_outputs(&args, &ctx, &scene, r.as_ref(), &frame)?;
     eprintln!("{}", summary(&ctx, &scene, &design, &args, &frame));
     Ok(())
+}
+
+/// `--rotate`: the scene of frame `i` (from 1) turned by `i` × `--turn` degrees (its objects'
+/// model matrices set in `r`), and the camera to render it with.
+fn turn(args: &RenderArgs, scene: &Scene, r: &mut dyn Renderer, i: u32) -> Result<Camera> {
+    let degrees = args.turn * i as f32;
+    let center = || rotation_center(scene);
+    Ok(match args.rotate {
+        None => scene.camera,
+        Some(Rotation::Camera) => scene.camera.orbited(center(), -degrees),
+        Some(Rotation::Objects) => {
+            let m = turn_about(center(), degrees);
+            for (k, o) in scene.objects.iter().enumerate() {
+                r.set_model(k, m * o.model)?;
+            }
+            scene.camera
+        }
+    })
 }
 
 /// `export-triangles`: the scene's world-space triangles as f32 [T,3,3].

@@ -61,6 +61,8 @@ slot_table! {
         // subtree SAH cost as the refit's passes write them
         REFIT_TOPOLOGY = 10,
         REFIT_BOXES = 11,
+        /// and per inner node the arrivals of its children (glsl/bvh/refit_leaves.comp)
+        REFIT_ARRIVALS = 12,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,

@@ -337,7 +337,7 @@ impl BvhTree {
     }
 
     /// The node records of octant `o` ([`BvhTree::gpu_words`]) into `out`.
-    fn octant_records(&self, o: usize, out: &mut [NodeRecord]) {
+    pub(crate) fn octant_records(&self, o: usize, out: &mut [NodeRecord]) {
         let order = self.octant_order(o);
         let record = self.texels_in_order(o, &order);
         let end = record[self.nodes.len()];

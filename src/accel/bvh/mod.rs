@@ -9,11 +9,13 @@
 //! `reference::bvh` (the walks of [`BvhTree`]).
 
 use std::any::Any;
+use std::cell::Cell;
 use std::sync::Arc;
 
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, Result};
 use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
+use glow::HasContext;
 use serde_json::json;
 
 use super::{
@@ -118,7 +120,6 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
     let kernel = |file| b.kernel(file, &defs, REFIT_TIMER);
     Ok(RefitKernels {
         leaves: kernel("bvh/refit_leaves.comp")?,
-        nodes: kernel("bvh/refit_nodes.comp")?,
         records: kernel("bvh/refit_records.comp")?,
     })
 }
@@ -152,8 +153,12 @@ struct Moving {
     refit: Option<Refit>,
     /// refits since the last build
     refits: u64,
-    /// the SAH cost of the tree as the last refit left it (the last build's after a build)
-    cost: f64,
+    /// the SAH cost of the tree as the last refit whose cost was read left it (the last build's
+    /// after a build)
+    cost: Cell<f64>,
+    /// the fence after the last refit, while its cost is not read: the host reads it once the
+    /// GPU has passed the fence, without waiting ([`Bvh::read_cost`])
+    pending: Cell<Option<glow::Fence>>,
     /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
     max_block: i64,
 }
@@ -205,7 +210,8 @@ impl Bvh {
                 kernels: refit_kernels(b, &defs)?,
                 refit: None,
                 refits: 0,
-                cost: 0.0,
+                cost: Cell::new(0.0),
+                pending: Cell::new(None),
                 max_block: b.info.max_ssbo_block_size,
             },
             objects: scene
@@ -245,7 +251,9 @@ impl Bvh {
         // the old buffers (if any) drop after the new ones are made, as before
         self.buffers = Some(buffers);
         self.moving.refit = Some(refit);
-        (self.moving.refits, self.moving.cost) = (0, bvh.stats.sah_cost);
+        self.drop_pending();
+        self.moving.refits = 0;
+        self.moving.cost.set(bvh.stats.sah_cost);
         self.stats = bvh.stats;
         // the rest: the world transform, the words (octant records, leaf triangles), the upload
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
@@ -277,18 +285,68 @@ impl Bvh {
     }
 
     /// The SAH cost of the tree as the last refit left it over the last build's (1 after a
-    /// build): past [`REBUILD_GROWTH`], the next frame that moves an object rebuilds.
-    pub fn sah_growth(&self) -> f64 {
-        self.moving.cost / self.stats.sah_cost
+    /// build): past [`REBUILD_GROWTH`], the next frame that moves an object rebuilds. Waits for
+    /// the last refit (for tests; the frames read it without waiting: [`Bvh::read_cost`]).
+    pub fn sah_growth(&self) -> Result<f64> {
+        self.read_cost(true)?;
+        Ok(self.moving.cost.get() / self.stats.sah_cost)
+    }
+
+    /// Read the last refit's SAH cost (32 bytes) once the GPU has finished the refit: with
+    /// `wait`, now; without, only if it has (a fence), else the cost stays the one before and
+    /// is read at a later frame. So a frame never waits for its refit; the rebuild a refit's
+    /// growth calls for comes at the first moving frame after its cost was read — the next
+    /// frame, where the frame's statistics (timer queries) waited for the GPU anyway, else a
+    /// frame or more later (docs/design/bvh.md, "Moving objects").
+    fn read_cost(&self, wait: bool) -> Result<()> {
+        let Some(fence) = self.moving.pending.take() else {
+            return Ok(());
+        };
+        let timeout = if wait { i32::MAX } else { 0 };
+        loop {
+            // SAFETY: a fence of ours, not deleted (it is deleted once, here or in drop_pending).
+            let flush = glow::SYNC_FLUSH_COMMANDS_BIT;
+            let state = unsafe { self.gl.client_wait_sync(fence, flush, timeout) };
+            match state {
+                glow::TIMEOUT_EXPIRED if wait => continue,
+                glow::TIMEOUT_EXPIRED => {
+                    self.moving.pending.set(Some(fence));
+                    return Ok(());
+                }
+                _ => break,
+            }
+        }
+        // SAFETY: as above.
+        unsafe { self.gl.delete_sync(fence) };
+        let refit = self
+            .moving
+            .refit
+            .as_ref()
+            .expect("a refit before its fence");
+        self.moving.cost.set(refit.sah_cost(&self.gl)?);
+        Ok(())
+    }
+
+    /// Forget the last refit's cost unread (a rebuild replaces it).
+    fn drop_pending(&self) {
+        if let Some(fence) = self.moving.pending.take() {
+            // SAFETY: a fence of ours, not deleted yet.
+            unsafe { self.gl.delete_sync(fence) };
+        }
     }
 
     /// Refit the tree on the GPU to this frame's world-space vertices (the scene's `vertex` SSBO,
-    /// bound), and read the refitted tree's SAH cost.
+    /// bound); its SAH cost is read later ([`Bvh::read_cost`]).
     fn refit(&mut self, f: &mut FrameContext) -> Result<()> {
         let refit = self.moving.refit.as_ref().expect("a tree to refit");
         self.bind(f.gl, glow::READ_WRITE);
         refit.run(f.gl, f.timers, &self.moving.kernels);
-        self.moving.cost = refit.sah_cost(f.gl)?;
+        self.drop_pending();
+        // SAFETY: a fence on a current context; deleted in read_cost or drop_pending.
+        let fence = unsafe { f.gl.fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0) };
+        self.moving
+            .pending
+            .set(Some(fence.map_err(|e| anyhow!("glFenceSync: {e}"))?));
         self.built_for = Some(f.models.to_vec());
         self.moving.refits += 1;
         Ok(())
@@ -303,13 +361,21 @@ impl Bvh {
     }
 }
 
+impl Drop for Bvh {
+    fn drop(&mut self) {
+        self.drop_pending();
+    }
+}
+
 impl Accelerator for Bvh {
     fn build(&mut self, f: &mut FrameContext) -> Result<()> {
         self.rebuilt = false;
         if self.built_for.as_deref() == Some(f.models) {
             return Ok(());
         }
-        if self.moving.refit.is_some() && self.sah_growth() <= REBUILD_GROWTH {
+        self.read_cost(false)?;
+        let growth = self.moving.cost.get() / self.stats.sah_cost;
+        if self.moving.refit.is_some() && growth <= REBUILD_GROWTH {
             return self.refit(f);
         }
         self.rebuilt = true;
@@ -342,7 +408,9 @@ impl Accelerator for Bvh {
         f.insert("bvh_leaves".into(), json!(s.leaves));
         f.insert("bvh_depth".into(), json!(s.depth));
         f.insert("bvh_bytes".into(), json!(s.bytes));
-        f.insert("bvh_sah_cost".into(), json!(self.moving.cost));
+        // the frame's timer queries were read: its refit is done, its cost read without a wait
+        let _ = self.read_cost(false);
+        f.insert("bvh_sah_cost".into(), json!(self.moving.cost.get()));
         f.insert("bvh_build_sah_cost".into(), json!(s.sah_cost));
         f.insert("bvh_refits".into(), json!(self.moving.refits));
         let refit_ms = stats.gpu_ms.get(REFIT_TIMER).copied().unwrap_or(0.0);

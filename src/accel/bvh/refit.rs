@@ -1,8 +1,9 @@
 //! Moving objects without a CPU rebuild — ours: the BVH's boxes refitted bottom-up on the GPU
 //! every frame in which a model matrix changed, the topology of the last CPU build kept (Wald,
 //! Boulos and Shirley 2007, "Ray tracing deformable scenes using dynamic bounding volume
-//! hierarchies"; Kopta et al. 2012, "Fast, effective BVH updates for animated scenes"), one
-//! dispatch per level of the tree (`glsl/bvh/refit.glsl`), and a CPU rebuild when the refitted
+//! hierarchies"; Kopta et al. 2012, "Fast, effective BVH updates for animated scenes"), in two
+//! dispatches: the boxes bottom-up with an arrival counter per inner node (Karras 2012), then the
+//! records (`glsl/bvh/refit.glsl`), and a CPU rebuild when the refitted
 //! tree's SAH cost has grown past [`REBUILD_GROWTH`] times the last build's
 //! (`docs/design/bvh.md`, "Moving objects").
 //!
@@ -13,9 +14,9 @@
 //! | [`Header`](super::Header): node count | `gpu_words` | `refit_records.comp` (node 0): unchanged | — |
 //! | Header: grid origin, step | `Grid::over` the root's box | `refit_records.comp` (`gridOver`, every invocation; node 0 stores it) | [`BvhTree::refit`] |
 //! | [`NodeRecord`](super::NodeRecord) planes, every octant | `Grid::planes` of the built boxes | `refit_records.comp` (`axisPlanes`) of the refitted boxes | [`BvhTree::refit`] |
-//! | NodeRecord `reference` (miss link, leaf triangles) | `octant_records` | kept (read and written back) | — |
+//! | NodeRecord `reference` (miss link, leaf triangles) | `octant_records` | kept (the topology holds it: [`Topology::of`]) | — |
 //! | [`LeafTriangle`](super::LeafTriangle) v0, id, edges | `gpu_words` from the CPU's world transform | `refit_leaves.comp` from the transform pass' `vertex` SSBO | [`BvhTree::refit`] |
-//! | node boxes (not uploaded) | the build, padded by `build::pad` | `refit_leaves.comp`, `refit_nodes.comp` (SSBO `REFIT_BOXES`), padded by the build's pad | [`BvhTree::refit`] |
+//! | node boxes (not uploaded) | the build, padded by `build::pad` | `refit_leaves.comp` (SSBO `REFIT_BOXES`), padded by the build's pad | [`BvhTree::refit`] |
 //!
 //! The block entries after the leaf triangles are `glsl/bvh/entry.comp`'s every pass, either way.
 
@@ -26,7 +27,9 @@ use glam::Vec3;
 use glow::HasContext;
 use rayon::prelude::*;
 
-use super::layout::{Aabb, BvhTree, Node, OCTANTS};
+use bytemuck::Zeroable;
+
+use super::layout::{Aabb, BvhTree, Node, NodeRecord, OCTANTS};
 use super::planes::Grid;
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
@@ -103,53 +106,60 @@ pub fn sah_cost(nodes: &[Node]) -> f64 {
     nodes.iter().map(cost).sum()
 }
 
-/// The tree's topology as the refit's kernels read it (`glsl/bvh/refit.glsl` lays the words out),
-/// and its passes: the leaves, then the inner nodes level by level, the deepest first.
+/// The tree's topology as the refit's kernels read it (`glsl/bvh/refit.glsl` lays the words out):
+/// the nodes, their parents, the leaves, every record's texel and reference, the leaf triangles.
 pub struct Topology {
     pub words: Vec<u32>,
-    /// (first, count) of each pass in the order of the nodes
-    pub passes: Vec<(u32, u32)>,
+    /// the number of leaves (the boxes pass' invocations)
+    pub leaves: u32,
 }
 
 impl Topology {
     pub fn of(tree: &BvhTree) -> Topology {
         let nodes = &tree.nodes;
         let n = nodes.len();
-        let mut depth = vec![0usize; n];
-        let mut levels: Vec<Vec<u32>> = Vec::new();
+        let mut parent = vec![u32::MAX; n];
         let mut leaves = Vec::new();
         for (k, node) in nodes.iter().enumerate() {
-            if node.is_leaf() {
-                leaves.push(k as u32);
-                continue;
+            match node.is_leaf() {
+                true => leaves.push(k as u32),
+                false => {
+                    (parent[node.first as usize], parent[node.first as usize + 1]) =
+                        (k as u32, k as u32)
+                }
             }
-            let first = node.first as usize;
-            (depth[first], depth[first + 1]) = (depth[k] + 1, depth[k] + 1);
-            levels.resize_with(levels.len().max(depth[k] + 1), Vec::new);
-            levels[depth[k]].push(k as u32);
         }
-        let mut passes = vec![(0, leaves.len() as u32)];
-        let mut order = leaves;
-        for level in levels.iter().rev() {
-            passes.push((order.len() as u32, level.len() as u32));
-            order.extend(level);
-        }
+        let count = leaves.len() as u32;
         let mut words: Vec<u32> = nodes
             .iter()
             .flat_map(|n| [n.first, n.meta as u32])
             .collect();
-        words.extend(order);
-        let texels: Vec<Vec<u32>> = (0..OCTANTS).map(|o| tree.record_texels(o)).collect();
-        words.extend((0..n).flat_map(|k| texels.iter().map(move |t| t[k])));
+        words.extend(parent);
+        leaves.resize(n, 0);
+        words.extend(leaves);
+        let slots: Vec<Vec<[u32; 2]>> = (0..OCTANTS).map(|o| record_slots(tree, o)).collect();
+        words.extend((0..n).flat_map(|k| slots.iter().flat_map(move |s| s[k])));
         words.extend(&tree.tris);
-        Topology { words, passes }
+        Topology {
+            words,
+            leaves: count,
+        }
     }
 }
 
-/// The refit's three kernels (`glsl/bvh/refit_*.comp`).
+/// Per node of `tree`, the texel of its record in octant `o`'s copy and the record's reference.
+fn record_slots(tree: &BvhTree, o: usize) -> Vec<[u32; 2]> {
+    let texels = tree.record_texels(o);
+    let mut records = vec![NodeRecord::zeroed(); tree.nodes.len()];
+    tree.octant_records(o, &mut records);
+    let root = tree.root_texel(o) as u32;
+    let slot = |&t: &u32| [t, records[(t - root) as usize].reference as u32];
+    texels[..tree.nodes.len()].iter().map(slot).collect()
+}
+
+/// The refit's two kernels (`glsl/bvh/refit_*.comp`).
 pub struct RefitKernels {
     pub leaves: Kernel,
-    pub nodes: Kernel,
     pub records: Kernel,
 }
 
@@ -157,7 +167,9 @@ pub struct RefitKernels {
 pub struct Refit {
     topology: Ssbo,
     boxes: Ssbo,
-    passes: Vec<(u32, u32)>,
+    /// the arrival count of every node (`glsl/bvh/refit_leaves.comp`), zeros when made
+    arrivals: Ssbo,
+    leaves: u32,
     nodes: u32,
     pad: f32,
 }
@@ -177,31 +189,32 @@ impl Refit {
                 max_block,
             )?,
             boxes: Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?,
-            passes: t.passes,
+            arrivals: Ssbo::new(
+                gl,
+                "bvh refit arrivals",
+                4 * n,
+                Some(&vec![0; 4 * n]),
+                max_block,
+            )?,
+            leaves: t.leaves,
             nodes: n as u32,
             pad: tree.pad,
         })
     }
 
-    /// Run the refit's passes (the BVH's word buffer bound for reading and writing, the scene's
-    /// `vertex` SSBO holding this frame's world-space vertices), a barrier after each: a level
-    /// reads the boxes the pass before wrote (GL 4.6 §7.13), the records' pass the root's box.
-    /// Timed together as [`REFIT_TIMER`].
+    /// Run the refit's two passes (the BVH's word buffer bound for reading and writing, the
+    /// scene's `vertex` SSBO holding this frame's world-space vertices), a barrier after each:
+    /// the records' pass reads the boxes the boxes' pass wrote (GL 4.6 §7.13). Timed together as
+    /// [`REFIT_TIMER`].
     pub fn run(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels) {
         self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
         self.boxes.bind(gl, ssbo::REFIT_BOXES);
+        self.arrivals.bind(gl, ssbo::REFIT_ARRIVALS);
         sync::barrier(gl);
-        let n = self.nodes as i32;
         timers.time(gl, REFIT_TIMER, || {
-            let all = (0, self.nodes);
-            let passes = self.passes.iter().enumerate().map(|(i, &p)| match i {
-                0 => (&k.leaves, p),
-                _ => (&k.nodes, p),
-            });
-            for (kernel, (start, count)) in passes.chain([(&k.records, all)]) {
+            for (kernel, count) in [(&k.leaves, self.leaves), (&k.records, self.nodes)] {
                 kernel.use_program();
-                kernel.set_i32("nodeCount", n);
-                kernel.set_i32("orderStart", start as i32);
+                kernel.set_i32("nodeCount", self.nodes as i32);
                 kernel.set_i32("orderCount", count as i32);
                 if std::ptr::eq(kernel, &k.leaves) {
                     kernel.set_f32("pad", self.pad);
@@ -286,31 +299,31 @@ mod tests {
     }
 
     #[test]
-    fn the_passes_take_every_node_once_after_its_children() {
+    fn the_topology_names_every_node_s_parent_every_leaf_and_every_record() {
         let bvh = BvhTree::new(soup());
         let t = Topology::of(&bvh);
         let n = bvh.nodes.len();
-        let order = &t.words[2 * n..3 * n];
-        let mut pass_of = vec![usize::MAX; n];
-        let mut next = 0;
-        for (i, &(start, count)) in t.passes.iter().enumerate() {
-            assert_eq!(start, next);
-            next += count;
-            for &k in &order[start as usize..(start + count) as usize] {
-                assert_eq!(pass_of[k as usize], usize::MAX, "node {k} twice");
-                pass_of[k as usize] = i;
+        let parent = &t.words[2 * n..3 * n];
+        assert_eq!(parent[0], u32::MAX, "the root has none");
+        for (k, node) in bvh.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
+            let c = node.first as usize;
+            assert_eq!((parent[c], parent[c + 1]), (k as u32, k as u32));
+        }
+        let mut leaves = t.words[3 * n..3 * n + t.leaves as usize].to_vec();
+        leaves.sort_unstable();
+        let want: Vec<u32> = (0..n as u32)
+            .filter(|&k| bvh.nodes[k as usize].is_leaf())
+            .collect();
+        assert_eq!(leaves, want);
+        let words = bvh.gpu_words();
+        for k in 0..n {
+            for o in 0..OCTANTS {
+                let at = 4 * n + 2 * (OCTANTS * k + o);
+                let (texel, reference) = (t.words[at] as usize, t.words[at + 1]);
+                assert_eq!(texel, bvh.record_texels(o)[k] as usize);
+                assert_eq!(reference, words[4 * texel + 3], "node {k}, octant {o}");
             }
         }
-        for (k, node) in bvh.nodes.iter().enumerate() {
-            assert_eq!(
-                node.is_leaf(),
-                pass_of[k] == 0,
-                "the leaves' pass is the first"
-            );
-            if !node.is_leaf() {
-                let c = node.first as usize;
-                assert!(pass_of[c] < pass_of[k] && pass_of[c + 1] < pass_of[k]);
-            }
-        }
+        assert_eq!(&t.words[20 * n..], &bvh.tris[..]);
     }
 }

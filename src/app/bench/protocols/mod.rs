@@ -18,6 +18,7 @@ pub mod sweep;
 pub mod thesis_5_1;
 pub mod thesis_5_2;
 pub mod thesis_5_3;
+pub mod thesis_bvh;
 pub mod wagner;
 
 use std::fmt::Write as _;

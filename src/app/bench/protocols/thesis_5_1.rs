@@ -5,7 +5,7 @@
 
 use anyhow::Result;
 
-use super::{Protocol, Section, Units};
+use super::{thesis_bvh, Protocol, Section, Units};
 use crate::bench::published::thesis::{self, TEAPOT_TRIANGLES};
 use crate::bench::report::format::{int, percent, ratio, table};
 use crate::bench::report::plots::{self, Chart, Figure, Series, Style};
@@ -27,15 +27,25 @@ pub const FULL: Sizing = Sizing::full(360, 5);
 fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     // configure: the base tracer on the three teapot scenes, reflection depth 1
     let s = bench.sizing(QUICK, FULL);
-    let configs: Vec<Config> = TEAPOT_TRIANGLES
+    let scenes: Vec<String> = TEAPOT_TRIANGLES
         .iter()
-        .map(|(name, _)| Config::new(&format!("{name}.toml"), TracerSpec::Base, 1, s))
+        .map(|(name, _)| format!("{name}.toml"))
         .collect();
+    let mut configs: Vec<Config> = scenes
+        .iter()
+        .map(|scene| Config::new(scene, TracerSpec::Base, 1, s))
+        .collect();
+    let names: Vec<&str> = scenes.iter().map(String::as_str).collect();
+    configs.extend(thesis_bvh::configs(&names, 1, s));
     // measure
     let outcomes = bench.measure(p.name, &configs)?;
-    // report
-    let markdown = setup_text(s) + &results_table(&outcomes) + &findings(&outcomes);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures(s, &outcomes))
+    // report: the thesis' tracer in its table and figures, the BVH beside it
+    let base = thesis_bvh::thesis_outcomes(&outcomes);
+    let markdown = setup_text(s)
+        + &results_table(&base)
+        + &findings(&base)
+        + &thesis_bvh::table_text(&outcomes);
+    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures(s, &base))
 }
 
 /// Fig. 19 and 20: one curve per scene over the rotation.

@@ -6,7 +6,7 @@
 use anyhow::Result;
 
 use super::sweep::{self, resolution_chart};
-use super::{Protocol, Section, Units};
+use super::{thesis_bvh, Protocol, Section, Units};
 use crate::bench::published::thesis;
 use crate::bench::report::format::{int, num};
 use crate::bench::report::plots::Figure;
@@ -32,6 +32,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let variants = bench.variants();
     let mut configs = vec![Config::new(SCENE, TracerSpec::Base, 1, s)];
     configs.extend(sweep::grid_configs(SCENE, 1, s, &variants, &resolutions));
+    configs.extend(thesis_bvh::configs(&[SCENE], 1, s));
     // measure
     let outcomes = bench.measure(p.name, &configs)?;
     // report
@@ -39,7 +40,8 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let grid = sweep::grid_outcomes(&outcomes, SCENE);
     let markdown = setup_text(s, &resolutions, &variants)
         + &sweep::resolution_table(&grid, base)
-        + &findings(&grid);
+        + &findings(&grid)
+        + &thesis_bvh::table_text(&outcomes);
     let figures = figures(s, &grid, base);
     Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
 }

@@ -7,7 +7,7 @@
 use anyhow::Result;
 
 use super::sweep::{self, resolution_chart};
-use super::{Protocol, Section, Units};
+use super::{thesis_bvh, Protocol, Section, Units};
 use crate::bench::published::thesis::{self as p, Published};
 use crate::bench::report::format::{int, num, ratio, table};
 use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
@@ -46,8 +46,10 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     };
     let outcomes = bench.measure(p.name, &plan.configs())?;
     let results = Results::of(&outcomes, dragon_mesh_triangles(bench));
-    let markdown =
-        setup_text(&plan, &results) + &comparison(&results, &plan.variants) + &tables(&results);
+    let markdown = setup_text(&plan, &results)
+        + &comparison(&results, &plan.variants)
+        + &tables(&results)
+        + &thesis_bvh::table_text(&outcomes);
     let figures = figures(plan.sizing, &results);
     Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
 }
@@ -55,7 +57,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
 impl Plan {
     /// The bunny without reflections (REFL_DEPTH 0), base and grid; the dragon with the grid
     /// at 28³ (the thesis' scene had a reflective floor, so REFL_DEPTH 1), and at full scale
-    /// with the base tracer (202520 triangles per ray).
+    /// with the base tracer (202520 triangles per ray); the SAH BVH on both (ours).
     fn configs(&self) -> Vec<Config> {
         let (s, variants) = (self.sizing, &self.variants);
         let mut configs = vec![Config::new(BUNNY, TracerSpec::Base, 0, s)];
@@ -71,6 +73,9 @@ impl Plan {
         if self.dragon_base {
             configs.push(Config::new(DRAGON, TracerSpec::Base, 1, s));
         }
+        // the SAH BVH on both, with the grid's reflection depths
+        configs.extend(thesis_bvh::configs(&[BUNNY], 0, s));
+        configs.extend(thesis_bvh::configs(&[DRAGON], 1, s));
         configs
     }
 }

@@ -536,9 +536,7 @@ impl<'a> Turntable<'a> {
             Rotation::Objects if angle == 0.0 && !self.turned.get() => self.scene.camera,
             Rotation::Objects => {
                 self.turned.set(true);
-                let r = Mat4::from_translation(self.center)
-                    * Mat4::from_rotation_y((angle as f32).to_radians())
-                    * Mat4::from_translation(-self.center);
+                let r = turn_about(self.center, angle as f32);
                 for (i, m) in self.models.iter().enumerate() {
                     tracer.set_model(i, r * *m)?;
                 }
@@ -550,8 +548,15 @@ impl<'a> Turntable<'a> {
     }
 }
 
+/// The turn by `degrees` about the vertical axis through `center`.
+pub(crate) fn turn_about(center: Vec3, degrees: f32) -> Mat4 {
+    Mat4::from_translation(center)
+        * Mat4::from_rotation_y(degrees.to_radians())
+        * Mat4::from_translation(-center)
+}
+
 /// The vertical axis the scene turns about passes through the centre of its bounding box.
-fn rotation_center(scene: &Scene) -> Vec3 {
+pub(crate) fn rotation_center(scene: &Scene) -> Vec3 {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for t in scene.world_triangles() {
