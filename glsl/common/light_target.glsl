@@ -9,6 +9,11 @@
 //                (common/light_samples.glsl, SAMPLES_U × SAMPLES_V).
 #include "light_samples.glsl"
 
+// pointTarget: a point light's position, lightPos[lightSource], set by the host for each
+// dispatch (LightTarget::set_uniforms). Ours: Listing 15 reads lightPos[lightSource] from the
+// scene's buffer in every invocation; llvmpipe makes that storage-buffer load a loop over the
+// lanes even with a uniform index (docs/design/bvh.md, "Shadow feelers").
+uniform vec3 pointTarget;
 uniform int lightSource;
 uniform int lightSample;
 uniform vec3 areaCorner;
@@ -17,6 +22,6 @@ uniform vec3 areaEdgeV;
 
 vec3 feelerTarget()
 {
-    if (lightSample < 0) return lightPos[lightSource].xyz;
+    if (lightSample < 0) return pointTarget;
     return lightSamplePoint(areaCorner, areaEdgeU, areaEdgeV, lightSample, SAMPLES_U, SAMPLES_V);
 }

@@ -78,8 +78,11 @@ pub trait Accelerator {
 /// What the shadow feelers of one intersect2 dispatch aim at (`glsl/common/light_target.glsl`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightTarget {
-    /// Point light `0` (Listing 15): its flag is its index.
-    Point(usize),
+    /// Point light `light` at `position` (Listing 15): its flag is its index. Ours: the
+    /// position as a uniform (`pointTarget`), where Listing 15 reads `lightPos[light]`, the
+    /// scene's buffer in every invocation — on llvmpipe a storage-buffer load is a loop over
+    /// the lanes (docs/design/bvh.md, "Shadow feelers").
+    Point { light: usize, position: Vec3 },
     /// Ours, after Klee 2016: sample `sample` of the area light `corner`, `edges`; its flag is
     /// bit `slot` of the shadow flags.
     AreaSample {
@@ -94,9 +97,10 @@ impl LightTarget {
     /// Its uniforms, on `kernel` (in use).
     pub fn set_uniforms(&self, kernel: &Kernel) {
         match *self {
-            LightTarget::Point(light) => {
+            LightTarget::Point { light, position } => {
                 kernel.set_i32("lightSource", light as i32);
                 kernel.set_i32("lightSample", -1);
+                kernel.set_vec3("pointTarget", position.to_array());
             }
             LightTarget::AreaSample {
                 slot,

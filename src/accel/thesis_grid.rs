@@ -11,6 +11,7 @@
 use std::any::Any;
 
 use anyhow::{bail, Result};
+use glam::Vec3;
 use serde_json::json;
 
 use super::grid_frame::GridMapping;
@@ -109,7 +110,11 @@ impl ThesisGrid {
         k.use_program();
         self.frame.set_uniforms(k);
         k.set_i32("traversalMode", feelers.is_some() as i32);
-        feelers.unwrap_or(&LightTarget::Point(0)).set_uniforms(k);
+        let none = LightTarget::Point {
+            light: 0,
+            position: Vec3::ZERO,
+        };
+        feelers.unwrap_or(&none).set_uniforms(k);
         k.dispatch_pixels(f.timers, f.pixels);
     }
 

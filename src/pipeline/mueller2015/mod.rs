@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Result};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use serde::Serialize;
 use serde_json::json;
 
@@ -141,7 +141,9 @@ struct Kernels {
 
 /// The scene's lighting and background, as the kernels' uniforms take them.
 struct Lighting {
-    lights: usize,
+    /// The point lights' positions, as the scene's `lightPos` buffer holds them (the feelers'
+    /// targets: [`LightTarget::Point`]).
+    lights: Vec<Vec3>,
     area_lights: Vec<AreaLight>,
     background: [f32; 3],
     ambient: [f32; 3],
@@ -168,12 +170,16 @@ pub fn shadow_slots(scene: &Scene, (su, sv): (u32, u32)) -> usize {
 /// The intersect2 dispatches of a pass, in order: each with the light it counts under
 /// ([`Bank::occluded`]: point lights first, then the area lights) and its feelers' target.
 pub fn light_targets(
-    lights: usize,
+    lights: &[Vec3],
     area_lights: &[AreaLight],
     (su, sv): (u32, u32),
 ) -> Vec<(usize, LightTarget)> {
     let samples = (su * sv) as usize;
-    let points = (0..lights).map(|l| (l, LightTarget::Point(l)));
+    let points = lights
+        .iter()
+        .enumerate()
+        .map(|(light, &position)| (light, LightTarget::Point { light, position }));
+    let lights = lights.len();
     let areas = area_lights.iter().enumerate().flat_map(move |(a, area)| {
         (0..samples).map(move |r| {
             let target = LightTarget::AreaSample {
@@ -324,7 +330,7 @@ impl RayTracer {
             counters,
             timers: GpuTimers::new(&gl),
             lighting: Lighting {
-                lights: scene.lights.len(),
+                lights: scene.lights.iter().map(|l| l.position).collect(),
                 area_lights: scene.area_lights.clone(),
                 background: scene.settings.background,
                 ambient: scene.settings.ambient,
@@ -393,7 +399,8 @@ impl RayTracer {
         // would inherit the flags of the pass before it)
         self.images.shadow.clear(&self.gl);
         let l = &self.lighting;
-        for (light, target) in light_targets(l.lights, &l.area_lights, self.options.light_samples) {
+        for (light, target) in light_targets(&l.lights, &l.area_lights, self.options.light_samples)
+        {
             self.counters.bind(f.gl, f.timers, Bank::occluded(light));
             let k = self.accel.occluded(&mut f, &target);
             target.set_uniforms(k);
@@ -407,7 +414,7 @@ impl RayTracer {
         k.use_program();
         k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
         k.set_vec4("ambientColor", self.lighting.ambient, 1.0);
-        k.set_i32("lightCount", self.lighting.lights as i32);
+        k.set_i32("lightCount", self.lighting.lights.len() as i32);
         k.set_vec4_slice("areaLight", &self.lighting.area_uniform());
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
@@ -539,7 +546,7 @@ impl Renderer for RayTracer {
     fn settings(&self) -> serde_json::Map<String, serde_json::Value> {
         let o = &self.options;
         [
-            ("lights", json!(self.lighting.lights)),
+            ("lights", json!(self.lighting.lights.len())),
             ("refl_depth", json!(o.refl_depth)),
             ("shadow_flags", json!(o.shadow_flags)),
             ("tile", json!(o.tile)),
