@@ -123,6 +123,9 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // when no AOVs are asked, the texture lookup in a scene without textures
         .set("STORE_AOVS", options.aovs as i32)
         .set("SCENE_TEXTURES", !scene.textures.is_empty() as i32)
+        // the vertex normals and colours through image buffers: the SAH BVH's evaluate_hit
+        // only, where the scene has them (GpuScene::vertex_images; records.rs)
+        .set("SCENE_IMAGES", 0)
         // the area lights' samples (common/light_target.glsl, shading.comp)
         .set("SAMPLES_U", options.light_samples.0)
         .set("SAMPLES_V", options.light_samples.1)
@@ -306,7 +309,11 @@ impl RayTracer {
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
         let records = accel
             .records()
-            .then(|| Records::new(&gl, info, shaders, &defines, (w, h)))
+            .then(|| {
+                let images = gpu_scene.vertex_images() as i32;
+                let defines = defines.clone().set("SCENE_IMAGES", images);
+                Records::new(&gl, info, shaders, &defines, (w, h))
+            })
             .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
