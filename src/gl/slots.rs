@@ -108,6 +108,10 @@ slot_table! {
         /// `GL_MAX_IMAGE_UNITS` has them
         SCENE_NORMAL = 8,
         SCENE_COLOR = 9,
+        /// the lights' positions and colours (the SSBOs LIGHT_POS, LIGHT_COLOR) read as
+        /// image buffers by shading's light loop (SCENE_IMAGES), the same way
+        SCENE_LIGHT_POS = 10,
+        SCENE_LIGHT_COLOR = 11,
     }
 }
 

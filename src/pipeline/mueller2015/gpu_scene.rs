@@ -37,7 +37,7 @@ pub struct GpuScene {
     fbo: Owned<glow::Framebuffer>,
     _rbo: Owned<glow::Renderbuffer>,
     textures: Owned<glow::Texture>,
-    /// The normals and colours SSBOs viewed as RGBA32F buffer textures (image unit, view),
+    /// The normals, colours and lights SSBOs viewed as RGBA32F buffer textures (image unit, view),
     /// where the GL has the image units: [`vertex_images`](GpuScene::vertex_images).
     vertex_views: Vec<(u32, Owned<glow::Texture>)>,
     pub triangles: usize,
@@ -185,8 +185,9 @@ fn scene_ssbos(gl: &Arc<Gl>, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>
         .collect()
 }
 
-/// The normals and colours SSBOs as RGBA32F buffer textures over the same storage (no copy:
-/// the transform pass' stores show through them after its barrier), for the hit evaluation:
+/// The normals, colours and lights SSBOs as RGBA32F buffer textures over the same storage (no
+/// copy: the transform pass' stores show through them after its barrier), for the hit
+/// evaluation and shading:
 /// llvmpipe loads a storage-buffer vector lane by lane and component by component, an image
 /// texel for all lanes at once (docs/design/frame.md). None where the GL lacks the image units
 /// (GL 4.5 guarantees 8, which the ray-state images and the BVH take) or the texels.
@@ -202,6 +203,8 @@ fn vertex_views(
     let views = [
         (binding::NORMAL, image::SCENE_NORMAL),
         (binding::COLOR, image::SCENE_COLOR),
+        (binding::LIGHT_POS, image::SCENE_LIGHT_POS),
+        (binding::LIGHT_COLOR, image::SCENE_LIGHT_COLOR),
     ];
     let fits = views.iter().all(|&(b, unit)| {
         let s = &ssbos
@@ -353,8 +356,8 @@ impl GpuScene {
         self.ssbos.iter().map(|(_, s)| s.bytes).sum()
     }
 
-    /// Whether the vertex normals and colours are also bound as image buffers
-    /// (`SCENE_IMAGES` of `glsl/common/intersect1_hit.glsl`).
+    /// Whether the vertex normals and colours and the lights are also bound as image buffers
+    /// (`SCENE_IMAGES` of `glsl/common/intersect1_hit.glsl` and `shading.comp`).
     pub fn vertex_images(&self) -> bool {
         !self.vertex_views.is_empty()
     }
