@@ -14,6 +14,20 @@ uniform vec4 backgroundColor;
 uniform int storePrimaryHit;
 layout(binding = SAMPLER_TEXTURES) uniform sampler2DArray textures;
 
+// The vertex normals and colours of the scene (common/scene.glsl). Ours: with SCENE_IMAGES
+// (the SAH BVH's evaluate_hit, where the GL has the image units: GpuScene::vertex_images) the
+// same buffers are read as image buffers — llvmpipe loads a storage-buffer vector lane by lane
+// and component by component, an image texel for all lanes at once (docs/design/frame.md).
+#if SCENE_IMAGES
+layout(rgba32f, binding = IMAGE_SCENE_NORMAL) readonly uniform imageBuffer normalImage;
+layout(rgba32f, binding = IMAGE_SCENE_COLOR) readonly uniform imageBuffer colorImage;
+vec3 vertexNormal(int k) { return imageLoad(normalImage, k).xyz; }
+vec3 vertexColor(int k) { return imageLoad(colorImage, k).rgb; }
+#else
+vec3 vertexNormal(int k) { return normals[k].xyz; }
+vec3 vertexColor(int k) { return colors[k].rgb; }
+#endif
+
 // inactive ray: an empty colour buffer, nothing for shading to add. Ours: weight -1 marks it;
 // the thesis' shading skips an empty colour buffer (ch. 4.1.3, "sofern dieser nicht leer
 // ist") without saying how it is marked, and a weight of 0 is a real one (a perfect mirror)
@@ -42,15 +56,15 @@ void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
     if (triID >= 0) {
         // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
         float w = 1.0 - hit_u - hit_v;
-        interpolated_normal = normalize(w * normals[3 * triID].xyz
-                                        + hit_u * normals[3 * triID + 1].xyz
-                                        + hit_v * normals[3 * triID + 2].xyz);
+        interpolated_normal = normalize(w * vertexNormal(3 * triID)
+                                        + hit_u * vertexNormal(3 * triID + 1)
+                                        + hit_v * vertexNormal(3 * triID + 2));
         // ours: the normal faces the incoming ray (two-sided surfaces)
         if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
 
         vec4 mat = material[triMaterial[triID]];
-        vec3 color = w * colors[3 * triID].rgb + hit_u * colors[3 * triID + 1].rgb
-                   + hit_v * colors[3 * triID + 2].rgb;
+        vec3 color = w * vertexColor(3 * triID) + hit_u * vertexColor(3 * triID + 1)
+                   + hit_v * vertexColor(3 * triID + 2);
 #if SCENE_TEXTURES
         if (mat.w >= 0.0) {
             // textured triangle: interpolated texture coordinates, sampled through the sampler

@@ -25,6 +25,19 @@ uniform int lightCount;
 uniform vec4 areaLight[4 * AREA_LIGHTS];
 #endif
 
+// The point lights (common/scene.glsl). Ours: with SCENE_IMAGES the same buffers read as image
+// buffers — llvmpipe loads a storage-buffer vector lane by lane and component by component, an
+// image texel for all lanes at once (docs/design/frame.md; common/intersect1_hit.glsl).
+#if SCENE_IMAGES
+layout(rgba32f, binding = IMAGE_SCENE_LIGHT_POS) readonly uniform imageBuffer lightPosImage;
+layout(rgba32f, binding = IMAGE_SCENE_LIGHT_COLOR) readonly uniform imageBuffer lightColorImage;
+vec3 pointLightPos(int l) { return imageLoad(lightPosImage, l).xyz; }
+vec3 pointLightColor(int l) { return imageLoad(lightColorImage, l).rgb; }
+#else
+vec3 pointLightPos(int l) { return lightPos[l].xyz; }
+vec3 pointLightColor(int l) { return lightColor[l].rgb; }
+#endif
+
 bool inShadow(ivec2 storePos, int l)
 {
 #if SHADOW_BITS
@@ -81,8 +94,8 @@ void main()
         temp_color = ambientColor.rgb * pColor.rgb;
         for (int l = 0; l < lightCount; l++) {
             if (inShadow(storePos, l)) continue;
-            vec3 L = normalize(lightPos[l].xyz - p);
-            temp_color += lightColor[l].rgb * phong(n, L, view, mat, pColor.rgb);
+            vec3 L = normalize(pointLightPos(l) - p);
+            temp_color += pointLightColor(l) * phong(n, L, view, mat, pColor.rgb);
         }
 #if AREA_LIGHTS > 0
         for (int a = 0; a < AREA_LIGHTS; a++) {

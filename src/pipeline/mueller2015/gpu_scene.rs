@@ -37,6 +37,9 @@ pub struct GpuScene {
     fbo: Owned<glow::Framebuffer>,
     _rbo: Owned<glow::Renderbuffer>,
     textures: Owned<glow::Texture>,
+    /// The normals, colours and lights SSBOs viewed as RGBA32F buffer textures (image unit, view),
+    /// where the GL has the image units: [`vertex_images`](GpuScene::vertex_images).
+    vertex_views: Vec<(u32, Owned<glow::Texture>)>,
     pub triangles: usize,
     /// The model matrices the SSBOs were last written with (none before the first pass).
     written: Option<Vec<Mat4>>,
@@ -182,6 +185,58 @@ fn scene_ssbos(gl: &Arc<Gl>, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>
         .collect()
 }
 
+/// The normals, colours and lights SSBOs as RGBA32F buffer textures over the same storage (no
+/// copy: the transform pass' stores show through them after its barrier), for the hit
+/// evaluation and shading:
+/// llvmpipe loads a storage-buffer vector lane by lane and component by component, an image
+/// texel for all lanes at once (docs/design/frame.md). None where the GL lacks the image units
+/// (GL 4.5 guarantees 8, which the ray-state images and the BVH take) or the texels.
+fn vertex_views(
+    gl: &Arc<Gl>,
+    info: &GlInfo,
+    ssbos: &[(u32, Ssbo)],
+) -> Result<Vec<(u32, Owned<glow::Texture>)>> {
+    use crate::gl::slots::image;
+    let texels = |s: &Ssbo| (s.bytes / 16) as i64;
+    // SAFETY: a limit query on a current context.
+    let max_texels = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
+    let views = [
+        (binding::NORMAL, image::SCENE_NORMAL),
+        (binding::COLOR, image::SCENE_COLOR),
+        (binding::LIGHT_POS, image::SCENE_LIGHT_POS),
+        (binding::LIGHT_COLOR, image::SCENE_LIGHT_COLOR),
+    ];
+    let fits = views.iter().all(|&(b, unit)| {
+        let s = &ssbos
+            .iter()
+            .find(|(sb, _)| *sb == b)
+            .expect("a scene SSBO")
+            .1;
+        unit < info.max_image_units as u32 && texels(s) <= max_texels
+    });
+    if !fits {
+        return Ok(Vec::new());
+    }
+    views
+        .iter()
+        .map(|&(b, unit)| {
+            let s = &ssbos
+                .iter()
+                .find(|(sb, _)| *sb == b)
+                .expect("a scene SSBO")
+                .1;
+            // SAFETY: a texture over our own buffer on a current context.
+            unsafe {
+                let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+                gl.bind_texture(glow::TEXTURE_BUFFER, Some(t.raw()));
+                gl.tex_buffer(glow::RGBA32F, s.buffer.raw());
+                gl.bind_texture(glow::TEXTURE_BUFFER, None);
+                Ok((unit, t))
+            }
+        })
+        .collect()
+}
+
 /// Binding, name and bytes of every scene SSBO.
 fn ssbo_sizes(scene: &Scene) -> [(u32, &'static str, usize); 8] {
     let triangles = scene.triangle_count();
@@ -277,6 +332,7 @@ impl GpuScene {
         let ssbos = scene_ssbos(gl, scene, info.max_ssbo_block_size)?;
         let (fbo, rbo) = point_target(gl)?;
         let textures = upload_textures(gl, info, scene)?;
+        let vertex_views = vertex_views(gl, info, &ssbos)?;
         crate::gl::check_error(gl, "uploading the scene")?;
         Ok(GpuScene {
             vao,
@@ -289,6 +345,7 @@ impl GpuScene {
             fbo,
             _rbo: rbo,
             textures,
+            vertex_views,
             triangles: scene.triangle_count(),
             written: None,
         })
@@ -299,9 +356,22 @@ impl GpuScene {
         self.ssbos.iter().map(|(_, s)| s.bytes).sum()
     }
 
+    /// Whether the vertex normals and colours and the lights are also bound as image buffers
+    /// (`SCENE_IMAGES` of `glsl/common/intersect1_hit.glsl` and `shading.comp`).
+    pub fn vertex_images(&self) -> bool {
+        !self.vertex_views.is_empty()
+    }
+
     pub fn bind(&self, gl: &Gl) {
         for (b, s) in &self.ssbos {
             s.bind(gl, *b);
+        }
+        for (unit, view) in &self.vertex_views {
+            // SAFETY: binding our own buffer texture to an image unit, read-only.
+            unsafe {
+                let (t, f) = (Some(view.raw()), glow::RGBA32F);
+                gl.bind_image_texture(*unit, t, 0, false, 0, glow::READ_ONLY, f);
+            }
         }
         // SAFETY: binding our texture array to its unit (sampler `textures`).
         unsafe {

@@ -123,6 +123,9 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // when no AOVs are asked, the texture lookup in a scene without textures
         .set("STORE_AOVS", options.aovs as i32)
         .set("SCENE_TEXTURES", !scene.textures.is_empty() as i32)
+        // the vertex normals and colours, the lights through image buffers: the SAH BVH's
+        // evaluate_hit and shading only, where the GL has the units (GpuScene::vertex_images)
+        .set("SCENE_IMAGES", 0)
         // the area lights' samples (common/light_target.glsl, shading.comp)
         .set("SAMPLES_U", options.light_samples.0)
         .set("SAMPLES_V", options.light_samples.1)
@@ -292,12 +295,15 @@ impl RayTracer {
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
         let defines = kernel_defines(scene, &options);
         let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
+        let images = defines
+            .clone()
+            .set("SCENE_IMAGES", gpu_scene.vertex_images() as i32);
         let kernels = Kernels {
             eye_ray_generation: compute(
                 "mueller2015/eye_ray_generation.comp",
                 "eye_ray_generation",
             )?,
-            shading: compute("mueller2015/shading.comp", "shading")?,
+            shading: Kernel::compute(&gl, shaders, "mueller2015/shading.comp", &images, "shading")?,
         };
         let (w, h) = (options.width, options.height);
         let build = BuildContext {
@@ -312,7 +318,7 @@ impl RayTracer {
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
         let records = accel
             .records()
-            .then(|| Records::new(&gl, info, shaders, &defines, (w, h)))
+            .then(|| Records::new(&gl, info, shaders, &images, (w, h)))
             .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
