@@ -118,10 +118,10 @@ fn two_shards_merged_equal_the_unsharded_run() {
         .collect();
     assert_eq!(
         ids.len(),
-        4,
-        "three teapot configurations and klee-table2:\n{listed}"
+        7,
+        "three teapot configurations with base and with the SAH BVH, and klee-table2:\n{listed}"
     );
-    assert_eq!(ids.iter().collect::<BTreeSet<_>>().len(), 4, "unique ids");
+    assert_eq!(ids.iter().collect::<BTreeSet<_>>().len(), 7, "unique ids");
     assert!(ids.contains(&"klee-table2".to_string()));
     assert!(!dir("listed").exists(), "--list writes nothing");
 

@@ -571,9 +571,12 @@ impl ObjectDef {
 
     fn teapot_mesh(&self, dir: &Path) -> Result<Mesh, ObjectError> {
         let path = self.model_path(dir, "models/teapot.bpt")?;
-        // 32 patches in Newell's teapot (a .bpt with more patches gives more)
+        // here one patch's triangles: the file's patch count, and with it the whole mesh's
+        // size and memory, is checked when the file is read (bpt::teapot) — a memory check for
+        // Newell's 32 patches here would refuse a file of 64 for the wrong reason, and only
+        // where the host has less memory
         let n = procedural_size("tessellation", self.shape.tessellation, 10, 1, |n| {
-            32 * 2 * n * n
+            2 * n * n
         })?;
         let mut mesh = bpt::teapot(&path, n).map_err(ObjectError::File)?;
         mesh.colors.fill(self.color_or(Vec3::new(0.8, 0.3, 0.2)));
