@@ -16,9 +16,12 @@
 //                     the leaf triangles) and meta (a leaf: its count > 0; inner: < 0);
 //   words 2N .. 3N:   per node k its parent (the root: -1);
 //   words 3N .. 4N:   the leaves, orderCount of them (the rest unused);
-//   words 4N .. 20N:  per node k and octant o the texel of its record in octant o's copy and
-//                     the record's `reference` (miss link or leaf triangles, the build's);
-//   words 20N ..:     per entry s of the leaf triangles its triangle id.
+//   words 4N .. 12N:  per node k and octant o the texel of its record in octant o's copy;
+//   words 12N .. 13N: per node k what its records' `reference` is made from, the same in every
+//                     octant: a leaf's reference itself (< 0: its leaf triangles), an inner
+//                     node's subtree size (> 0): its miss link is its own texel plus that size,
+//                     the copies being depth-first orders (BvhTree::octant_order);
+//   words 13N ..:     per entry s of the leaf triangles its triangle id.
 // The boxes: per node k, boxes[2k] = (lo, the subtree's SAH cost), boxes[2k + 1] = (hi, 0): a
 // leaf's cost is its half area times its count, an inner node's its half area plus its
 // children's, so the root's cost over its half area is BvhStats::sah_cost.
@@ -46,13 +49,15 @@ int passNode(bool leaves)
     if (i >= orderCount) return -1;
     return leaves ? int(topology[3 * nodeCount + i]) : i;
 }
-// (texel, reference) of node k's record in octant o's copy
-uvec2 recordSlot(int k, int octant)
+// the texel of node k's record in octant o's copy
+uint recordTexel(int k, int octant) { return topology[4 * nodeCount + 8 * k + octant]; }
+// the `reference` of the record at `texel`, from node k's reference word
+uint recordReference(int k, uint texel)
 {
-    int at = 4 * nodeCount + 2 * (8 * k + octant);
-    return uvec2(topology[at], topology[at + 1]);
+    uint word = topology[12 * nodeCount + k];
+    return int(word) < 0 ? word : texel + word;
 }
-int leafTriangleId(int s) { return int(topology[20 * nodeCount + s]); }
+int leafTriangleId(int s) { return int(topology[13 * nodeCount + s]); }
 
 // Aabb::half_area: xdim·ydim + ydim·zdim + zdim·xdim
 float halfArea(vec3 lo, vec3 hi)

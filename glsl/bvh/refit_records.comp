@@ -3,8 +3,10 @@
 // src/accel/bvh/planes.rs), quantises its node's box onto it conservatively (Grid::planes: the
 // low planes rounded down, the high ones up, so that the record still holds its subtree) and
 // writes its record in every octant's copy (NodeRecord, BvhTree::octant_records in
-// src/accel/bvh/layout.rs) with the record's `reference` from the topology (miss link or leaf
-// triangles: the build's, so no texel is read); node 0's invocation writes the Header's grid.
+// src/accel/bvh/layout.rs) with the record's `reference` made from one word of the topology per
+// node (a miss link is the record's texel plus its subtree's size in every octant's depth-first
+// copy; leaf triangles are the build's), so no texel is read; node 0's invocation writes the
+// Header's grid.
 // The planes are the host's, bit for bit: a first guess in floats (a step count off by a few at
 // most), then the host's test in doubles, where a plane origin + q·step is exact (q has 16 bits,
 // step 24), moves it to the tightest plane that holds the box.
@@ -67,8 +69,8 @@ void main()
         // octant_planes: the near plane is the low one unless the octant's rays point down
         bvec3 down = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
         uvec3 near = mix(low, high, down), far = mix(high, low, down);
-        uvec2 slot = recordSlot(k, o);
-        imageStore(bvh, int(slot.x), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
-                                     far.y | far.z << 16u, slot.y));
+        uint texel = recordTexel(k, o);
+        imageStore(bvh, int(texel), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
+                                    far.y | far.z << 16u, recordReference(k, texel)));
     }
 }

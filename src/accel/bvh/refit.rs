@@ -14,7 +14,7 @@
 //! | [`Header`](super::Header): node count | `gpu_words` | `refit_records.comp` (node 0): unchanged | — |
 //! | Header: grid origin, step | `Grid::over` the root's box | `refit_records.comp` (`gridOver`, every invocation; node 0 stores it) | [`BvhTree::refit`] |
 //! | [`NodeRecord`](super::NodeRecord) planes, every octant | `Grid::planes` of the built boxes | `refit_records.comp` (`axisPlanes`) of the refitted boxes | [`BvhTree::refit`] |
-//! | NodeRecord `reference` (miss link, leaf triangles) | `octant_records` | kept (the topology holds it: [`Topology::of`]) | — |
+//! | NodeRecord `reference` (miss link, leaf triangles) | `octant_records` | `refit_records.comp`: the record's texel plus the node's subtree size, or the leaf's reference ([`Topology::of`]) | — |
 //! | [`LeafTriangle`](super::LeafTriangle) v0, id, edges | `gpu_words` from the CPU's world transform | `refit_leaves.comp` from the transform pass' `vertex` SSBO | [`BvhTree::refit`] |
 //! | node boxes (not uploaded) | the build, padded by `build::pad` | `refit_leaves.comp` (SSBO `REFIT_BOXES`), padded by the build's pad | [`BvhTree::refit`] |
 //!
@@ -27,9 +27,7 @@ use glam::Vec3;
 use glow::HasContext;
 use rayon::prelude::*;
 
-use bytemuck::Zeroable;
-
-use super::layout::{Aabb, BvhTree, Node, NodeRecord, OCTANTS};
+use super::layout::{Aabb, BvhTree, Node, LEAF_COUNT_BITS, OCTANTS};
 use super::planes::Grid;
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
@@ -137,8 +135,9 @@ impl Topology {
         words.extend(parent);
         leaves.resize(n, 0);
         words.extend(leaves);
-        let slots: Vec<Vec<[u32; 2]>> = (0..OCTANTS).map(|o| record_slots(tree, o)).collect();
-        words.extend((0..n).flat_map(|k| slots.iter().flat_map(move |s| s[k])));
+        let texels: Vec<Vec<u32>> = (0..OCTANTS).map(|o| tree.record_texels(o)).collect();
+        words.extend((0..n).flat_map(|k| texels.iter().map(move |t| t[k])));
+        words.extend(reference_words(nodes));
         words.extend(&tree.tris);
         Topology {
             words,
@@ -147,14 +146,22 @@ impl Topology {
     }
 }
 
-/// Per node of `tree`, the texel of its record in octant `o`'s copy and the record's reference.
-fn record_slots(tree: &BvhTree, o: usize) -> Vec<[u32; 2]> {
-    let texels = tree.record_texels(o);
-    let mut records = vec![NodeRecord::zeroed(); tree.nodes.len()];
-    tree.octant_records(o, &mut records);
-    let root = tree.root_texel(o) as u32;
-    let slot = |&t: &u32| [t, records[(t - root) as usize].reference as u32];
-    texels[..tree.nodes.len()].iter().map(slot).collect()
+/// Per node, what its records' `reference` is made from in every octant's copy: a leaf's
+/// reference itself (< 0, as `octant_records` makes it), an inner node's subtree size (> 0): each
+/// copy lists the nodes depth first (`octant_order`), so a subtree's records are contiguous and
+/// an inner node's miss link, the record after them, is its own texel plus that size.
+fn reference_words(nodes: &[Node]) -> Vec<u32> {
+    let mut size = vec![1u32; nodes.len()];
+    // children follow their parents in `nodes` (the build's order), so sizes go bottom-up
+    for k in (0..nodes.len()).rev().filter(|&k| !nodes[k].is_leaf()) {
+        let c = nodes[k].first as usize;
+        size[k] = 1 + size[c] + size[c + 1];
+    }
+    let word = |(n, s): (&Node, u32)| match n.is_leaf() {
+        true => (-1 - ((n.first << LEAF_COUNT_BITS | n.count()) as i32)) as u32,
+        false => s,
+    };
+    nodes.iter().zip(size).map(word).collect()
 }
 
 /// The refit's two kernels (`glsl/bvh/refit_*.comp`).
@@ -318,12 +325,18 @@ mod tests {
         let words = bvh.gpu_words();
         for k in 0..n {
             for o in 0..OCTANTS {
-                let at = 4 * n + 2 * (OCTANTS * k + o);
-                let (texel, reference) = (t.words[at] as usize, t.words[at + 1]);
-                assert_eq!(texel, bvh.record_texels(o)[k] as usize);
-                assert_eq!(reference, words[4 * texel + 3], "node {k}, octant {o}");
+                let texel = t.words[4 * n + OCTANTS * k + o];
+                assert_eq!(texel, bvh.record_texels(o)[k]);
+                // as recordReference in glsl/bvh/refit.glsl makes it
+                let word = t.words[12 * n + k];
+                let reference = match (word as i32) < 0 {
+                    true => word,
+                    false => texel + word,
+                };
+                let want = words[4 * texel as usize + 3];
+                assert_eq!(reference, want, "node {k}, octant {o}");
             }
         }
-        assert_eq!(&t.words[20 * n..], &bvh.tris[..]);
+        assert_eq!(&t.words[13 * n..], &bvh.tris[..]);
     }
 }
