@@ -20,18 +20,6 @@
 //
 // The kernel is timed as part of intersect1; what it saves there and what it costs:
 // docs/design/bvh.md, step 26.
-//
-// With FEELER_ENTRY (ours, issue 34): the same search for the shadow feelers of one intersect2
-// dispatch (bvh/intersect2.comp), run before it with the dispatch's light target: a block's
-// rays are its pixels' feelers (blockRay), bounded as rays from the hit point (t >= 0, a
-// superset of each feeler's segment). Why the walk from the entry still finds every occluder:
-// a walk from node X sees only the triangles under X, so no feeler of the block may reach a
-// triangle outside X's subtree; the search descends from the root only to a child whose
-// sibling's box no ray of the bounds can enter (mayEnter false), so every subtree left out on
-// the path from the root to X lies in a box that every feeler's whole ray (and so its segment)
-// misses by more than a grid step, and the boxes hold their triangles. Blocked or not, a
-// feeler sees the triangles of a walk from the root, in the same order: the same flag and
-// triangle tests, fewer nodes (docs/design/bvh.md, "Shadow feelers"). Timed with intersect2.
 #include "../common/images.glsl"
 #define BVH_WORDS_WRITABLE
 #include "words.glsl"
@@ -46,48 +34,24 @@ vec3 invLo = vec3(0.0), invHi = vec3(0.0), roLo = vec3(0.0), roHi = vec3(0.0);
 // the grid of the records' planes (plane q of axis a at gridOrigin[a] + q·gridStep[a])
 vec3 gridOrigin = vec3(0.0), gridStep = vec3(0.0);
 
-#if FEELER_ENTRY
-#include "../common/light_target.glsl"
-
-// Pixel p's shadow feeler of this dispatch, set up as common/intersect2_main.glsl sets it up
-// (Listing 15: from the hit point towards feelerTarget()); false where intersect2 traces none
-// there (no hit in this pass, or the light behind the surface: N·L <= 0).
-bool blockRay(ivec2 p, out vec3 ro, out vec3 rd)
-{
-    vec4 originState = imageLoad(rayOriginTexture, p);
-    ro = originState.xyz;
-    vec3 toLight = feelerTarget() - ro;
-    rd = toLight / length(toLight);
-    return originState.w > 0.0 && dot(imageLoad(normalTexture, p).xyz, rd) > 0.0;
-}
-#else
-// Pixel p's ray; false where intersect1 traces none (inactive).
-bool blockRay(ivec2 p, out vec3 ro, out vec3 rd)
-{
-    vec4 originState = imageLoad(rayOriginTexture, p);
-    ro = originState.xyz;
-    rd = imageLoad(rayDirTexture, p).xyz;
-    return originState.w > 0.0;
-}
-#endif
-
 // The bounds of the block's active rays; false if it has none, or if they point up and down
 // one axis (two octants or more: no entry, every ray walks from its root). Ours, for llvmpipe:
 // per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose inverses are
 // the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding keeps the order —
 // so that a ray costs no division; inactive rays, and pixels out of the image (which imageLoad
-// reads as zeros: rayState 0), count for nothing (as feelers: also those not traced).
+// reads as zeros: rayState 0), count for nothing.
 bool bound(ivec2 block, out int octant)
 {
     const float inf = 1.0 / 0.0;
     vec3 dLo = vec3(inf), dHi = vec3(-inf);
     roLo = vec3(inf); roHi = vec3(-inf);
     for (int k = 0; k < 64; k++) {
-        vec3 ro, d;
-        if (blockRay(block * 8 + ivec2(k & 7, k >> 3), ro, d)) {
-            d = safeDivisors(d);
+        ivec2 p = block * 8 + ivec2(k & 7, k >> 3);
+        vec4 originState = imageLoad(rayOriginTexture, p);
+        vec3 d = safeDivisors(imageLoad(rayDirTexture, p).xyz);
+        if (originState.w > 0.0) { // active, as intersect1 traces it
             dLo = min(dLo, d); dHi = max(dHi, d);
-            roLo = min(roLo, ro); roHi = max(roHi, ro);
+            roLo = min(roLo, originState.xyz); roHi = max(roHi, originState.xyz);
         }
     }
     invLo = 1.0 / dHi; invHi = 1.0 / dLo;

@@ -1,8 +1,7 @@
 // intersect2 kernel of the BVH — ours, after Wagner 2018 ch. 4.2 (hard shadows: a shadow ray
 // towards the one light through the same BVH): the shadow feeler walks the BVH
 // (bvh/traverse.glsl, nodes beyond the light and those it leaves before the shadow offset
-// pruned) from its 8×8 block's entry point (bvh/entry.comp with FEELER_ENTRY, ours) and
-// tests the triangles of each leaf until the first occluder (any hit).
+// pruned) and tests the triangles of each leaf until the first occluder (any hit).
 // Deviations: see traverse.glsl; any number of lights.
 // Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
 #if RECORD_STORE_64
@@ -13,9 +12,6 @@
 #include "../common/intersect_head.glsl"
 #include "records.glsl"
 #include "traverse.glsl"
-// the entry point of each 8×8 block of this dispatch's feelers (bvh/entry.comp with
-// FEELER_ENTRY, run before this kernel with the same light target)
-#include "entries.glsl"
 
 // the feeler, for triangleHit
 vec3 rayO = vec3(0.0), rayD = vec3(0.0);
@@ -34,7 +30,7 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
     rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
-    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, bvhRecord(entryTexel(storePos >> 3)).xyz);
+    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
 }
 
 #include "../common/intersect2_main.glsl"

@@ -168,10 +168,6 @@ pub struct Bvh {
     /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into the
     /// last texels of the word buffer: one per 8×8 pixels, row by row (`glsl/bvh/entries.glsl`)
     entry: Kernel,
-    /// the same search for each block of the shadow feelers of one intersect2 dispatch
-    /// (`entry.comp` with `FEELER_ENTRY`), into the same texels: each pass runs `entry` again
-    /// before intersect1
-    feeler_entry: Kernel,
     /// the blocks of the image
     blocks: u32,
     intersect1: Kernel,
@@ -199,18 +195,14 @@ impl Bvh {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
         let defs = kernel_defines(b.info, blocks);
-        let entry = |feelers: bool, timer| {
-            let extra = [
-                ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
-                ("FEELER_ENTRY", (feelers as i32).to_string()),
-            ];
-            b.kernel("bvh/entry.comp", &[&defs[..], &extra[..]].concat(), timer)
-        };
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
-            // timed as a part of intersect1 and intersect2: the searches of the passes
-            entry: entry(false, "intersect1")?,
-            feeler_entry: entry(true, "intersect2")?,
+            // timed as a part of intersect1: the closest-hit search of the passes
+            entry: b.kernel(
+                "bvh/entry.comp",
+                &[&defs[..], &[("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string())]].concat(),
+                "intersect1",
+            )?,
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
@@ -400,12 +392,7 @@ impl Accelerator for Bvh {
         &self.intersect1
     }
 
-    fn occluded(&mut self, f: &mut FrameContext, target: &LightTarget) -> &Kernel {
-        self.bind(f.gl, glow::READ_WRITE);
-        self.feeler_entry.use_program();
-        target.set_uniforms(&self.feeler_entry);
-        self.feeler_entry
-            .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+    fn occluded(&mut self, f: &mut FrameContext, _target: &LightTarget) -> &Kernel {
         self.bind(f.gl, glow::READ_ONLY);
         self.intersect2.use_program();
         &self.intersect2

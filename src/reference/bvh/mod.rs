@@ -27,22 +27,9 @@ impl BvhTree {
     /// its nodes visited. No hit before the offset counts, so neither do the boxes the feeler
     /// leaves before it.
     pub fn feeler_walk(&self, feeler: &Feeler) -> (bool, u64, u64) {
-        self.feeler_walk_from(None, feeler)
-    }
-
-    /// [`BvhTree::feeler_walk`] from its block's entry point, as intersect2 walks: the entry of
-    /// [`BvhTree::block_entries`] over the block's feelers (`(ro, rd)` of each pixel's
-    /// [`Feeler`], none where intersect2 traces none), as `glsl/bvh/entry.comp` finds it with
-    /// `FEELER_ENTRY`. The same flag and tests as from the root, fewer nodes.
-    pub fn feeler_walk_from(
-        &self,
-        entry: Option<&BlockEntry>,
-        feeler: &Feeler,
-    ) -> (bool, u64, u64) {
         let (mut blocked, mut tests) = (false, 0);
         let (ro, rd) = (feeler.ro, feeler.rd);
-        let (t_min, limit) = (feeler.offset, feeler.light_distance);
-        let nodes = self.traverse_from(entry, ro, rd, t_min, limit, |ids| {
+        let nodes = self.traverse(ro, rd, feeler.offset, feeler.light_distance, |ids| {
             let ids = ids.iter().map(|&i| i as usize);
             blocked = feeler.blocked_among(self.triangles(), ids, &mut tests);
             if blocked {
