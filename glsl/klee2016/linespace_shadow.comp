@@ -847,18 +847,31 @@ void shadePixel(ivec2 storePos, vec4 pos, vec4 before)
     }
 }
 
+// the latest attempt that completed a pixel of each row of the work group in the last frame
+shared uint rowAttempt[8];
+
 void main()
 {
     countersBegin();
     ivec2 storePos = ivec2(gl_GlobalInvocationID.xy) + tileOffset;
     bool inside = all(lessThan(storePos, imageSize(positionTexture)));
     // the pixel's state; at the frame's first dispatch the pixel starts from ray 0 with nothing
-    // lit, in the attempt that completed it in the last frame (.a; 0 after the host forgot it:
-    // ShadowPass::forget_attempts) — one whose batches were truncated then starts with smaller
-    // ones now, without the truncated work
+    // lit, in the attempt that completed its row's pixels in the last frame (.a: the latest of
+    // the row's; 0 after the host forgot them: ShadowPass::forget_attempts) — a pixel whose
+    // batches were truncated then starts with smaller ones now, without the truncated work.
+    // The row (ours): llvmpipe runs a row of the 8×8 group as one SIMD vector, which iterates
+    // while any lane does, so lanes started in different attempts would make it pay for each.
     bool first = attempt == 0 && batchIndex == 0;
     vec4 before = inside ? imageLoad(shadowTexture, storePos) : vec4(0.0);
-    if (first) before = vec4(0.0, 0.0, 0.0, before.a);
+    // (the barriers outside any branch: GLSL 4.50 §8.16 allows them only in uniform flow)
+    uint row = gl_LocalInvocationID.y;
+    if (gl_LocalInvocationID.x == 0u) rowAttempt[row] = 0u;
+    memoryBarrierShared();
+    barrier();
+    if (first && inside) atomicMax(rowAttempt[row], uint(before.a));
+    memoryBarrierShared();
+    barrier();
+    if (first) before = vec4(0.0, 0.0, 0.0, float(rowAttempt[row]));
     if (first && inside && before.a > 0.0) imageStore(shadowTexture, storePos, before);
     rayBegin = int(before.b) + batchIndex * batchRays;
     rayEnd = min(rayBegin + batchRays, NUM_RAYS);
