@@ -43,10 +43,10 @@
 // the others return at once), each from its first ray not done, in batches of half as many
 // rays (batchRays; one dispatch per batch, the lit counts summed in shadowTexture.g), until no
 // pixel is truncated; a pixel truncated with one ray per batch is refused. The next frame
-// starts each pixel in the attempt that completed it (a static view: no batch truncated again). A ray's result does
-// not depend on the other rays of its packet, so the batches give the same image, and every
-// ray's work is counted once, in the batch that completes it (ours; the thesis' GPU had no
-// such limit).
+// starts each row of 8 pixels in the latest attempt that completed one of them (main). A ray's
+// result does not depend on the other rays of its packet, so the batches give the same image,
+// and every ray's work is counted once, in the batch that completes it (ours; the thesis' GPU
+// had no such limit; docs/design/linespace.md, "Ray batches per pixel").
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N

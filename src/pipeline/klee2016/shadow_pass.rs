@@ -286,11 +286,11 @@ impl ShadowPass {
             let truncated = counts.get("truncated") - retried;
             // the pixels the last frame completed in a later attempt start there
             let remembered = attempt + 1 < self.remembered_attempts;
-            if truncated == 0 && !remembered {
+            if truncated == 0 && (!remembered || batch_rays == 1) {
                 self.remembered_attempts = attempt + 1;
                 return Ok((counts, rays.div_ceil(batch_rays)));
             }
-            if batch_rays == 1 {
+            if truncated > 0 && batch_rays == 1 {
                 bail!(
                     "{truncated} pixels of the shadow pass hit the loop budget even with one shadow \
                      ray per dispatch (llvmpipe ends loops after 65535 iterations); use a coarser \
