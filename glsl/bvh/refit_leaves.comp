@@ -8,7 +8,7 @@
 // counts its arrival; the first child's invocation stops there, the second's (whose sibling's
 // box is then written) makes the parent's box, the union of its children's, and its subtree's
 // SAH cost (its half area plus theirs), and goes on up. Every parent thus gets its box from
-// both children's final boxes in one dispatch, where a pass per level took ~190 dispatches.
+// both children's final boxes in one dispatch instead of one dispatch per level of the tree.
 #define SCENE_QUALIFIER readonly
 #include "../common/scene.glsl"
 #include "refit.glsl"
@@ -49,7 +49,7 @@ void main()
         // §4.10: coherent stores, then a memory barrier, are visible to the invocation that sees
         // the count). memoryBarrier(), which orders buffer accesses as memoryBarrierBuffer()
         // does and more: Mesa 22.3's zink on lavapipe counted no arrival past a
-        // memoryBarrierBuffer() in this divergent loop (tests/bvh_refit.rs failed there).
+        // memoryBarrierBuffer() in this divergent loop.
         memoryBarrier();
         if ((atomicAdd(arrivals[p], 1u) & 1u) == 0u) return;
         // acquire: the sibling's box is read after its arrival was seen

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use crate::args::{DesignArgs, GpuArgs};
 use crate::bench::runner::args::Rotation;
-use crate::bench::runner::{rotation_center, turn_about};
+use crate::bench::runner::Turntable;
 use gpgpu_rt::design::Design;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
@@ -191,33 +191,31 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let ctx = GlContext::headless(args.gpu.device)?;
     let mut r = design.renderer(ctx.gl.clone(), &ctx.info, &scene, &shaders)?;
     // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
+    let table = args.rotate.map(|how| Turntable::new(&scene, how));
     for i in 1..args.frames {
-        let camera = turn(&args, &scene, r.as_mut(), i)?;
+        let camera = turn(&args, &scene, &table, r.as_mut(), i)?;
         r.draw(&camera)?;
     }
-    let camera = turn(&args, &scene, r.as_mut(), args.frames)?;
+    let camera = turn(&args, &scene, &table, r.as_mut(), args.frames)?;
     let frame = r.render(&camera)?;
     write_outputs(&args, &ctx, &scene, r.as_ref(), &frame)?;
     eprintln!("{}", summary(&ctx, &scene, &design, &args, &frame));
     Ok(())
 }
 
-/// `--rotate`: the scene of frame `i` (from 1) turned by `i` × `--turn` degrees (its objects'
-/// model matrices set in `r`), and the camera to render it with.
-fn turn(args: &RenderArgs, scene: &Scene, r: &mut dyn Renderer, i: u32) -> Result<Camera> {
-    let degrees = args.turn * i as f32;
-    let center = || rotation_center(scene);
-    Ok(match args.rotate {
-        None => scene.camera,
-        Some(Rotation::Camera) => scene.camera.orbited(center(), -degrees),
-        Some(Rotation::Objects) => {
-            let m = turn_about(center(), degrees);
-            for (k, o) in scene.objects.iter().enumerate() {
-                r.set_model(k, m * o.model)?;
-            }
-            scene.camera
-        }
-    })
+/// The camera of frame `i` (from 1): with `--rotate`, the scene turned by `i` × `--turn`
+/// degrees on `table` (the objects' model matrices set in `r`, or the camera orbited).
+fn turn(
+    args: &RenderArgs,
+    scene: &Scene,
+    table: &Option<Turntable>,
+    r: &mut dyn Renderer,
+    i: u32,
+) -> Result<Camera> {
+    match table {
+        Some(t) => t.turn(&mut |k, m| r.set_model(k, m), (args.turn * i as f32) as f64),
+        None => Ok(scene.camera),
+    }
 }
 
 /// `export-triangles`: the scene's world-space triangles as f32 [T,3,3].

@@ -185,13 +185,29 @@ impl Ssbo {
 
     pub fn read_u32(&self, gl: &Gl) -> Vec<u32> {
         let mut bytes = vec![0u8; self.bytes];
-        // SAFETY: the slice is the buffer's size.
-        unsafe {
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer.raw()));
-            gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
-        }
+        self.read_bytes(gl, &mut bytes);
         bytemuck::pod_collect_to_vec(&bytes)
+    }
+
+    /// The buffer's first `bytes.len()` bytes (at most its size).
+    pub fn read_bytes(&self, gl: &Gl, bytes: &mut [u8]) {
+        assert!(
+            bytes.len() <= self.bytes,
+            "{}: read past the end",
+            self.name
+        );
+        read_buffer(gl, self.buffer.raw(), bytes);
+    }
+}
+
+/// The first `bytes.len()` bytes of `buffer`, which must hold at least as many (bound to
+/// GL_COPY_READ_BUFFER, which no kernel binding uses).
+fn read_buffer(gl: &Gl, buffer: glow::Buffer, bytes: &mut [u8]) {
+    // SAFETY: reading an existing buffer of at least bytes.len() bytes; unbound again.
+    unsafe {
+        gl.bind_buffer(glow::COPY_READ_BUFFER, Some(buffer));
+        gl.get_buffer_sub_data(glow::COPY_READ_BUFFER, 0, bytes);
+        gl.bind_buffer(glow::COPY_READ_BUFFER, None);
     }
 }
 
@@ -464,12 +480,7 @@ impl TextureBuffers {
     pub fn read_u32(&self, gl: &Gl, index: usize) -> Vec<u32> {
         let t = &self.0[index].0;
         let mut bytes = vec![0u8; t.bytes];
-        // SAFETY: reading `t.bytes` bytes of our own buffer, which holds at least as many.
-        unsafe {
-            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(t.buffer.raw()));
-            gl.get_buffer_sub_data(glow::TEXTURE_BUFFER, 0, &mut bytes);
-            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
-        }
+        read_buffer(gl, t.buffer.raw(), &mut bytes);
         bytemuck::pod_collect_to_vec(&bytes)
     }
 }

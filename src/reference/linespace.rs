@@ -401,6 +401,13 @@ impl<'a> LinespaceShadows<'a> {
         starts: &[usize],
     ) -> (f32, ShadowCounts) {
         let rays = (self.samples_u * self.samples_v) as usize;
+        // every ray in exactly one packet
+        assert!(
+            starts.first() == Some(&0)
+                && starts.windows(2).all(|w| w[0] < w[1])
+                && starts.last().is_some_and(|&l| l < rays),
+            "batch starts {starts:?} do not split {rays} rays"
+        );
         let mut counts = ShadowCounts::default();
         let mut lit = 0;
         let ends = starts.iter().skip(1).copied().chain([rays]);

@@ -187,6 +187,8 @@ impl Refit {
         let t = Topology::of(tree);
         let words = bytemuck::cast_slice(&t.words);
         let n = tree.nodes.len();
+        let arrivals = Ssbo::new(gl, "bvh refit arrivals", 4 * n, None, max_block)?;
+        arrivals.clear_u32(gl, 0);
         Ok(Refit {
             topology: Ssbo::new(
                 gl,
@@ -196,13 +198,7 @@ impl Refit {
                 max_block,
             )?,
             boxes: Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?,
-            arrivals: Ssbo::new(
-                gl,
-                "bvh refit arrivals",
-                4 * n,
-                Some(&vec![0; 4 * n]),
-                max_block,
-            )?,
+            arrivals,
             leaves: t.leaves,
             nodes: n as u32,
             pad: tree.pad,
@@ -237,12 +233,7 @@ impl Refit {
     /// its half area, as the refit's passes found them (`glsl/bvh/refit.glsl`).
     pub fn sah_cost(&self, gl: &Gl) -> Result<f64> {
         let mut bytes = [0u8; 32];
-        // SAFETY: reading the first 32 bytes of our own buffer, which has at least 32.
-        unsafe {
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.boxes.buffer.raw()));
-            gl.get_buffer_sub_data(glow::SHADER_STORAGE_BUFFER, 0, &mut bytes);
-            gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None);
-        }
+        self.boxes.read_bytes(gl, &mut bytes);
         let f: [f32; 8] = bytemuck::cast(bytes);
         let root = Aabb {
             lo: Vec3::new(f[0], f[1], f[2]),

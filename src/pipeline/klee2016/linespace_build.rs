@@ -86,8 +86,8 @@ fn linespaces_per_dispatch(words: u32) -> u32 {
 }
 
 /// Build `tree`'s line spaces on the GPU into a new texture with Listing 3's layout (at most
-/// `max_dim` texels per axis), read them back into `tree.linespaces`
-/// and the layout's texels, and set `tree.linespace_build_ms` to the whole step's wall time
+/// `max_dim` texels per axis), read them back into the layout's texels (what the CPU twin
+/// reads; `tree.linespaces` stays empty: the bits are held once on the host), and set `tree.linespace_build_ms` to the whole step's wall time
 /// (occupancy rows, dispatches, read-back).
 pub fn build(
     gl: &Arc<Gl>,
@@ -139,7 +139,6 @@ pub fn build(
     crate::gl::check_error(gl, "building the line spaces on the GPU")?;
     let gpu_ms = timers.resolve(gl).values().sum();
     packed.texels = read_texture_3d(gl, texture.raw(), packed.texel_count());
-    tree.linespaces = (0..count).flat_map(|ls| packed.unpack(ls)).collect();
     tree.linespace_build_ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(GpuLinespaces {
         texture,

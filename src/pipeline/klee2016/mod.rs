@@ -218,7 +218,7 @@ impl SoftShadowRenderer {
         scene: &Scene,
         shaders: &ShaderSource,
         options: SoftShadowOptions,
-        tree: NTree,
+        mut tree: NTree,
     ) -> Result<Self> {
         let light = scene_light(scene)?;
         if options.width == 0 || options.height == 0 {
@@ -233,7 +233,6 @@ impl SoftShadowRenderer {
             options.tile,
             info.dispatch_threads(),
         )?;
-        let mut tree = tree;
         let (linespace_texture, packed) = linespaces(&gl, info, shaders, &mut tree)?;
         let samples = (options.samples_u, options.samples_v);
         let limit = info.loop_limit();
@@ -343,7 +342,7 @@ impl SoftShadowRenderer {
 
     /// Per pixel of the last frame (row 0 = the top image row) the first rays of the batches
     /// its shadow rays were traced in, a bit per ray (bit r of word r / 32): the split the
-    /// CPU twin needs to count as the GPU did (`LinespaceCpu::shadow_in_ranges`).
+    /// CPU twin needs to count as the GPU did (`LinespaceShadows::shadow_in_ranges`).
     pub fn read_batch_starts(&self) -> Vec<[u32; 4]> {
         let (w, h) = self.size();
         flip_rows(&self.shadow.read_batch_starts(w, h), w, h)
@@ -351,7 +350,7 @@ impl SoftShadowRenderer {
 
     /// A frame: the G-buffer, the shadow pass (`ray_batches` dispatches per tile, more for the
     /// pixels that hit llvmpipe's loop limit: `ShadowPass::run`) and the quad; its statistics.
-    fn draw_once(&mut self, camera: &Camera) -> Result<FrameStats> {
+    fn draw_passes(&mut self, camera: &Camera) -> Result<FrameStats> {
         let (w, h) = self.size();
         let (lo, hi) = self.scene.bounds;
         let vp = view_projection(camera, w, h, lo, hi);
@@ -509,7 +508,7 @@ impl Renderer for SoftShadowRenderer {
     /// and read back only the counters and the timers.
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
-        let mut stats = self.draw_once(camera)?;
+        let mut stats = self.draw_passes(camera)?;
         stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)

@@ -206,25 +206,23 @@ fn vertex_views(
         (binding::LIGHT_POS, image::SCENE_LIGHT_POS),
         (binding::LIGHT_COLOR, image::SCENE_LIGHT_COLOR),
     ];
-    let fits = views.iter().all(|&(b, unit)| {
-        let s = &ssbos
+    let ssbo = |b: u32| {
+        &ssbos
             .iter()
             .find(|(sb, _)| *sb == b)
             .expect("a scene SSBO")
-            .1;
-        unit < info.max_image_units as u32 && texels(s) <= max_texels
-    });
+            .1
+    };
+    let fits = views
+        .iter()
+        .all(|&(b, unit)| unit < info.max_image_units as u32 && texels(ssbo(b)) <= max_texels);
     if !fits {
         return Ok(Vec::new());
     }
     views
         .iter()
         .map(|&(b, unit)| {
-            let s = &ssbos
-                .iter()
-                .find(|(sb, _)| *sb == b)
-                .expect("a scene SSBO")
-                .1;
+            let s = ssbo(b);
             // SAFETY: a texture over our own buffer on a current context.
             unsafe {
                 let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);

@@ -371,12 +371,12 @@ impl Bench {
         out.setup_ms = start.elapsed().as_secs_f64() * 1e3;
         let turntable = Turntable::new(scene, self.args.rotate);
         for _ in 0..c.warmup {
-            let camera = turntable.turn(&mut tracer, c.angles[0])?;
+            let camera = turntable.turn(&mut |k, m| tracer.set_model(k, m), c.angles[0])?;
             tracer.render(&camera, None).context("warm-up frame")?;
             pb.inc(1);
         }
         for (i, &angle) in c.angles.iter().enumerate() {
-            let camera = turntable.turn(&mut tracer, angle)?;
+            let camera = turntable.turn(&mut |k, m| tracer.set_model(k, m), angle)?;
             let image = (i == 0).then(|| first_png.clone());
             let png = image.as_ref().map(|rel| self.out.join(rel));
             let at = || format!("frame at {angle}°");
@@ -507,7 +507,7 @@ fn first_frame_pngs(protocol: &str, configs: &[Config]) -> Vec<PathBuf> {
 
 /// "The scene rotated through 360°": its objects turned about the vertical axis through the
 /// centre of its bounding box, or the camera orbiting that axis (`--rotate`).
-struct Turntable<'a> {
+pub(crate) struct Turntable<'a> {
     scene: &'a Scene,
     center: Vec3,
     models: Vec<Mat4>,
@@ -517,7 +517,7 @@ struct Turntable<'a> {
 }
 
 impl<'a> Turntable<'a> {
-    fn new(scene: &'a Scene, rotate: Rotation) -> Turntable<'a> {
+    pub(crate) fn new(scene: &'a Scene, rotate: Rotation) -> Turntable<'a> {
         Turntable {
             scene,
             center: rotation_center(scene),
@@ -527,9 +527,13 @@ impl<'a> Turntable<'a> {
         }
     }
 
-    /// Turn the scene to `angle` degrees: the objects' models in `tracer`, or the camera. The
-    /// camera to render with.
-    fn turn(&self, tracer: &mut RayTracer, angle: f64) -> Result<Camera> {
+    /// Turn the scene to `angle` degrees: the objects' models through `set_model` (a tracer's
+    /// or a renderer's), or the camera. The camera to render with.
+    pub(crate) fn turn(
+        &self,
+        set_model: &mut dyn FnMut(usize, Mat4) -> Result<()>,
+        angle: f64,
+    ) -> Result<Camera> {
         Ok(match self.rotate {
             // at 0° before any turn the objects stay where they are: a static tracer (seed
             // 004's stream, which refuses moving objects) renders fixed configurations
@@ -538,7 +542,7 @@ impl<'a> Turntable<'a> {
                 self.turned.set(true);
                 let r = turn_about(self.center, angle as f32);
                 for (i, m) in self.models.iter().enumerate() {
-                    tracer.set_model(i, r * *m)?;
+                    set_model(i, r * *m)?;
                 }
                 self.scene.camera
             }
@@ -549,14 +553,14 @@ impl<'a> Turntable<'a> {
 }
 
 /// The turn by `degrees` about the vertical axis through `center`.
-pub(crate) fn turn_about(center: Vec3, degrees: f32) -> Mat4 {
+fn turn_about(center: Vec3, degrees: f32) -> Mat4 {
     Mat4::from_translation(center)
         * Mat4::from_rotation_y(degrees.to_radians())
         * Mat4::from_translation(-center)
 }
 
 /// The vertical axis the scene turns about passes through the centre of its bounding box.
-pub(crate) fn rotation_center(scene: &Scene) -> Vec3 {
+fn rotation_center(scene: &Scene) -> Vec3 {
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     for t in scene.world_triangles() {
