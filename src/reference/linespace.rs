@@ -348,6 +348,10 @@ struct Shaft {
     active_count: usize,
     /// `LinespaceFast`: two walks, packet tests of the leaves
     fast: bool,
+    /// `LinespaceFast`: the light's corners and the side planes of the pyramid from the origin
+    /// to them ([`pyramid_sides`]), the same for every leaf of the packet
+    corners: [Vec3; 4],
+    sides: [Vec3; 4],
     /// `LinespaceFast`'s walk: 0 the nodes away from the origin, 1 those near it.
     phase: u8,
 }
@@ -459,7 +463,8 @@ impl<'a> LinespaceShadows<'a> {
                 })
                 .count(),
             _ => {
-                let corner_dir = light_corners(&self.light).map(|c| (c - origin) * inv);
+                let corners = light_corners(&self.light);
+                let corner_dir = corners.map(|c| (c - origin) * inv);
                 let Some(k) = traversal_axis(&corner_dir, self.light.center() - origin) else {
                     // no packet: lit, counted once per pixel
                     counts.packet_failures += (batch.start == 0) as u64;
@@ -479,6 +484,12 @@ impl<'a> LinespaceShadows<'a> {
                     active_rays,
                     active_count,
                     fast: mode.fast_path(),
+                    corners,
+                    sides: if mode.fast_path() {
+                        pyramid_sides(origin, &corners)
+                    } else {
+                        [Vec3::ZERO; 4]
+                    },
                     phase: 0,
                 };
                 shaft.ray_start[0] = o;
@@ -659,15 +670,13 @@ impl<'a> LinespaceShadows<'a> {
     ) {
         let te = self.t_end(level);
         let mut crossing: Option<Vec<usize>> = None;
-        let corners = light_corners(&self.light);
-        let sides = pyramid_sides(s.origin_world, &corners);
         let off = (node[0] >> 2) as usize;
         for &t in &self.tree.leaf_triangles[off..off + node[1] as usize] {
             if crossing.as_ref().is_some_and(|c| c.is_empty()) {
                 break;
             }
             let tri = &self.triangles[t as usize];
-            if packet_misses(tri, s.origin_world, &corners, &sides) {
+            if packet_misses(tri, s.origin_world, &s.corners, &s.sides) {
                 counts.triangles_culled += 1;
                 continue;
             }
