@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::Rng;
 use glam::Vec3;
 use gpgpu_rt::frame::{Aovs, FrameStats};
 use gpgpu_rt::gl::{GlContext, ShaderSource};
@@ -53,20 +54,6 @@ fn batch_starts(f: &SoftFrame, i: usize) -> Vec<usize> {
         .collect();
     assert_eq!(starts.first(), Some(&0), "pixel {i}: batches {mask:?}");
     starts
-}
-
-/// A small deterministic generator (xorshift).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[test]

@@ -3,16 +3,12 @@
 
 mod common;
 
+use common::lattice;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::klee2016::linespace_build;
 use gpgpu_rt::pipeline::klee2016::ntree::{
     self, face_rect, shaft_hits_box, shaft_hits_cell, Aabb, NTree, FACES,
 };
-
-/// A lattice box's corners as integers.
-fn lattice(b: &Aabb) -> ([i32; 3], [i32; 3]) {
-    (b.lo.map(|v| v as i32), b.hi.map(|v| v as i32))
-}
 
 #[test]
 fn integer_shaft_test_gives_the_f64_tests_answers() {

@@ -5,15 +5,13 @@
 
 mod common;
 
+use common::lattice;
+use common::Rng;
 use gpgpu_rt::pipeline::klee2016::linespace_cpu::{build_linespaces, cell_mask};
 use gpgpu_rt::pipeline::klee2016::ntree::{
-    build_linespace, entry_index, face_rect, get_bit, shaft_hits_cell, Aabb, NTree, FACES,
+    build_linespace, entry_index, face_rect, get_bit, shaft_hits_cell, NTree, FACES,
 };
 use rayon::prelude::*;
-
-fn lattice(b: &Aabb) -> ([i32; 3], [i32; 3]) {
-    (b.lo.map(|v| v as i32), b.hi.map(|v| v as i32))
-}
 
 #[test]
 fn cell_masks_hold_exactly_the_shafts_that_cut_the_cell() {
@@ -43,18 +41,6 @@ fn cell_masks_hold_exactly_the_shafts_that_cut_the_cell() {
             }
         }
         assert!(set > 0, "N {n}: no shaft cuts any cell");
-    }
-}
-
-/// A xorshift generator: the same random nodes every run.
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 

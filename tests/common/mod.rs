@@ -381,3 +381,25 @@ pub fn renderer(
         .renderer(ctx.gl.clone(), &ctx.info, scene, &ShaderSource::default())
         .expect("a renderer")
 }
+
+/// A small deterministic generator (xorshift): the same random cases every run.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// A float in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A lattice box's corners as integers (the N-tree's shaft tests take them so).
+pub fn lattice(b: &gpgpu_rt::pipeline::klee2016::ntree::Aabb) -> ([i32; 3], [i32; 3]) {
+    (b.lo.map(|v| v as i32), b.hi.map(|v| v as i32))
+}
