@@ -15,7 +15,8 @@ triangle-id order) and `gpgpu-rt info --json` (light positions, shadow offset). 
   = feelers / seconds, ours = feelers / gpu_ms.intersect2; agreement with shadow.npy;
 - the whole frame: our GPU time of every kernel of the frame (`gpu_ms_total`: transform, eye
   rays, searches, hit evaluation, counts, shading) against Embree's time for the primary rays
-  plus the feelers, with each kernel's share of ours.
+  plus the feelers, with each kernel's share of ours; for `--tracer bvh --bvh-variant sah`
+  also the frame with `--fused-passes` (each pass in one kernel), rendered in the same rounds.
 
 Threads: embreex's `run` loops over single rays (rtcIntersect1/rtcOccluded1, Embree's
 single-ray path; it binds no packet calls) on the calling thread with the GIL released, so
@@ -324,8 +325,16 @@ def measure(scene, a, work):
         queries["feelers"], traced = feeler_query(aov, info, first_light_only=wagner)
     # the megakernel times primary rays and feelers together: agreement only
     timed = ray_tracer and a.bvh_variant == "sah"
-    rerender = (lambda k: rerun(a, scene, pipeline_args, d, k)) if timed else None
-    first, secs, summary, renders = rounds(emb, queries, a.repeats, rerender)
+    # the SAH BVH's frame also as one kernel per pass (--fused-passes), rendered beside the
+    # four kernels in every round
+    fused_args = [*pipeline_args, "--fused-passes"] if timed and a.tracer == "bvh" else None
+    fused_runs = [rerun(a, scene, fused_args, d, "0f")] if fused_args else []
+
+    def rerender(k):
+        if fused_args:
+            fused_runs.append(rerun(a, scene, fused_args, d, f"{k}f"))
+        return rerun(a, scene, pipeline_args, d, k)
+    first, secs, summary, renders = rounds(emb, queries, a.repeats, rerender if timed else None)
     emb.close()
     r = {"scene": str(scene.relative_to(ROOT) if scene.is_relative_to(ROOT) else scene),
          "size": f"{a.size}×{a.size}", "triangles": len(tris), "tracer": stats["tracer"],
@@ -349,6 +358,8 @@ def measure(scene, a, work):
             m["paired"] = paired(secs[kind][a.threads], runs, lambda s: s["gpu_ms"][kernel])
         if "feelers" in r:
             r["frame"] = frame(secs, a.threads, runs)
+            if fused_runs:
+                r["frame_fused"] = frame(secs, a.threads, fused_runs)
     return r
 
 
@@ -510,12 +521,21 @@ def frame_lines(results, threads):
              "| scene | ours ms | Embree ms (primary + feelers) | ours / Embree: median (range) "
              "| kernels: ms (share) |", "|---|---:|---:|---:|---|"]
     for r in rows:
-        f = r["frame"]
-        shares = ", ".join(f"{k} {ms:.1f} ({100 * ms / f['ours_ms']:.0f} %)"
-                           for k, ms in f["kernel_ms"].items() if ms > 0)
-        q = f["ratio"]
-        lines.append(f"| `{r['scene']}` | {f['ours_ms']:.1f} | {f['embree_ms']:.1f} | "
-                     f"{q['median']:.2f} ({q['min']:.2f}–{q['max']:.2f}) | {shares} |")
+        for key, how in (("frame", ""), ("frame_fused", " (`--fused-passes`)")):
+            if key not in r:
+                continue
+            f = r[key]
+            shares = ", ".join(f"{k} {ms:.1f} ({100 * ms / f['ours_ms']:.0f} %)"
+                               for k, ms in f["kernel_ms"].items() if ms > 0)
+            q = f["ratio"]
+            lines.append(f"| `{r['scene']}`{how} | {f['ours_ms']:.1f} | {f['embree_ms']:.1f} | "
+                         f"{q['median']:.2f} ({q['min']:.2f}–{q['max']:.2f}) | {shares} |")
+    if any("frame_fused" in r for r in rows):
+        lines += ["", "`--fused-passes`: the same frame with each pass in one kernel "
+                  "(`glsl/bvh/fused_pass.comp`: closest hit, Listings 13–14, the feelers and "
+                  "Listing 16), rendered beside the four kernels in every round; its "
+                  "`intersect1` is the blocks' entry pass alone, and the Mrays/s above are the "
+                  "four kernels'."]
     return lines
 
 

@@ -14,6 +14,18 @@ layout(local_size_x = COUNT_GROUP) in;
 
 // the global counter slot of each component
 uniform ivec4 countSlots;
+// The records summed: IMAGE_WIDTH × IMAGE_HEIGHT of them from record recordBase on, packed
+// (packCounts: the intersection kernels' and the fused pass' closest-hit records) or, with
+// plainRecords, unpacked as (tests, nodes, rays, truncated) — the fused pass' feeler records,
+// where one pixel counts several feelers of a kind (bvh/fused_pass.comp).
+uniform int recordBase;
+uniform int plainRecords;
+
+uvec4 recordCounts(int k)
+{
+    uvec4 r = pixelRecord[recordBase + k];
+    return plainRecords != 0 ? r.xywz : unpackCounts(r.xy);
+}
 
 void main()
 {
@@ -21,7 +33,7 @@ void main()
     uvec4 sum = uvec4(0u);
     int first = int(gl_GlobalInvocationID.x) * PIXELS_PER_INVOCATION;
     int end = min(first + PIXELS_PER_INVOCATION, IMAGE_WIDTH * IMAGE_HEIGHT);
-    for (int k = first; k < end; k++) sum += unpackCounts(pixelRecord[k].xy);
+    for (int k = first; k < end; k++) sum += recordCounts(k);
     for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
     for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);
 }

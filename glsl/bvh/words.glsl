@@ -2,6 +2,9 @@
 // in one buffer (BvhTree::gpu_words in src/accel/bvh/layout.rs; its layout: bvh/traverse.glsl),
 // read as RGBA32UI texels of 4 words, for bvh/traverse.glsl and bvh/hit_record.glsl.
 // (bvh/entry.comp defines BVH_WORDS_WRITABLE: it writes the blocks' entries, bvh/entries.glsl)
+// (included by both of those in bvh/fused_pass.comp: once)
+#ifndef BVH_WORDS_GLSL
+#define BVH_WORDS_GLSL
 #ifdef BVH_WORDS_WRITABLE
 layout(rgba32ui, binding = IMAGE_BVH) uniform uimageBuffer bvh;
 #else
@@ -24,3 +27,4 @@ void recordPlanes(uvec4 record, out vec3 near, out vec3 far)
     near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));
     far = vec3(ivec3(record.y >> 16u, record.z & 0xffffu, record.z >> 16u));
 }
+#endif

@@ -36,14 +36,14 @@ void emptyColorBuffer(ivec2 storePos)
     imageStore(colorBufferTexture, storePos, vec4(0.0, 0.0, 0.0, -1.0));
 }
 
-void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
-                 float t_min, int triID, float hit_u, float hit_v)
+// The four texels Listings 13 and 14 leave for the hit (t_min, triID, hit_u, hit_v; triID −1: a
+// miss) of the ray (ro, rd, rayState): rayOrigin (hit point, rayState), rayDir (direction,
+// triangle), normal and colorBuffer. Ours: a function of its own so that the SAH BVH's fused
+// pass (bvh/fused_pass.comp) computes the same values without storing them.
+void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float hit_u,
+               float hit_v, out vec4 hitPoint, out vec4 dirTri, out vec4 normal,
+               out vec4 colorWeight)
 {
-#if STORE_AOVS
-    if (storePrimaryHit != 0)
-        imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
-#endif
-
     // Ours: a hit and a miss compute the same four texels and share one store per texture —
     // llvmpipe runs both sides of a branch that any lane takes, and every store is a loop over
     // the lanes (docs/design/frame.md). A miss: the background colour with full weight, and the
@@ -51,8 +51,8 @@ void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
     // reads for an ended ray.
     vec3 direction = rd;
     vec3 interpolated_normal = vec3(0.0);
-    vec4 hitPoint = vec4(ro, 0.0);
-    vec4 colorWeight = vec4(backgroundColor.rgb, 1.0);
+    hitPoint = vec4(ro, 0.0);
+    colorWeight = vec4(backgroundColor.rgb, 1.0);
     if (triID >= 0) {
         // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
         float w = 1.0 - hit_u - hit_v;
@@ -84,8 +84,27 @@ void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
         // weight of the hit colour; the reflection gets the rest
         colorWeight = vec4(color, 1.0 - refl);
     }
+    dirTri = vec4(direction, float(triID));
+    normal = vec4(interpolated_normal, 0.0);
+}
+
+// The first hit for the AOVs (ours; only where the host keeps AOVs: STORE_AOVS).
+void storeFirstHit(ivec2 storePos, float t_min, int triID, float hit_u, float hit_v)
+{
+#if STORE_AOVS
+    if (storePrimaryHit != 0)
+        imageStore(primaryHitTexture, storePos, vec4(t_min, intBitsToFloat(triID), hit_u, hit_v));
+#endif
+}
+
+void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
+                 float t_min, int triID, float hit_u, float hit_v)
+{
+    storeFirstHit(storePos, t_min, triID, hit_u, hit_v);
+    vec4 hitPoint, dirTri, normal, colorWeight;
+    hitTexels(ro, rd, rayState, t_min, triID, hit_u, hit_v, hitPoint, dirTri, normal, colorWeight);
     imageStore(rayOriginTexture, storePos, hitPoint);
-    imageStore(rayDirTexture, storePos, vec4(direction, float(triID)));
-    imageStore(normalTexture, storePos, vec4(interpolated_normal, 0.0));
+    imageStore(rayDirTexture, storePos, dirTri);
+    imageStore(normalTexture, storePos, normal);
     imageStore(colorBufferTexture, storePos, colorWeight);
 }

@@ -17,6 +17,7 @@
 // before it); see RayTracer::pass in src/pipeline/raytrace/mod.rs.
 
 #include "light_target.glsl"
+#include "feeler.glsl"
 
 // Is this light's shadow flag already set at storePos? (For a kernel that splits its search
 // over several dispatches: brute_force/intersect2.comp.)
@@ -47,17 +48,7 @@ void trace(ivec2 storePos)
 #else
     vec4 shadows = imageLoad(shadowTexture, storePos);
 #endif
-    vec3 ro = originState.xyz;
-    vec3 toLight = feelerTarget() - ro;
-    float lightDistance = length(toLight);
-    vec3 rd = toLight / lightDistance;
-
-    // light in the back half-space of the hit point: shadow without a test
-    bool shadow = dot(n, rd) <= 0.0;
-    if (!shadow) {
-        raysTraced = uint(COUNTS_RAY); // ours: the feelers traced, per ray kind
-        shadow = occluded(storePos, ro, rd, lightDistance, lastTriID);
-    }
+    bool shadow = feelerBlocked(storePos, originState.xyz, n, lastTriID, feelerTarget());
 
     // set the shadow flag if needed
     if (shadow) {

@@ -38,39 +38,18 @@ vec3 pointLightPos(int l) { return lightPos[l].xyz; }
 vec3 pointLightColor(int l) { return lightColor[l].rgb; }
 #endif
 
-bool inShadow(ivec2 storePos, int l)
+#include "shade.glsl"
+
+// The pixel's shadow flags as one bit per slot (shade.glsl): the bitwise flags as they are,
+// the thesis' RGBA flags (channel l > 0.5: light l blocked) as bits 0–3.
+uvec4 blockedSlots(ivec2 storePos)
 {
 #if SHADOW_BITS
-    uvec4 flags = imageLoad(shadowTexture, storePos);
-    return (flags[l >> 5] & (1u << uint(l & 31))) != 0u;
+    return imageLoad(shadowTexture, storePos);
 #else
-    return imageLoad(shadowTexture, storePos)[l] > 0.5;
+    bvec4 set = greaterThan(imageLoad(shadowTexture, storePos), vec4(0.5));
+    return uvec4(uint(set.x) | uint(set.y) << 1 | uint(set.z) << 2 | uint(set.w) << 3, 0u, 0u, 0u);
 #endif
-}
-
-#if AREA_LIGHTS > 0
-// The share of area light a's feelers at storePos that no triangle blocked: its sample bits
-// are lightCount + a·U·V … + U·V − 1 (a sample behind the surface counts as blocked, as
-// Listing 15 treats a point light behind it).
-float unblockedShare(ivec2 storePos, int a)
-{
-    const int samples = SAMPLES_U * SAMPLES_V;
-    uvec4 flags = imageLoad(shadowTexture, storePos);
-    int first = lightCount + a * samples;
-    int blocked = 0;
-    for (int s = first; s < first + samples; s++)
-        blocked += int((flags[s >> 5] >> uint(s & 31)) & 1u);
-    return float(samples - blocked) / float(samples);
-}
-#endif
-
-// The Phong terms of Listing 16's loop for a light from direction L.
-vec3 phong(vec3 n, vec3 L, vec3 view, vec4 mat, vec3 albedo)
-{
-    float diffuse = max(dot(n, L), 0.0);
-    vec3 R = reflect(-L, n);
-    float specular = mat.y * pow(max(dot(R, view), 0.0), mat.z);
-    return diffuse * albedo + vec3(specular);
 }
 
 void main()
@@ -86,27 +65,9 @@ void main()
 
     vec3 temp_color;
     if (rayState > 0.0) {
-        vec3 p = originState.xyz;
         vec3 n = imageLoad(normalTexture, storePos).xyz;
         int triID = int(imageLoad(rayDirTexture, storePos).w);
-        vec4 mat = material[triMaterial[triID]];
-        vec3 view = normalize(camPosition.xyz - p);
-        temp_color = ambientColor.rgb * pColor.rgb;
-        for (int l = 0; l < lightCount; l++) {
-            if (inShadow(storePos, l)) continue;
-            vec3 L = normalize(pointLightPos(l) - p);
-            temp_color += pointLightColor(l) * phong(n, L, view, mat, pColor.rgb);
-        }
-#if AREA_LIGHTS > 0
-        for (int a = 0; a < AREA_LIGHTS; a++) {
-            float share = unblockedShare(storePos, a);
-            if (share <= 0.0) continue;
-            vec3 centre = areaLight[4 * a].xyz
-                        + 0.5 * (areaLight[4 * a + 1].xyz + areaLight[4 * a + 2].xyz);
-            vec3 L = normalize(centre - p);
-            temp_color += share * areaLight[4 * a + 3].rgb * phong(n, L, view, mat, pColor.rgb);
-        }
-#endif
+        temp_color = litColor(originState.xyz, n, triID, pColor.rgb, blockedSlots(storePos));
     } else {
         // the ray left the scene in this pass: the background colour
         temp_color = pColor.rgb;
@@ -114,10 +75,7 @@ void main()
 
     // Listing 16: weighted addition of the colour to the output colour
     vec4 final_color = imageLoad(finalTexture, storePos);
-    float weight = final_color.w;
-    final_color.rgb = weight * final_color.rgb + (1.0 - weight) * temp_color;
-    final_color.w = weight + (1.0 - weight) * pColor.w;
-    imageStore(finalTexture, storePos, final_color);
+    imageStore(finalTexture, storePos, addToFinal(final_color, temp_color, pColor.w));
 
     if (rayState > 0.0)
         imageStore(rayOriginTexture, storePos, vec4(originState.xyz, rayState - 1.0));

@@ -71,6 +71,12 @@ pub trait Accelerator {
     fn records(&self) -> bool {
         false
     }
+    /// With `--fused-passes` ([`BuildContext::fused`]): prepare the design's fused pass
+    /// kernel as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
+    /// bind, put it in use) and return it; `None` for a design without one.
+    fn fused_pass(&mut self, _f: &mut FrameContext, _pass: u32) -> Option<&Kernel> {
+        None
+    }
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
 }
@@ -142,6 +148,22 @@ pub struct BuildContext<'a> {
     /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
     /// split only where the GL implementation ends long loops.
     pub triangles_per_dispatch: Option<u32>,
+    /// `--fused-passes`: the pass in one kernel ([`Accelerator::fused_pass`]).
+    pub fused: Option<FusedPasses>,
+}
+
+/// What a fused pass kernel (`glsl/bvh/fused_pass.comp`) needs to know at compile time.
+#[derive(Debug, Clone, Copy)]
+pub struct FusedPasses {
+    /// The shadow feelers of a hit: one per point light and area-light sample. A pixel's
+    /// feeler records sum their counts (`glsl/bvh/pixel_counts.comp`), so the structure must
+    /// keep that many walks' events under [`MAX_PIXEL_EVENTS`].
+    pub feelers: u32,
+    /// The lights (point and area lights): their feelers count under the first light's kind
+    /// and, past the first, the other lights' (`pipeline::ray_kinds::Bank::occluded`).
+    pub lights: u32,
+    /// The scene's vertex attributes and lights as image buffers (`SCENE_IMAGES`).
+    pub scene_images: bool,
 }
 
 impl BuildContext<'_> {

@@ -261,6 +261,12 @@ pub struct DesignArgs {
     /// shadows, no reflection).
     #[arg(long, value_enum, default_value = "sah")]
     pub bvh_variant: BvhVariant,
+    /// With --tracer bvh (sah): each pass of Müller 2015's Fig. 8 in one kernel (ours: the
+    /// closest hit, Listings 13–14, the shadow feelers of Listing 15 and the shading of Listing
+    /// 16 in `glsl/bvh/fused_pass.comp`) instead of the four kernels — the same image and
+    /// counts, without storing and reloading the ray state between them.
+    #[arg(long)]
+    pub fused_passes: bool,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
     /// scene's).
     #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
@@ -379,6 +385,7 @@ impl DesignArgs {
                 grid: self.grid.options(),
                 triangles_per_dispatch: None,
                 light_samples: self.soft.samples(),
+                fused_passes: self.fused_passes,
             }),
         }
     }

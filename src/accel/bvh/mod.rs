@@ -19,8 +19,8 @@ use glow::HasContext;
 use serde_json::json;
 
 use super::{
-    Accelerator, BuildContext, Entry, FrameContext, GridOptions, LightTarget, TracerKind,
-    MAX_PIXEL_EVENTS,
+    Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions, LightTarget,
+    TracerKind, MAX_PIXEL_EVENTS,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
@@ -124,6 +124,29 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
     })
 }
 
+/// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's feeler records after the
+/// closest-hit records — the first light's at record 1, the other lights' at record 2 where a
+/// hit has more than one feeler (`pipeline::mueller2015::records`).
+fn fused_kernel(
+    b: &BuildContext,
+    defs: &[(&'static str, String)],
+    f: FusedPasses,
+) -> Result<Kernel> {
+    let extra = [
+        ("RECORD_FIRST_LIGHT", "1".to_string()),
+        (
+            "RECORD_OTHER_LIGHTS",
+            if f.feelers > 1 { "2" } else { "0" }.to_string(),
+        ),
+        ("SCENE_IMAGES", (f.scene_images as i32).to_string()),
+    ];
+    b.kernel(
+        "bvh/fused_pass.comp",
+        &[defs, &extra[..]].concat(),
+        "fused_pass",
+    )
+}
+
 /// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
 const ENTRY_GROUP: u32 = 64;
 const _: () = assert!(
@@ -172,6 +195,10 @@ pub struct Bvh {
     blocks: u32,
     intersect1: Kernel,
     intersect2: Kernel,
+    /// `--fused-passes`: the pass in one kernel (`glsl/bvh/fused_pass.comp`)
+    fused: Option<Kernel>,
+    /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
+    walks_per_record: u64,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
     /// the model matrices of the tree as uploaded, built or refitted (`None`: not built yet)
@@ -206,6 +233,8 @@ impl Bvh {
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
+            fused: b.fused.map(|f| fused_kernel(b, &defs, f)).transpose()?,
+            walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
             moving: Moving {
                 kernels: refit_kernels(b, &defs)?,
                 refit: None,
@@ -238,12 +267,14 @@ impl Bvh {
                 .zip(models.iter().copied()),
         ));
         let events = bvh.stats.nodes.max(bvh.tris.len()) as u64;
-        if events > MAX_PIXEL_EVENTS {
+        if events * self.walks_per_record > MAX_PIXEL_EVENTS {
             bail!(
-                "the BVH has {} nodes and {} leaf slots: a ray could count more than {MAX_PIXEL_EVENTS} \
-                 events, beyond the per-pixel counts' 32 bits; use a smaller scene",
+                "the BVH has {} nodes and {} leaf slots: {} walks of a pixel could count more than \
+                 {MAX_PIXEL_EVENTS} events, beyond the per-pixel counts' 32 bits; use a smaller \
+                 scene (or, with --fused-passes, fewer lights or light samples)",
                 bvh.stats.nodes,
-                bvh.tris.len()
+                bvh.tris.len(),
+                self.walks_per_record
             );
         }
         let buffers = upload(&self.gl, &bvh, self.blocks)?;
@@ -419,6 +450,14 @@ impl Accelerator for Bvh {
 
     fn records(&self) -> bool {
         true
+    }
+
+    fn fused_pass(&mut self, f: &mut FrameContext, pass: u32) -> Option<&Kernel> {
+        self.fused.as_ref()?;
+        self.closest_hit(f, pass);
+        let k = self.fused.as_ref()?;
+        k.use_program();
+        Some(k)
     }
 
     fn as_any(&self) -> &dyn Any {

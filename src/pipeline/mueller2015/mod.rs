@@ -18,12 +18,12 @@ use serde_json::json;
 
 use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
-use self::records::Records;
+use self::records::{Record, Records, FUSED_RECORDS};
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
-    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, GridOptions, LightTarget,
-    TracerKind,
+    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, FusedPasses, GridOptions,
+    LightTarget, TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
@@ -80,6 +80,11 @@ pub struct RenderOptions {
     /// `--light-samples` U×V: the feelers towards each area light per hit point (ours, after
     /// Klee 2016; the scene's point lights get one each, as Listing 15).
     pub light_samples: (u32, u32),
+    /// `--fused-passes` (ours, the SAH BVH only): each pass of Fig. 8 in one kernel
+    /// (`glsl/bvh/fused_pass.comp`) instead of intersect1, the hit evaluation, intersect2 per
+    /// light and shading — the same image and counts, without the ray-state traffic between
+    /// them.
+    pub fused_passes: bool,
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -225,6 +230,13 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
         bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
     check_area_lights(scene, options)?;
+    if options.fused_passes && options.tracer != TracerKind::Bvh {
+        bail!(
+            "--fused-passes needs --tracer bvh (the SAH BVH's fused pass kernel); --tracer {} \
+             runs Müller 2015's four kernels",
+            options.tracer.name()
+        );
+    }
     let max_tex = info.max_texture_size as u32;
     let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > max_tex || h > max_tex {
@@ -314,11 +326,21 @@ impl RayTracer {
             width: w,
             height: h,
             triangles_per_dispatch: options.triangles_per_dispatch,
+            fused: options.fused_passes.then(|| FusedPasses {
+                feelers: shadow_slots(scene, options.light_samples) as u32,
+                lights: (scene.lights.len() + scene.area_lights.len()) as u32,
+                scene_images: gpu_scene.vertex_images(),
+            }),
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
+        let per_pixel = if options.fused_passes {
+            FUSED_RECORDS
+        } else {
+            1
+        };
         let records = accel
             .records()
-            .then(|| Records::new(&gl, info, shaders, &images, (w, h)))
+            .then(|| Records::new(&gl, info, shaders, &images, (w, h), per_pixel))
             .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
@@ -384,8 +406,12 @@ impl RayTracer {
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
 
-    /// One pass of Fig. 8's loop: intersect1, intersect2 per light, shading.
+    /// One pass of Fig. 8's loop: intersect1, intersect2 per light, shading — or with
+    /// `--fused-passes` the accelerator's fused pass kernel.
     fn pass(&mut self, cam: &CameraRays, pass: u32) {
+        if self.options.fused_passes {
+            return self.fused_pass(cam, pass);
+        }
         let mut f = FrameContext {
             gl: &self.gl,
             timers: &mut self.timers,
@@ -423,6 +449,47 @@ impl RayTracer {
         k.set_i32("lightCount", self.lighting.lights.len() as i32);
         k.set_vec4_slice("areaLight", &self.lighting.area_uniform());
         k.dispatch_pixels(&mut self.timers, self.pixels);
+    }
+
+    /// One pass in the accelerator's fused kernel (`glsl/bvh/fused_pass.comp`, ours): the
+    /// uniforms of the four kernels it stands for, then the counts of its three records, each
+    /// under the bank intersect1 and intersect2 count under.
+    fn fused_pass(&mut self, cam: &CameraRays, pass: u32) {
+        let mut f = FrameContext {
+            gl: &self.gl,
+            timers: &mut self.timers,
+            pixels: self.pixels,
+            models: &self.models,
+        };
+        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
+        let l = &self.lighting;
+        let k = self
+            .accel
+            .fused_pass(&mut f, pass)
+            .expect("--fused-passes is refused for an accelerator without a fused pass");
+        k.set_vec4("backgroundColor", l.background, 1.0);
+        k.set_i32("storePrimaryHit", (pass == 0) as i32);
+        k.set_i32("storeRayState", (pass < self.options.refl_depth) as i32);
+        k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
+        k.set_vec4("ambientColor", l.ambient, 1.0);
+        k.set_i32("lightCount", l.lights.len() as i32);
+        k.set_vec4_slice("areaLight", &l.area_uniform());
+        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
+        self.counters.bind(f.gl, f.timers, Bank::Frame);
+        k.dispatch_pixels(f.timers, f.pixels);
+        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
+        let r = self
+            .records
+            .as_ref()
+            .expect("the fused pass stores records");
+        r.add_record_counts(f.timers, "intersect1", Record::Packed(0));
+        let lights = l.lights.len() + l.area_lights.len();
+        let kinds = [(Bank::occluded(0), 1), (Bank::occluded(1), 2)];
+        for (bank, record) in kinds.into_iter().take(lights.min(2)) {
+            self.counters.bind(&self.gl, &mut self.timers, bank);
+            r.add_record_counts(&mut self.timers, "intersect2", Record::Plain(record));
+        }
+        self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
     }
 
     /// The area lights and their samples, for the settings (none without area lights).
@@ -559,6 +626,7 @@ impl Renderer for RayTracer {
         ]
         .into_iter()
         .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
+        .chain(o.fused_passes.then(|| ("fused_passes", json!(true))))
         .chain(self.area_settings())
         .map(|(k, v)| (k.to_string(), v))
         .collect()

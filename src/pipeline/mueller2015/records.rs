@@ -36,6 +36,20 @@ pub struct PixelRecord {
 }
 const _: () = assert!(std::mem::size_of::<PixelRecord>() == 16);
 
+/// Which of a pixel's records `pixel_counts.comp` adds up, and how they are laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Record {
+    /// record i of every pixel, its counts packed in two words ([`PixelRecord`])
+    Packed(u32),
+    /// record i, its counts as four words (tests, nodes, rays, truncated): the fused pass'
+    /// feeler records, which sum several feelers
+    Plain(u32),
+}
+
+/// Records per pixel with `--fused-passes`: the closest hit's, the first light's feelers',
+/// the other lights' feelers' (`glsl/bvh/fused_pass.comp`).
+pub const FUSED_RECORDS: u32 = 3;
+
 /// The work group size of `pixel_counts.comp` (its `COUNT_GROUP`).
 const COUNT_GROUP: u32 = 64;
 
@@ -59,8 +73,9 @@ impl Records {
         shaders: &ShaderSource,
         defines: &Defines,
         (w, h): (u32, u32),
+        per_pixel: u32,
     ) -> Result<Records> {
-        let pixels = (w as usize) * (h as usize);
+        let records = (w as usize) * (h as usize) * per_pixel as usize;
         let max = info.max_ssbo_block_size;
         let (mask, mask_value) = crate::accel::bvh::texel_index_mask();
         let defines = defines
@@ -75,7 +90,7 @@ impl Records {
             records: Ssbo::new(
                 gl,
                 "pixel records",
-                std::mem::size_of::<PixelRecord>() * pixels,
+                std::mem::size_of::<PixelRecord>() * records,
                 None,
                 max,
             )?,
@@ -108,8 +123,20 @@ impl Records {
     /// After an intersection dispatch whose triangle tests count under `tests`: add every
     /// pixel's counts to the bound bank.
     pub fn add_counts(&self, timers: &mut GpuTimers, tests: &str) {
+        self.add_record_counts(timers, tests, Record::Packed(0));
+    }
+
+    /// Add every pixel's `record` (the fused pass keeps three a pixel:
+    /// `glsl/bvh/fused_pass.comp`) to the bound bank, its triangle tests under `tests`.
+    pub fn add_record_counts(&self, timers: &mut GpuTimers, tests: &str, record: Record) {
         let k = &self.pixel_counts;
         k.use_program();
+        let (index, plain) = match record {
+            Record::Packed(i) => (i, false),
+            Record::Plain(i) => (i, true),
+        };
+        k.set_i32("recordBase", (index * self.pixels) as i32);
+        k.set_i32("plainRecords", plain as i32);
         k.set_ivec4(
             "countSlots",
             [

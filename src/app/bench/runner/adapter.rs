@@ -75,6 +75,7 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
             grid,
             triangles_per_dispatch: None,
             light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
+            fused_passes: false,
         })
     };
     match c.tracer {

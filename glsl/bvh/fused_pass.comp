@@ -1,0 +1,206 @@
+// One pass of Müller 2015's Fig. 8 loop in one kernel, for the SAH BVH (ours; the documented
+// variant `--fused-passes`, docs/listings.md): per pixel the closest hit (intersect1, the SAH
+// BVH's walk of bvh/intersect1.comp), its evaluation (Listings 13 and 14:
+// common/intersect1_hit.glsl's hitTexels, from the hit record as bvh/evaluate_hit.comp finds
+// it), a shadow feeler towards every light and light sample (Listing 15:
+// common/feeler.glsl, the walk of bvh/intersect2.comp) and the shading (Listing 16:
+// mueller2015/shade.glsl) — the same functions on the same values as the four kernels, so the
+// same image and counts. What it saves is the traffic between them: the four-kernel pass
+// stores the hit's four ray-state texels, loads them again in every intersect2 dispatch and in
+// shading, and stores and loads the shadow flags; on llvmpipe each stored texel costs more
+// than a node step (docs/design/frame.md). Here the values stay in registers; a pass stores
+// the ray state only where a reflection pass follows (storeRayState), and the first pass
+// the AOVs' texels where the host keeps AOVs (STORE_AOVS). The eye rays (Listing 11) and the
+// blocks' entry points (bvh/entry.comp) are still kernels of their own before it.
+//
+// The work counts go to three per-pixel records (bvh/records.glsl), which pixel_counts.comp
+// adds to the counter bank of each ray kind: the closest-hit search's (packed, with the hit
+// record, as intersect1's), the feelers towards the first light's (RECORD_FIRST_LIGHT) and
+// towards the other lights' (RECORD_OTHER_LIGHTS), the latter two unpacked (plainRecord), as a
+// pixel traces several feelers of one kind.
+#if RECORD_STORE_64
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
+#define PIXEL_RECORDS
+#include "../common/intersect_head.glsl"
+#include "records.glsl"
+#include "traverse.glsl"
+#include "entries.glsl"
+#include "hit_record.glsl"
+#include "../common/intersect1_hit.glsl"
+#include "../common/light_samples.glsl"
+#include "../common/feeler.glsl"
+
+uniform vec4 camPosition;
+uniform vec4 ambientColor;
+uniform int lightCount;
+#if AREA_LIGHTS > 0 && !SHADOW_BITS
+#error "area lights need the bitwise shadow flags (a bit per light sample)"
+#endif
+#if AREA_LIGHTS > 0
+// per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
+uniform vec4 areaLight[4 * AREA_LIGHTS];
+#endif
+// 1 where a reflection pass follows this one: the rays' state is stored for it
+uniform int storeRayState;
+
+// the point lights, as shading.comp reads them
+#if SCENE_IMAGES
+layout(rgba32f, binding = IMAGE_SCENE_LIGHT_POS) readonly uniform imageBuffer lightPosImage;
+layout(rgba32f, binding = IMAGE_SCENE_LIGHT_COLOR) readonly uniform imageBuffer lightColorImage;
+vec3 pointLightPos(int l) { return imageLoad(lightPosImage, l).xyz; }
+vec3 pointLightColor(int l) { return imageLoad(lightColorImage, l).rgb; }
+#else
+vec3 pointLightPos(int l) { return lightPos[l].xyz; }
+vec3 pointLightColor(int l) { return lightColor[l].rgb; }
+#endif
+#include "../mueller2015/shade.glsl"
+
+// The ray of the walk and what triangleHit does with a triangle: with anyHit unset, keep the
+// closest hit (bvh/intersect1.comp's triangleHit); with it set, end the walk at the first
+// triangle on the feeler's segment (bvh/intersect2.comp's).
+vec3 rayO = vec3(0.0), rayD = vec3(0.0);
+int rayLast = -1;
+bool anyHit = false;
+float rayLight = 0.0;
+float bestT = 0.0;
+int bestID = -1;
+int bestAt = -1;
+
+bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
+{
+    float t, u, v;
+    bool hit = intersectEdges(rayO, rayD, v0, edge1, edge2, t, u, v);
+    if (tri == rayLast) return false;
+    tests++;
+    if (anyHit) return hit && t > SHADOW_OFFSET && t < rayLight;
+    if (hit && (t < bestT || (t == bestT && tri < bestID))) {
+        bestT = t;
+        bestID = tri;
+        bestAt = at;
+    }
+    limit = bestT;
+    return false;
+}
+
+bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
+{
+    rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
+    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
+}
+
+// The work counts of one kind so far, unpacked (tests, nodes, rays, truncated), and the
+// globals of common/intersect_head.glsl cleared for the next kind.
+uvec4 takeCounts()
+{
+    uvec4 c = uvec4(tests, nodesVisited, raysTraced, truncated);
+    tests = 0u; nodesVisited = 0u; raysTraced = 0u; truncated = 0u;
+    return c;
+}
+
+// The feelers of the hit at p (normal n, triangle id) towards every point light and every
+// area light's samples (the slots of shade.glsl), their counts added to first (light 0's,
+// Bank::occluded) and others.
+uvec4 feelers(ivec2 storePos, vec3 p, vec3 n, int id, inout uvec4 first, inout uvec4 others)
+{
+    uvec4 blocked = uvec4(0u);
+    anyHit = true;
+    for (int l = 0; l < lightCount; l++) {
+        if (feelerBlocked(storePos, p, n, id, pointLightPos(l)))
+            blocked[l >> 5] |= 1u << uint(l & 31);
+        if (l == 0) first += takeCounts(); else others += takeCounts();
+    }
+#if AREA_LIGHTS > 0
+    const int samples = SAMPLES_U * SAMPLES_V;
+    for (int a = 0; a < AREA_LIGHTS; a++) {
+        for (int r = 0; r < samples; r++) {
+            vec3 target = lightSamplePoint(areaLight[4 * a].xyz, areaLight[4 * a + 1].xyz,
+                                           areaLight[4 * a + 2].xyz, r, SAMPLES_U, SAMPLES_V);
+            int s = lightCount + a * samples + r;
+            if (feelerBlocked(storePos, p, n, id, target))
+                blocked[s >> 5] |= 1u << uint(s & 31);
+            if (lightCount + a == 0) first += takeCounts(); else others += takeCounts();
+        }
+    }
+#endif
+    return blocked;
+}
+
+// The shadow AOV's texel: the flags in the layout of the shadow texture.
+void storeShadowFlags(ivec2 storePos, uvec4 blocked)
+{
+#if STORE_AOVS
+#if SHADOW_BITS
+    imageStore(shadowTexture, storePos, blocked);
+#else
+    imageStore(shadowTexture, storePos, vec4(notEqual(blocked.xxxx & uvec4(1u, 2u, 4u, 8u),
+                                                      uvec4(0u))));
+#endif
+#endif
+}
+
+void storeRecords(ivec2 storePos, uvec4 primary, uvec4 first, uvec4 others)
+{
+    int at = pixelIndex(storePos);
+    uvec2 counts = packCounts(primary.x, primary.y, primary.w, primary.z);
+#if RECORD_STORE_64
+    pixelRecordWords[at] = u64vec2(packUint2x32(counts), uint64_t(uint(closestHitRecord)));
+#else
+    pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
+#endif
+    pixelRecord[RECORD_FIRST_LIGHT * IMAGE_WIDTH * IMAGE_HEIGHT + at] = first;
+#if RECORD_OTHER_LIGHTS > 0
+    pixelRecord[RECORD_OTHER_LIGHTS * IMAGE_WIDTH * IMAGE_HEIGHT + at] = others;
+#endif
+}
+
+// The pass for one pixel (the declaration of common/intersect_head.glsl).
+void trace(ivec2 storePos)
+{
+    uvec4 primary = uvec4(0u), first = uvec4(0u), others = uvec4(0u);
+    vec4 originState = imageLoad(rayOriginTexture, storePos);
+    vec4 dirTri = imageLoad(rayDirTexture, storePos);
+    float rayState = originState.w;
+    // an inactive ray: nothing to trace, an empty colour buffer, nothing to shade
+    if (rayState > 0.0) {
+        raysTraced = 1u;
+        vec3 ro = originState.xyz, rd = dirTri.xyz;
+        rayO = ro; rayD = rd; rayLast = int(dirTri.w);
+        bestT = 1.0 / 0.0; // +inf
+        traverse(ro, rd, 0.0, bestT, bvhRecord(entryTexel(storePos >> 3)).xyz);
+        closestHitRecord = bestAt;
+        primary = takeCounts();
+
+        float t, u, v;
+        int id;
+        hitFromRecord(closestHitRecord, ro, rd, t, id, u, v);
+        storeFirstHit(storePos, t, id, u, v);
+        vec4 hitPoint, dirOut, normal, colorWeight;
+        hitTexels(ro, rd, rayState, t, id, u, v, hitPoint, dirOut, normal, colorWeight);
+
+        vec3 temp_color = colorWeight.rgb; // a miss: the background
+        if (hitPoint.w > 0.0) {
+            uvec4 blocked = feelers(storePos, hitPoint.xyz, normal.xyz, id, first, others);
+            storeShadowFlags(storePos, blocked);
+            temp_color = litColor(hitPoint.xyz, normal.xyz, id, colorWeight.rgb, blocked);
+        }
+        vec4 final_color = imageLoad(finalTexture, storePos);
+        imageStore(finalTexture, storePos, addToFinal(final_color, temp_color, colorWeight.w));
+#if STORE_AOVS
+        imageStore(normalTexture, storePos, normal);
+#endif
+        if (storeRayState != 0) {
+            // shading's decrement of the rayState (Listing 16's kernel)
+            hitPoint.w = max(hitPoint.w - 1.0, 0.0);
+            imageStore(rayOriginTexture, storePos, hitPoint);
+            imageStore(rayDirTexture, storePos, dirOut);
+        }
+    }
+    storeRecords(storePos, primary, first, others);
+}
+
+void main()
+{
+    ivec2 storePos = pixelPosition();
+    if (insideImage(storePos)) trace(storePos);
+}
