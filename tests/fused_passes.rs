@@ -187,3 +187,22 @@ fn the_fused_pass_is_refused_beside_other_accelerators() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("fused-passes"), "{}", stderr(&o));
 }
+
+#[test]
+fn eye_rays_in_place_without_aovs() {
+    // without AOVs the first pass computes its eye rays in place (no eye-ray kernel; the
+    // entry pass too): the same colours and counts as the four kernels
+    let scene = load("bunny_low.toml");
+    let opts = RenderOptions {
+        aovs: false,
+        ..bvh(64, 48, 2)
+    };
+    let (four, fused) = both(&scene, &opts);
+    assert!(
+        !fused.stats.gpu_ms.contains_key("eye_ray_generation"),
+        "{:?}",
+        fused.stats.gpu_ms
+    );
+    assert_eq!(four.color, fused.color, "bunny_low without AOVs: colours");
+    assert_same_counts(&four, &fused, "bunny_low without AOVs");
+}

@@ -28,6 +28,7 @@
 layout(local_size_x = BVH_ENTRY_GROUP) in;
 
 #include "entries.glsl"
+#include "../common/pass_ray.glsl"
 
 // the block's rays: per axis the smallest and largest 1/direction and origin
 vec3 invLo = vec3(0.0), invHi = vec3(0.0), roLo = vec3(0.0), roHi = vec3(0.0);
@@ -47,8 +48,9 @@ bool bound(ivec2 block, out int octant)
     roLo = vec3(inf); roHi = vec3(-inf);
     for (int k = 0; k < 64; k++) {
         ivec2 p = block * 8 + ivec2(k & 7, k >> 3);
-        vec4 originState = imageLoad(rayOriginTexture, p);
-        vec3 d = safeDivisors(imageLoad(rayDirTexture, p).xyz);
+        vec4 originState, dirTri;
+        passRay(p, originState, dirTri);
+        vec3 d = safeDivisors(dirTri.xyz);
         if (originState.w > 0.0) { // active, as intersect1 traces it
             dLo = min(dLo, d); dHi = max(dHi, d);
             roLo = min(roLo, originState.xyz); roHi = max(roHi, originState.xyz);

@@ -30,6 +30,7 @@
 #include "../common/intersect1_hit.glsl"
 #include "../common/light_samples.glsl"
 #include "../common/feeler.glsl"
+#include "../common/pass_ray.glsl"
 
 uniform vec4 camPosition;
 uniform vec4 ambientColor;
@@ -158,8 +159,8 @@ void storeRecords(ivec2 storePos, uvec4 primary, uvec4 first, uvec4 others)
 void trace(ivec2 storePos)
 {
     uvec4 primary = uvec4(0u), first = uvec4(0u), others = uvec4(0u);
-    vec4 originState = imageLoad(rayOriginTexture, storePos);
-    vec4 dirTri = imageLoad(rayDirTexture, storePos);
+    vec4 originState, dirTri;
+    passRay(storePos, originState, dirTri);
     float rayState = originState.w;
     // an inactive ray: nothing to trace, an empty colour buffer, nothing to shade
     if (rayState > 0.0) {
@@ -175,14 +176,14 @@ void trace(ivec2 storePos)
         int id;
         hitFromRecord(closestHitRecord, ro, rd, t, id, u, v);
         storeFirstHit(storePos, t, id, u, v);
-        vec4 hitPoint, dirOut, normal, colorWeight;
-        hitTexels(ro, rd, rayState, t, id, u, v, hitPoint, dirOut, normal, colorWeight);
+        vec4 hitPoint, dirOut, normal, colorWeight, mat;
+        hitTexels(ro, rd, rayState, t, id, u, v, hitPoint, dirOut, normal, colorWeight, mat);
 
         vec3 temp_color = colorWeight.rgb; // a miss: the background
         if (hitPoint.w > 0.0) {
             uvec4 blocked = feelers(storePos, hitPoint.xyz, normal.xyz, id, first, others);
             storeShadowFlags(storePos, blocked);
-            temp_color = litColor(hitPoint.xyz, normal.xyz, id, colorWeight.rgb, blocked);
+            temp_color = litColor(hitPoint.xyz, normal.xyz, mat, colorWeight.rgb, blocked);
         }
         vec4 final_color = imageLoad(finalTexture, storePos);
         imageStore(finalTexture, storePos, addToFinal(final_color, temp_color, colorWeight.w));

@@ -21,11 +21,24 @@ uniform ivec4 countSlots;
 uniform int recordBase;
 uniform int plainRecords;
 
+// Ours: with RECORD_IMAGE the records are read through an RGBA32UI image buffer over the same
+// storage (src/pipeline/mueller2015/records.rs) — llvmpipe loads a storage-buffer vector lane
+// by lane and component by component, an image texel for all lanes at once
+// (docs/design/frame.md).
+#if RECORD_IMAGE
+layout(rgba32ui, binding = IMAGE_PIXEL_RECORDS) readonly uniform uimageBuffer recordImage;
 uvec4 recordCounts(int k)
 {
-    uvec4 r = pixelRecord[recordBase + k];
+    uvec4 r = imageLoad(recordImage, recordBase + k);
     return plainRecords != 0 ? r.xywz : unpackCounts(r.xy);
 }
+#else
+uvec4 recordCounts(int k)
+{
+    if (plainRecords != 0) return pixelRecord[recordBase + k].xywz;
+    return unpackCounts(pixelRecord[recordBase + k].xy);
+}
+#endif
 
 void main()
 {

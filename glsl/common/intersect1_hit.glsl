@@ -38,11 +38,11 @@ void emptyColorBuffer(ivec2 storePos)
 
 // The four texels Listings 13 and 14 leave for the hit (t_min, triID, hit_u, hit_v; triID −1: a
 // miss) of the ray (ro, rd, rayState): rayOrigin (hit point, rayState), rayDir (direction,
-// triangle), normal and colorBuffer. Ours: a function of its own so that the SAH BVH's fused
+// triangle), normal and colorBuffer; and the hit triangle's material (0 for a miss). Ours: a function of its own so that the SAH BVH's fused
 // pass (bvh/fused_pass.comp) computes the same values without storing them.
 void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float hit_u,
                float hit_v, out vec4 hitPoint, out vec4 dirTri, out vec4 normal,
-               out vec4 colorWeight)
+               out vec4 colorWeight, out vec4 mat)
 {
     // Ours: a hit and a miss compute the same four texels and share one store per texture —
     // llvmpipe runs both sides of a branch that any lane takes, and every store is a loop over
@@ -53,6 +53,7 @@ void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float h
     vec3 interpolated_normal = vec3(0.0);
     hitPoint = vec4(ro, 0.0);
     colorWeight = vec4(backgroundColor.rgb, 1.0);
+    mat = vec4(0.0);
     if (triID >= 0) {
         // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
         float w = 1.0 - hit_u - hit_v;
@@ -62,7 +63,7 @@ void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float h
         // ours: the normal faces the incoming ray (two-sided surfaces)
         if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
 
-        vec4 mat = material[triMaterial[triID]];
+        mat = material[triMaterial[triID]];
         vec3 color = w * vertexColor(3 * triID) + hit_u * vertexColor(3 * triID + 1)
                    + hit_v * vertexColor(3 * triID + 2);
 #if SCENE_TEXTURES
@@ -101,8 +102,9 @@ void evaluateHit(ivec2 storePos, vec3 ro, vec3 rd, float rayState,
                  float t_min, int triID, float hit_u, float hit_v)
 {
     storeFirstHit(storePos, t_min, triID, hit_u, hit_v);
-    vec4 hitPoint, dirTri, normal, colorWeight;
-    hitTexels(ro, rd, rayState, t_min, triID, hit_u, hit_v, hitPoint, dirTri, normal, colorWeight);
+    vec4 hitPoint, dirTri, normal, colorWeight, mat;
+    hitTexels(ro, rd, rayState, t_min, triID, hit_u, hit_v, hitPoint, dirTri, normal, colorWeight,
+              mat);
     imageStore(rayOriginTexture, storePos, hitPoint);
     imageStore(rayDirTexture, storePos, dirTri);
     imageStore(normalTexture, storePos, normal);

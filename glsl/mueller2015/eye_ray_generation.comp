@@ -12,28 +12,14 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "../common/images.glsl"
 
-uniform vec4 camImgPosition;
-uniform vec4 camWidth;
-uniform vec4 camHeight;
-uniform vec4 camImgOffset;
+#include "../common/eye_ray.glsl"
 
 void main()
 {
     ivec2 storePos = pixelPosition();
     if (!insideImage(storePos)) return;
-    // xy coordinate of the pixel in the texture (row 0 is the bottom row)
-    float x = float(storePos.x), y = float(storePos.y);
-
-    // position of the pixel's projection onto the image plane in scene space; the texture
-    // height inverts the y direction (camHeight points down the image)
-    vec4 across = (x + 0.5) * camWidth
-                + (float(imageSize(rayDirTexture).y) - y - 0.5) * camHeight;
-    vec4 pixelCoord = camImgPosition + across;
-
-    // Listing 11: normalize(pixelCoord - camPosition); ours, the same vector without the
-    // cancellation (see the header)
-    vec3 direction = normalize(camImgOffset.xyz + across.xyz);
-
-    imageStore(rayOriginTexture, storePos, vec4(pixelCoord.xyz, 1.0));
-    imageStore(rayDirTexture, storePos, vec4(direction, -1.0));
+    vec4 originState, dirTri;
+    eyeRay(storePos, originState, dirTri);
+    imageStore(rayOriginTexture, storePos, originState);
+    imageStore(rayDirTexture, storePos, dirTri);
 }

@@ -36,11 +36,10 @@ float unblockedShare(uvec4 blocked, int a)
 }
 #endif
 
-// Listing 16's lit colour of the hit at p (normal n, triangle triID, colour albedo) with the
-// shadow slots `blocked`: the ambient term and Phong per light that reaches it.
-vec3 litColor(vec3 p, vec3 n, int triID, vec3 albedo, uvec4 blocked)
+// Listing 16's lit colour of the hit at p (normal n, material mat of its triangle, colour
+// albedo) with the shadow slots `blocked`: the ambient term and Phong per light that reaches it.
+vec3 litColor(vec3 p, vec3 n, vec4 mat, vec3 albedo, uvec4 blocked)
 {
-    vec4 mat = material[triMaterial[triID]];
     vec3 view = normalize(camPosition.xyz - p);
     vec3 temp_color = ambientColor.rgb * albedo;
     for (int l = 0; l < lightCount; l++) {

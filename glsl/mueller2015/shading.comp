@@ -67,7 +67,8 @@ void main()
     if (rayState > 0.0) {
         vec3 n = imageLoad(normalTexture, storePos).xyz;
         int triID = int(imageLoad(rayDirTexture, storePos).w);
-        temp_color = litColor(originState.xyz, n, triID, pColor.rgb, blockedSlots(storePos));
+        vec4 mat = material[triMaterial[triID]];
+        temp_color = litColor(originState.xyz, n, mat, pColor.rgb, blockedSlots(storePos));
     } else {
         // the ray left the scene in this pass: the background colour
         temp_color = pColor.rgb;

@@ -38,7 +38,7 @@ use serde::Serialize;
 use crate::frame::FrameStats;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
-use crate::scene::Scene;
+use crate::scene::{CameraRays, Scene};
 
 /// Pixels each invocation of `glsl/bvh/pixel_counts.comp` sums (its `PIXELS_PER_INVOCATION`,
 /// a #define of `pipeline::mueller2015::records`), for the accelerators whose kernels store
@@ -74,11 +74,35 @@ pub trait Accelerator {
     /// With `--fused-passes` ([`BuildContext::fused`]): prepare the design's fused pass
     /// kernel as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
     /// bind, put it in use) and return it; `None` for a design without one.
-    fn fused_pass(&mut self, _f: &mut FrameContext, _pass: u32) -> Option<&Kernel> {
+    /// `eye`: the camera where the pass computes its eye rays in place (`eyeRays`,
+    /// `glsl/common/pass_ray.glsl`) instead of loading the eye-ray kernel's texels.
+    fn fused_pass(
+        &mut self,
+        _f: &mut FrameContext,
+        _pass: u32,
+        _eye: Option<&CameraRays>,
+    ) -> Option<&Kernel> {
         None
     }
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
+}
+
+/// The camera uniforms of Listing 11 (`glsl/common/eye_ray.glsl`) on `k`, the program in use.
+pub fn set_camera(k: &Kernel, cam: &CameraRays) {
+    k.set_vec4("camImgPosition", cam.cam_img_position.into(), 1.0);
+    k.set_vec4("camImgOffset", cam.cam_img_offset.into(), 0.0);
+    k.set_vec4("camWidth", cam.cam_width.into(), 0.0);
+    k.set_vec4("camHeight", cam.cam_height.into(), 0.0);
+}
+
+/// Whether `k` (the program in use, with `glsl/common/pass_ray.glsl`) computes the eye rays in
+/// place — with `eye`'s camera — or loads the pass' rays from the ray-state images.
+pub fn set_pass_rays(k: &Kernel, eye: Option<&CameraRays>) {
+    k.set_i32("eyeRays", eye.is_some() as i32);
+    if let Some(cam) = eye {
+        set_camera(k, cam);
+    }
 }
 
 /// What the shadow feelers of one intersect2 dispatch aim at (`glsl/common/light_target.glsl`).

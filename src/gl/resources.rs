@@ -160,6 +160,34 @@ impl Ssbo {
         };
     }
 
+    /// A buffer texture of `format` (16-byte texels) over this buffer's storage, no copy, for a
+    /// kernel to read it as an image buffer: shader stores through the SSBO show through it
+    /// after the barrier between passes (`gl::sync`). Llvmpipe loads an image texel for all
+    /// lanes at once, a storage-buffer vector lane by lane (docs/design/frame.md). `None`
+    /// where `unit` is beyond `GL_MAX_IMAGE_UNITS` or the texels beyond
+    /// `GL_MAX_TEXTURE_BUFFER_SIZE`: the kernel reads the SSBO instead.
+    pub fn texel_view(
+        &self,
+        gl: &Arc<Gl>,
+        max_image_units: i32,
+        unit: u32,
+        format: u32,
+    ) -> Result<Option<Owned<glow::Texture>>> {
+        // SAFETY: a limit query on a current context.
+        let max_texels = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
+        if unit as i64 >= max_image_units as i64 || (self.bytes / 16) as i64 > max_texels {
+            return Ok(None);
+        }
+        // SAFETY: a texture over our own buffer on a current context.
+        unsafe {
+            let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+            gl.bind_texture(glow::TEXTURE_BUFFER, Some(t.raw()));
+            gl.tex_buffer(format, self.buffer.raw());
+            gl.bind_texture(glow::TEXTURE_BUFFER, None);
+            Ok(Some(t))
+        }
+    }
+
     /// Bind `bytes` bytes from `offset` (a multiple of `GlInfo::ssbo_offset_alignment`).
     pub fn bind_range(&self, gl: &Gl, binding: u32, offset: usize, bytes: usize) {
         debug_assert!(offset + bytes <= self.bytes);
@@ -212,7 +240,7 @@ fn read_buffer(gl: &Gl, buffer: glow::Buffer, bytes: &mut [u8]) {
 }
 
 /// Bind level 0 of `texture` (all layers) to image unit `unit` with `access` and `format`.
-fn bind_image_unit(gl: &Gl, unit: u32, texture: glow::Texture, access: u32, format: u32) {
+pub fn bind_image_unit(gl: &Gl, unit: u32, texture: glow::Texture, access: u32, format: u32) {
     // SAFETY: binding an existing texture to an image unit.
     unsafe { gl.bind_image_texture(unit, Some(texture), 0, false, 0, access, format) };
 }

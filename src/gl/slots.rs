@@ -116,6 +116,10 @@ slot_table! {
         /// image buffers by shading's light loop (SCENE_IMAGES), the same way
         SCENE_LIGHT_POS = 10,
         SCENE_LIGHT_COLOR = 11,
+        /// the SAH BVH's per-pixel records (the SSBO PIXEL_RECORDS) read as an RGBA32UI image
+        /// buffer by glsl/bvh/pixel_counts.comp (RECORD_IMAGE), the same way, where
+        /// `GL_MAX_IMAGE_UNITS` has the unit
+        PIXEL_RECORDS = 12,
     }
 }
 
@@ -190,7 +194,8 @@ mod tests {
     /// (`GL_MAX_IMAGE_UNITS` ≥ 8, `GL_MAX_COMPUTE_TEXTURE_IMAGE_UNITS` ≥ 16): the designs run
     /// on any GL 4.5 implementation, not only on llvmpipe's 192 units. The exceptions are the
     /// scene's image-buffer views, which `gpu_scene::vertex_views` binds only where
-    /// `GL_MAX_IMAGE_UNITS` has them (else the kernels read the SSBOs: `SCENE_IMAGES` 0).
+    /// `GL_MAX_IMAGE_UNITS` has them (else the kernels read the SSBOs: `SCENE_IMAGES` 0), and
+    /// the pixel records' view (`mueller2015::records`; else `RECORD_IMAGE` 0).
     #[test]
     fn units_are_within_gl_4_5_minimums() {
         let optional = [
@@ -198,6 +203,7 @@ mod tests {
             "IMAGE_SCENE_COLOR",
             "IMAGE_SCENE_LIGHT_POS",
             "IMAGE_SCENE_LIGHT_COLOR",
+            "IMAGE_PIXEL_RECORDS",
         ];
         for (table, units) in [(image::TABLE, 8), (sampler::TABLE, 16)] {
             for (name, slot) in table {

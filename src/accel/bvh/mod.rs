@@ -19,15 +19,15 @@ use glow::HasContext;
 use serde_json::json;
 
 use super::{
-    Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions, LightTarget,
-    TracerKind, MAX_PIXEL_EVENTS,
+    set_pass_rays, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions,
+    LightTarget, TracerKind, MAX_PIXEL_EVENTS,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::{TexelData, TextureBuffers};
 use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
-use crate::scene::{transform_triangles, Scene};
+use crate::scene::{transform_triangles, CameraRays, Scene};
 
 mod build;
 pub mod layout;
@@ -452,11 +452,19 @@ impl Accelerator for Bvh {
         true
     }
 
-    fn fused_pass(&mut self, f: &mut FrameContext, pass: u32) -> Option<&Kernel> {
+    fn fused_pass(
+        &mut self,
+        f: &mut FrameContext,
+        pass: u32,
+        eye: Option<&CameraRays>,
+    ) -> Option<&Kernel> {
         self.fused.as_ref()?;
+        self.entry.use_program();
+        set_pass_rays(&self.entry, eye);
         self.closest_hit(f, pass);
         let k = self.fused.as_ref()?;
         k.use_program();
+        set_pass_rays(k, eye);
         Some(k)
     }
 

@@ -197,9 +197,6 @@ fn vertex_views(
     ssbos: &[(u32, Ssbo)],
 ) -> Result<Vec<(u32, Owned<glow::Texture>)>> {
     use crate::gl::slots::image;
-    let texels = |s: &Ssbo| (s.bytes / 16) as i64;
-    // SAFETY: a limit query on a current context.
-    let max_texels = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
     let views = [
         (binding::NORMAL, image::SCENE_NORMAL),
         (binding::COLOR, image::SCENE_COLOR),
@@ -213,26 +210,15 @@ fn vertex_views(
             .expect("a scene SSBO")
             .1
     };
-    let fits = views
-        .iter()
-        .all(|&(b, unit)| unit < info.max_image_units as u32 && texels(ssbo(b)) <= max_texels);
-    if !fits {
-        return Ok(Vec::new());
+    let mut made = Vec::new();
+    for (b, unit) in views {
+        match ssbo(b).texel_view(gl, info.max_image_units, unit, glow::RGBA32F)? {
+            Some(t) => made.push((unit, t)),
+            // all four or none: the kernels read all of them one way
+            None => return Ok(Vec::new()),
+        }
     }
-    views
-        .iter()
-        .map(|&(b, unit)| {
-            let s = ssbo(b);
-            // SAFETY: a texture over our own buffer on a current context.
-            unsafe {
-                let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
-                gl.bind_texture(glow::TEXTURE_BUFFER, Some(t.raw()));
-                gl.tex_buffer(glow::RGBA32F, s.buffer.raw());
-                gl.bind_texture(glow::TEXTURE_BUFFER, None);
-                Ok((unit, t))
-            }
-        })
-        .collect()
+    Ok(made)
 }
 
 /// Binding, name and bytes of every scene SSBO.

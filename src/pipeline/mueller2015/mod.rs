@@ -399,10 +399,7 @@ impl RayTracer {
     fn eye_rays(&mut self, cam: &CameraRays) {
         let k = &self.kernels.eye_ray_generation;
         k.use_program();
-        k.set_vec4("camImgPosition", cam.cam_img_position.into(), 1.0);
-        k.set_vec4("camImgOffset", cam.cam_img_offset.into(), 0.0);
-        k.set_vec4("camWidth", cam.cam_width.into(), 0.0);
-        k.set_vec4("camHeight", cam.cam_height.into(), 0.0);
+        accel::set_camera(k, cam);
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
 
@@ -451,10 +448,17 @@ impl RayTracer {
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
 
+    /// Whether pass `pass` computes its eye rays in place (the fused pass' first, where no
+    /// AOVs keep the rays: `glsl/common/pass_ray.glsl`), so no eye-ray kernel runs.
+    fn eye_in_place(&self, pass: u32) -> bool {
+        self.options.fused_passes && pass == 0 && self.aov_images.is_none()
+    }
+
     /// One pass in the accelerator's fused kernel (`glsl/bvh/fused_pass.comp`, ours): the
     /// uniforms of the four kernels it stands for, then the counts of its three records, each
     /// under the bank intersect1 and intersect2 count under.
     fn fused_pass(&mut self, cam: &CameraRays, pass: u32) {
+        let eye = self.eye_in_place(pass);
         let mut f = FrameContext {
             gl: &self.gl,
             timers: &mut self.timers,
@@ -465,7 +469,7 @@ impl RayTracer {
         let l = &self.lighting;
         let k = self
             .accel
-            .fused_pass(&mut f, pass)
+            .fused_pass(&mut f, pass, eye.then_some(cam))
             .expect("--fused-passes is refused for an accelerator without a fused pass");
         k.set_vec4("backgroundColor", l.background, 1.0);
         k.set_i32("storePrimaryHit", (pass == 0) as i32);
@@ -564,7 +568,9 @@ impl Renderer for RayTracer {
             r.bind(&gl);
         }
         let cam = camera.rays(self.options.width, self.options.height);
-        self.eye_rays(&cam);
+        if !self.eye_in_place(0) {
+            self.eye_rays(&cam);
+        }
         if let Some(a) = &self.aov_images {
             a.keep_rays(&gl, &self.images);
         }

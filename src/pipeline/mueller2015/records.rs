@@ -13,8 +13,8 @@ use bytemuck::{Pod, Zeroable};
 
 use super::COUNTERS;
 use crate::accel::PIXELS_PER_INVOCATION;
-use crate::gl::resources::{GpuTimers, Ssbo};
-use crate::gl::slots::ssbo;
+use crate::gl::resources::{bind_image_unit, GpuTimers, Owned, Ssbo};
+use crate::gl::slots::{image, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 
 /// One pixel's record (`pixelRecord` in `glsl/bvh/records.glsl`, a uvec4): 16 bytes, which the
@@ -58,6 +58,9 @@ pub struct Records {
     records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
+    /// the records as an RGBA32UI image buffer for `pixel_counts` (`RECORD_IMAGE`), where the
+    /// GL has the unit ([`Ssbo::texel_view`])
+    view: Option<Owned<glow::Texture>>,
     pixels: u32,
 }
 
@@ -75,8 +78,16 @@ impl Records {
         (w, h): (u32, u32),
         per_pixel: u32,
     ) -> Result<Records> {
-        let records = (w as usize) * (h as usize) * per_pixel as usize;
+        let count = (w as usize) * (h as usize) * per_pixel as usize;
         let max = info.max_ssbo_block_size;
+        let bytes = std::mem::size_of::<PixelRecord>() * count;
+        let records = Ssbo::new(gl, "pixel records", bytes, None, max)?;
+        let view = records.texel_view(
+            gl,
+            info.max_image_units,
+            image::PIXEL_RECORDS,
+            glow::RGBA32UI,
+        )?;
         let (mask, mask_value) = crate::accel::bvh::texel_index_mask();
         let defines = defines
             .clone()
@@ -84,24 +95,24 @@ impl Records {
             .set("COUNT_GROUP", COUNT_GROUP)
             // 32-bit stores only: these two kernels do not enable 64-bit integers
             .set("RECORD_STORE_64", 0)
+            .set("RECORD_IMAGE", view.is_some() as i32)
             .set(mask, mask_value);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
-            records: Ssbo::new(
-                gl,
-                "pixel records",
-                std::mem::size_of::<PixelRecord>() * records,
-                None,
-                max,
-            )?,
+            records,
             evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: compute("bvh/pixel_counts.comp", "pixel_counts")?,
+            view,
             pixels: w * h,
         })
     }
 
     pub fn bind(&self, gl: &Gl) {
         self.records.bind(gl, ssbo::PIXEL_RECORDS);
+        if let Some(v) = &self.view {
+            let (access, format) = (glow::READ_ONLY, glow::RGBA32UI);
+            bind_image_unit(gl, image::PIXEL_RECORDS, v.raw(), access, format);
+        }
     }
 
     /// After intersect1: evaluate the hits (Listings 13, 14), then count.
