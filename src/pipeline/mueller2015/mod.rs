@@ -632,7 +632,7 @@ impl Renderer for RayTracer {
         ]
         .into_iter()
         .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
-        .chain(o.fused_passes.then(|| ("fused_passes", json!(true))))
+        .chain(o.fused_passes.then_some(("fused_passes", json!(true))))
         .chain(self.area_settings())
         .map(|(k, v)| (k.to_string(), v))
         .collect()
