@@ -35,6 +35,21 @@ layout(std430, binding = SSBO_REFIT_TOPOLOGY) readonly buffer RefitTopology { ui
 // §7.12.1; refit_leaves.comp)
 layout(std430, binding = SSBO_REFIT_BOXES) coherent buffer RefitBoxes { vec4 boxes[]; };
 
+// The refit's stores of the word buffer's texels (node records, leaf triangles). Ours: with
+// wordsStorage set (the host's: where the buffer fits GL_MAX_SHADER_STORAGE_BLOCK_SIZE) through
+// the same buffer bound as a storage buffer — llvmpipe stores an image texel component by
+// component, lane by lane, at about three times a storage-buffer vector's cost
+// (docs/design/frame.md, docs/design/bvh.md "Moving objects") — else as image texels. The
+// walks read the texels as images after the refit's barrier (gl::sync: image access included).
+layout(std430, binding = SSBO_BVH_WORDS) writeonly buffer BvhWords { uvec4 bvhWords[]; };
+uniform int wordsStorage;
+
+void storeTexel(int texel, uvec4 value)
+{
+    if (wordsStorage != 0) bvhWords[texel] = value;
+    else imageStore(bvh, texel, value);
+}
+
 uniform int nodeCount;
 uniform int orderCount;
 

@@ -30,9 +30,9 @@ void leafBox(int k)
         lo = min(lo, min(v0, min(v1, v2)));
         hi = max(hi, max(v0, max(v1, v2)));
         int t = base + 3 * s;
-        imageStore(bvh, t, uvec4(floatBitsToUint(v0), uint(id)));
-        imageStore(bvh, t + 1, uvec4(floatBitsToUint(v1 - v0), 0u));
-        imageStore(bvh, t + 2, uvec4(floatBitsToUint(v2 - v0), 0u));
+        storeTexel(t, uvec4(floatBitsToUint(v0), uint(id)));
+        storeTexel(t + 1, uvec4(floatBitsToUint(v1 - v0), 0u));
+        storeTexel(t + 2, uvec4(floatBitsToUint(v2 - v0), 0u));
     }
     lo -= vec3(pad);
     hi += vec3(pad);

@@ -55,8 +55,8 @@ void main()
     if (k < 0) return;
     gridOver(boxes[0].xyz, boxes[1].xyz);
     if (k == 0) {
-        imageStore(bvh, 0, uvec4(uint(nodeCount), floatBitsToUint(gridOrigin)));
-        imageStore(bvh, 1, uvec4(floatBitsToUint(gridStep), 0u));
+        storeTexel(0, uvec4(uint(nodeCount), floatBitsToUint(gridOrigin)));
+        storeTexel(1, uvec4(floatBitsToUint(gridStep), 0u));
     }
     vec3 lo = boxes[2 * k].xyz, hi = boxes[2 * k + 1].xyz;
     uvec3 low, high;
@@ -70,7 +70,7 @@ void main()
         bvec3 down = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
         uvec3 near = mix(low, high, down), far = mix(high, low, down);
         uint texel = recordTexel(k, o);
-        imageStore(bvh, int(texel), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
-                                    far.y | far.z << 16u, recordReference(k, texel)));
+        storeTexel(int(texel), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
+                                     far.y | far.z << 16u, recordReference(k, texel)));
     }
 }

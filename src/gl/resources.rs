@@ -504,6 +504,21 @@ impl TextureBuffers {
         }
     }
 
+    /// Bind buffer `index` (in upload order) also as the storage buffer `binding`, where it
+    /// fits `max_block` (`GL_MAX_SHADER_STORAGE_BLOCK_SIZE`): whether it was bound.
+    pub fn bind_storage(&self, gl: &Gl, index: usize, binding: u32, max_block: i64) -> bool {
+        let t = &self.0[index].0;
+        let bytes = t.texels * 16;
+        if bytes as i64 > max_block {
+            return false;
+        }
+        // SAFETY: binding our own buffer to a storage-buffer binding point.
+        unsafe {
+            gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, binding, Some(t.buffer.raw()));
+        }
+        true
+    }
+
     /// For tests: the 32-bit words of buffer `index` (in upload order), as kernels left them.
     pub fn read_u32(&self, gl: &Gl, index: usize) -> Vec<u32> {
         let t = &self.0[index].0;

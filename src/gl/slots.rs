@@ -63,6 +63,9 @@ slot_table! {
         REFIT_BOXES = 11,
         /// and per inner node the arrivals of its children (glsl/bvh/refit_leaves.comp)
         REFIT_ARRIVALS = 12,
+        /// and the BVH's word buffer itself (the image buffer the walks read), which the
+        /// refit's passes store into as a storage buffer where it fits one
+        BVH_WORDS = 13,
         // Klee 2016's shadow pass (glsl/klee2016/linespace_shadow.comp)
         TRI_VERTEX = 0,
         LEAF_TRIANGLES = 1,

@@ -25,7 +25,7 @@ use super::{
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::{TexelData, TextureBuffers};
-use crate::gl::slots::image;
+use crate::gl::slots::{image, ssbo};
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::scene::{transform_triangles, CameraRays, Scene};
 
@@ -371,7 +371,9 @@ impl Bvh {
     fn refit(&mut self, f: &mut FrameContext) -> Result<()> {
         let refit = self.moving.refit.as_ref().expect("a tree to refit");
         self.bind(f.gl, glow::READ_WRITE);
-        refit.run(f.gl, f.timers, &self.moving.kernels);
+        let buffers = self.buffers.as_ref().expect("a built tree's buffers");
+        let storage = buffers.bind_storage(f.gl, 0, ssbo::BVH_WORDS, self.moving.max_block);
+        refit.run(f.gl, f.timers, &self.moving.kernels, storage);
         self.drop_pending();
         // SAFETY: a fence on a current context; deleted in read_cost or drop_pending.
         let fence = unsafe { f.gl.fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0) };

@@ -209,7 +209,9 @@ impl Refit {
     /// scene's `vertex` SSBO holding this frame's world-space vertices), a barrier after each:
     /// the records' pass reads the boxes the boxes' pass wrote (GL 4.6 §7.13). Timed together as
     /// [`REFIT_TIMER`].
-    pub fn run(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels) {
+    /// `words_storage`: the word buffer is bound as the storage buffer `BVH_WORDS` too (the
+    /// passes store through it, else as image texels; `glsl/bvh/refit.glsl`).
+    pub fn run(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels, words_storage: bool) {
         self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
         self.boxes.bind(gl, ssbo::REFIT_BOXES);
         self.arrivals.bind(gl, ssbo::REFIT_ARRIVALS);
@@ -219,6 +221,7 @@ impl Refit {
                 kernel.use_program();
                 kernel.set_i32("nodeCount", self.nodes as i32);
                 kernel.set_i32("orderCount", count as i32);
+                kernel.set_i32("wordsStorage", words_storage as i32);
                 if std::ptr::eq(kernel, &k.leaves) {
                     kernel.set_f32("pad", self.pad);
                 }

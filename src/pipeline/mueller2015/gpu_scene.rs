@@ -390,6 +390,8 @@ impl GpuScene {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo.raw()));
                 gl.enable(glow::RASTERIZER_DISCARD);
                 k.set_i32("transformLights", 0);
+                // the first frame writes every attribute, later ones a moved object's geometry
+                k.set_i32("geometryOnly", self.written.is_some() as i32);
                 gl.bind_vertex_array(Some(self.vao.raw()));
                 for &i in &moved {
                     let (first, count) = self.ranges[i];
