@@ -13,11 +13,13 @@
 // the AOVs' texels where the host keeps AOVs (STORE_AOVS). The eye rays (Listing 11) and the
 // blocks' entry points (bvh/entry.comp) are still kernels of their own before it.
 //
-// The work counts go to three per-pixel records (bvh/records.glsl), which pixel_counts.comp
-// adds to the counter bank of each ray kind: the closest-hit search's (packed, with the hit
-// record, as intersect1's), the feelers towards the first light's (RECORD_FIRST_LIGHT) and
-// towards the other lights' (RECORD_OTHER_LIGHTS), the latter two unpacked (plainRecord), as a
-// pixel traces several feelers of one kind.
+// The work counts go to per-pixel records (bvh/records.glsl), which pixel_counts.comp adds to
+// the counter bank of each ray kind: the closest-hit search's packed in words 0–1 of record 0
+// (packCounts, as intersect1's; no hit record: nothing reads it after this kernel); the
+// feelers towards the first light packed in its words 2–3 where that light is a point light
+// (FIRST_LIGHT_PACKED: one feeler a pixel, so one store of the record for both kinds), else
+// unpacked in record RECORD_FIRST_LIGHT (an area light's samples: several feelers a pixel);
+// the other lights' unpacked in record RECORD_OTHER_LIGHTS (plainRecords in pixel_counts).
 #if RECORD_STORE_64
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
@@ -44,6 +46,8 @@ uniform vec4 areaLight[4 * AREA_LIGHTS];
 #endif
 // 1 where a reflection pass follows this one: the rays' state is stored for it
 uniform int storeRayState;
+// 1 in the first pass of a frame
+uniform int firstPass;
 
 // the point lights, as shading.comp reads them
 #if SCENE_IMAGES
@@ -140,16 +144,21 @@ void storeShadowFlags(ivec2 storePos, uvec4 blocked)
 #endif
 }
 
+// (tests, nodes, rays, truncated) packed as packCounts does (at most one ray)
+uvec2 packedCounts(uvec4 c) { return packCounts(c.x, c.y, c.w, c.z); }
+
 void storeRecords(ivec2 storePos, uvec4 primary, uvec4 first, uvec4 others)
 {
     int at = pixelIndex(storePos);
-    uvec2 counts = packCounts(primary.x, primary.y, primary.w, primary.z);
-#if RECORD_STORE_64
-    pixelRecordWords[at] = u64vec2(packUint2x32(counts), uint64_t(uint(closestHitRecord)));
+#if FIRST_LIGHT_PACKED && RECORD_STORE_64
+    pixelRecordWords[at] = u64vec2(packUint2x32(packedCounts(primary)),
+                                   packUint2x32(packedCounts(first)));
+#elif FIRST_LIGHT_PACKED
+    pixelRecord[at] = uvec4(packedCounts(primary), packedCounts(first));
 #else
-    pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
-#endif
+    pixelRecord[at].xy = packedCounts(primary);
     pixelRecord[RECORD_FIRST_LIGHT * IMAGE_WIDTH * IMAGE_HEIGHT + at] = first;
+#endif
 #if RECORD_OTHER_LIGHTS > 0
     pixelRecord[RECORD_OTHER_LIGHTS * IMAGE_WIDTH * IMAGE_HEIGHT + at] = others;
 #endif
@@ -185,7 +194,10 @@ void trace(ivec2 storePos)
             storeShadowFlags(storePos, blocked);
             temp_color = litColor(hitPoint.xyz, normal.xyz, mat, colorWeight.rgb, blocked);
         }
-        vec4 final_color = imageLoad(finalTexture, storePos);
+        // the output colour so far: none in the first pass, whose texture the host cleared
+        // (ours: one load fewer where llvmpipe loads every texel)
+        vec4 final_color = vec4(0.0);
+        if (firstPass == 0) final_color = imageLoad(finalTexture, storePos);
         imageStore(finalTexture, storePos, addToFinal(final_color, temp_color, colorWeight.w));
 #if STORE_AOVS
         imageStore(normalTexture, storePos, normal);

@@ -15,11 +15,13 @@ layout(local_size_x = COUNT_GROUP) in;
 // the global counter slot of each component
 uniform ivec4 countSlots;
 // The records summed: IMAGE_WIDTH × IMAGE_HEIGHT of them from record recordBase on, packed
-// (packCounts: the intersection kernels' and the fused pass' closest-hit records) or, with
-// plainRecords, unpacked as (tests, nodes, rays, truncated) — the fused pass' feeler records,
-// where one pixel counts several feelers of a kind (bvh/fused_pass.comp).
+// (packCounts) in words 0–1 — the intersection kernels' — or with packedHigh in words 2–3 (the
+// fused pass' first-light feelers beside its closest-hit counts), or with plainRecords
+// unpacked as (tests, nodes, rays, truncated): the fused pass' records of a kind one pixel
+// counts several feelers of (bvh/fused_pass.comp).
 uniform int recordBase;
 uniform int plainRecords;
+uniform int packedHigh;
 
 // Ours: with RECORD_IMAGE the records are read through an RGBA32UI image buffer over the same
 // storage (src/pipeline/mueller2015/records.rs) — llvmpipe loads a storage-buffer vector lane
@@ -30,12 +32,13 @@ layout(rgba32ui, binding = IMAGE_PIXEL_RECORDS) readonly uniform uimageBuffer re
 uvec4 recordCounts(int k)
 {
     uvec4 r = imageLoad(recordImage, recordBase + k);
-    return plainRecords != 0 ? r.xywz : unpackCounts(r.xy);
+    return plainRecords != 0 ? r.xywz : unpackCounts(packedHigh != 0 ? r.zw : r.xy);
 }
 #else
 uvec4 recordCounts(int k)
 {
     if (plainRecords != 0) return pixelRecord[recordBase + k].xywz;
+    if (packedHigh != 0) return unpackCounts(pixelRecord[recordBase + k].zw);
     return unpackCounts(pixelRecord[recordBase + k].xy);
 }
 #endif

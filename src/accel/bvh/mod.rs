@@ -124,9 +124,10 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
     })
 }
 
-/// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's feeler records after the
-/// closest-hit records — the first light's at record 1, the other lights' at record 2 where a
-/// hit has more than one feeler (`pipeline::mueller2015::records`).
+/// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's counts in record 0 (the first
+/// light's beside the closest hit's where it is a point light), else the first light's at
+/// record 1; the other lights' at record 2 where the scene has more than one light
+/// (`pipeline::mueller2015::records`).
 fn fused_kernel(
     b: &BuildContext,
     defs: &[(&'static str, String)],
@@ -136,7 +137,11 @@ fn fused_kernel(
         ("RECORD_FIRST_LIGHT", "1".to_string()),
         (
             "RECORD_OTHER_LIGHTS",
-            if f.feelers > 1 { "2" } else { "0" }.to_string(),
+            if f.lights > 1 { "2" } else { "0" }.to_string(),
+        ),
+        (
+            "FIRST_LIGHT_PACKED",
+            (f.first_light_point as i32).to_string(),
         ),
         ("SCENE_IMAGES", (f.scene_images as i32).to_string()),
     ];

@@ -329,6 +329,7 @@ impl RayTracer {
             fused: options.fused_passes.then(|| FusedPasses {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
+                first_light_point: !scene.lights.is_empty(),
                 scene_images: gpu_scene.vertex_images(),
             }),
         };
@@ -474,6 +475,7 @@ impl RayTracer {
         k.set_vec4("backgroundColor", l.background, 1.0);
         k.set_i32("storePrimaryHit", (pass == 0) as i32);
         k.set_i32("storeRayState", (pass < self.options.refl_depth) as i32);
+        k.set_i32("firstPass", (pass == 0) as i32);
         k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
         k.set_vec4("ambientColor", l.ambient, 1.0);
         k.set_i32("lightCount", l.lights.len() as i32);
@@ -488,10 +490,17 @@ impl RayTracer {
             .expect("the fused pass stores records");
         r.add_record_counts(f.timers, "intersect1", Record::Packed(0));
         let lights = l.lights.len() + l.area_lights.len();
-        let kinds = [(Bank::occluded(0), 1), (Bank::occluded(1), 2)];
+        let first = match l.lights.is_empty() {
+            false => Record::PackedHigh(0),
+            true => Record::Plain(1),
+        };
+        let kinds = [
+            (Bank::occluded(0), first),
+            (Bank::occluded(1), Record::Plain(2)),
+        ];
         for (bank, record) in kinds.into_iter().take(lights.min(2)) {
             self.counters.bind(&self.gl, &mut self.timers, bank);
-            r.add_record_counts(&mut self.timers, "intersect2", Record::Plain(record));
+            r.add_record_counts(&mut self.timers, "intersect2", record);
         }
         self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
     }

@@ -41,6 +41,8 @@ const _: () = assert!(std::mem::size_of::<PixelRecord>() == 16);
 pub enum Record {
     /// record i of every pixel, its counts packed in two words ([`PixelRecord`])
     Packed(u32),
+    /// record i, its counts packed in words 2–3 (the fused pass' first-light feelers)
+    PackedHigh(u32),
     /// record i, its counts as four words (tests, nodes, rays, truncated): the fused pass'
     /// feeler records, which sum several feelers
     Plain(u32),
@@ -142,12 +144,14 @@ impl Records {
     pub fn add_record_counts(&self, timers: &mut GpuTimers, tests: &str, record: Record) {
         let k = &self.pixel_counts;
         k.use_program();
-        let (index, plain) = match record {
-            Record::Packed(i) => (i, false),
-            Record::Plain(i) => (i, true),
+        let (index, plain, high) = match record {
+            Record::Packed(i) => (i, false, false),
+            Record::PackedHigh(i) => (i, false, true),
+            Record::Plain(i) => (i, true, false),
         };
         k.set_i32("recordBase", (index * self.pixels) as i32);
         k.set_i32("plainRecords", plain as i32);
+        k.set_i32("packedHigh", high as i32);
         k.set_ivec4(
             "countSlots",
             [
