@@ -66,12 +66,8 @@ int passNode(bool leaves)
 }
 // the texel of node k's record in octant o's copy
 uint recordTexel(int k, int octant) { return topology[4 * nodeCount + 8 * k + octant]; }
-// the `reference` of the record at `texel`, from node k's reference word
-uint recordReference(int k, uint texel)
-{
-    uint word = topology[12 * nodeCount + k];
-    return int(word) < 0 ? word : texel + word;
-}
+// the `reference` of the record at `texel`, from its node's reference word
+uint referenceOf(uint word, uint texel) { return int(word) < 0 ? word : texel + word; }
 int leafTriangleId(int s) { return int(topology[13 * nodeCount + s]); }
 
 // Aabb::half_area: xdim·ydim + ydim·zdim + zdim·xdim

@@ -19,6 +19,18 @@ layout(std430, binding = SSBO_REFIT_ARRIVALS) coherent buffer RefitArrivals { ui
 
 uniform float pad;
 
+// The transform pass' world-space vertices (common/scene.glsl). Ours: with SCENE_IMAGES read as
+// an image buffer over the same SSBO (GpuScene::vertex_images, unit SCENE_VERTEX) — llvmpipe
+// loads a storage-buffer vector lane by lane and component by component, an image texel for
+// all lanes at once (docs/design/frame.md); nine such loads a leaf triangle were most of this
+// pass (docs/design/bvh.md, "Moving objects").
+#if SCENE_IMAGES
+layout(rgba32f, binding = IMAGE_SCENE_VERTEX) readonly uniform imageBuffer vertexImage;
+vec3 vertexPos(int k) { return imageLoad(vertexImage, k).xyz; }
+#else
+vec3 vertexPos(int k) { return vertex[k].xyz; }
+#endif
+
 void leafBox(int k)
 {
     int first = nodeFirst(k), count = nodeMeta(k);
@@ -26,7 +38,7 @@ void leafBox(int k)
     vec3 lo = vec3(1.0 / 0.0), hi = vec3(-1.0 / 0.0);
     for (int s = first; s < first + count; s++) {
         int id = leafTriangleId(s);
-        vec3 v0 = vertex[3 * id].xyz, v1 = vertex[3 * id + 1].xyz, v2 = vertex[3 * id + 2].xyz;
+        vec3 v0 = vertexPos(3 * id), v1 = vertexPos(3 * id + 1), v2 = vertexPos(3 * id + 2);
         lo = min(lo, min(v0, min(v1, v2)));
         hi = max(hi, max(v0, max(v1, v2)));
         int t = base + 3 * s;

@@ -14,6 +14,39 @@
 
 const double GRID_MAX = double(BVH_GRID_STEPS);
 
+// Ours: with refitViews set (the host's, where it could make them: REFIT_VIEWS, the units, and
+// the texel counts) a node's box and its 8 record texels and reference word are read through
+// image buffers over the same storage (RGBA32F boxes, RGBA32UI topology: the 8 texel indices
+// are two texels) — llvmpipe loads a storage-buffer vector lane by lane and component by
+// component, an image texel for all lanes at once (docs/design/frame.md).
+#if REFIT_VIEWS
+layout(rgba32ui, binding = IMAGE_REFIT_TOPOLOGY) readonly uniform uimageBuffer topologyTexels;
+layout(rgba32f, binding = IMAGE_REFIT_BOXES) readonly uniform imageBuffer boxTexels;
+#endif
+uniform int refitViews;
+
+// Node k's box (lo, hi), the texels of its 8 octant records and its reference word.
+void nodeInputs(int k, out vec3 lo, out vec3 hi, out uvec4 texels0, out uvec4 texels1,
+                out uint referenceWord)
+{
+#if REFIT_VIEWS
+    if (refitViews != 0) {
+        lo = imageLoad(boxTexels, 2 * k).xyz;
+        hi = imageLoad(boxTexels, 2 * k + 1).xyz;
+        // recordTexel's words 4N + 8k + o, referenceWord's 12N + k (refit.glsl)
+        texels0 = imageLoad(topologyTexels, nodeCount + 2 * k);
+        texels1 = imageLoad(topologyTexels, nodeCount + 2 * k + 1);
+        referenceWord = imageLoad(topologyTexels, 3 * nodeCount + (k >> 2))[k & 3];
+        return;
+    }
+#endif
+    lo = boxes[2 * k].xyz;
+    hi = boxes[2 * k + 1].xyz;
+    texels0 = uvec4(recordTexel(k, 0), recordTexel(k, 1), recordTexel(k, 2), recordTexel(k, 3));
+    texels1 = uvec4(recordTexel(k, 4), recordTexel(k, 5), recordTexel(k, 6), recordTexel(k, 7));
+    referenceWord = topology[12 * nodeCount + k];
+}
+
 vec3 gridOrigin = vec3(0.0), gridStep = vec3(1.0);
 
 // Grid::over: the root's low corner and per axis the smallest float step whose BVH_GRID_STEPS
@@ -58,7 +91,10 @@ void main()
         storeTexel(0, uvec4(uint(nodeCount), floatBitsToUint(gridOrigin)));
         storeTexel(1, uvec4(floatBitsToUint(gridStep), 0u));
     }
-    vec3 lo = boxes[2 * k].xyz, hi = boxes[2 * k + 1].xyz;
+    vec3 lo, hi;
+    uvec4 texels0, texels1;
+    uint referenceWord;
+    nodeInputs(k, lo, hi, texels0, texels1, referenceWord);
     uvec3 low, high;
     for (int a = 0; a < 3; a++) {
         uvec2 q = axisPlanes(a, lo[a], hi[a]);
@@ -69,8 +105,8 @@ void main()
         // octant_planes: the near plane is the low one unless the octant's rays point down
         bvec3 down = bvec3((o & 1) != 0, (o & 2) != 0, (o & 4) != 0);
         uvec3 near = mix(low, high, down), far = mix(high, low, down);
-        uint texel = recordTexel(k, o);
+        uint texel = o < 4 ? texels0[o] : texels1[o - 4];
         storeTexel(int(texel), uvec4(near.x | near.y << 16u, near.z | far.x << 16u,
-                                     far.y | far.z << 16u, recordReference(k, texel)));
+                                     far.y | far.z << 16u, referenceOf(referenceWord, texel)));
     }
 }

@@ -174,6 +174,9 @@ pub struct BuildContext<'a> {
     pub triangles_per_dispatch: Option<u32>,
     /// `--fused-passes`: the pass in one kernel ([`Accelerator::fused_pass`]).
     pub fused: Option<FusedPasses>,
+    /// The scene's vertex attributes and lights are bound as image buffers too
+    /// (`SCENE_IMAGES`, `GpuScene::vertex_images`).
+    pub scene_images: bool,
 }
 
 /// What a fused pass kernel (`glsl/bvh/fused_pass.comp`) needs to know at compile time.
@@ -189,8 +192,6 @@ pub struct FusedPasses {
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,
-    /// The scene's vertex attributes and lights as image buffers (`SCENE_IMAGES`).
-    pub scene_images: bool,
 }
 
 impl BuildContext<'_> {

@@ -119,6 +119,13 @@ slot_table! {
         /// image buffers by shading's light loop (SCENE_IMAGES), the same way
         SCENE_LIGHT_POS = 10,
         SCENE_LIGHT_COLOR = 11,
+        /// the world-space vertices (the SSBO VERTEX) read the same way by the SAH BVH's
+        /// refit (glsl/bvh/refit_leaves.comp)
+        SCENE_VERTEX = 13,
+        /// the SAH BVH refit's topology and boxes (the SSBOs REFIT_TOPOLOGY, REFIT_BOXES) read
+        /// the same way by its records' pass (glsl/bvh/refit_records.comp)
+        REFIT_TOPOLOGY = 14,
+        REFIT_BOXES = 15,
         /// the SAH BVH's per-pixel records (the SSBO PIXEL_RECORDS) read as an RGBA32UI image
         /// buffer by glsl/bvh/pixel_counts.comp (RECORD_IMAGE), the same way, where
         /// `GL_MAX_IMAGE_UNITS` has the unit
@@ -207,6 +214,9 @@ mod tests {
             "IMAGE_SCENE_LIGHT_POS",
             "IMAGE_SCENE_LIGHT_COLOR",
             "IMAGE_PIXEL_RECORDS",
+            "IMAGE_SCENE_VERTEX",
+            "IMAGE_REFIT_TOPOLOGY",
+            "IMAGE_REFIT_BOXES",
         ];
         for (table, units) in [(image::TABLE, 8), (sampler::TABLE, 16)] {
             for (name, slot) in table {

@@ -114,6 +114,12 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
 fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<RefitKernels> {
     let extra = [
         ("REFIT_GROUP", REFIT_GROUP.to_string()),
+        ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
+        // the records' pass reads through image buffers where the units exist (Refit::run)
+        (
+            "REFIT_VIEWS",
+            ((b.info.max_image_units as u32 > image::REFIT_BOXES) as i32).to_string(),
+        ),
         ("BVH_GRID_STEPS", GRID_STEPS.to_string()),
     ];
     let defs = [defs, &extra[..]].concat();
@@ -134,6 +140,7 @@ fn fused_kernel(
     f: FusedPasses,
 ) -> Result<Kernel> {
     let extra = [
+        ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
         ("RECORD_FIRST_LIGHT", "1".to_string()),
         (
             "RECORD_OTHER_LIGHTS",
@@ -143,7 +150,6 @@ fn fused_kernel(
             "FIRST_LIGHT_PACKED",
             (f.first_light_point as i32).to_string(),
         ),
-        ("SCENE_IMAGES", (f.scene_images as i32).to_string()),
     ];
     b.kernel(
         "bvh/fused_pass.comp",
@@ -189,6 +195,8 @@ struct Moving {
     pending: Cell<Option<glow::Fence>>,
     /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
     max_block: i64,
+    /// `GL_MAX_IMAGE_UNITS`, for the refit's image-buffer views
+    max_units: i32,
 }
 
 pub struct Bvh {
@@ -247,6 +255,7 @@ impl Bvh {
                 cost: Cell::new(0.0),
                 pending: Cell::new(None),
                 max_block: b.info.max_ssbo_block_size,
+                max_units: b.info.max_image_units,
             },
             objects: scene
                 .objects
@@ -283,7 +292,8 @@ impl Bvh {
             );
         }
         let buffers = upload(&self.gl, &bvh, self.blocks)?;
-        let refit = Refit::new(&self.gl, &bvh, self.moving.max_block)?;
+        let m = &self.moving;
+        let refit = Refit::new(&self.gl, &bvh, m.max_block, m.max_units)?;
         // the old buffers (if any) drop after the new ones are made, as before
         self.buffers = Some(buffers);
         self.moving.refit = Some(refit);

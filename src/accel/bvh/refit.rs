@@ -29,8 +29,8 @@ use rayon::prelude::*;
 
 use super::layout::{Aabb, BvhTree, Node, LEAF_COUNT_BITS, OCTANTS};
 use super::planes::Grid;
-use crate::gl::resources::{GpuTimers, Ssbo};
-use crate::gl::slots::ssbo;
+use crate::gl::resources::{bind_image_unit, GpuTimers, Owned, Ssbo};
+use crate::gl::slots::{image, ssbo};
 use crate::gl::{sync, Gl, Kernel};
 
 /// Rebuild on the CPU when the refitted tree's SAH cost exceeds the last build's by this factor
@@ -174,6 +174,9 @@ pub struct RefitKernels {
 pub struct Refit {
     topology: Ssbo,
     boxes: Ssbo,
+    /// the topology (RGBA32UI) and the boxes (RGBA32F) as image buffers for the records' pass
+    /// (`refitViews`), where the GL has the units and the texels
+    views: Option<[Owned<glow::Texture>; 2]>,
     /// the arrival count of every node (`glsl/bvh/refit_leaves.comp`), zeros when made
     arrivals: Ssbo,
     leaves: u32,
@@ -183,21 +186,35 @@ pub struct Refit {
 
 impl Refit {
     /// The buffers of `tree`'s refit.
-    pub fn new(gl: &Arc<Gl>, tree: &BvhTree, max_block: i64) -> Result<Refit> {
+    /// `max_units`: `GL_MAX_IMAGE_UNITS`, for the records' pass' views.
+    pub fn new(gl: &Arc<Gl>, tree: &BvhTree, max_block: i64, max_units: i32) -> Result<Refit> {
         let t = Topology::of(tree);
-        let words = bytemuck::cast_slice(&t.words);
+        // whole texels, so that the records' pass' view holds every word it reads
+        let mut padded = t.words.clone();
+        padded.resize(padded.len().next_multiple_of(4), 0);
+        let words = bytemuck::cast_slice(&padded);
         let n = tree.nodes.len();
         let arrivals = Ssbo::new(gl, "bvh refit arrivals", 4 * n, None, max_block)?;
         arrivals.clear_u32(gl, 0);
+        let topology = Ssbo::new(
+            gl,
+            "bvh refit topology",
+            words.len(),
+            Some(words),
+            max_block,
+        )?;
+        let boxes = Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?;
+        let views = match (
+            topology.texel_view(gl, max_units, image::REFIT_TOPOLOGY, glow::RGBA32UI)?,
+            boxes.texel_view(gl, max_units, image::REFIT_BOXES, glow::RGBA32F)?,
+        ) {
+            (Some(t), Some(b)) => Some([t, b]),
+            _ => None,
+        };
         Ok(Refit {
-            topology: Ssbo::new(
-                gl,
-                "bvh refit topology",
-                words.len(),
-                Some(words),
-                max_block,
-            )?,
-            boxes: Ssbo::new(gl, "bvh refit boxes", 32 * n, None, max_block)?,
+            topology,
+            boxes,
+            views,
             arrivals,
             leaves: t.leaves,
             nodes: n as u32,
@@ -215,6 +232,22 @@ impl Refit {
         self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
         self.boxes.bind(gl, ssbo::REFIT_BOXES);
         self.arrivals.bind(gl, ssbo::REFIT_ARRIVALS);
+        if let Some([t, b]) = &self.views {
+            bind_image_unit(
+                gl,
+                image::REFIT_TOPOLOGY,
+                t.raw(),
+                glow::READ_ONLY,
+                glow::RGBA32UI,
+            );
+            bind_image_unit(
+                gl,
+                image::REFIT_BOXES,
+                b.raw(),
+                glow::READ_ONLY,
+                glow::RGBA32F,
+            );
+        }
         sync::barrier(gl);
         timers.time(gl, REFIT_TIMER, || {
             for (kernel, count) in [(&k.leaves, self.leaves), (&k.records, self.nodes)] {
@@ -222,6 +255,7 @@ impl Refit {
                 kernel.set_i32("nodeCount", self.nodes as i32);
                 kernel.set_i32("orderCount", count as i32);
                 kernel.set_i32("wordsStorage", words_storage as i32);
+                kernel.set_i32("refitViews", self.views.is_some() as i32);
                 if std::ptr::eq(kernel, &k.leaves) {
                     kernel.set_f32("pad", self.pad);
                 }

@@ -185,7 +185,7 @@ fn scene_ssbos(gl: &Arc<Gl>, scene: &Scene, max: i64) -> Result<Vec<(u32, Ssbo)>
         .collect()
 }
 
-/// The normals, colours and lights SSBOs as RGBA32F buffer textures over the same storage (no
+/// The normals, colours, lights and vertex SSBOs as RGBA32F buffer textures over the same storage (no
 /// copy: the transform pass' stores show through them after its barrier), for the hit
 /// evaluation and shading:
 /// llvmpipe loads a storage-buffer vector lane by lane and component by component, an image
@@ -202,6 +202,7 @@ fn vertex_views(
         (binding::COLOR, image::SCENE_COLOR),
         (binding::LIGHT_POS, image::SCENE_LIGHT_POS),
         (binding::LIGHT_COLOR, image::SCENE_LIGHT_COLOR),
+        (binding::VERTEX, image::SCENE_VERTEX),
     ];
     let ssbo = |b: u32| {
         &ssbos

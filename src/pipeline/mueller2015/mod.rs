@@ -330,8 +330,8 @@ impl RayTracer {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
-                scene_images: gpu_scene.vertex_images(),
             }),
+            scene_images: gpu_scene.vertex_images(),
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
         let per_pixel = if options.fused_passes {
