@@ -12,7 +12,7 @@ use gpgpu_rt::gl::program::Defines;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::scene::{Light, Scene};
+use gpgpu_rt::scene::Scene;
 
 #[test]
 fn bunny_brute_force_tests_every_triangle_once_per_pixel() {
@@ -75,19 +75,6 @@ fn teapot_with_two_reflection_passes_matches_reference() {
         .filter(|(a, b)| (a[0] - b[0]).abs() > 0.01)
         .count();
     assert!(changed > 50, "reflections changed only {changed} pixels");
-}
-
-fn ring_of_lights(scene: &mut Scene, n: usize) {
-    scene.lights = (0..n)
-        .map(|i| {
-            let a = i as f32 / n as f32 * std::f32::consts::TAU;
-            Light {
-                position: Vec3::new(3.0 * a.cos(), 3.0 + (i % 3) as f32, 3.0 * a.sin()),
-                color: Vec3::splat(0.9 / n as f32 * 2.0)
-                    * Vec3::new(1.0, 0.6 + 0.4 * (i % 2) as f32, 0.8),
-            }
-        })
-        .collect();
 }
 
 #[test]

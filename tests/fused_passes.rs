@@ -6,12 +6,11 @@
 mod common;
 
 use common::*;
-use glam::Vec3;
 use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
-use gpgpu_rt::scene::{Light, Scene};
+use gpgpu_rt::scene::Scene;
 
 fn bvh(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
     RenderOptions {
@@ -94,23 +93,10 @@ fn reflections_equal_the_four_kernels_and_the_reference() {
     assert!(reflected > 100, "too few reflected rays: {reflected}");
 }
 
-/// `n` point lights around the scene (some behind surfaces, some blocked).
-fn lights(scene: &mut Scene, n: usize) {
-    scene.lights = (0..n)
-        .map(|i| {
-            let a = i as f32 / n as f32 * std::f32::consts::TAU;
-            Light {
-                position: Vec3::new(3.0 * a.cos(), 2.0 + i as f32, 3.0 * a.sin()),
-                color: Vec3::splat(0.5),
-            }
-        })
-        .collect();
-}
-
 #[test]
 fn several_lights_in_both_flag_layouts_and_tiles() {
     let mut scene = load("teapot1.toml");
-    lights(&mut scene, 3);
+    ring_of_lights(&mut scene, 3);
     for flags in [ShadowFlags::Rgba, ShadowFlags::Bits] {
         let opts = RenderOptions {
             shadow_flags: flags,

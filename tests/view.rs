@@ -376,7 +376,8 @@ fn kernel_edit_reloads_live() {
     broken.insert(main_line - 1, "this is not GLSL;");
     let broken = broken.join("\n") + "\n";
     // the fix: Listing 16's store replaced by a constant colour
-    let store = "imageStore(finalTexture, storePos, final_color);";
+    let store =
+        "imageStore(finalTexture, storePos, addToFinal(final_color, temp_color, pColor.w));";
     assert_eq!(
         original.matches(store).count(),
         1,

@@ -11,7 +11,7 @@ use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
-use gpgpu_rt::scene::Scene;
+use gpgpu_rt::scene::{Light, Scene};
 
 pub fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -403,4 +403,18 @@ impl Rng {
 /// A lattice box's corners as integers (the N-tree's shaft tests take them so).
 pub fn lattice(b: &gpgpu_rt::pipeline::klee2016::ntree::Aabb) -> ([i32; 3], [i32; 3]) {
     (b.lo.map(|v| v as i32), b.hi.map(|v| v as i32))
+}
+
+/// `n` point lights in a ring around the scene, of different heights and colours.
+pub fn ring_of_lights(scene: &mut Scene, n: usize) {
+    scene.lights = (0..n)
+        .map(|i| {
+            let a = i as f32 / n as f32 * std::f32::consts::TAU;
+            Light {
+                position: Vec3::new(3.0 * a.cos(), 3.0 + (i % 3) as f32, 3.0 * a.sin()),
+                color: Vec3::splat(0.9 / n as f32 * 2.0)
+                    * Vec3::new(1.0, 0.6 + 0.4 * (i % 2) as f32, 0.8),
+            }
+        })
+        .collect();
 }
