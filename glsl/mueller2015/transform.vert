@@ -16,11 +16,6 @@ layout(location = 4) in int inMaterial;  // material id of the vertex's triangle
 uniform mat4 modelMatrix;
 uniform mat3 normalMatrix;
 uniform int transformLights;
-// Ours: 1 once the SSBOs hold every object's attributes (the first frame wrote them): a moved
-// object's colours, texture coordinates and materials do not change with its model matrix, so
-// only its vertices and normals are written again — on llvmpipe every stored component costs a
-// loop over the lanes (docs/design/frame.md).
-uniform int geometryOnly;
 
 void main()
 {
@@ -31,11 +26,9 @@ void main()
     } else {
         vertex[i] = modelMatrix * vec4(inPosition, 1.0);
         normals[i] = vec4(normalize(normalMatrix * inNormal), 0.0);
-        if (geometryOnly == 0) {
-            colors[i] = vec4(inColor, 1.0);
-            texcoords[i] = inTexCoord;
-            if (i % 3 == 0) triMaterial[i / 3] = inMaterial;
-        }
+        colors[i] = vec4(inColor, 1.0);
+        texcoords[i] = inTexCoord;
+        if (i % 3 == 0) triMaterial[i / 3] = inMaterial;
     }
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
 }

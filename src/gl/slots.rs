@@ -56,6 +56,10 @@ slot_table! {
         /// hit's evaluation and count per pixel (glsl/bvh/records.glsl): per pixel its work
         /// counts and hit record
         PIXEL_RECORDS = 21,
+        /// the transform pass' object-space positions and normals (its VBOs), read by the
+        /// moved objects' compute pass (glsl/mueller2015/transform_moved.comp)
+        TRANSFORM_POSITIONS = 22,
+        TRANSFORM_NORMALS = 23,
         // the SAH BVH's GPU refit (glsl/bvh/refit.glsl): the tree's topology as the host lays
         // it out once per build (src/accel/bvh/refit.rs), and every node's float box and
         // subtree SAH cost as the refit's passes write them

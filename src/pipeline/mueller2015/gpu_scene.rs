@@ -7,7 +7,11 @@
 //! frame draws only the objects whose model matrix changed since their vertices were last
 //! written (the lights once), since the SSBOs keep what the pass wrote and the kernels only read
 //! them — the same buffers, without re-transforming a static scene every frame
-//! (`docs/design/frame.md`).
+//! (`docs/design/frame.md`). And once the first frame's pass has written every attribute, a
+//! moved object's vertices and normals — all a model matrix changes — are rewritten by a compute
+//! kernel (`glsl/mueller2015/transform_moved.comp`, [`MovedTransform`]): llvmpipe runs a draw's
+//! vertex shader on the calling thread, a dispatch on all its threads (`docs/design/bvh.md`,
+//! "Moving objects").
 
 use std::sync::Arc;
 
@@ -43,6 +47,85 @@ pub struct GpuScene {
     pub triangles: usize,
     /// The model matrices the SSBOs were last written with (none before the first pass).
     written: Option<Vec<Mat4>>,
+    /// The moved objects' compute pass, where the VBOs fit storage buffers.
+    moved: Option<MovedTransform>,
+}
+
+/// The transform of the objects that moved once the SSBOs are written (ours,
+/// `glsl/mueller2015/transform_moved.comp`): their vertices and normals only, in a compute
+/// kernel that reads the transform pass' position and normal VBOs as storage buffers.
+struct MovedTransform {
+    kernel: Kernel,
+    positions: glow::Buffer,
+    normals: glow::Buffer,
+}
+
+/// Invocations of a work group of `transform_moved.comp` (`TRANSFORM_GROUP`).
+const TRANSFORM_GROUP: u32 = 64;
+
+impl MovedTransform {
+    /// The pass over the VBOs `vbos[0]` (positions) and `vbos[1]` (normals), unless they exceed
+    /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE` (then the vertex-shader pass does it all).
+    fn new(
+        gl: &Arc<Gl>,
+        info: &GlInfo,
+        shaders: &ShaderSource,
+        vbos: &[Owned<glow::Buffer>],
+        bytes: usize,
+    ) -> Result<Option<MovedTransform>> {
+        if bytes as i64 > info.max_ssbo_block_size {
+            return Ok(None);
+        }
+        let defines = Defines::new().set("TRANSFORM_GROUP", TRANSFORM_GROUP);
+        let kernel = Kernel::compute(
+            gl,
+            shaders,
+            "mueller2015/transform_moved.comp",
+            &defines,
+            "transform",
+        )?;
+        Ok(Some(MovedTransform {
+            kernel,
+            positions: vbos[0].raw(),
+            normals: vbos[1].raw(),
+        }))
+    }
+
+    /// One dispatch per moved object, with its model and normal matrices.
+    fn run(
+        &self,
+        gl: &Gl,
+        timers: &mut GpuTimers,
+        moved: &[usize],
+        ranges: &[(i32, i32)],
+        models: &[Mat4],
+    ) {
+        use crate::gl::slots::ssbo;
+        let k = &self.kernel;
+        k.use_program();
+        // SAFETY: binding our own buffers to storage-buffer binding points.
+        unsafe {
+            gl.bind_buffer_base(
+                glow::SHADER_STORAGE_BUFFER,
+                ssbo::TRANSFORM_POSITIONS,
+                Some(self.positions),
+            );
+            gl.bind_buffer_base(
+                glow::SHADER_STORAGE_BUFFER,
+                ssbo::TRANSFORM_NORMALS,
+                Some(self.normals),
+            );
+        }
+        for &i in moved {
+            let (first, count) = ranges[i];
+            let normal = Mat3::from_mat4(models[i]).inverse().transpose();
+            k.set_mat4("modelMatrix", &models[i].to_cols_array());
+            k.set_mat3("normalMatrix", &normal.to_cols_array());
+            k.set_i32("first", first);
+            k.set_i32("count", count);
+            k.dispatch_1d(timers, (count as u32).div_ceil(TRANSFORM_GROUP));
+        }
+    }
 }
 
 fn upload_vbo(gl: &Arc<Gl>, data: &[u8]) -> Result<Owned<glow::Buffer>> {
@@ -318,6 +401,8 @@ impl GpuScene {
         let (fbo, rbo) = point_target(gl)?;
         let textures = upload_textures(gl, info, scene)?;
         let vertex_views = vertex_views(gl, info, &ssbos)?;
+        let vbo_bytes = std::mem::size_of_val(data.positions.as_slice());
+        let moved = MovedTransform::new(gl, info, shaders, &vbos, vbo_bytes)?;
         crate::gl::check_error(gl, "uploading the scene")?;
         Ok(GpuScene {
             vao,
@@ -333,6 +418,7 @@ impl GpuScene {
             vertex_views,
             triangles: scene.triangle_count(),
             written: None,
+            moved,
         })
     }
 
@@ -378,6 +464,13 @@ impl GpuScene {
             return;
         }
         self.bind(gl);
+        if self.written.is_some() {
+            if let Some(m) = &self.moved {
+                m.run(gl, timers, &moved, &self.ranges, models);
+                self.written = Some(models.to_vec());
+                return;
+            }
+        }
         let k = &self.transform;
         k.use_program();
         // a pass whose vertex shader stores into the scene's buffers, which the last frame's
@@ -391,8 +484,6 @@ impl GpuScene {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, Some(self.fbo.raw()));
                 gl.enable(glow::RASTERIZER_DISCARD);
                 k.set_i32("transformLights", 0);
-                // the first frame writes every attribute, later ones a moved object's geometry
-                k.set_i32("geometryOnly", self.written.is_some() as i32);
                 gl.bind_vertex_array(Some(self.vao.raw()));
                 for &i in &moved {
                     let (first, count) = self.ranges[i];
