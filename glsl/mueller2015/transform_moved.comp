@@ -21,12 +21,28 @@ uniform mat3 normalMatrix;
 uniform int first;
 uniform int count;
 
+// The same floats as R32F image buffers over the VBOs (TRANSFORM_VIEWS, where the GL has the
+// units and texels): llvmpipe loads a storage buffer lane by lane, which was three quarters of
+// this kernel (docs/design/bvh.md, "Moving objects").
+#if TRANSFORM_VIEWS
+layout(r32f, binding = IMAGE_TRANSFORM_POSITIONS) readonly uniform imageBuffer positionTexels;
+layout(r32f, binding = IMAGE_TRANSFORM_NORMALS) readonly uniform imageBuffer normalTexels;
+vec3 objectVector(int i, bool normal)
+{
+    int k = 3 * i;
+    return normal ? vec3(imageLoad(normalTexels, k).x, imageLoad(normalTexels, k + 1).x,
+                         imageLoad(normalTexels, k + 2).x)
+                  : vec3(imageLoad(positionTexels, k).x, imageLoad(positionTexels, k + 1).x,
+                         imageLoad(positionTexels, k + 2).x);
+}
+#else
 vec3 objectVector(int i, bool normal)
 {
     return normal ? vec3(objectNormals[3 * i], objectNormals[3 * i + 1], objectNormals[3 * i + 2])
                   : vec3(objectPositions[3 * i], objectPositions[3 * i + 1],
                          objectPositions[3 * i + 2]);
 }
+#endif
 
 void main()
 {

@@ -173,19 +173,14 @@ impl Ssbo {
         unit: u32,
         format: u32,
     ) -> Result<Option<Owned<glow::Texture>>> {
-        // SAFETY: a limit query on a current context.
-        let max_texels = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
-        if unit as i64 >= max_image_units as i64 || (self.bytes / 16) as i64 > max_texels {
-            return Ok(None);
-        }
-        // SAFETY: a texture over our own buffer on a current context.
-        unsafe {
-            let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(t.raw()));
-            gl.tex_buffer(format, self.buffer.raw());
-            gl.bind_texture(glow::TEXTURE_BUFFER, None);
-            Ok(Some(t))
-        }
+        buffer_view(
+            gl,
+            self.buffer.raw(),
+            self.bytes / 16,
+            max_image_units,
+            unit,
+            format,
+        )
     }
 
     /// Bind `bytes` bytes from `offset` (a multiple of `GlInfo::ssbo_offset_alignment`).
@@ -243,6 +238,33 @@ fn read_buffer(gl: &Gl, buffer: glow::Buffer, bytes: &mut [u8]) {
 pub fn bind_image_unit(gl: &Gl, unit: u32, texture: glow::Texture, access: u32, format: u32) {
     // SAFETY: binding an existing texture to an image unit.
     unsafe { gl.bind_image_texture(unit, Some(texture), 0, false, 0, access, format) };
+}
+
+/// A buffer texture of `format` over `buffer` (`texels` of that format), no copy, for a kernel
+/// to read as an image buffer at image unit `unit`; `None` where `unit` is beyond
+/// `GL_MAX_IMAGE_UNITS` or the texels beyond `GL_MAX_TEXTURE_BUFFER_SIZE` (the kernel reads the
+/// buffer as a storage buffer instead). See [`Ssbo::texel_view`].
+pub fn buffer_view(
+    gl: &Arc<Gl>,
+    buffer: glow::Buffer,
+    texels: usize,
+    max_image_units: i32,
+    unit: u32,
+    format: u32,
+) -> Result<Option<Owned<glow::Texture>>> {
+    // SAFETY: a limit query on a current context.
+    let max_texels = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE) } as i64;
+    if unit as i64 >= max_image_units as i64 || texels as i64 > max_texels {
+        return Ok(None);
+    }
+    // SAFETY: a texture over our own buffer on a current context.
+    unsafe {
+        let t = Owned::new(gl, gl.create_texture().map_err(|e| anyhow!(e))?);
+        gl.bind_texture(glow::TEXTURE_BUFFER, Some(t.raw()));
+        gl.tex_buffer(format, buffer);
+        gl.bind_texture(glow::TEXTURE_BUFFER, None);
+        Ok(Some(t))
+    }
 }
 
 /// A 2D texture used as an image (RGBA32F or RGBA32UI).

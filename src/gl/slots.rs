@@ -130,6 +130,11 @@ slot_table! {
         /// the same way by its records' pass (glsl/bvh/refit_records.comp)
         REFIT_TOPOLOGY = 14,
         REFIT_BOXES = 15,
+        /// the transform pass' object-space positions and normals (its VBOs, tightly packed
+        /// floats) read as R32F image buffers by the moved objects' compute pass
+        /// (glsl/mueller2015/transform_moved.comp, TRANSFORM_VIEWS)
+        TRANSFORM_POSITIONS = 16,
+        TRANSFORM_NORMALS = 17,
         /// the SAH BVH's per-pixel records (the SSBO PIXEL_RECORDS) read as an RGBA32UI image
         /// buffer by glsl/bvh/pixel_counts.comp (RECORD_IMAGE), the same way, where
         /// `GL_MAX_IMAGE_UNITS` has the unit
@@ -221,6 +226,8 @@ mod tests {
             "IMAGE_SCENE_VERTEX",
             "IMAGE_REFIT_TOPOLOGY",
             "IMAGE_REFIT_BOXES",
+            "IMAGE_TRANSFORM_POSITIONS",
+            "IMAGE_TRANSFORM_NORMALS",
         ];
         for (table, units) in [(image::TABLE, 8), (sampler::TABLE, 16)] {
             for (name, slot) in table {

@@ -19,7 +19,8 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use glam::{Mat3, Mat4};
 use glow::HasContext;
 
-use crate::gl::resources::{GpuTimers, Owned, Ssbo};
+use crate::gl::resources::{bind_image_unit, buffer_view, GpuTimers, Owned, Ssbo};
+use crate::gl::slots;
 use crate::gl::{Defines, Gl, GlInfo, Kernel, ShaderSource};
 use crate::scene::{budget, Scene};
 
@@ -58,6 +59,8 @@ struct MovedTransform {
     kernel: Kernel,
     positions: glow::Buffer,
     normals: glow::Buffer,
+    /// the same as R32F image buffers (`TRANSFORM_VIEWS`), where the GL has the units
+    views: Option<[Owned<glow::Texture>; 2]>,
 }
 
 /// Invocations of a work group of `transform_moved.comp` (`TRANSFORM_GROUP`).
@@ -76,7 +79,27 @@ impl MovedTransform {
         if bytes as i64 > info.max_ssbo_block_size {
             return Ok(None);
         }
-        let defines = Defines::new().set("TRANSFORM_GROUP", TRANSFORM_GROUP);
+        let floats = bytes / 4;
+        let view = |vbo: &Owned<glow::Buffer>, unit| {
+            buffer_view(
+                gl,
+                vbo.raw(),
+                floats,
+                info.max_image_units,
+                unit,
+                glow::R32F,
+            )
+        };
+        let views = match (
+            view(&vbos[0], slots::image::TRANSFORM_POSITIONS)?,
+            view(&vbos[1], slots::image::TRANSFORM_NORMALS)?,
+        ) {
+            (Some(p), Some(n)) => Some([p, n]),
+            _ => None,
+        };
+        let defines = Defines::new()
+            .set("TRANSFORM_GROUP", TRANSFORM_GROUP)
+            .set("TRANSFORM_VIEWS", views.is_some() as i32);
         let kernel = Kernel::compute(
             gl,
             shaders,
@@ -88,6 +111,7 @@ impl MovedTransform {
             kernel,
             positions: vbos[0].raw(),
             normals: vbos[1].raw(),
+            views,
         }))
     }
 
@@ -115,6 +139,17 @@ impl MovedTransform {
                 ssbo::TRANSFORM_NORMALS,
                 Some(self.normals),
             );
+        }
+        if let Some([p, n]) = &self.views {
+            let (access, format) = (glow::READ_ONLY, glow::R32F);
+            bind_image_unit(
+                gl,
+                slots::image::TRANSFORM_POSITIONS,
+                p.raw(),
+                access,
+                format,
+            );
+            bind_image_unit(gl, slots::image::TRANSFORM_NORMALS, n.raw(), access, format);
         }
         for &i in moved {
             let (first, count) = ranges[i];
