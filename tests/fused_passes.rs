@@ -192,3 +192,46 @@ fn eye_rays_in_place_without_aovs() {
     assert_eq!(four.color, fused.color, "bunny_low without AOVs: colours");
     assert_same_counts(&four, &fused, "bunny_low without AOVs");
 }
+
+/// Two frames of `opts` on `scene` — the second with object 0 turned (a refit and the moved
+/// objects' transform) — on a GL that reports `units` image units.
+fn two_frames(scene: &Scene, opts: &RenderOptions, units: i32) -> (Frame, Frame) {
+    let ctx = context();
+    let mut info = ctx.info.clone();
+    info.max_image_units = units;
+    let shaders = gpgpu_rt::gl::ShaderSource::default();
+    let mut t = gpgpu_rt::pipeline::mueller2015::RayTracer::new(
+        ctx.gl.clone(),
+        &info,
+        scene,
+        &shaders,
+        opts.clone(),
+    )
+    .expect("tracer");
+    let still = t.render(&scene.camera).expect("frame");
+    let turned = scene.objects[0].model * glam::Mat4::from_rotation_y(0.4);
+    t.set_model(0, turned).unwrap();
+    (still, t.render(&scene.camera).expect("frame"))
+}
+
+#[test]
+fn the_storage_buffer_reads_where_the_gl_has_only_8_image_units() {
+    // GL 4.5 guarantees 8 image units: there the kernels read the scene, the pixel records,
+    // the refit's topology and boxes and the transform's VBOs as storage buffers, not through
+    // the image-buffer views of units 8–17 — the same frames, still and after a turn
+    let mut scene = load("teapot1.toml");
+    ring_of_lights(&mut scene, 2);
+    for fused_passes in [false, true] {
+        let opts = RenderOptions {
+            fused_passes,
+            ..bvh(48, 40, 1)
+        };
+        let (a, b) = (two_frames(&scene, &opts, 192), two_frames(&scene, &opts, 8));
+        for (x, y, frame) in [(&a.0, &b.0, "still"), (&a.1, &b.1, "turned")] {
+            let what = format!("fused {fused_passes}, {frame}, 8 image units");
+            assert_same_frame(x, y, &what);
+            assert_same_counts(x, y, &what);
+        }
+        assert_ne!(a.0.color, a.1.color, "the turn changed nothing");
+    }
+}
