@@ -10,8 +10,8 @@
 // shading, and stores and loads the shadow flags; on llvmpipe each stored texel costs more
 // than a node step (docs/design/frame.md). Here the values stay in registers; a pass stores
 // the ray state only where a reflection pass follows (storeRayState), and the first pass
-// the AOVs' texels where the host keeps AOVs (STORE_AOVS). The eye rays (Listing 11) and the
-// blocks' entry points (bvh/entry.comp) are still kernels of their own before it.
+// the AOVs' texels where the host keeps AOVs (STORE_AOVS). The blocks' entry points
+// (bvh/entry.comp) run before it; without AOVs both compute the eye rays in place (pass_ray.glsl).
 //
 // The work counts go to per-pixel records (bvh/records.glsl), which pixel_counts.comp adds to
 // the counter bank of each ray kind: the closest-hit search's packed in words 0–1 of record 0
