@@ -385,7 +385,9 @@ impl DesignArgs {
                 grid: self.grid.options(),
                 triangles_per_dispatch: None,
                 light_samples: self.soft.samples(),
-                fused_passes: self.fused_passes,
+                // only for the row it belongs to: the viewer's keys and `parity` switch rows
+                // with the command line's options (which refuse it beside any other row)
+                fused_passes: self.fused_passes && row.options().any(|o| o == "fused-passes"),
             }),
         }
     }
@@ -402,4 +404,26 @@ fn given(matches: Option<&ArgMatches>) -> Vec<String> {
         .filter(|o| m.value_source(&o.replace('-', "_")) == Some(ValueSource::CommandLine))
         .map(str::to_string)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--fused-passes` reaches the SAH BVH's design only: the viewer switching to another
+    /// tracer with it set gets that tracer's four kernels, not a refusal.
+    #[test]
+    fn fused_passes_only_for_the_sah_bvh() {
+        let fused = |name: &str| {
+            let row = design::row(name).unwrap();
+            let args = DesignArgs::of_row(row, &["--fused-passes"]).unwrap();
+            match args.tracer_design(row, (8, 8), 0, false) {
+                Design::Mueller2015(o) => o.fused_passes,
+                _ => panic!("{name}: not Müller 2015's pipeline"),
+            }
+        };
+        assert!(fused("bvh"));
+        assert!(!fused("grid-exact"));
+        assert!(!fused("base"));
+    }
 }
