@@ -27,12 +27,11 @@ fn both(scene: &Scene, opts: &RenderOptions) -> (Frame, Frame) {
         fused_passes: true,
         ..opts.clone()
     };
-    let tracer = ray_tracer(&ctx, scene, fused);
+    let mut tracer = ray_tracer(&ctx, scene, fused);
     assert!(
         tracer.settings().contains_key("fused_passes"),
         "the fused pass was not selected"
     );
-    let mut tracer = tracer;
     let fused = tracer.render(&scene.camera).expect("frame");
     assert!(
         fused.stats.gpu_ms.contains_key("fused_pass")

@@ -13,7 +13,7 @@
 // (bvh/hit_record.glsl), −1 for none.
 int closestHitRecord = -1;
 
-// One record per pixel, a PixelRecord (src/pipeline/mueller2015/records.rs): xy its counts
+// One record per pixel (three with the fused pass: bvh/fused_pass.comp), a PixelRecord (src/pipeline/mueller2015/records.rs): xy its counts
 // (packCounts: tests_truncated, nodes_traced), z its hit record (hit; intersect1 only), w
 // unused. One store per invocation: on llvmpipe every store costs a loop over the 8 lanes per
 // component and about as much again for the store itself (docs/design/frame.md).

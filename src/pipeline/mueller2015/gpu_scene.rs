@@ -42,8 +42,8 @@ pub struct GpuScene {
     fbo: Owned<glow::Framebuffer>,
     _rbo: Owned<glow::Renderbuffer>,
     textures: Owned<glow::Texture>,
-    /// The normals, colours and lights SSBOs viewed as RGBA32F buffer textures (image unit, view),
-    /// where the GL has the image units: [`vertex_images`](GpuScene::vertex_images).
+    /// The normals, colours, lights and vertex SSBOs viewed as RGBA32F buffer textures (image
+    /// unit, view), where the GL has the image units: [`vertex_images`](GpuScene::vertex_images).
     vertex_views: Vec<(u32, Owned<glow::Texture>)>,
     pub triangles: usize,
     /// The model matrices the SSBOs were last written with (none before the first pass).

@@ -31,7 +31,8 @@ pub struct PixelRecord {
     /// bytes 8–11 (intersect1 only): the hit record, the word address of the closest hit's
     /// [`LeafTriangle`](crate::accel::bvh::LeafTriangle) in the BVH's word buffer (−1: no hit)
     pub hit: i32,
-    /// bytes 12–15: unused
+    /// bytes 12–15: unused (the fused pass packs the first point light's feeler counts in
+    /// bytes 8–15 of its record 0 instead of a hit record: [`Record::PackedHigh`])
     pub unused: u32,
 }
 const _: () = assert!(std::mem::size_of::<PixelRecord>() == 16);
@@ -48,8 +49,9 @@ pub enum Record {
     Plain(u32),
 }
 
-/// Records per pixel with `--fused-passes`: the closest hit's, the first light's feelers',
-/// the other lights' feelers' (`glsl/bvh/fused_pass.comp`).
+/// Records per pixel with `--fused-passes` (`glsl/bvh/fused_pass.comp`): record 0 the closest
+/// hit's counts (and a first point light's feelers' beside them), record 1 an area light's
+/// samples' as the first light, record 2 the other lights' feelers'.
 pub const FUSED_RECORDS: u32 = 3;
 
 /// The work group size of `pixel_counts.comp` (its `COUNT_GROUP`).
