@@ -221,6 +221,9 @@ pub struct RayTracer {
     accel: Box<dyn Accelerator>,
     /// The hit records and per-pixel counts, for an accelerator that uses them.
     records: Option<Records>,
+    /// `--fused-passes`: what the fused kernel was compiled for, which decides where its
+    /// counts lie (`glsl/bvh/fused_pass.comp`)
+    fused: Option<FusedPasses>,
     last: Option<FrameStats>,
 }
 
@@ -371,6 +374,7 @@ impl RayTracer {
             entry,
             accel,
             records,
+            fused: build.fused,
             last: None,
             gl,
         };
@@ -489,16 +493,18 @@ impl RayTracer {
             .as_ref()
             .expect("the fused pass stores records");
         r.add_record_counts(f.timers, "intersect1", Record::Packed(0));
-        let lights = l.lights.len() + l.area_lights.len();
-        let first = match l.lights.is_empty() {
-            false => Record::PackedHigh(0),
-            true => Record::Plain(1),
+        let fused = self
+            .fused
+            .expect("fused_pass runs with --fused-passes only");
+        let first = match fused.first_light_point {
+            true => Record::PackedHigh(0),
+            false => Record::Plain(1),
         };
         let kinds = [
             (Bank::occluded(0), first),
             (Bank::occluded(1), Record::Plain(2)),
         ];
-        for (bank, record) in kinds.into_iter().take(lights.min(2)) {
+        for (bank, record) in kinds.into_iter().take(fused.lights.min(2) as usize) {
             self.counters.bind(&self.gl, &mut self.timers, bank);
             r.add_record_counts(&mut self.timers, "intersect2", record);
         }
