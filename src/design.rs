@@ -206,7 +206,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with our SAH BVH",
         select: &[("tracer", "bvh"), ("bvh-variant", "sah")],
         accel: Some(&accel::bvh::ENTRY),
-        options: &[MUELLER, &["bvh-variant", "fused-passes"]],
+        options: &[MUELLER, &["bvh-variant", "fused-passes", "bvh-instances"]],
         glsl: &["mueller2015", "bvh"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD + host_bytes::SAH_BVH,
     },
@@ -346,6 +346,7 @@ impl Design {
                 triangles_per_dispatch: None,
                 light_samples: defaults::LIGHT_SAMPLES,
                 fused_passes: false,
+                bvh_instances: false,
             }),
             (Pipeline::Wagner2018, _) => Design::Wagner2018(WagnerOptions {
                 width,

@@ -43,6 +43,8 @@ fn every_kernel_compiles_without_warnings() {
                 shadow_flags,
                 // the SAH BVH's fused pass (bvh/fused_pass.comp) in one of the two runs
                 fused_passes: entry.tracer == TracerKind::Bvh && shadow_flags == ShadowFlags::Rgba,
+                // and its two levels (BVH_INSTANCES) in the other
+                bvh_instances: entry.tracer == TracerKind::Bvh && shadow_flags == ShadowFlags::Bits,
                 ..common::options(8, 8, 1)
             };
             let mut t =

@@ -61,10 +61,9 @@ vec3 pointLightColor(int l) { return lightColor[l].rgb; }
 #endif
 #include "../mueller2015/shade.glsl"
 
-// The ray of the walk and what triangleHit does with a triangle: with anyHit unset, keep the
+// What triangleHit does with a triangle of the walk (its ray: rayO, rayD of bvh/traverse.glsl): with anyHit unset, keep the
 // closest hit (bvh/intersect1.comp's triangleHit); with it set, end the walk at the first
 // triangle on the feeler's segment (bvh/intersect2.comp's).
-vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 int rayLast = -1;
 bool anyHit = false;
 float rayLight = 0.0;
@@ -90,8 +89,8 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
-    rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
-    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
+    rayLast = lastTriID; rayLight = lightDistance;
+    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
 }
 
 // The work counts of one kind so far, unpacked (tests, nodes, rays, truncated), and the
@@ -175,9 +174,10 @@ void trace(ivec2 storePos)
     if (rayState > 0.0) {
         raysTraced = 1u;
         vec3 ro = originState.xyz, rd = dirTri.xyz;
-        rayO = ro; rayD = rd; rayLast = int(dirTri.w);
+        rayLast = int(dirTri.w);
         bestT = 1.0 / 0.0; // +inf
-        traverse(ro, rd, 0.0, bestT, bvhRecord(entryTexel(storePos >> 3)).xyz);
+        float limit = bestT;
+        traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)).xyz);
         closestHitRecord = bestAt;
         primary = takeCounts();
 

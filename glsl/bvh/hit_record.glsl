@@ -4,7 +4,9 @@
 // of (t, triangle id, u, v) — on llvmpipe each stored component is a loop over the 8 lanes —
 // and bvh/evaluate_hit.comp finds the hit again here: the same Algorithm 1 (intersectEdges of
 // common/intersect.glsl) on the same ray and the same words as the walk's triangleHit, so the
-// same t, u and v.
+// same t, u and v. With two levels (BVH_INSTANCES) the leaf triangle is in its object's space
+// and its zero1 word (t1.w) is its instance + 1 (src/accel/bvh/instances.rs): the ray is taken
+// there as the walk took it (instanceRay); with one level that word is 0.
 #include "words.glsl"
 
 void hitFromRecord(int at, vec3 ro, vec3 rd, out float t, out int id, out float u, out float v)
@@ -15,6 +17,8 @@ void hitFromRecord(int at, vec3 ro, vec3 rd, out float t, out int id, out float 
     if (at < 0) return;
     uvec4 t0 = bvhTexel(at), t1 = bvhTexel(at + 4), t2 = bvhTexel(at + 8);
     id = int(t0.w);
-    intersectEdges(ro, rd, uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
+    vec3 o = ro, d = rd;
+    if (t1.w != 0u) instanceRay(int(t1.w) - 1, ro, rd, o, d);
+    intersectEdges(o, d, uintBitsToFloat(t0.xyz), uintBitsToFloat(t1.xyz),
                    uintBitsToFloat(t2.xyz), t, u, v);
 }

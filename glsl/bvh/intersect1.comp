@@ -17,9 +17,9 @@
 // the entry point of each 8×8 block of rays (bvh/entry.comp, run before this kernel)
 #include "entries.glsl"
 
-// the ray and its closest hit so far, for triangleHit: its distance, triangle id and the word
-// address of its leaf triangle (the hit record; u and v are found again from it)
-vec3 rayO = vec3(0.0), rayD = vec3(0.0);
+// the ray's last triangle and its closest hit so far, for triangleHit: its distance, triangle
+// id and the word address of its leaf triangle (the hit record; u and v are found again from
+// it); the ray itself: rayO, rayD of bvh/traverse.glsl
 int rayLast = -1;
 float bestT = 0.0;
 int bestID = -1;
@@ -43,9 +43,10 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
                 inout float t_min, inout int triID, inout float hit_u, inout float hit_v)
 {
-    rayO = ro; rayD = rd; rayLast = lastTriID;
+    rayLast = lastTriID;
     bestT = t_min; bestID = triID;
-    traverse(ro, rd, 0.0, bestT, bvhRecord(entryTexel(storePos >> 3)).xyz);
+    float limit = bestT;
+    traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)).xyz);
     t_min = bestT; triID = bestID;
     closestHitRecord = bestAt;
 }

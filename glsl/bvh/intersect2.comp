@@ -13,8 +13,8 @@
 #include "records.glsl"
 #include "traverse.glsl"
 
-// the feeler, for triangleHit
-vec3 rayO = vec3(0.0), rayD = vec3(0.0);
+// the feeler's last triangle and the light's distance, for triangleHit (the feeler itself:
+// rayO, rayD of bvh/traverse.glsl)
 int rayLast = -1;
 float rayLight = 0.0;
 
@@ -29,8 +29,8 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
-    rayO = ro; rayD = rd; rayLast = lastTriID; rayLight = lightDistance;
-    return traverse(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
+    rayLast = lastTriID; rayLight = lightDistance;
+    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
 }
 
 #include "../common/intersect2_main.glsl"

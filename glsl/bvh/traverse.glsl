@@ -67,12 +67,18 @@
 // node < end and guard < bound.
 //
 // The including kernel defines triangleHit (declared below), which tests one leaf triangle
-// (its word address, id, v0 and edges), may lower the limit, and returns true to end the walk.
+// (its word address, id, v0 and edges) against the walk's ray (rayO, rayD: in the space of the
+// tree walked), may lower the limit, and returns true to end the walk. The kernels walk the
+// scene by traverseScene (below): one tree, or with BVH_INSTANCES the tree of every object
+// whose box the ray enters.
 
 #include "words.glsl"
 #include "octant.glsl"
 
 bool triangleHit(int at, int id, vec3 v0, vec3 edge1, vec3 edge2, inout float limit);
+
+// the ray of the walk, in the space of the tree walked (traverseScene sets it), for triangleHit
+vec3 rayO = vec3(0.0), rayD = vec3(0.0);
 
 // the word address of the first leaf triangle (after the records)
 int triangleBase = 0;
@@ -157,26 +163,27 @@ bool leafTriangles(inout int slot, int slotEnd, inout float limit)
     return false;
 }
 
-// The walk along ro + t·rd for tMin <= t <= limit; true if triangleHit ended it. `entry`: the
-// entry point of the ray's block (bvh/entry.comp: its octant + 1, first record and the texel
-// after its subtree) — a ray of that octant walks that subtree only, the others (and every ray
-// where entry.x is 0, no entry, as in intersect2) the whole tree.
-bool traverse(vec3 ro, vec3 rd, float tMin, float limit, uvec3 entry)
+// The walk along ro + t·rd for tMin <= t <= limit through the tree whose header is at texel
+// `base` (0 with one level); true if triangleHit ended it; `limit` as triangleHit left it.
+// `entry`: the entry point of the ray's block (bvh/entry.comp: its octant + 1, first record and
+// the texel after its subtree) — a ray of that octant walks that subtree only, the others (and
+// every ray where entry.x is 0, no entry, as in intersect2) the whole tree.
+bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int base)
 {
     vec3 inv = safeInverses(rd);
     int octant = rayOctant(inv);
     // the header: the node count N and the grid (plane q of axis a at origin[a] + q·step[a])
-    uvec4 header = bvhTexel(0);
-    vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhTexel(4).xyz);
+    uvec4 header = bvhRecord(base);
+    vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhRecord(base + 1).xyz);
     int nodes = int(header.x);
-    triangleBase = BVH_HEADER_WORDS + 8 * BVH_NODE_WORDS * nodes;
+    triangleBase = 4 * base + BVH_HEADER_WORDS + 8 * BVH_NODE_WORDS * nodes;
     // a slab's distances: q·gridA + gridB for its planes q (boxEntered), the factors clamped to
     // the finite floats (an overflow to ±inf could make 0·inf or inf − inf; Grid::ray)
     const float finite = 3.40282347e38;
     vec3 gridA = clamp(gridStep * inv, -finite, finite);
     vec3 gridB = clamp((gridOrigin - ro) * inv, -finite, finite);
     // the root: the first record of the octant's copy; end: the texel after its last
-    int node = BVH_HEADER_WORDS / 4 + octant * nodes;
+    int node = base + BVH_HEADER_WORDS / 4 + octant * nodes;
     int end = node + nodes;
     if (int(entry.x) == octant + 1) {
         node = int(entry.y);
@@ -216,4 +223,37 @@ bool traverse(vec3 ro, vec3 rd, float tMin, float limit, uvec3 entry)
     // (slot < slotEnd: llvmpipe's loop limit can still cut a triangle loop short)
     if (node < end || slot < slotEnd) truncated = 1u;
     return false;
+}
+
+// The scene's walk along ro + t·rd for tMin <= t <= limit (the kernels' entry to the walk);
+// true if triangleHit ended it; `limit` as triangleHit left it. One level: the one tree, from
+// `entry`. Two levels (BVH_INSTANCES, ours: src/accel/bvh/instances.rs): every instance in
+// turn, in the list's order — its world box tested (Listing 4.5 in floats; counted as a node
+// visited), and where the ray enters it at some tMin <= t <= limit, the object's tree walked
+// from its root with the ray in the object's space (instanceRay; no block entries), the limit
+// carried from one tree to the next. The thesis' scenes have 2–7 objects; a list of many would
+// want a tree over the instances (docs/design/bvh.md, "Two levels").
+bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry)
+{
+#if BVH_INSTANCES
+    int count = int(bvhRecord(0).x);
+    vec3 inv = safeInverses(rd);
+    for (int k = 0; k < count; k++) {
+        uvec4 lo = bvhRecord(1 + k * BVH_INSTANCE_TEXELS);
+        vec3 hi = uintBitsToFloat(bvhRecord(2 + k * BVH_INSTANCE_TEXELS).xyz);
+        vec3 t0 = (uintBitsToFloat(lo.xyz) - ro) * inv, t1 = (hi - ro) * inv;
+        vec3 tNear = min(t0, t1), tFar = max(t0, t1);
+        float enter = max(max(tNear.x, tNear.y), max(tNear.z, tMin));
+        float leave = min(min(tFar.x, tFar.y), min(tFar.z, limit));
+        nodesVisited++;
+        if (enter <= leave) {
+            instanceRay(k, ro, rd, rayO, rayD);
+            if (traverse(rayO, rayD, tMin, limit, uvec3(0u), int(lo.w))) return true;
+        }
+    }
+    return false;
+#else
+    rayO = ro; rayD = rd;
+    return traverse(ro, rd, tMin, limit, entry, 0);
+#endif
 }

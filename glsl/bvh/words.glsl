@@ -27,4 +27,20 @@ void recordPlanes(uvec4 record, out vec3 near, out vec3 far)
     near = vec3(ivec3(record.x & 0xffffu, record.x >> 16u, record.y & 0xffffu));
     far = vec3(ivec3(record.y >> 16u, record.z & 0xffffu, record.z >> 16u));
 }
+
+// Two levels (ours; BVH_INSTANCES, src/accel/bvh/instances.rs): texel 0 holds the instance
+// count, instance k's InstanceRecord (BVH_INSTANCE_TEXELS texels) starts at texel
+// 1 + k·BVH_INSTANCE_TEXELS — its world box (lo, and its tree's texel in lo's w; hi), then the
+// rows of the inverse of its model matrix. The ray ro + t·rd in instance k's object space, with
+// the same t (an affine map, the direction not normalised): one function for the walk
+// (bvh/traverse.glsl) and the hit record (bvh/hit_record.glsl), so that both find the same t.
+void instanceRay(int k, vec3 ro, vec3 rd, out vec3 o, out vec3 d)
+{
+    int at = 1 + k * BVH_INSTANCE_TEXELS + 2;
+    vec4 r0 = uintBitsToFloat(bvhRecord(at));
+    vec4 r1 = uintBitsToFloat(bvhRecord(at + 1));
+    vec4 r2 = uintBitsToFloat(bvhRecord(at + 2));
+    o = vec3(dot(r0.xyz, ro) + r0.w, dot(r1.xyz, ro) + r1.w, dot(r2.xyz, ro) + r2.w);
+    d = vec3(dot(r0.xyz, rd), dot(r1.xyz, rd), dot(r2.xyz, rd));
+}
 #endif

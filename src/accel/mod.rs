@@ -177,6 +177,9 @@ pub struct BuildContext<'a> {
     /// The scene's vertex attributes and lights are bound as image buffers too
     /// (`SCENE_IMAGES`, `GpuScene::vertex_images`).
     pub scene_images: bool,
+    /// `--bvh-instances`: the SAH BVH as a tree per object under instances
+    /// (`bvh::instances`), which moving objects update without a refit.
+    pub bvh_instances: bool,
 }
 
 /// What a fused pass kernel (`glsl/bvh/fused_pass.comp`) needs to know at compile time.

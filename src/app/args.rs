@@ -267,6 +267,11 @@ pub struct DesignArgs {
     /// counts, without storing and reloading the ray state between them.
     #[arg(long)]
     pub fused_passes: bool,
+    /// With --tracer bvh (sah): a tree per object, built once in object space, under the
+    /// objects' instances (ours: two levels) instead of one tree over the world-space scene —
+    /// an object that moves updates its instance, no refit or rebuild.
+    #[arg(long)]
+    pub bvh_instances: bool,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
     /// scene's).
     #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
@@ -388,6 +393,7 @@ impl DesignArgs {
                 // only for the row it belongs to: the viewer's keys and `parity` switch rows
                 // with the command line's options (which refuse it beside any other row)
                 fused_passes: self.fused_passes && row.options().any(|o| o == "fused-passes"),
+                bvh_instances: self.bvh_instances && row.options().any(|o| o == "bvh-instances"),
             }),
         }
     }

@@ -541,6 +541,20 @@ impl TextureBuffers {
         true
     }
 
+    /// Overwrite the first words of buffer `index` (in upload order) with `words`, which must
+    /// fit in it. Dispatches issued later read them (GL orders a buffer update before the
+    /// commands after it).
+    pub fn write_u32(&self, gl: &Gl, index: usize, words: &[u32]) {
+        let t = &self.0[index].0;
+        assert!(4 * words.len() <= t.bytes, "a write within the buffer");
+        // SAFETY: an update of our own buffer within its size.
+        unsafe {
+            gl.bind_buffer(glow::TEXTURE_BUFFER, Some(t.buffer.raw()));
+            gl.buffer_sub_data_u8_slice(glow::TEXTURE_BUFFER, 0, bytemuck::cast_slice(words));
+            gl.bind_buffer(glow::TEXTURE_BUFFER, None);
+        }
+    }
+
     /// For tests: the 32-bit words of buffer `index` (in upload order), as kernels left them.
     pub fn read_u32(&self, gl: &Gl, index: usize) -> Vec<u32> {
         let t = &self.0[index].0;

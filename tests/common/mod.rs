@@ -40,6 +40,7 @@ pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
         triangles_per_dispatch: None,
         light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
         fused_passes: false,
+        bvh_instances: false,
     }
 }
 

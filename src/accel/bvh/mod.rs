@@ -30,9 +30,11 @@ use crate::gl::{Gl, GlInfo, Kernel};
 use crate::scene::{transform_triangles, CameraRays, Scene};
 
 mod build;
+pub mod instances;
 pub mod layout;
 mod planes;
 pub mod refit;
+pub use instances::{InstanceRecord, Instances, INSTANCE_TEXELS};
 pub use layout::{
     block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
     NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
@@ -55,8 +57,9 @@ pub const ENTRY: Entry = Entry {
 /// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
 /// `glsl/bvh/entry.comp` to write its entry point into ([`EntryTexel`]), 0 (no entry) until it
 /// does: the same image unit, so the BVH binds no more than GL 4.5's 8.
-fn upload(gl: &Arc<Gl>, bvh: &BvhTree, blocks: u32) -> Result<TextureBuffers> {
-    let mut words = bvh.gpu_words();
+/// With `--bvh-instances` the words are [`Instances::gpu_words`]'s, and no kernel writes the
+/// entries (every walk starts at its tree's root).
+fn upload(gl: &Arc<Gl>, mut words: Vec<u32>, blocks: u32) -> Result<TextureBuffers> {
     let entries = vec![EntryTexel::zeroed(); blocks as usize];
     words.extend_from_slice(bytemuck::cast_slice(&entries));
     let data = TexelData::new;
@@ -94,9 +97,16 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// per-pixel counts (`Accelerator::records`, `glsl/bvh/records.glsl`), in one store of two 64-bit
 /// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); on llvmpipe
 /// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
-/// `glsl/bvh/intersect1_main.glsl`).
-fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 9] {
+/// `glsl/bvh/intersect1_main.glsl`); with `--bvh-instances` the walks start at the instances
+/// (`BVH_INSTANCES`, [`instances`]).
+fn kernel_defines(
+    info: &GlInfo,
+    blocks: (u32, u32),
+    two_level: bool,
+) -> [(&'static str, String); 11] {
     [
+        ("BVH_INSTANCES", (two_level as i32).to_string()),
+        ("BVH_INSTANCE_TEXELS", INSTANCE_TEXELS.to_string()),
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
@@ -214,6 +224,10 @@ pub struct Bvh {
     walks_per_record: u64,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
+    /// `--bvh-instances`: a tree per object under the instances ([`instances`]), built once
+    two_level: bool,
+    /// with `two_level`, the objects' trees once built
+    instances: Option<Instances>,
     /// the model matrices of the tree as uploaded, built or refitted (`None`: not built yet)
     built_for: Option<Vec<Mat4>>,
     buffers: Option<TextureBuffers>,
@@ -234,7 +248,7 @@ impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
-        let defs = kernel_defines(b.info, blocks);
+        let defs = kernel_defines(b.info, blocks, b.bvh_instances);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             // timed as a part of intersect1: the closest-hit search of the passes
@@ -262,6 +276,8 @@ impl Bvh {
                 .iter()
                 .map(|o| o.mesh.positions.clone())
                 .collect(),
+            two_level: b.bvh_instances,
+            instances: None,
             built_for: None,
             buffers: None,
             stats: BvhStats::default(),
@@ -291,7 +307,7 @@ impl Bvh {
                 self.walks_per_record
             );
         }
-        let buffers = upload(&self.gl, &bvh, self.blocks)?;
+        let buffers = upload(&self.gl, bvh.gpu_words(), self.blocks)?;
         let m = &self.moving;
         let refit = Refit::new(&self.gl, &bvh, m.max_block, m.max_units)?;
         // the old buffers (if any) drop after the new ones are made, as before
@@ -305,6 +321,37 @@ impl Bvh {
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - bvh.stats.build_ms;
         self.built_for = Some(models.to_vec());
         self.builds += 1;
+        Ok(())
+    }
+
+    /// `--bvh-instances`: build every object's tree and upload them under the instances the
+    /// first time; after that write only the instances (their world boxes and inverse model
+    /// matrices), a frame's whole update where objects moved.
+    fn place_instances(&mut self, models: &[Mat4]) -> Result<()> {
+        let start = std::time::Instant::now();
+        match (&self.instances, &self.buffers) {
+            (Some(inst), Some(buffers)) => buffers.write_u32(&self.gl, 0, &inst.table(models)),
+            _ => {
+                let inst = Instances::new(&self.objects);
+                if inst.events() * self.walks_per_record > MAX_PIXEL_EVENTS {
+                    bail!(
+                        "the objects' trees have {} events a walk (instances, nodes, leaf slots):                          {} walks of a pixel could count more than {MAX_PIXEL_EVENTS}, beyond the                          per-pixel counts' 32 bits; use a smaller scene",
+                        inst.events(),
+                        self.walks_per_record
+                    );
+                }
+                self.buffers = Some(upload(&self.gl, inst.gpu_words(models), self.blocks)?);
+                self.stats = inst.stats();
+                self.moving.cost.set(self.stats.sah_cost);
+                self.instances = Some(inst);
+                self.rebuilt = true;
+                self.builds += 1;
+            }
+        }
+        // a build's words and upload after its trees; after it, the instances' update
+        let trees_ms = if self.rebuilt { self.stats.build_ms } else { 0.0 };
+        self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - trees_ms;
+        self.built_for = Some(models.to_vec());
         Ok(())
     }
 
@@ -421,6 +468,9 @@ impl Accelerator for Bvh {
         if self.built_for.as_deref() == Some(f.models) {
             return Ok(());
         }
+        if self.two_level {
+            return self.place_instances(f.models);
+        }
         self.read_cost(false)?;
         let growth = self.moving.cost.get() / self.stats.sah_cost;
         if self.moving.refit.is_some() && growth <= REBUILD_GROWTH {
@@ -431,10 +481,13 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
-        self.bind(f.gl, glow::READ_WRITE);
-        self.entry.use_program();
-        self.entry
-            .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+        // two levels: every walk starts at its tree's root (the entries stay 0)
+        if !self.two_level {
+            self.bind(f.gl, glow::READ_WRITE);
+            self.entry.use_program();
+            self.entry
+                .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+        }
         self.bind(f.gl, glow::READ_ONLY);
         self.intersect1.use_program();
         &self.intersect1
@@ -451,6 +504,9 @@ impl Accelerator for Bvh {
         let f = &mut stats.facts;
         f.insert("bvh_build_ms".into(), json!(s.build_ms));
         f.insert("bvh_upload_ms".into(), json!(self.upload_ms));
+        if let Some(inst) = &self.instances {
+            f.insert("bvh_instances".into(), json!(inst.trees.len()));
+        }
         f.insert("bvh_rebuilt".into(), json!(self.rebuilt));
         f.insert("bvh_nodes".into(), json!(s.nodes));
         f.insert("bvh_leaves".into(), json!(s.leaves));

@@ -85,6 +85,10 @@ pub struct RenderOptions {
     /// light and shading — the same image and counts, without the ray-state traffic between
     /// them.
     pub fused_passes: bool,
+    /// `--bvh-instances` (ours, the SAH BVH only): a tree per object, built once in object
+    /// space, under the objects' instances (`accel::bvh::instances`) — a moving object costs
+    /// its instance's update, no refit.
+    pub bvh_instances: bool,
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -233,6 +237,13 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
         bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
     check_area_lights(scene, options)?;
+    if options.bvh_instances && options.tracer != TracerKind::Bvh {
+        bail!(
+            "--bvh-instances needs --tracer bvh (the SAH BVH's trees per object); --tracer {} \
+             has no instances",
+            options.tracer.name()
+        );
+    }
     if options.fused_passes && options.tracer != TracerKind::Bvh {
         bail!(
             "--fused-passes needs --tracer bvh (the SAH BVH's fused pass kernel); --tracer {} \
@@ -335,6 +346,7 @@ impl RayTracer {
                 first_light_point: !scene.lights.is_empty(),
             }),
             scene_images: gpu_scene.vertex_images(),
+            bvh_instances: options.bvh_instances,
         };
         let accel = (entry.gpu)(&build, scene, &options.grid)?;
         let per_pixel = if options.fused_passes {
@@ -648,6 +660,7 @@ impl Renderer for RayTracer {
         .into_iter()
         .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
         .chain(o.fused_passes.then_some(("fused_passes", json!(true))))
+        .chain(o.bvh_instances.then_some(("bvh_instances", json!(true))))
         .chain(self.area_settings())
         .map(|(k, v)| (k.to_string(), v))
         .collect()

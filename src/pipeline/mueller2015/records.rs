@@ -100,7 +100,9 @@ impl Records {
             // 32-bit stores only: these two kernels do not enable 64-bit integers
             .set("RECORD_STORE_64", 0)
             .set("RECORD_IMAGE", view.is_some() as i32)
-            .set(mask, mask_value);
+            .set(mask, mask_value)
+            // evaluate_hit's hit records of two levels (glsl/bvh/words.glsl's instanceRay)
+            .set("BVH_INSTANCE_TEXELS", crate::accel::bvh::INSTANCE_TEXELS);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         Ok(Records {
             records,

@@ -76,6 +76,7 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
             triangles_per_dispatch: None,
             light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
             fused_passes: false,
+            bvh_instances: false,
         })
     };
     match c.tracer {
