@@ -18,6 +18,12 @@
 // the first dispatch (the host uploads zeros; bvh/entries.glsl), and its rays walk from their
 // roots.
 //
+// Two levels (BVH_INSTANCES, ours): the block's bounds are taken into each instance's object
+// space (instanceBounds) and its tree is descended as above; the block stores the entry of the
+// instance where the descent went deepest, tagged with its instance + 1 (entry.w), and its rays
+// walk that instance's tree from there, the other instances' from their roots
+// (bvh/traverse.glsl's traverseScene); no descent below a root: no entry.
+//
 // The kernel is timed as part of intersect1; what it saves there and what it costs:
 // docs/design/bvh.md, step 26.
 #include "../common/images.glsl"
@@ -30,21 +36,22 @@ layout(local_size_x = BVH_ENTRY_GROUP) in;
 #include "entries.glsl"
 #include "../common/pass_ray.glsl"
 
-// the block's rays: per axis the smallest and largest 1/direction and origin
+// the block's rays: per axis the smallest and largest 1/direction and origin (in the space of
+// the tree descended), and the divisors of safeInverse in world space
 vec3 invLo = vec3(0.0), invHi = vec3(0.0), roLo = vec3(0.0), roHi = vec3(0.0);
+vec3 dLo = vec3(0.0), dHi = vec3(0.0);
 // the grid of the records' planes (plane q of axis a at gridOrigin[a] + q·gridStep[a])
 vec3 gridOrigin = vec3(0.0), gridStep = vec3(0.0);
 
-// The bounds of the block's active rays; false if it has none, or if they point up and down
-// one axis (two octants or more: no entry, every ray walks from its root). Ours, for llvmpipe:
-// per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose inverses are
-// the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding keeps the order —
-// so that a ray costs no division; inactive rays, and pixels out of the image (which imageLoad
-// reads as zeros: rayState 0), count for nothing.
-bool bound(ivec2 block, out int octant)
+// The bounds of the block's active rays (dLo, dHi, roLo, roHi); false if it has none. Ours,
+// for llvmpipe: per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose
+// inverses are the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding
+// keeps the order — so that a ray costs no division; inactive rays, and pixels out of the
+// image (which imageLoad reads as zeros: rayState 0), count for nothing.
+bool bound(ivec2 block)
 {
     const float inf = 1.0 / 0.0;
-    vec3 dLo = vec3(inf), dHi = vec3(-inf);
+    dLo = vec3(inf); dHi = vec3(-inf);
     roLo = vec3(inf); roHi = vec3(-inf);
     for (int k = 0; k < 64; k++) {
         ivec2 p = block * 8 + ivec2(k & 7, k >> 3);
@@ -57,8 +64,14 @@ bool bound(ivec2 block, out int octant)
         }
     }
     invLo = 1.0 / dHi; invHi = 1.0 / dLo;
-    octant = rayOctant(dLo);
-    return dLo.x <= dHi.x && !any(lessThan(dLo * sign(dHi), vec3(0.0)));
+    return dLo.x <= dHi.x;
+}
+
+// The octant of the bounds' rays, or −1 where they point up and down one axis (two octants or
+// more: no entry, every ray walks from its root).
+int boundsOctant()
+{
+    return any(lessThan(dLo * sign(dHi), vec3(0.0))) ? -1 : rayOctant(dLo);
 }
 
 // The distances from the rays' origins to the planes at world coordinates w, bounded over the
@@ -92,16 +105,18 @@ bool mayEnter(uvec4 record)
     return !(tFar < 0.0 || tNear > tFar);
 }
 
-// The entry of the bounds' rays in the records of `octant`: (octant + 1, first record, end).
-uvec4 entryPoint(int octant)
+// The entry of the bounds' rays in the records of `octant` of the tree whose header is at
+// texel `base`: (octant + 1, first record, end, 0); `depth`: the levels it went down.
+uvec4 entryPoint(int octant, int base, out int depth)
 {
-    uvec4 header = bvhTexel(0);
+    uvec4 header = bvhRecord(base);
     gridOrigin = uintBitsToFloat(header.yzw);
-    gridStep = uintBitsToFloat(bvhTexel(4).xyz);
+    gridStep = uintBitsToFloat(bvhRecord(base + 1).xyz);
     int nodes = int(header.x);
-    int n = BVH_HEADER_WORDS / 4 + octant * nodes;
+    int n = base + BVH_HEADER_WORDS / 4 + octant * nodes;
     uvec4 record = bvhRecord(n); // n's
     bool empty = !mayEnter(record);
+    depth = 0;
     // down one level a step, while n is an inner node (the tree's depth is below the node count)
     for (int d = 0; !empty && int(record.w) >= 0 && d < nodes; d++) {
         // an inner node's near child is the next record, its far child the near child's miss
@@ -116,6 +131,7 @@ uvec4 entryPoint(int octant)
         if (!empty) {
             n = nearEntered ? near : far;
             record = nearEntered ? nearRecord : farRecord;
+            depth++;
         }
     }
     // the texel after n's subtree: its miss link (a leaf's: the next record)
@@ -124,12 +140,77 @@ uvec4 entryPoint(int octant)
     return uvec4(uint(octant + 1), uint(empty ? end : n), uint(end), 0u);
 }
 
+#if BVH_INSTANCES
+// The interval of r.xyz·x + r.w·w over the box lo <= x <= hi, widened by 2^-20 of the
+// magnitudes of its terms and by 10^-19 per unit of |r.xyz|: it holds instanceRay's rounded
+// dot product of every x in the box, and of x's with components below safeInverse's 1e-20 where
+// the box holds their divisors (bvh/words.glsl).
+vec2 rowBounds(vec4 r, float w, vec3 lo, vec3 hi)
+{
+    vec3 a = r.xyz * lo, b = r.xyz * hi;
+    vec3 small = min(a, b), large = max(a, b);
+    float terms = dot(abs(r.xyz), max(abs(lo), abs(hi))) + abs(r.w * w);
+    float margin = terms * 9.5367431640625e-7 + 1e-19 * dot(abs(r.xyz), vec3(1.0));
+    return vec2(small.x + small.y + small.z + r.w * w - margin,
+                large.x + large.y + large.z + r.w * w + margin);
+}
+
+// The world bounds (wdLo, wdHi: divisors; wroLo, wroHi: origins) in instance k's object space,
+// as roLo, roHi, invLo, invHi; its octant, or −1 where the bounds' directions point up and down
+// an axis or come within 1e-18 of 0 on one (where safeInverse would change them).
+int instanceBounds(int k, vec3 wdLo, vec3 wdHi, vec3 wroLo, vec3 wroHi)
+{
+    int at = 1 + k * BVH_INSTANCE_TEXELS + 2;
+    vec4 r0 = uintBitsToFloat(bvhRecord(at));
+    vec4 r1 = uintBitsToFloat(bvhRecord(at + 1));
+    vec4 r2 = uintBitsToFloat(bvhRecord(at + 2));
+    vec2 ox = rowBounds(r0, 1.0, wroLo, wroHi), oy = rowBounds(r1, 1.0, wroLo, wroHi);
+    vec2 oz = rowBounds(r2, 1.0, wroLo, wroHi);
+    vec2 dx = rowBounds(r0, 0.0, wdLo, wdHi), dy = rowBounds(r1, 0.0, wdLo, wdHi);
+    vec2 dz = rowBounds(r2, 0.0, wdLo, wdHi);
+    roLo = vec3(ox.x, oy.x, oz.x); roHi = vec3(ox.y, oy.y, oz.y);
+    vec3 lo = vec3(dx.x, dy.x, dz.x), hi = vec3(dx.y, dy.y, dz.y);
+    // min(|x|) over [lo, hi] per axis: 0 where the interval holds 0
+    vec3 nearest = max(max(lo, -hi), vec3(0.0));
+    if (any(lessThan(nearest, vec3(1e-18)))) return -1;
+    invLo = 1.0 / hi; invHi = 1.0 / lo;
+    return rayOctant(lo);
+}
+
+// The block's entry: that of the instance whose tree its bounds go deepest into, with its
+// instance + 1 in w; none where no descent leaves a root.
+uvec4 blockEntry()
+{
+    vec3 wdLo = dLo, wdHi = dHi, wroLo = roLo, wroHi = roHi;
+    uvec4 best = uvec4(0u);
+    int deepest = 0;
+    int count = int(bvhRecord(0).x);
+    for (int k = 0; k < count; k++) {
+        int octant = instanceBounds(k, wdLo, wdHi, wroLo, wroHi);
+        if (octant < 0) continue;
+        int depth;
+        uvec4 e = entryPoint(octant, int(bvhRecord(1 + k * BVH_INSTANCE_TEXELS).w), depth);
+        if (depth > deepest) {
+            deepest = depth;
+            best = uvec4(e.xyz, uint(k + 1));
+        }
+    }
+    return best;
+}
+#else
+// The block's entry in the one tree, where its rays share an octant.
+uvec4 blockEntry()
+{
+    int octant = boundsOctant(), depth;
+    return octant < 0 ? uvec4(0u) : entryPoint(octant, 0, depth);
+}
+#endif
+
 void main()
 {
     int b = int(gl_GlobalInvocationID.x);
     if (b >= BVH_ENTRY_TEXELS) return;
     ivec2 block = ivec2(b % BVH_BLOCKS_X, b / BVH_BLOCKS_X);
-    int octant;
-    uvec4 entry = bound(block, octant) ? entryPoint(octant) : uvec4(0u);
+    uvec4 entry = bound(block) ? blockEntry() : uvec4(0u);
     imageStore(bvh, entryTexel(block), entry);
 }

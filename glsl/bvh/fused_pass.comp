@@ -90,7 +90,7 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
     rayLast = lastTriID; rayLight = lightDistance;
-    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
+    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec4(0u)); // from the root
 }
 
 // The work counts of one kind so far, unpacked (tests, nodes, rays, truncated), and the
@@ -177,7 +177,7 @@ void trace(ivec2 storePos)
         rayLast = int(dirTri.w);
         bestT = 1.0 / 0.0; // +inf
         float limit = bestT;
-        traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)).xyz);
+        traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)));
         closestHitRecord = bestAt;
         primary = takeCounts();
 

@@ -46,7 +46,7 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
     rayLast = lastTriID;
     bestT = t_min; bestID = triID;
     float limit = bestT;
-    traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)).xyz);
+    traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)));
     t_min = bestT; triID = bestID;
     closestHitRecord = bestAt;
 }

@@ -30,7 +30,7 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
 bool occluded(ivec2 storePos, vec3 ro, vec3 rd, float lightDistance, int lastTriID)
 {
     rayLast = lastTriID; rayLight = lightDistance;
-    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec3(0u)); // from the root
+    return traverseScene(ro, rd, SHADOW_OFFSET, lightDistance, uvec4(0u)); // from the root
 }
 
 #include "../common/intersect2_main.glsl"

@@ -226,14 +226,16 @@ bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int 
 }
 
 // The scene's walk along ro + t·rd for tMin <= t <= limit (the kernels' entry to the walk);
-// true if triangleHit ended it; `limit` as triangleHit left it. One level: the one tree, from
-// `entry`. Two levels (BVH_INSTANCES, ours: src/accel/bvh/instances.rs): every instance in
-// turn, in the list's order — its world box tested (Listing 4.5 in floats; counted as a node
-// visited), and where the ray enters it at some tMin <= t <= limit, the object's tree walked
-// from its root with the ray in the object's space (instanceRay; no block entries), the limit
-// carried from one tree to the next. The thesis' scenes have 2–7 objects; a list of many would
-// want a tree over the instances (docs/design/bvh.md, "Two levels").
-bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry)
+// true if triangleHit ended it; `limit` as triangleHit left it. `entry`: the ray's block entry
+// (bvh/entries.glsl; 0: none). One level: the one tree, from the entry. Two levels
+// (BVH_INSTANCES, ours: src/accel/bvh/instances.rs): every instance in turn, in the list's
+// order — its world box tested (Listing 4.5 in floats; counted as a node visited), and where
+// the ray enters it at some tMin <= t <= limit, the object's tree walked with the ray in the
+// object's space (instanceRay), from the block's entry where the entry is this instance's
+// (entry.w = k + 1, bvh/entry.comp), else from its root; the limit carried from one tree to
+// the next. The thesis' scenes have 2–7 objects; a list of many would want a tree over the
+// instances (docs/design/bvh.md, "Two levels").
+bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
 {
 #if BVH_INSTANCES
     int count = int(bvhRecord(0).x);
@@ -248,12 +250,13 @@ bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry)
         nodesVisited++;
         if (enter <= leave) {
             instanceRay(k, ro, rd, rayO, rayD);
-            if (traverse(rayO, rayD, tMin, limit, uvec3(0u), int(lo.w))) return true;
+            uvec3 own = int(entry.w) == k + 1 ? entry.xyz : uvec3(0u);
+            if (traverse(rayO, rayD, tMin, limit, own, int(lo.w))) return true;
         }
     }
     return false;
 #else
     rayO = ro; rayD = rd;
-    return traverse(ro, rd, tMin, limit, entry, 0);
+    return traverse(ro, rd, tMin, limit, entry.xyz, 0);
 #endif
 }

@@ -57,8 +57,8 @@ pub const ENTRY: Entry = Entry {
 /// `GL_MAX_TEXTURE_BUFFER_SIZE`), naming it. After them a texel per block of the image for
 /// `glsl/bvh/entry.comp` to write its entry point into ([`EntryTexel`]), 0 (no entry) until it
 /// does: the same image unit, so the BVH binds no more than GL 4.5's 8.
-/// With `--bvh-instances` the words are [`Instances::gpu_words`]'s, and no kernel writes the
-/// entries (every walk starts at its tree's root).
+/// With `--bvh-instances` the words are [`Instances::gpu_words`]'s, and an entry belongs to one
+/// instance.
 fn upload(gl: &Arc<Gl>, mut words: Vec<u32>, blocks: u32) -> Result<TextureBuffers> {
     let entries = vec![EntryTexel::zeroed(); blocks as usize];
     words.extend_from_slice(bytemuck::cast_slice(&entries));
@@ -481,13 +481,10 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
-        // two levels: every walk starts at its tree's root (the entries stay 0)
-        if !self.two_level {
-            self.bind(f.gl, glow::READ_WRITE);
-            self.entry.use_program();
-            self.entry
-                .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
-        }
+        self.bind(f.gl, glow::READ_WRITE);
+        self.entry.use_program();
+        self.entry
+            .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
         self.bind(f.gl, glow::READ_ONLY);
         self.intersect1.use_program();
         &self.intersect1
