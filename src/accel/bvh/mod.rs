@@ -97,15 +97,10 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// per-pixel counts (`Accelerator::records`, `glsl/bvh/records.glsl`), in one store of two 64-bit
 /// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); on llvmpipe
 /// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
-/// `glsl/bvh/intersect1_main.glsl`); with `--bvh-instances` the walks start at the instances
-/// (`BVH_INSTANCES`, [`instances`]).
-fn kernel_defines(
-    info: &GlInfo,
-    blocks: (u32, u32),
-    two_level: bool,
-) -> [(&'static str, String); 11] {
+/// `glsl/bvh/intersect1_main.glsl`); the size of an instance ([`instances`]; whether the walks
+/// start at the instances is the pipeline's `BVH_INSTANCES`, which the hit evaluation needs too).
+fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 10] {
     [
-        ("BVH_INSTANCES", (two_level as i32).to_string()),
         ("BVH_INSTANCE_TEXELS", INSTANCE_TEXELS.to_string()),
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
@@ -248,7 +243,7 @@ impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
-        let defs = kernel_defines(b.info, blocks, b.bvh_instances);
+        let defs = kernel_defines(b.info, blocks);
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             // timed as a part of intersect1: the closest-hit search of the passes

@@ -112,8 +112,9 @@ pub const TRIANGLE_TEST_COUNTERS: &[&str] = &["intersect1", "intersect2"];
 
 /// `#define`s every kernel gets: counter slots, the shadow-flag layout, the scene's triangle
 /// count (`glsl/common/scene.glsl`'s `triangleCount()`), the image size, whether AOVs are kept
-/// and the scene has textures. (The SAH BVH's
-/// switches are its own: `accel::bvh`.)
+/// and the scene has textures, whether the SAH BVH keeps the objects in their own space
+/// (`BVH_INSTANCES`: its hit evaluation turns the normals into world space). (The SAH BVH's
+/// other switches are its own: `accel::bvh`.)
 pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
     let mut d = Defines::new()
         .set(
@@ -138,7 +139,8 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // the area lights' samples (common/light_target.glsl, shading.comp)
         .set("SAMPLES_U", options.light_samples.0)
         .set("SAMPLES_V", options.light_samples.1)
-        .set("AREA_LIGHTS", scene.area_lights.len());
+        .set("AREA_LIGHTS", scene.area_lights.len())
+        .set("BVH_INSTANCES", options.bvh_instances as i32);
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
@@ -579,8 +581,17 @@ impl Renderer for RayTracer {
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let start = Instant::now();
         let gl = self.gl.clone();
-        // the objects that moved are transformed into the SSBOs at the start of the frame
-        self.scene.transform(&gl, &mut self.timers, &self.models);
+        // the objects that moved are transformed into the SSBOs at the start of the frame; with
+        // --bvh-instances the SSBOs keep object space (the instances place the objects, the
+        // hit evaluation turns the normals), so nothing is transformed after the first frame
+        let identity;
+        let scene_models = if self.options.bvh_instances {
+            identity = vec![Mat4::IDENTITY; self.models.len()];
+            &identity
+        } else {
+            &self.models
+        };
+        self.scene.transform(&gl, &mut self.timers, scene_models);
         self.scene.bind(&gl);
         self.counters.clear(&gl, &mut self.timers);
         self.accel.build(&mut FrameContext {
