@@ -163,12 +163,14 @@ bool leafTriangles(inout int slot, int slotEnd, inout float limit)
     return false;
 }
 
-// The walk along ro + t·rd for tMin <= t <= limit through the tree whose header is at texel
-// `base` (0 with one level); true if triangleHit ended it; `limit` as triangleHit left it.
-// `entry`: the entry point of the ray's block (bvh/entry.comp: its octant + 1, first record and
-// the texel after its subtree) — a ray of that octant walks that subtree only, the others (and
-// every ray where entry.x is 0, no entry, as in intersect2) the whole tree.
-bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int base)
+// The start of a walk along ro + t·rd through the tree whose header is at texel `base` (0 with
+// one level): the slab factors gridA, gridB (boxEntered), the first record `node` and the texel
+// after the last, `end`, and the global triangleBase. `entry`: the entry point of the ray's block
+// (bvh/entry.comp: its octant + 1, first record and the texel after its subtree) — a ray of that
+// octant walks that subtree only, the others (and every ray where entry.x is 0, no entry, as in
+// intersect2) the whole tree.
+void treeStart(vec3 ro, vec3 rd, uvec3 entry, int base, out vec3 gridA, out vec3 gridB,
+               out int node, out int end)
 {
     vec3 inv = safeInverses(rd);
     int octant = rayOctant(inv);
@@ -180,15 +182,43 @@ bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int 
     // a slab's distances: q·gridA + gridB for its planes q (boxEntered), the factors clamped to
     // the finite floats (an overflow to ±inf could make 0·inf or inf − inf; Grid::ray)
     const float finite = 3.40282347e38;
-    vec3 gridA = clamp(gridStep * inv, -finite, finite);
-    vec3 gridB = clamp((gridOrigin - ro) * inv, -finite, finite);
+    gridA = clamp(gridStep * inv, -finite, finite);
+    gridB = clamp((gridOrigin - ro) * inv, -finite, finite);
     // the root: the first record of the octant's copy; end: the texel after its last
-    int node = base + BVH_HEADER_WORDS / 4 + octant * nodes;
-    int end = node + nodes;
+    node = base + BVH_HEADER_WORDS / 4 + octant * nodes;
+    end = node + nodes;
     if (int(entry.x) == octant + 1) {
         node = int(entry.y);
         end = int(entry.z);
     }
+}
+
+// One pass of the walk's outer loop: the node loop to the next leaf entered (or the walk's end)
+// and that leaf's triangles (`slot`, `slotEnd`: those still to test); true if triangleHit ended
+// the walk. `guard`: the node steps so far, below `bound`.
+bool walkPass(vec3 gridA, vec3 gridB, float tMin, inout float limit, int end, inout int node,
+              inout int guard, int bound, inout int slot, inout int slotEnd)
+{
+    int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
+    do {
+        int steps;
+        nodePass(gridA, gridB, tMin, limit, end, node, leaf, steps);
+        guard += steps;
+    } while (guard < bound && node < end && leaf == 0);
+    int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
+    slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS) : 0;
+    int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
+    slotEnd = slot + BVH_TRIANGLE_WORDS * count;
+    return leafTriangles(slot, slotEnd, limit);
+}
+
+// The walk along ro + t·rd for tMin <= t <= limit through the tree whose header is at texel
+// `base`, from `entry` (treeStart); true if triangleHit ended it; `limit` as triangleHit left it.
+bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int base)
+{
+    vec3 gridA, gridB;
+    int node, end;
+    treeStart(ro, rd, entry, base, gridA, gridB, node, end);
     // the entered leaf's triangles still to test: at words slot, slot + BVH_TRIANGLE_WORDS, ...
     // below slotEnd
     int slot = 0, slotEnd = 0;
@@ -202,18 +232,7 @@ bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int 
         // pass while other lanes went on — a lane whose walk ended at the leaf it entered
         // (miss link END) was left with untested triangles (tests/edge_cases.rs, the tie scene).
         if (guard < bound && node < end) {
-            int leaf = 0; // the leaf reference of the leaf entered (0: none yet)
-            do {
-                int steps;
-                nodePass(gridA, gridB, tMin, limit, end, node, leaf, steps);
-                guard += steps;
-            } while (guard < bound && node < end && leaf == 0);
-            int code = -1 - leaf; // s·32 + count: the leaf's triangles from entry s on
-            slot = leaf < 0 ? triangleBase + BVH_TRIANGLE_WORDS * (code >> BVH_LEAF_COUNT_BITS)
-                            : 0;
-            int count = leaf < 0 ? code & ((1 << BVH_LEAF_COUNT_BITS) - 1) : 0;
-            slotEnd = slot + BVH_TRIANGLE_WORDS * count;
-            if (leafTriangles(slot, slotEnd, limit)) {
+            if (walkPass(gridA, gridB, tMin, limit, end, node, guard, bound, slot, slotEnd)) {
                 nodesVisited += uint(guard);
                 return true;
             }
@@ -225,22 +244,20 @@ bool traverse(vec3 ro, vec3 rd, float tMin, inout float limit, uvec3 entry, int 
     return false;
 }
 
-// The scene's walk along ro + t·rd for tMin <= t <= limit (the kernels' entry to the walk);
-// true if triangleHit ended it; `limit` as triangleHit left it. `entry`: the ray's block entry
-// (bvh/entries.glsl; 0: none). One level: the one tree, from the entry. Two levels
-// (BVH_INSTANCES, ours: src/accel/bvh/instances.rs): every instance in turn, in the list's
-// order — its world box tested (Listing 4.5 in floats; counted as a node visited), and where
-// the ray enters it at some tMin <= t <= limit, the object's tree walked with the ray in the
-// object's space (instanceRay), from the block's entry where the entry is this instance's
-// (entry.w = k + 1, bvh/entry.comp), else from its root; the limit carried from one tree to
-// the next. The thesis' scenes have 2–7 objects; a list of many would want a tree over the
-// instances (docs/design/bvh.md, "Two levels").
-bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
-{
 #if BVH_INSTANCES
-    int count = int(bvhRecord(0).x);
-    vec3 inv = safeInverses(rd);
-    for (int k = 0; k < count; k++) {
+// Two levels: the next instance from k on whose world box the ray ro + t·rd (1/direction
+// `inv`) enters at some tMin <= t <= limit (Listing 4.5 in floats; each box tested counts as a
+// node visited), its walk started (treeStart, with the ray in its object space: rayO, rayD, and
+// the block's entry where it is this instance's: entry.w = k + 1); the instance after it, or
+// `count` where none is left (then node = end: no walk).
+int nextInstance(int k, int count, vec3 ro, vec3 rd, vec3 inv, float tMin, float limit,
+                 uvec4 entry, out vec3 gridA, out vec3 gridB, out int node, out int end)
+{
+    gridA = vec3(0.0); gridB = vec3(0.0);
+    node = 0; end = 0;
+    bool entered = false;
+    int base = 0;
+    while (k < count && !entered) {
         uvec4 lo = bvhRecord(1 + k * BVH_INSTANCE_TEXELS);
         vec3 hi = uintBitsToFloat(bvhRecord(2 + k * BVH_INSTANCE_TEXELS).xyz);
         vec3 t0 = (uintBitsToFloat(lo.xyz) - ro) * inv, t1 = (hi - ro) * inv;
@@ -248,12 +265,55 @@ bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
         float enter = max(max(tNear.x, tNear.y), max(tNear.z, tMin));
         float leave = min(min(tFar.x, tFar.y), min(tFar.z, limit));
         nodesVisited++;
-        if (enter <= leave) {
-            instanceRay(k, ro, rd, rayO, rayD);
-            uvec3 own = int(entry.w) == k + 1 ? entry.xyz : uvec3(0u);
-            if (traverse(rayO, rayD, tMin, limit, own, int(lo.w))) return true;
-        }
+        entered = enter <= leave;
+        base = int(lo.w);
+        k++;
     }
+    if (entered) {
+        instanceRay(k - 1, ro, rd, rayO, rayD);
+        uvec3 own = int(entry.w) == k ? entry.xyz : uvec3(0u);
+        treeStart(rayO, rayD, own, base, gridA, gridB, node, end);
+    }
+    return k;
+}
+#endif
+
+// The scene's walk along ro + t·rd for tMin <= t <= limit (the kernels' entry to the walk);
+// true if triangleHit ended it; `limit` as triangleHit left it. `entry`: the ray's block entry
+// (bvh/entries.glsl; 0: none). One level: the one tree, from the entry. Two levels
+// (BVH_INSTANCES, ours: src/accel/bvh/instances.rs): the instances in the list's order, each
+// whose world box the ray enters walked with the ray in the object's space, from the block's
+// entry where it is this instance's, else from its root (nextInstance), the limit carried from
+// one tree to the next. One loop for all the trees (ours): a lane whose tree is done starts its
+// next instance in the next pass of the outer loop while the other lanes of its SIMD group go
+// on with theirs — llvmpipe runs the lanes in lock step, and a loop per instance made every
+// lane wait for the group's longest walk of each instance in turn (docs/design/bvh.md, "Two
+// levels"). The thesis' scenes have 2–7 objects; a list of many would want a tree over the
+// instances.
+bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
+{
+#if BVH_INSTANCES
+    int count = int(bvhRecord(0).x);
+    vec3 inv = safeInverses(rd);
+    vec3 gridA, gridB;
+    int node, end;
+    int k = nextInstance(0, count, ro, rd, inv, tMin, limit, entry, gridA, gridB, node, end);
+    int slot = 0, slotEnd = 0;
+    // every node of every tree visited at most once: as in traverse
+    int bound = imageSize(bvh) + 1;
+    int guard = 0;
+    do {
+        if (guard < bound && node < end) {
+            if (walkPass(gridA, gridB, tMin, limit, end, node, guard, bound, slot, slotEnd)) {
+                nodesVisited += uint(guard);
+                return true;
+            }
+        }
+        if (node >= end && k < count)
+            k = nextInstance(k, count, ro, rd, inv, tMin, limit, entry, gridA, gridB, node, end);
+    } while (guard < bound && (node < end || k < count));
+    nodesVisited += uint(guard);
+    if (node < end || slot < slotEnd) truncated = 1u;
     return false;
 #else
     rayO = ro; rayD = rd;
