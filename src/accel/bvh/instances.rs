@@ -168,11 +168,7 @@ pub fn world_box(tree: &BvhTree, model: Mat4) -> Aabb {
     let (lo, hi) = (Vec3::from(root.lo), Vec3::from(root.hi));
     let mut world = Aabb::EMPTY;
     for c in 0..8 {
-        let corner = Vec3::select(
-            glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
-            hi,
-            lo,
-        );
+        let corner = Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo);
         world.grow_point(model.transform_point3(corner));
     }
     let extent = (world.hi - world.lo)
@@ -204,7 +200,11 @@ mod tests {
         let objects = vec![quad(0.0), Vec::new(), quad(1.0)];
         let inst = Instances::new(&objects);
         assert_eq!(inst.objects, vec![0, 2]);
-        let models = [Mat4::IDENTITY, Mat4::IDENTITY, Mat4::from_translation(Vec3::X)];
+        let models = [
+            Mat4::IDENTITY,
+            Mat4::IDENTITY,
+            Mat4::from_translation(Vec3::X),
+        ];
         let words = inst.gpu_words(&models);
         assert_eq!(words[0], 2);
         assert_eq!(words.len(), inst.stats().bytes / 4);

@@ -344,7 +344,11 @@ impl Bvh {
             }
         }
         // a build's words and upload after its trees; after it, the instances' update
-        let trees_ms = if self.rebuilt { self.stats.build_ms } else { 0.0 };
+        let trees_ms = if self.rebuilt {
+            self.stats.build_ms
+        } else {
+            0.0
+        };
         self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - trees_ms;
         self.built_for = Some(models.to_vec());
         Ok(())
