@@ -43,7 +43,7 @@ fn moved(scene: &Scene, degrees: f32, lift: f32) -> Vec<Mat4> {
 fn assert_hits_reference(gpu: &Frame, scene: &Scene, opts: &RenderOptions, what: &str) {
     let c = compare(gpu, &render_cpu(scene, opts));
     eprintln!("{what}: {c:?}");
-    assert!(c.hits > c.pixels / 4, "{what}: too little geometry: {c:?}");
+    assert!(c.hits > c.pixels / 16, "{what}: too little geometry: {c:?}");
     // measured on llvmpipe (teapot1, 3 and 6, 40×40, still and moved): no id differs, hit
     // distances within 4.0e-6 relative, colours within 1.2e-4 at worst and 2.3e-7 on average;
     // an edge ray or two may flip where a GL implementation rounds the transform otherwise
@@ -53,12 +53,12 @@ fn assert_hits_reference(gpu: &Frame, scene: &Scene, opts: &RenderOptions, what:
     assert!(c.mean_color_diff <= 1e-5, "{what}: colours differ: {c:?}");
 }
 
-/// Still scenes of 2, 4 and 7 objects: the CPU reference's first hits, distances and colours,
-/// as one tree gives them.
+/// Still scenes of 1 (the walk without the instance loop), 2, 4 and 7 objects: the CPU
+/// reference's first hits, distances and colours, as one tree gives them.
 #[test]
 fn instances_hit_what_the_reference_hits() {
     let ctx = context();
-    for name in ["teapot1.toml", "teapot3.toml", "teapot6.toml"] {
+    for name in ["cow.toml", "teapot1.toml", "teapot3.toml", "teapot6.toml"] {
         let scene = load(name);
         let opts = instances(40, 40, 1);
         let mut t = ray_tracer(&ctx, &scene, opts.clone());
@@ -78,29 +78,33 @@ fn instances_hit_what_the_reference_hits() {
 #[test]
 fn moving_objects_update_the_instances_only() {
     let ctx = context();
-    let scene = load("teapot3.toml");
-    let opts = instances(40, 40, 1);
-    let mut t = ray_tracer(&ctx, &scene, opts.clone());
-    let first = t.render(&scene.camera).unwrap();
-    assert!(first.stats.gpu_ms.contains_key("transform"));
-    for frame in 1..=3 {
-        let models = moved(&scene, 25.0 * frame as f32, 0.3 * frame as f32);
-        let mut now = scene.clone();
-        for (k, m) in models.iter().enumerate() {
-            t.set_model(k, *m).unwrap();
-            now.objects[k].model = *m;
+    // one object (no instance loop) and four
+    for name in ["cow.toml", "teapot3.toml"] {
+        let scene = load(name);
+        let opts = instances(40, 40, 1);
+        let mut t = ray_tracer(&ctx, &scene, opts.clone());
+        let first = t.render(&scene.camera).unwrap();
+        assert!(first.stats.gpu_ms.contains_key("transform"));
+        for frame in 1..=3 {
+            let models = moved(&scene, 25.0 * frame as f32, 0.3 * frame as f32);
+            let mut now = scene.clone();
+            for (k, m) in models.iter().enumerate() {
+                t.set_model(k, *m).unwrap();
+                now.objects[k].model = *m;
+            }
+            let v = t.render(&scene.camera).unwrap();
+            let f = &v.stats.facts;
+            let what = format!("{name}, frame {frame}");
+            assert_eq!(f["bvh_rebuilt"], json!(false), "{what}");
+            assert_eq!(f["bvh_refits"], json!(0), "{what}");
+            assert_eq!(bvh(&t).builds(), 1, "{what}");
+            assert!(
+                !v.stats.gpu_ms.contains_key("transform"),
+                "{what}: {:?}",
+                v.stats.gpu_ms
+            );
+            assert_hits_reference(&v, &now, &opts, &what);
         }
-        let v = t.render(&scene.camera).unwrap();
-        let f = &v.stats.facts;
-        assert_eq!(f["bvh_rebuilt"], json!(false), "frame {frame}");
-        assert_eq!(f["bvh_refits"], json!(0), "frame {frame}");
-        assert_eq!(bvh(&t).builds(), 1, "frame {frame}");
-        assert!(
-            !v.stats.gpu_ms.contains_key("transform"),
-            "frame {frame}: {:?}",
-            v.stats.gpu_ms
-        );
-        assert_hits_reference(&v, &now, &opts, &format!("frame {frame}"));
     }
 }
 

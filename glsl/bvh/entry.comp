@@ -184,8 +184,7 @@ uvec4 blockEntry()
     vec3 wdLo = dLo, wdHi = dHi, wroLo = roLo, wroHi = roHi;
     uvec4 best = uvec4(0u);
     int deepest = 0;
-    int count = int(bvhRecord(0).x);
-    for (int k = 0; k < count; k++) {
+    for (int k = 0; k < BVH_INSTANCE_COUNT; k++) {
         int octant = instanceBounds(k, wdLo, wdHi, wroLo, wroHi);
         if (octant < 0) continue;
         int depth;

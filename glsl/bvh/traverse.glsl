@@ -289,11 +289,18 @@ int nextInstance(int k, int count, vec3 ro, vec3 rd, vec3 inv, float tMin, float
 // on with theirs — llvmpipe runs the lanes in lock step, and a loop per instance made every
 // lane wait for the group's longest walk of each instance in turn (docs/design/bvh.md, "Two
 // levels"). The thesis' scenes have 2–7 objects; a list of many would want a tree over the
-// instances.
+// instances. One instance (BVH_INSTANCE_COUNT, the host's): its tree walked at once, without
+// the instance loop or the world box (the root's box in object space stands in for it) —
+// on llvmpipe the loop's instance switch costs every pass of the outer loop, under an empty
+// lane mask where no lane switches.
 bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
 {
-#if BVH_INSTANCES
-    int count = int(bvhRecord(0).x);
+#if BVH_INSTANCES && BVH_INSTANCE_COUNT == 1
+    instanceRay(0, ro, rd, rayO, rayD);
+    uvec3 own = entry.w == 1u ? entry.xyz : uvec3(0u);
+    return traverse(rayO, rayD, tMin, limit, own, int(bvhRecord(1).w));
+#elif BVH_INSTANCES
+    const int count = BVH_INSTANCE_COUNT;
     vec3 inv = safeInverses(rd);
     vec3 gridA, gridB;
     int node, end;

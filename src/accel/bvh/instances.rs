@@ -42,6 +42,19 @@ const _: () = assert!(std::mem::size_of::<InstanceRecord>() == 80);
 /// Texels of an [`InstanceRecord`] (`BVH_INSTANCE_TEXELS`).
 pub const INSTANCE_TEXELS: usize = std::mem::size_of::<InstanceRecord>() / 16;
 
+/// The instances of `scene`: its objects with triangles (`BVH_INSTANCE_COUNT` of the kernels).
+pub fn instance_count(scene: &crate::scene::Scene) -> usize {
+    scene
+        .objects
+        .iter()
+        .filter(|o| has_triangles(&o.mesh.positions))
+        .count()
+}
+
+fn has_triangles(positions: &[Vec3]) -> bool {
+    positions.len() >= 3
+}
+
 /// The objects' trees and where they lie in the word buffer.
 pub struct Instances {
     /// one tree per object with triangles, in object space (triangle id: its index in the
@@ -66,7 +79,7 @@ impl Instances {
             bases: Vec::new(),
         };
         let mut first = 0u32;
-        let mut base = 1 + INSTANCE_TEXELS * objects.iter().filter(|o| o.len() >= 3).count();
+        let mut base = 1 + INSTANCE_TEXELS * objects.iter().filter(|o| has_triangles(o)).count();
         for (k, positions) in objects.iter().enumerate() {
             let triangles: Vec<[Vec3; 3]> = positions
                 .chunks_exact(3)

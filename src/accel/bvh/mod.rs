@@ -34,7 +34,7 @@ pub mod instances;
 pub mod layout;
 mod planes;
 pub mod refit;
-pub use instances::{InstanceRecord, Instances, INSTANCE_TEXELS};
+pub use instances::{instance_count, InstanceRecord, Instances, INSTANCE_TEXELS};
 pub use layout::{
     block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
     NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,

@@ -140,7 +140,12 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         .set("SAMPLES_U", options.light_samples.0)
         .set("SAMPLES_V", options.light_samples.1)
         .set("AREA_LIGHTS", scene.area_lights.len())
-        .set("BVH_INSTANCES", options.bvh_instances as i32);
+        .set("BVH_INSTANCES", options.bvh_instances as i32)
+        // and how many instances it has: one per object with triangles (accel::bvh::instances)
+        .set(
+            "BVH_INSTANCE_COUNT",
+            crate::accel::bvh::instance_count(scene),
+        );
     for (i, c) in COUNTERS.iter().enumerate() {
         d = d.set(&format!("COUNTER_{}", c.to_uppercase()), i);
     }
