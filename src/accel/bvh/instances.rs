@@ -15,6 +15,7 @@
 //! texels) moved with it, its leaf triangles' ids made the scene's and their `zero1` word the
 //! instance + 1 (`glsl/bvh/hit_record.glsl` finds the instance of a hit from it).
 
+use anyhow::{bail, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
@@ -100,13 +101,23 @@ impl Instances {
     }
 
     /// The texels before the first tree: the count, then the instances as `models` place them
-    /// (the model matrix of every object of the scene).
-    pub fn table(&self, models: &[Mat4]) -> Vec<u32> {
+    /// (the model matrix of every object of the scene). An instance needs the inverse of its
+    /// model matrix: a singular one (an object scaled flat) is refused by name.
+    pub fn table(&self, models: &[Mat4]) -> Result<Vec<u32>> {
         let mut words = vec![self.trees.len() as u32, 0, 0, 0];
         for (i, tree) in self.trees.iter().enumerate() {
             let model = models[self.objects[i]];
             let world = world_box(tree, model);
             let inverse = model.inverse();
+            if !inverse.is_finite() || !model.is_finite() || model.determinant() == 0.0 {
+                bail!(
+                    "object {} has a model matrix without an inverse (determinant {}): \
+                     --bvh-instances takes every ray into each object's own space; scale the \
+                     object by a nonzero factor on every axis, or leave out --bvh-instances",
+                    self.objects[i],
+                    model.determinant()
+                );
+            }
             let record = InstanceRecord {
                 lo: world.lo.to_array(),
                 tree: self.bases[i],
@@ -116,19 +127,19 @@ impl Instances {
             };
             words.extend_from_slice(bytemuck::cast_slice(&[record]));
         }
-        words
+        Ok(words)
     }
 
     /// The whole buffer: [`Instances::table`], then every tree at its base texel.
-    pub fn gpu_words(&self, models: &[Mat4]) -> Vec<u32> {
-        let mut words = self.table(models);
+    pub fn gpu_words(&self, models: &[Mat4]) -> Result<Vec<u32>> {
+        let mut words = self.table(models)?;
         for (i, tree) in self.trees.iter().enumerate() {
             debug_assert_eq!(words.len(), 4 * self.bases[i] as usize);
             let mut tree_words = tree.gpu_words();
             self.relocate(i, tree, &mut tree_words);
             words.extend_from_slice(&tree_words);
         }
-        words
+        Ok(words)
     }
 
     /// Tree `i`'s words at its base texel: every miss link (a record's texel) moved by the
@@ -218,7 +229,7 @@ mod tests {
             Mat4::IDENTITY,
             Mat4::from_translation(Vec3::X),
         ];
-        let words = inst.gpu_words(&models);
+        let words = inst.gpu_words(&models).unwrap();
         assert_eq!(words[0], 2);
         assert_eq!(words.len(), inst.stats().bytes / 4);
         for (i, tree) in inst.trees.iter().enumerate() {
@@ -245,5 +256,14 @@ mod tests {
             bytemuck::pod_read_unaligned(bytemuck::cast_slice(&words[24..44]));
         assert!((second.lo[0] - 1.0).abs() < 1e-4 && (second.hi[0] - 2.0).abs() < 1e-4);
         assert_eq!(second.inverse[0][3], -1.0, "the inverse moves back");
+    }
+
+    /// An object scaled flat has no inverse: refused, naming the object.
+    #[test]
+    fn a_singular_model_matrix_is_refused() {
+        let inst = Instances::new(&[quad(0.0), quad(1.0)]);
+        let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
+        let err = inst.table(&[Mat4::IDENTITY, flat]).unwrap_err().to_string();
+        assert!(err.contains("object 1") && err.contains("inverse"), "{err}");
     }
 }

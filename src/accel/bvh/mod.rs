@@ -325,7 +325,7 @@ impl Bvh {
     fn place_instances(&mut self, models: &[Mat4]) -> Result<()> {
         let start = std::time::Instant::now();
         match (&self.instances, &self.buffers) {
-            (Some(inst), Some(buffers)) => buffers.write_u32(&self.gl, 0, &inst.table(models)),
+            (Some(inst), Some(buffers)) => buffers.write_u32(&self.gl, 0, &inst.table(models)?),
             _ => {
                 let inst = Instances::new(&self.objects);
                 if inst.events() * self.walks_per_record > MAX_PIXEL_EVENTS {
@@ -335,7 +335,7 @@ impl Bvh {
                         self.walks_per_record
                     );
                 }
-                self.buffers = Some(upload(&self.gl, inst.gpu_words(models), self.blocks)?);
+                self.buffers = Some(upload(&self.gl, inst.gpu_words(models)?, self.blocks)?);
                 self.stats = inst.stats();
                 self.moving.cost.set(self.stats.sah_cost);
                 self.instances = Some(inst);
