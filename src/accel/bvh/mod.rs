@@ -185,6 +185,14 @@ fn image_units_suffice(max_image_units: i32) -> Result<()> {
     Ok(())
 }
 
+/// The BVH's structure: one tree over the world-space scene (refitted or rebuilt when objects
+/// move), or with `--bvh-instances` a tree per object under instances ([`instances`]), built at
+/// the first frame (`None` before it), which moving objects update without a refit.
+enum Levels {
+    One,
+    Two(Option<Instances>),
+}
+
 /// The refit of the last build's tree ([`refit`]) and what the rebuild policy knows of it.
 struct Moving {
     kernels: RefitKernels,
@@ -219,10 +227,8 @@ pub struct Bvh {
     walks_per_record: u64,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
-    /// `--bvh-instances`: a tree per object under the instances ([`instances`]), built once
-    two_level: bool,
-    /// with `two_level`, the objects' trees once built
-    instances: Option<Instances>,
+    /// one tree over the world-space scene, or a tree per object under instances
+    levels: Levels,
     /// the model matrices of the tree as uploaded, built or refitted (`None`: not built yet)
     built_for: Option<Vec<Mat4>>,
     buffers: Option<TextureBuffers>,
@@ -271,8 +277,10 @@ impl Bvh {
                 .iter()
                 .map(|o| o.mesh.positions.clone())
                 .collect(),
-            two_level: b.bvh_instances,
-            instances: None,
+            levels: match b.bvh_instances {
+                true => Levels::Two(None),
+                false => Levels::One,
+            },
             built_for: None,
             buffers: None,
             stats: BvhStats::default(),
@@ -324,13 +332,17 @@ impl Bvh {
     /// matrices), a frame's whole update where objects moved.
     fn place_instances(&mut self, models: &[Mat4]) -> Result<()> {
         let start = std::time::Instant::now();
-        match (&self.instances, &self.buffers) {
-            (Some(inst), Some(buffers)) => buffers.write_u32(&self.gl, 0, &inst.table(models)?),
+        match (&self.levels, &self.buffers) {
+            (Levels::Two(Some(inst)), Some(buffers)) => {
+                buffers.write_u32(&self.gl, 0, &inst.table(models)?)
+            }
             _ => {
                 let inst = Instances::new(&self.objects);
                 if inst.events() * self.walks_per_record > MAX_PIXEL_EVENTS {
                     bail!(
-                        "the objects' trees have {} events a walk (instances, nodes, leaf slots):                          {} walks of a pixel could count more than {MAX_PIXEL_EVENTS}, beyond the                          per-pixel counts' 32 bits; use a smaller scene",
+                        "the objects' trees have {} events a walk (instances, nodes, leaf slots): \
+                         {} walks of a pixel could count more than {MAX_PIXEL_EVENTS}, beyond the \
+                         per-pixel counts' 32 bits; use a smaller scene",
                         inst.events(),
                         self.walks_per_record
                     );
@@ -338,7 +350,7 @@ impl Bvh {
                 self.buffers = Some(upload(&self.gl, inst.gpu_words(models)?, self.blocks)?);
                 self.stats = inst.stats();
                 self.moving.cost.set(self.stats.sah_cost);
-                self.instances = Some(inst);
+                self.levels = Levels::Two(Some(inst));
                 self.rebuilt = true;
                 self.builds += 1;
             }
@@ -467,7 +479,7 @@ impl Accelerator for Bvh {
         if self.built_for.as_deref() == Some(f.models) {
             return Ok(());
         }
-        if self.two_level {
+        if let Levels::Two(_) = self.levels {
             return self.place_instances(f.models);
         }
         self.read_cost(false)?;
@@ -500,7 +512,7 @@ impl Accelerator for Bvh {
         let f = &mut stats.facts;
         f.insert("bvh_build_ms".into(), json!(s.build_ms));
         f.insert("bvh_upload_ms".into(), json!(self.upload_ms));
-        if let Some(inst) = &self.instances {
+        if let Levels::Two(Some(inst)) = &self.levels {
             f.insert("bvh_instances".into(), json!(inst.trees.len()));
         }
         f.insert("bvh_rebuilt".into(), json!(self.rebuilt));
