@@ -30,11 +30,17 @@ fn bvh(t: &RayTracer) -> &Bvh {
         .expect("a BVH tracer")
 }
 
-/// Every object of `scene` turned by `degrees` about its vertical axis and lifted by `lift`.
+/// Every object of `scene` stretched unevenly (its normals then turn otherwise than its
+/// surface), turned by `degrees` about its vertical axis and lifted by `lift`.
 fn moved(scene: &Scene, degrees: f32, lift: f32) -> Vec<Mat4> {
+    let stretch = Mat4::from_scale(Vec3::new(1.6, 0.5, 1.0));
     let turn = Mat4::from_axis_angle(Vec3::Y, degrees.to_radians());
     let up = Mat4::from_translation(Vec3::Y * lift);
-    scene.objects.iter().map(|o| up * o.model * turn).collect()
+    scene
+        .objects
+        .iter()
+        .map(|o| up * o.model * turn * stretch)
+        .collect()
 }
 
 /// The walk meets the triangles in object space, and the rounding of the ray's transform moves

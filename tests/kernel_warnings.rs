@@ -53,6 +53,21 @@ fn every_kernel_compiles_without_warnings() {
         }
     }
 
+    // the SAH BVH's instances with one object (its walk without the instance loop), in the
+    // fused pass and the four kernels
+    let cow = common::load("cow.toml");
+    for fused_passes in [false, true] {
+        let opts = RenderOptions {
+            tracer: TracerKind::Bvh,
+            bvh_instances: true,
+            fused_passes,
+            ..common::options(8, 8, 1)
+        };
+        let mut t =
+            RayTracer::new(ctx.gl.clone(), &ctx.info, &cow, &shaders, opts).expect("tracer");
+        t.render(&cow.camera).expect("frame");
+    }
+
     // Wagner 2018's kernel
     let opts = WagnerOptions {
         width: 8,

@@ -9,6 +9,9 @@ frame); the turning and the still frame with a tree per object under instances
 (`--bvh-instances`) — each with the four kernels and with `--fused-passes`. A frame's cost is
 the sum of its kernels' samples; each run renders FRAMES frames and keeps the median of its last
 three; the configurations alternate within a round, and the ratios are taken within a round.
+The frames are told apart by their count of kernel runs: a turning frame of one tree that
+rebuilt on the CPU instead of refitting (no refit kernels; the shipped scenes' turns stay
+below REBUILD_GROWTH) would shift them.
 
     python3 tools/turning_frames.py [--rounds N] [--out docs/results/turning_frames.md]
         [SCENE.toml ...]   (default: scenes/dragon.toml scenes/bunny.toml)

@@ -2,7 +2,8 @@
 // walks every ray from the root (ch. 4.2): the entry points of Reshetov, Soupikov and Hurley's
 // multi-level ray tracing (MLRTA, SIGGRAPH 2005), found for the 8×8 pixels of each work group
 // of bvh/intersect1.comp before it runs. CPU twin: src/reference/bvh/entry.rs
-// (RayBounds::may_enter, Bvh::block_entry), bit for bit.
+// (RayBounds::may_enter, Bvh::block_entry), bit for bit (one tree; the instances' entries below
+// have no twin: tests/bvh_instances.rs holds their hits to the CPU reference).
 //
 // One invocation per block (pixels 8bx .. 8bx + 7, 8by .. 8by + 7 of the image; 8: the pixel
 // kernels' work groups, PIXEL_GROUP on the host, as in common/images.glsl): it bounds the

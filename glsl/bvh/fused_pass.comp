@@ -61,9 +61,9 @@ vec3 pointLightColor(int l) { return lightColor[l].rgb; }
 #endif
 #include "../mueller2015/shade.glsl"
 
-// What triangleHit does with a triangle of the walk (its ray: rayO, rayD of bvh/traverse.glsl): with anyHit unset, keep the
-// closest hit (bvh/intersect1.comp's triangleHit); with it set, end the walk at the first
-// triangle on the feeler's segment (bvh/intersect2.comp's).
+// What triangleHit does with a triangle of the walk (its ray: rayO, rayD of bvh/traverse.glsl):
+// with anyHit unset, keep the closest hit (bvh/intersect1.comp's triangleHit); with it set, end
+// the walk at the first triangle on the feeler's segment (bvh/intersect2.comp's).
 int rayLast = -1;
 bool anyHit = false;
 float rayLight = 0.0;

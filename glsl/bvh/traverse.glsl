@@ -1,6 +1,7 @@
 // BVH traversal shared by glsl/bvh/intersect1.comp and intersect2.comp — ours, after Wagner
 // 2018 ch. 4.2 (ray–AABB slab test, Listing 4.5; depth-first traversal of the SAH BVH built on
-// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (BvhTree::traverse), same order and counts.
+// the CPU, ch. 3.2). CPU twin: src/reference/bvh/mod.rs (BvhTree::traverse), same order and counts
+// (of one tree; the two levels of traverseScene have none, tests/bvh_instances.rs).
 //
 // The hierarchy in one image buffer of 32-bit words, after Wagner's textures of Fig. 4.3 (his
 // node bounds, node integers and per-leaf triangle ids), read as RGBA32UI texels of 4 words
@@ -176,7 +177,8 @@ void treeStart(vec3 ro, vec3 rd, uvec3 entry, int base, out vec3 gridA, out vec3
     int octant = rayOctant(inv);
     // the header: the node count N and the grid (plane q of axis a at origin[a] + q·step[a])
     uvec4 header = bvhRecord(base);
-    vec3 gridOrigin = uintBitsToFloat(header.yzw), gridStep = uintBitsToFloat(bvhRecord(base + 1).xyz);
+    vec3 gridOrigin = uintBitsToFloat(header.yzw);
+    vec3 gridStep = uintBitsToFloat(bvhRecord(base + 1).xyz);
     int nodes = int(header.x);
     triangleBase = 4 * base + BVH_HEADER_WORDS + 8 * BVH_NODE_WORDS * nodes;
     // a slab's distances: q·gridA + gridB for its planes q (boxEntered), the factors clamped to
@@ -316,11 +318,15 @@ bool traverseScene(vec3 ro, vec3 rd, float tMin, inout float limit, uvec4 entry)
                 return true;
             }
         }
-        if (node >= end && k < count)
+        if (node >= end && k < count) {
+            // (slot < slotEnd: llvmpipe's loop limit cut the last leaf of this tree short)
+            if (slot < slotEnd) truncated = 1u;
             k = nextInstance(k, count, ro, rd, inv, tMin, limit, entry, gridA, gridB, node, end);
+        }
     } while (guard < bound && (node < end || k < count));
     nodesVisited += uint(guard);
-    if (node < end || slot < slotEnd) truncated = 1u;
+    // instances left unvisited count the ray as truncated too
+    if (node < end || slot < slotEnd || k < count) truncated = 1u;
     return false;
 #else
     rayO = ro; rayD = rd;

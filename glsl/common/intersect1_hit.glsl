@@ -30,10 +30,14 @@ vec3 vertexColor(int k) { return colors[k].rgb; }
 
 #if BVH_INSTANCES
 // The SAH BVH's two levels (ours; src/accel/bvh/instances.rs): the scene's vertex normals stay
-// in object space, and the hit's instance turns them into world space — the transpose of the
-// inverse of its model matrix' 3×3 part, as the transform pass' normalMatrix; bvh/hit_record.glsl
-// sets it for the hit's instance.
+// in object space, and the hit's instance turns each into world space and normalises it, as the
+// transform pass does with its normalMatrix (the transpose of the inverse of the model matrix'
+// 3×3 part), before Listing 13 interpolates them — the same normal under any scale;
+// bvh/hit_record.glsl sets it for the hit's instance.
 mat3 hitNormalMatrix = mat3(1.0);
+vec3 hitVertexNormal(int k) { return normalize(hitNormalMatrix * vertexNormal(k)); }
+#else
+vec3 hitVertexNormal(int k) { return vertexNormal(k); }
 #endif
 
 // inactive ray: an empty colour buffer, nothing for shading to add. Ours: weight -1 marks it;
@@ -65,12 +69,9 @@ void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float h
     if (triID >= 0) {
         // Listing 13: interpolation of the vertex normals with the (u, v) of the hit
         float w = 1.0 - hit_u - hit_v;
-        interpolated_normal = w * vertexNormal(3 * triID) + hit_u * vertexNormal(3 * triID + 1)
-                            + hit_v * vertexNormal(3 * triID + 2);
-#if BVH_INSTANCES
-        interpolated_normal = hitNormalMatrix * interpolated_normal;
-#endif
-        interpolated_normal = normalize(interpolated_normal);
+        interpolated_normal = normalize(w * hitVertexNormal(3 * triID)
+                                        + hit_u * hitVertexNormal(3 * triID + 1)
+                                        + hit_v * hitVertexNormal(3 * triID + 2));
         // ours: the normal faces the incoming ray (two-sided surfaces)
         if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
 

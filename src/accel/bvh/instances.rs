@@ -87,7 +87,7 @@ impl Instances {
                 .map(|t| [t[0], t[1], t[2]])
                 .collect();
             let count = triangles.len() as u32;
-            if count > 0 {
+            if has_triangles(positions) {
                 let tree = BvhTree::new(triangles);
                 out.objects.push(k);
                 out.first_ids.push(first);
@@ -102,20 +102,22 @@ impl Instances {
 
     /// The texels before the first tree: the count, then the instances as `models` place them
     /// (the model matrix of every object of the scene). An instance needs the inverse of its
-    /// model matrix: a singular one (an object scaled flat) is refused by name.
+    /// model matrix, found in doubles (a tiny scale, which the scene accepts, keeps an inverse
+    /// in floats): a singular one (an object scaled flat) is refused by name.
     pub fn table(&self, models: &[Mat4]) -> Result<Vec<u32>> {
         let mut words = vec![self.trees.len() as u32, 0, 0, 0];
         for (i, tree) in self.trees.iter().enumerate() {
             let model = models[self.objects[i]];
             let world = world_box(tree, model);
-            let inverse = model.inverse();
-            if !inverse.is_finite() || !model.is_finite() || model.determinant() == 0.0 {
+            let exact = model.as_dmat4();
+            let inverse = exact.inverse().as_mat4();
+            if exact.determinant() == 0.0 || !inverse.is_finite() {
                 bail!(
                     "object {} has a model matrix without an inverse (determinant {}): \
                      --bvh-instances takes every ray into each object's own space; scale the \
                      object by a nonzero factor on every axis, or leave out --bvh-instances",
                     self.objects[i],
-                    model.determinant()
+                    exact.determinant()
                 );
             }
             let record = InstanceRecord {
