@@ -173,19 +173,43 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
     let all = read_csv(&out.join("thesis-5.1.csv"));
     assert_eq!(
         all.len(),
-        2 * 3 * 2,
-        "base and BVH, three scenes, two angles each"
+        3 * 3 * 2,
+        "base and the BVH's two structures, three scenes, two angles each"
     );
     let (frames, bvh): (Vec<_>, Vec<_>) = all.iter().cloned().partition(|r| r["tracer"] == "base");
     let triangles: HashMap<&str, u64> =
         [("teapot1", 14592), ("teapot3", 27392), ("teapot6", 46592)].into();
-    // the SAH BVH beside the base tracer (issue 34): the same scenes and frames, fewer tests,
-    // and with the objects turned on the second angle a refit, not a rebuild
-    assert_eq!(bvh.len(), 3 * 2);
+    // the SAH BVH beside the base tracer (issue 34), one tree and instances: the same scenes
+    // and frames, fewer tests; with the objects turned on the second angle the one tree is
+    // refitted, the instances' table rewritten, neither rebuilt
+    assert_eq!(bvh.len(), 2 * 3 * 2);
     for r in &bvh {
         assert_eq!(r["tracer"], "bvh");
         assert_eq!(u(r, "triangles"), triangles[r["scene"].as_str()]);
         assert!(u(r, "triangle_tests") < 16 * 16 * u(r, "triangles"));
+        let turned = r["angle_deg"] == "180";
+        match r["variant"].as_str() {
+            "sah" => {
+                assert_eq!(r["fact_bvh_instances"], "", "{r:?}");
+                assert_eq!(
+                    r["fact_bvh_refits"],
+                    if turned { "1" } else { "0" },
+                    "{r:?}"
+                );
+            }
+            "sah-instances" => {
+                // a teapot scene's objects: the teapots and the floor
+                let objects: HashMap<&str, u64> =
+                    [("teapot1", 2), ("teapot3", 4), ("teapot6", 7)].into();
+                let n = objects[r["scene"].as_str()];
+                assert_eq!(u(r, "fact_bvh_instances"), n, "{r:?}");
+                assert_eq!(f(r, "fact_bvh_instances_ms") > 0.0, turned, "{r:?}");
+                assert_eq!(r["fact_bvh_refits"], "0", "{r:?}");
+            }
+            v => panic!("variant {v}"),
+        }
+        // built in the warm-up frame
+        assert_eq!(r["fact_bvh_rebuilt"], "false", "{r:?}");
     }
     for r in &frames {
         let t = triangles[r["scene"].as_str()];
@@ -231,7 +255,7 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
     assert!(tests_of("teapot1") < tests_of("teapot3") && tests_of("teapot3") < tests_of("teapot6"));
 
     let summary = read_csv(&out.join("thesis-5.1_summary.csv"));
-    assert_eq!(summary.len(), 2 * 3);
+    assert_eq!(summary.len(), 3 * 3);
     check_summary_against_frames(&all, &summary);
 
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
@@ -244,7 +268,9 @@ fn thesis_5_1_tiny_writes_consistent_csv_plots_and_report() {
         "Fig. 20",
         "14,592 / 14,592",
         "The SAH BVH beside them",
-        "BVH refit ms",
+        "refit ms, GPU",
+        "instance table ms, CPU",
+        "| teapot6 | instances |",
         "16×16",
         "512×512",
     ] {
@@ -281,8 +307,9 @@ fn thesis_5_3_tiny_base_tests_every_triangle_per_pixel_and_grid_cuts_tests() {
     let frames = read_csv(&out.join("thesis-5.3.csv"));
     let summary = read_csv(&out.join("thesis-5.3_summary.csv"));
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    // bunny base + 2 variants × 2 resolutions; dragon 2 variants × 28³; the BVH on both
-    assert_eq!(summary.len(), 1 + 4 + 2 + 2, "{err}");
+    // bunny base + 2 variants × 2 resolutions; dragon 2 variants × 28³; the BVH's two
+    // structures on both
+    assert_eq!(summary.len(), 1 + 4 + 2 + 2 * 2, "{err}");
 
     // no reflection on the bunny: intersect1 is exactly W·H·T, intersect2 at most that
     let base: Vec<_> = frames

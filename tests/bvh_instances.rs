@@ -91,6 +91,9 @@ fn moving_objects_update_the_instances_only() {
         let mut t = ray_tracer(&ctx, &scene, opts.clone());
         let first = t.render(&scene.camera).unwrap();
         assert!(first.stats.gpu_ms.contains_key("transform"));
+        // the first frame builds the trees; no table was rewritten
+        assert_eq!(first.stats.facts["bvh_rebuilt"], json!(true), "{name}");
+        assert_eq!(first.stats.facts["bvh_instances_ms"], json!(0.0), "{name}");
         for frame in 1..=3 {
             let models = moved(&scene, 25.0 * frame as f32, 0.3 * frame as f32);
             let mut now = scene.clone();
@@ -104,6 +107,8 @@ fn moving_objects_update_the_instances_only() {
             assert_eq!(f["bvh_rebuilt"], json!(false), "{what}");
             assert_eq!(f["bvh_refits"], json!(0), "{what}");
             assert_eq!(bvh(&t).builds(), 1, "{what}");
+            // the frame's one update: the instance table's write, timed
+            assert!(f["bvh_instances_ms"].as_f64().unwrap() > 0.0, "{what}");
             assert!(
                 !v.stats.gpu_ms.contains_key("transform"),
                 "{what}: {:?}",
@@ -111,6 +116,10 @@ fn moving_objects_update_the_instances_only() {
             );
             assert_hits_reference(&v, &now, &opts, &what);
         }
+        // a frame where nothing moved writes nothing
+        let still = t.render(&scene.camera).unwrap();
+        assert_eq!(still.stats.facts["bvh_instances_ms"], json!(0.0), "{name}");
+        assert_eq!(bvh(&t).builds(), 1, "{name}");
     }
 }
 

@@ -243,6 +243,8 @@ pub struct Bvh {
     moving: Moving,
     /// the last build's world transform, words (octant records, leaf triangles) and upload, ms
     upload_ms: f64,
+    /// with instances: this frame's write of the instance table, ms (0 where nothing moved)
+    instances_ms: f64,
 }
 
 impl Bvh {
@@ -287,6 +289,7 @@ impl Bvh {
             builds: 0,
             rebuilt: false,
             upload_ms: 0.0,
+            instances_ms: 0.0,
         }))
     }
 
@@ -334,7 +337,8 @@ impl Bvh {
         let start = std::time::Instant::now();
         match (&self.levels, &self.buffers) {
             (Levels::Two(Some(inst)), Some(buffers)) => {
-                buffers.write_u32(&self.gl, 0, &inst.table(models)?)
+                buffers.write_u32(&self.gl, 0, &inst.table(models)?);
+                self.instances_ms = start.elapsed().as_secs_f64() * 1e3;
             }
             _ => {
                 let inst = Instances::new(&self.objects);
@@ -353,15 +357,10 @@ impl Bvh {
                 self.levels = Levels::Two(Some(inst));
                 self.rebuilt = true;
                 self.builds += 1;
+                // the words and their upload, after the trees
+                self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - self.stats.build_ms;
             }
         }
-        // a build's words and upload after its trees; after it, the instances' update
-        let trees_ms = if self.rebuilt {
-            self.stats.build_ms
-        } else {
-            0.0
-        };
-        self.upload_ms = start.elapsed().as_secs_f64() * 1e3 - trees_ms;
         self.built_for = Some(models.to_vec());
         Ok(())
     }
@@ -476,6 +475,7 @@ impl Drop for Bvh {
 impl Accelerator for Bvh {
     fn build(&mut self, f: &mut FrameContext) -> Result<()> {
         self.rebuilt = false;
+        self.instances_ms = 0.0;
         if self.built_for.as_deref() == Some(f.models) {
             return Ok(());
         }
@@ -514,6 +514,7 @@ impl Accelerator for Bvh {
         f.insert("bvh_upload_ms".into(), json!(self.upload_ms));
         if let Levels::Two(Some(inst)) = &self.levels {
             f.insert("bvh_instances".into(), json!(inst.trees.len()));
+            f.insert("bvh_instances_ms".into(), json!(self.instances_ms));
         }
         f.insert("bvh_rebuilt".into(), json!(self.rebuilt));
         f.insert("bvh_nodes".into(), json!(s.nodes));

@@ -1,26 +1,38 @@
 //! The SAH BVH beside Müller 2015's tracers — ours (issue 34): each thesis protocol (ch.
-//! 5.1–5.3) measures `--tracer bvh` on its scenes too, turned as they are: with `--rotate
-//! objects` every frame moves every object, so the tree is refitted on the GPU every frame and
-//! rebuilt on the CPU only when the refit grew its SAH cost past `REBUILD_GROWTH`
-//! (`docs/design/bvh.md`, "Moving objects"). The protocols' own tables and figures stay the
-//! thesis' (base and grids); this module adds one table of the BVH beside them.
+//! 5.1–5.3) measures `--tracer bvh` on its scenes too, turned as they are, in both of its
+//! structures. With `--rotate objects` every frame moves every object: the one tree (the
+//! default) is refitted on the GPU every frame and rebuilt on the CPU only when the refit grew
+//! its SAH cost past `REBUILD_GROWTH`; with `--bvh-instances` (a tree per object, built once)
+//! the frame rewrites only the instances' table (`docs/design/bvh.md`, "Moving objects" and
+//! "Two levels"). The protocols' own tables and figures stay the thesis' (base and grids); this
+//! module adds one table of the BVH beside them.
 
 use crate::bench::report::format::{int, num, ratio, table};
 use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
 use crate::bench::runner::outcome::{FrameRecord, Outcome};
 
-/// The SAH BVH (the product's, not Wagner's) on each of `scenes`.
+/// The SAH BVH (the product's, not Wagner's) on each of `scenes`: one tree, then instances.
 pub fn configs(scenes: &[&str], refl_depth: u32, s: Sizing) -> Vec<Config> {
-    let tracer = TracerSpec::Bvh {
-        variant: BvhVariant::Sah,
-    };
-    let config = |scene: &&str| Config::new(scene, tracer, refl_depth, s);
-    scenes.iter().map(config).collect()
+    let tracers = [
+        TracerSpec::Bvh {
+            variant: BvhVariant::Sah,
+        },
+        TracerSpec::BvhInstances,
+    ];
+    let config = |(scene, tracer): (&&str, TracerSpec)| Config::new(scene, tracer, refl_depth, s);
+    scenes
+        .iter()
+        .flat_map(|scene| tracers.map(|t| (scene, t)))
+        .map(config)
+        .collect()
 }
 
 /// Whether `o` measured a BVH.
 pub fn is_bvh(o: &Outcome) -> bool {
-    matches!(o.config.tracer, TracerSpec::Bvh { .. })
+    matches!(
+        o.config.tracer,
+        TracerSpec::Bvh { .. } | TracerSpec::BvhInstances
+    )
 }
 
 /// The outcomes that are not the BVH's: those the thesis' tables and figures show.
@@ -46,8 +58,9 @@ fn count_true(o: &Outcome, name: &str) -> usize {
     o.frames.iter().filter(yes).count()
 }
 
-/// A row per BVH outcome: its run FPS and mean GPU time and tests beside the base tracer's and
-/// the fastest grid's on the same scene, its mean refit time, and its CPU builds during the
+/// A row per BVH outcome: its structure, its run FPS and mean GPU time and tests beside the base
+/// tracer's and the fastest grid's on the same scene, its mean update per frame (the one tree's
+/// refit on the GPU, the instances' table written by the CPU), and its CPU builds during the
 /// measured frames (the first build falls in the warm-up unless there is none).
 pub fn table_text(outcomes: &[Outcome]) -> String {
     let same = |o: &Outcome, bvh: &Outcome| o.ok() && o.config.scene == bvh.config.scene;
@@ -66,14 +79,27 @@ pub fn table_text(outcomes: &[Outcome]) -> String {
             let gpu = |o: Option<&Outcome>| o.and_then(|o| o.gpu_ms()).map(|s| s.mean);
             let tests = |o: Option<&Outcome>| o.and_then(|o| o.tests()).map(|s| s.mean);
             let cell = |v: Option<f64>, f: fn(f64) -> String| v.map_or("–".into(), f);
+            let instances = b.config.tracer == TracerSpec::BvhInstances;
+            let (structure, update) = if instances {
+                ("instances", "bvh_instances_ms")
+            } else {
+                ("one tree", "bvh_refit_ms")
+            };
+            let update_ms = num(mean_fact(b, update));
             vec![
                 b.config.scene_name().to_string(),
+                structure.to_string(),
                 cell(fps(Some(b)), num),
                 format!("{} / {}", cell(fps(base), num), cell(fps(grid), num)),
                 cell(gpu(Some(b)), num),
                 ratio(gpu(base).zip(gpu(Some(b))).map(|(a, b)| a / b)),
                 format!("{} / {}", cell(tests(Some(b)), int), cell(tests(base), int)),
-                num(mean_fact(b, "bvh_refit_ms")),
+                if instances {
+                    "–".into()
+                } else {
+                    update_ms.clone()
+                },
+                if instances { update_ms } else { "–".into() },
                 count_true(b, "bvh_rebuilt").to_string(),
             ]
         })
@@ -83,18 +109,22 @@ pub fn table_text(outcomes: &[Outcome]) -> String {
     }
     let header = [
         "scene",
+        "BVH",
         "BVH FPS (run)",
         "FPS base / best grid",
         "BVH GPU ms (mean)",
         "base GPU ms / BVH's",
         "tests per frame, BVH / base (mean)",
-        "BVH refit ms (mean per frame)",
-        "BVH rebuilds (frames)",
+        "refit ms, GPU (mean per frame)",
+        "instance table ms, CPU (mean per frame)",
+        "BVH builds (frames)",
     ];
-    "### The SAH BVH beside them (ours, issue 34)\n\n`--tracer bvh` on the same scenes and frames; \
-     with `--rotate objects` every frame moves the objects and refits the tree on the GPU \
-     (`bvh_refit_ms`), a CPU rebuild only where a refit grew the tree's SAH cost past \
-     `REBUILD_GROWTH` (`docs/design/bvh.md`, \"Moving objects\").\n\n"
+    "### The SAH BVH beside them (ours, issue 34)\n\n`--tracer bvh` on the same scenes and frames, \
+     one tree and a tree per object under instances (`--bvh-instances`). With `--rotate objects` \
+     every frame moves the objects: the one tree is refitted on the GPU (`bvh_refit_ms`) and \
+     rebuilt on the CPU only where a refit grew its SAH cost past `REBUILD_GROWTH`; the \
+     instances' trees are built once and a frame rewrites their table (`bvh_instances_ms`) \
+     (`docs/design/bvh.md`, \"Moving objects\", \"Two levels\").\n\n"
         .to_string()
         + &table(&header, &rows)
 }

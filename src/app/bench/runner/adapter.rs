@@ -63,7 +63,7 @@ pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
 fn design(c: &Config, args: &BenchArgs) -> Design {
     let d = GridOptions::default();
     let (width, height, aovs) = (c.width, c.height, c.judge);
-    let mueller = |tracer, grid| {
+    let mueller = |tracer, grid, bvh_instances| {
         Design::Mueller2015(RenderOptions {
             tracer,
             width,
@@ -76,11 +76,11 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
             triangles_per_dispatch: None,
             light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
             fused_passes: false,
-            bvh_instances: false,
+            bvh_instances,
         })
     };
     match c.tracer {
-        TracerSpec::Base => mueller(TracerKind::Base, d),
+        TracerSpec::Base => mueller(TracerKind::Base, d, false),
         TracerSpec::Grid {
             variant,
             resolution,
@@ -93,6 +93,7 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
                 ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
                 ..d
             },
+            false,
         ),
         TracerSpec::GridPc { resolution } => mueller(
             TracerKind::Grid,
@@ -101,10 +102,12 @@ fn design(c: &Config, args: &BenchArgs) -> Design {
                 proximity_clouds: true,
                 ..d
             },
+            false,
         ),
         TracerSpec::Bvh {
             variant: BvhVariant::Sah,
-        } => mueller(TracerKind::Bvh, d),
+        } => mueller(TracerKind::Bvh, d, false),
+        TracerSpec::BvhInstances => mueller(TracerKind::Bvh, d, true),
         TracerSpec::Bvh {
             variant: BvhVariant::Wagner,
         } => Design::Wagner2018(WagnerOptions {

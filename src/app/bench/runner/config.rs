@@ -63,6 +63,9 @@ pub enum TracerSpec {
     },
     /// A BVH tracer (`--tracer bvh`) of one variant.
     Bvh { variant: BvhVariant },
+    /// The SAH BVH as a tree per object under instances (`--tracer bvh --bvh-instances`): a
+    /// moving object rewrites its instance, where the one tree is refitted.
+    BvhInstances,
     /// Seed 004's streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
     /// proximity clouds: the paper's columns pc and g.
     /// With `naive_shadows`, the naive shadow rays the paper's optimisation is measured
@@ -91,7 +94,8 @@ impl TracerSpec {
             TracerSpec::Grid { .. } | TracerSpec::GridPc { .. } => "grid-exact",
             TracerSpec::Bvh {
                 variant: BvhVariant::Sah,
-            } => "bvh",
+            }
+            | TracerSpec::BvhInstances => "bvh",
             TracerSpec::Bvh {
                 variant: BvhVariant::Wagner,
             } => "bvh-wagner",
@@ -115,7 +119,7 @@ impl TracerSpec {
         match self {
             TracerSpec::Base => "base",
             TracerSpec::Grid { .. } => "grid",
-            TracerSpec::Bvh { .. } => "bvh",
+            TracerSpec::Bvh { .. } | TracerSpec::BvhInstances => "bvh",
             TracerSpec::Stream { .. } => "stream",
             TracerSpec::GridPc { .. } => "grid",
         }
@@ -158,6 +162,7 @@ impl TracerSpec {
             TracerSpec::Base => None,
             TracerSpec::Grid { variant, .. } => Some(variant_name(variant)),
             TracerSpec::Bvh { variant } => Some(variant.name()),
+            TracerSpec::BvhInstances => Some("sah-instances"),
             TracerSpec::Stream {
                 proximity_clouds,
                 naive_shadows,
@@ -185,6 +190,7 @@ impl TracerSpec {
                 resolution,
             } => format!("grid {} {resolution}³", variant_name(variant)),
             TracerSpec::Bvh { variant } => format!("bvh {}", variant.name()),
+            TracerSpec::BvhInstances => "bvh sah-instances".into(),
             TracerSpec::Stream { .. } | TracerSpec::GridPc { .. } => format!(
                 "{} {} {}",
                 self.name(),
@@ -342,6 +348,15 @@ mod tests {
             ("bvh sah".into(), "bvh-sah".into())
         );
         assert_eq!((bvh.variant_label(), bvh.grid()), (Some("sah"), None));
+        let instances = TracerSpec::BvhInstances;
+        assert_eq!(
+            (instances.label(), instances.slug(), instances.row().name),
+            (
+                "bvh sah-instances".into(),
+                "bvh-sah-instances".into(),
+                "bvh"
+            )
+        );
         let c = Config::fixed("square.toml", bvh, (320, 240), Sizing::quick(3, 1)).with_level(2);
         assert_eq!(
             (c.label(), c.slug()),
