@@ -206,11 +206,29 @@ uvec4 blockEntry()
 }
 #endif
 
+#if BVH_BLOCK_LISTS
+#include "block_lists.glsl"
+// Block b into list 1 where none of its rays can hit (no active ray, or an empty walk:
+// node = end), else into list 0 (bvh/block_lists.glsl).
+void listBlock(ivec2 block, int b, bool rays, uvec4 entry)
+{
+    uint list = !rays || (entry.x != 0u && entry.y == entry.z) ? 1u : 0u;
+    ivec2 tile = block / BVH_TILE_BLOCKS;
+    uint t = uint(tile.y * BVH_TILES_X + tile.x);
+    uint at = atomicAdd(blockWords[4u * (2u * t + list)], 1u);
+    blockWords[blockListWord(t, list, at)] = uint(b);
+}
+#endif
+
 void main()
 {
     int b = int(gl_GlobalInvocationID.x);
     if (b >= BVH_ENTRY_TEXELS) return;
     ivec2 block = ivec2(b % BVH_BLOCKS_X, b / BVH_BLOCKS_X);
-    uvec4 entry = bound(block) ? blockEntry() : uvec4(0u);
+    bool rays = bound(block);
+    uvec4 entry = rays ? blockEntry() : uvec4(0u);
     imageStore(bvh, entryTexel(block), entry);
+#if BVH_BLOCK_LISTS
+    listBlock(block, b, rays, entry);
+#endif
 }

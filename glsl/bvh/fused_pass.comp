@@ -12,6 +12,9 @@
 // the ray state only where a reflection pass follows (storeRayState), and the first pass
 // the AOVs' texels where the host keeps AOVs (STORE_AOVS). The blocks' entry points
 // (bvh/entry.comp) run before it; without AOVs both compute the eye rays in place (pass_ray.glsl).
+// With one tree (BVH_BLOCK_LISTS) the entry pass also sorts the blocks into those whose rays may
+// hit and those whose rays cannot, and this kernel runs a work group per block of the first
+// list and, compiled as FUSED_MISS (no walk), of the second (bvh/block_lists.glsl).
 //
 // The work counts go to per-pixel records (bvh/records.glsl), which pixel_counts.comp adds to
 // the counter bank of each ray kind: the closest-hit search's packed in words 0–1 of record 0
@@ -33,6 +36,24 @@
 #include "../common/light_samples.glsl"
 #include "../common/feeler.glsl"
 #include "../common/pass_ray.glsl"
+#if BVH_BLOCK_LISTS
+#include "block_lists.glsl"
+// the tile whose list this dispatch runs over
+uniform int blockListTile;
+// the threads that split a dispatch's work groups in contiguous shares (PixelGrid::threads)
+uniform int blockListThreads;
+
+// The list entry of work group i of n: llvmpipe hands each of its N threads a contiguous 1/N
+// of the work groups, and a list in the order of the blocks would give one thread the rows of
+// the tile the object fills (as pixelPosition's row stride avoids, common/images.glsl); so
+// the first N·q entries (q = n / N) are dealt out in turn — work group a + N·b takes entry
+// a·q + b — and each share takes blocks from the whole tile.
+uint listEntry(uint i, uint n)
+{
+    uint threads = uint(max(blockListThreads, 1)), q = n / threads;
+    return i < threads * q ? (i % threads) * q + i / threads : i;
+}
+#endif
 
 uniform vec4 camPosition;
 uniform vec4 ambientColor;
@@ -176,9 +197,15 @@ void trace(ivec2 storePos)
         vec3 ro = originState.xyz, rd = dirTri.xyz;
         rayLast = int(dirTri.w);
         bestT = 1.0 / 0.0; // +inf
+#if FUSED_MISS
+        // a block whose rays all miss the root (bvh/block_lists.glsl): the walk of its empty
+        // entry, which visits nothing, left out
+        closestHitRecord = -1;
+#else
         float limit = bestT;
         traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)));
         closestHitRecord = bestAt;
+#endif
         primary = takeCounts();
 
         float t, u, v;
@@ -214,6 +241,14 @@ void trace(ivec2 storePos)
 
 void main()
 {
+#if BVH_BLOCK_LISTS
+    // a work group per block of this kernel's list of the tile (FUSED_MISS: the blocks without
+    // a hit)
+    uint i = listEntry(gl_WorkGroupID.x, gl_NumWorkGroups.x);
+    uint b = blockWords[blockListWord(uint(blockListTile), uint(FUSED_MISS), i)];
+    ivec2 storePos = ivec2(b % uint(BVH_BLOCKS_X), b / uint(BVH_BLOCKS_X)) * 8 + groupPixel();
+#else
     ivec2 storePos = pixelPosition();
+#endif
     if (insideImage(storePos)) trace(storePos);
 }

@@ -39,14 +39,19 @@ uniform ivec2 tileOffset;
 //   pixels instead of a row of 8, whose rays diverge less (docs/design/frame.md).
 uniform int tileRowStride;
 
+// This invocation's pixel within its work group's 8×8: SIMD group l.y takes block
+// (l.y & 1, l.y >> 1) of 4×2 pixels, lane l.x a pixel of it.
+ivec2 groupPixel()
+{
+    ivec2 l = ivec2(gl_LocalInvocationID.xy);
+    return ivec2((l.y & 1) * 4 + (l.x & 3), (l.y >> 1) * 2 + (l.x >> 2));
+}
+
 // The pixel this invocation works on (storePos in the thesis, ch. 4).
 ivec2 pixelPosition()
 {
     int rows = int(gl_NumWorkGroups.y), y = int(gl_WorkGroupID.y);
     int row = y == rows - 1 ? y : y * max(tileRowStride, 1) % max(rows - 1, 1);
-    ivec2 l = ivec2(gl_LocalInvocationID.xy);
-    // SIMD group l.y: block (l.y & 1, l.y >> 1) of 4×2 pixels; lane l.x within it
-    ivec2 inGroup = ivec2((l.y & 1) * 4 + (l.x & 3), (l.y >> 1) * 2 + (l.x >> 2));
-    return ivec2(gl_WorkGroupID.x, row) * 8 + inGroup + tileOffset;
+    return ivec2(gl_WorkGroupID.x, row) * 8 + groupPixel() + tileOffset;
 }
 bool insideImage(ivec2 p) { return all(lessThan(p, imageSize(rayOriginTexture))); }

@@ -72,18 +72,21 @@ pub trait Accelerator {
         false
     }
     /// With `--fused-passes` ([`BuildContext::fused`]): prepare the design's fused pass
-    /// kernel as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
-    /// bind, put it in use) and return it; `None` for a design without one.
-    /// `eye`: the camera where the pass computes its eye rays in place (`eyeRays`,
+    /// kernels as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
+    /// bind) and return them — one, or the SAH BVH's two over its block lists — for the
+    /// pipeline to set the pass' uniforms on each; `None` for a design without one. `eye`: the
+    /// camera where the pass computes its eye rays in place (`eyeRays`,
     /// `glsl/common/pass_ray.glsl`) instead of loading the eye-ray kernel's texels.
     fn fused_pass(
         &mut self,
         _f: &mut FrameContext,
         _pass: u32,
         _eye: Option<&CameraRays>,
-    ) -> Option<&Kernel> {
+    ) -> Option<&[Kernel]> {
         None
     }
+    /// Dispatch the kernels [`Accelerator::fused_pass`] returned, their uniforms set.
+    fn dispatch_fused(&mut self, _f: &mut FrameContext) {}
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
 }
@@ -195,6 +198,9 @@ pub struct FusedPasses {
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,
+    /// The side of a dispatch's tile in 8×8 blocks, where the pass runs over block lists, one
+    /// pair a tile (`glsl/bvh/block_lists.glsl`): one tree; `None` with `--bvh-instances`.
+    pub block_lists: Option<u32>,
 }
 
 impl BuildContext<'_> {

@@ -249,6 +249,21 @@ impl Kernel {
 
     /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, between
     /// two barriers ([`sync`]).
+    /// Dispatch the work groups of the indirect command at byte `offset` of `commands`
+    /// (`glDispatchComputeIndirect`), which an earlier kernel wrote, between the two barriers.
+    pub fn dispatch_indirect(&self, timers: &mut GpuTimers, commands: glow::Buffer, offset: i32) {
+        let gl = &self.gl;
+        sync::barrier(gl);
+        // SAFETY: an existing buffer bound as the indirect command buffer, the command inside
+        // it; the program in use.
+        timers.time(gl, self.timer, || unsafe {
+            gl.bind_buffer(glow::DISPATCH_INDIRECT_BUFFER, Some(commands));
+            gl.dispatch_compute_indirect(offset);
+            gl.bind_buffer(glow::DISPATCH_INDIRECT_BUFFER, None);
+        });
+        sync::barrier(gl);
+    }
+
     pub fn dispatch_1d(&self, timers: &mut GpuTimers, groups: u32) {
         let gl = &self.gl;
         sync::barrier(gl);

@@ -60,6 +60,10 @@ slot_table! {
         /// moved objects' compute pass (glsl/mueller2015/transform_moved.comp)
         TRANSFORM_POSITIONS = 22,
         TRANSFORM_NORMALS = 23,
+        /// the SAH BVH's fused pass: its blocks sorted by the entry pass into those with rays
+        /// that may hit and those without, and the two dispatches' work-group counts
+        /// (glsl/bvh/block_lists.glsl)
+        BVH_BLOCK_LISTS = 24,
         // the SAH BVH's GPU refit (glsl/bvh/refit.glsl): the tree's topology as the host lays
         // it out once per build (src/accel/bvh/refit.rs), and every node's float box and
         // subtree SAH cost as the refit's passes write them

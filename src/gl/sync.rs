@@ -27,18 +27,20 @@ use super::context::Gl;
 /// | `SHADER_STORAGE_BARRIER_BIT` | SSBO loads, stores and atomics of the next kernels |
 /// | `SHADER_IMAGE_ACCESS_BARRIER_BIT` | image loads and stores (the ray-state images, the BVH's image buffer) |
 /// | `TEXTURE_FETCH_BARRIER_BIT` | sampler and `texelFetch` reads, texture buffers included (the quads, Wagner's and the streaming tracer's textures) |
-/// | `BUFFER_UPDATE_BARRIER_BIT` | `glGetBufferSubData` (counters, grid totals), `glClearBufferData` |
+/// | `BUFFER_UPDATE_BARRIER_BIT` | `glGetBufferSubData` (counters, grid totals), `glClearBufferData`, `glBufferSubData` (the BVH's block lists) |
 /// | `TEXTURE_UPDATE_BARRIER_BIT` | `glGetTexImage` (frames, AOVs), `glClearTexImage` (the ray-state images each frame, the shadow flags each pass), `glCopyImageSubData` (the AOV copies) |
 /// | `FRAMEBUFFER_BARRIER_BIT` | rendering or clearing into a texture a shader stored into (Klee 2016's G-buffer diffuse texture, which the shadow pass shades in place) |
+/// | `COMMAND_BARRIER_BIT` | indirect dispatch commands (the SAH BVH's fused pass over the block lists its entry pass counts) |
 ///
-/// Not needed: no indirect commands, no vertex or index data written by shaders, no atomic
-/// counter buffers, pixel buffers, uniform buffers or transform feedback.
+/// Not needed: no vertex or index data written by shaders, no atomic counter buffers, pixel
+/// buffers, uniform buffers or transform feedback.
 pub const SHADER_WRITE_READERS: u32 = glow::SHADER_STORAGE_BARRIER_BIT
     | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
     | glow::TEXTURE_FETCH_BARRIER_BIT
     | glow::BUFFER_UPDATE_BARRIER_BIT
     | glow::TEXTURE_UPDATE_BARRIER_BIT
-    | glow::FRAMEBUFFER_BARRIER_BIT;
+    | glow::FRAMEBUFFER_BARRIER_BIT
+    | glow::COMMAND_BARRIER_BIT;
 
 /// The barrier between passes (see the module's rule).
 pub fn barrier(gl: &Gl) {

@@ -24,7 +24,7 @@ use super::{
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
-use crate::gl::resources::{TexelData, TextureBuffers};
+use crate::gl::resources::{Ssbo, TexelData, TextureBuffers};
 use crate::gl::slots::{image, ssbo};
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::scene::{transform_triangles, CameraRays, Scene};
@@ -138,11 +138,72 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
 /// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's counts in record 0 (the first
 /// light's beside the closest hit's where it is a point light), else the first light's at
 /// record 1; the other lights' at record 2 where the scene has more than one light
-/// (`pipeline::mueller2015::records`).
+/// (`pipeline::mueller2015::records`). With block lists ([`FusedPasses::block_lists`]) two
+/// kernels, a work group per block: the blocks whose rays may hit (`fused_pass`) and those
+/// whose rays all miss (`FUSED_MISS`, timed as `fused_miss`; `glsl/bvh/block_lists.glsl`).
+fn fused_kernels(
+    b: &BuildContext,
+    defs: &[(&'static str, String)],
+    f: FusedPasses,
+) -> Result<Vec<Kernel>> {
+    let lists = [(
+        "BVH_BLOCK_LISTS",
+        (f.block_lists.is_some() as i32).to_string(),
+    )];
+    let kernel = |miss: bool, timer| {
+        let miss = [("FUSED_MISS", (miss as i32).to_string())];
+        fused_kernel(b, &[defs, &lists[..], &miss[..]].concat(), f, timer)
+    };
+    match f.block_lists {
+        Some(_) => Ok(vec![
+            kernel(false, "fused_pass")?,
+            kernel(true, "fused_miss")?,
+        ]),
+        None => Ok(vec![kernel(false, "fused_pass")?]),
+    }
+}
+
+/// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): a pair per tile of `side`×`side`
+/// blocks of the `blocks` (x, y) of the image.
+struct BlockLists {
+    buffer: Ssbo,
+    tiles: u32,
+}
+
+impl BlockLists {
+    fn new(b: &BuildContext, blocks: (u32, u32), side: u32) -> Result<BlockLists> {
+        let tiles = blocks.0.div_ceil(side) * blocks.1.div_ceil(side);
+        let words = 8 * tiles as usize + 2 * (tiles * side * side) as usize;
+        let max_block = b.info.max_ssbo_block_size;
+        let buffer = Ssbo::new(b.gl, "bvh_block_lists", 4 * words, None, max_block)?;
+        Ok(BlockLists { buffer, tiles })
+    }
+
+    /// The entry kernel's #defines: the tiles' side in blocks, the tiles in a row, the tiles.
+    fn defines(blocks: (u32, u32), side: u32) -> [(&'static str, String); 3] {
+        [
+            ("BVH_TILE_BLOCKS", side.to_string()),
+            ("BVH_TILES_X", blocks.0.div_ceil(side).to_string()),
+            (
+                "BVH_TILES",
+                (blocks.0.div_ceil(side) * blocks.1.div_ceil(side)).to_string(),
+            ),
+        ]
+    }
+
+    /// Every list empty, for the entry pass to fill; bound for it and the fused kernels.
+    fn reset(&self, gl: &Gl) {
+        let empty = [0, 1, 1, 0].repeat(2 * self.tiles as usize);
+        self.buffer.write_u32(gl, 0, &empty);
+        self.buffer.bind(gl, ssbo::BVH_BLOCK_LISTS);
+    }
+}
+
 fn fused_kernel(
     b: &BuildContext,
     defs: &[(&'static str, String)],
     f: FusedPasses,
+    timer: &'static str,
 ) -> Result<Kernel> {
     let extra = [
         ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
@@ -156,11 +217,7 @@ fn fused_kernel(
             (f.first_light_point as i32).to_string(),
         ),
     ];
-    b.kernel(
-        "bvh/fused_pass.comp",
-        &[defs, &extra[..]].concat(),
-        "fused_pass",
-    )
+    b.kernel("bvh/fused_pass.comp", &[defs, &extra[..]].concat(), timer)
 }
 
 /// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
@@ -221,8 +278,12 @@ pub struct Bvh {
     blocks: u32,
     intersect1: Kernel,
     intersect2: Kernel,
-    /// `--fused-passes`: the pass in one kernel (`glsl/bvh/fused_pass.comp`)
-    fused: Option<Kernel>,
+    /// `--fused-passes`: the pass in one kernel (`glsl/bvh/fused_pass.comp`), or in two over
+    /// the block lists (the blocks that may hit, those that cannot); none without
+    fused: Vec<Kernel>,
+    /// the block lists and their dispatch commands (`glsl/bvh/block_lists.glsl`), where the
+    /// fused pass runs over them
+    block_lists: Option<BlockLists>,
     /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
     walks_per_record: u64,
     /// object-space vertex positions of every object (triangle soup, scene order)
@@ -251,19 +312,33 @@ impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
-        let defs = kernel_defines(b.info, blocks);
+        let side = b.fused.and_then(|f| f.block_lists);
+        let lists = side.map(|s| BlockLists::defines(blocks, s));
+        let defs = [
+            &kernel_defines(b.info, blocks)[..],
+            lists.as_ref().map_or(&[], |l| &l[..]),
+        ]
+        .concat();
+        let entry_defs = [
+            ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
+            ("BVH_BLOCK_LISTS", (side.is_some() as i32).to_string()),
+        ];
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
             // timed as a part of intersect1: the closest-hit search of the passes
             entry: b.kernel(
                 "bvh/entry.comp",
-                &[&defs[..], &[("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string())]].concat(),
+                &[&defs[..], &entry_defs[..]].concat(),
                 "intersect1",
             )?,
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
-            fused: b.fused.map(|f| fused_kernel(b, &defs, f)).transpose()?,
+            fused: match b.fused {
+                Some(f) => fused_kernels(b, &defs, f)?,
+                None => Vec::new(),
+            },
+            block_lists: side.map(|s| BlockLists::new(b, blocks, s)).transpose()?,
             walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
             moving: Moving {
                 kernels: refit_kernels(b, &defs)?,
@@ -539,15 +614,43 @@ impl Accelerator for Bvh {
         f: &mut FrameContext,
         pass: u32,
         eye: Option<&CameraRays>,
-    ) -> Option<&Kernel> {
-        self.fused.as_ref()?;
+    ) -> Option<&[Kernel]> {
+        if self.fused.is_empty() {
+            return None;
+        }
+        if let Some(lists) = &self.block_lists {
+            lists.reset(f.gl);
+        }
         self.entry.use_program();
         set_pass_rays(&self.entry, eye);
         self.closest_hit(f, pass);
-        let k = self.fused.as_ref()?;
-        k.use_program();
-        set_pass_rays(k, eye);
-        Some(k)
+        for k in &self.fused {
+            k.use_program();
+            set_pass_rays(k, eye);
+        }
+        Some(&self.fused)
+    }
+
+    fn dispatch_fused(&mut self, f: &mut FrameContext) {
+        match &self.block_lists {
+            Some(lists) => {
+                // per tile (PixelGrid::tiles' order) the blocks that may hit, then the others
+                for t in 0..lists.tiles {
+                    for (list, k) in self.fused.iter().enumerate() {
+                        k.use_program();
+                        k.set_i32("blockListTile", t as i32);
+                        k.set_i32("blockListThreads", f.pixels.threads as i32);
+                        let command = 16 * (2 * t as i32 + list as i32);
+                        k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
+                    }
+                }
+            }
+            None => {
+                let k = &self.fused[0];
+                k.use_program();
+                k.dispatch_pixels(f.timers, f.pixels);
+            }
+        }
     }
 
     fn as_any(&self) -> &dyn Any {

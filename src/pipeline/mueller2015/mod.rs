@@ -26,6 +26,7 @@ use crate::accel::{
     LightTarget, TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
+use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::scene::{AreaLight, Camera, CameraRays, Scene};
@@ -351,6 +352,10 @@ impl RayTracer {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
+                block_lists: (!options.bvh_instances).then(|| match options.tile {
+                    0 => w.max(h).div_ceil(PIXEL_GROUP),
+                    tile => tile / PIXEL_GROUP,
+                }),
             }),
             scene_images: gpu_scene.vertex_images(),
             bvh_instances: options.bvh_instances,
@@ -491,21 +496,24 @@ impl RayTracer {
         };
         self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         let l = &self.lighting;
-        let k = self
+        let kernels = self
             .accel
             .fused_pass(&mut f, pass, eye.then_some(cam))
             .expect("--fused-passes is refused for an accelerator without a fused pass");
-        k.set_vec4("backgroundColor", l.background, 1.0);
-        k.set_i32("storePrimaryHit", (pass == 0) as i32);
-        k.set_i32("storeRayState", (pass < self.options.refl_depth) as i32);
-        k.set_i32("firstPass", (pass == 0) as i32);
-        k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
-        k.set_vec4("ambientColor", l.ambient, 1.0);
-        k.set_i32("lightCount", l.lights.len() as i32);
-        k.set_vec4_slice("areaLight", &l.area_uniform());
+        for k in kernels {
+            k.use_program();
+            k.set_vec4("backgroundColor", l.background, 1.0);
+            k.set_i32("storePrimaryHit", (pass == 0) as i32);
+            k.set_i32("storeRayState", (pass < self.options.refl_depth) as i32);
+            k.set_i32("firstPass", (pass == 0) as i32);
+            k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
+            k.set_vec4("ambientColor", l.ambient, 1.0);
+            k.set_i32("lightCount", l.lights.len() as i32);
+            k.set_vec4_slice("areaLight", &l.area_uniform());
+        }
         // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
         self.counters.bind(f.gl, f.timers, Bank::Frame);
-        k.dispatch_pixels(f.timers, f.pixels);
+        self.accel.dispatch_fused(&mut f);
         self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         let r = self
             .records
