@@ -10,21 +10,17 @@
 // shading (docs/design/frame.md, "The fused pass"). The miss kernel is the same pass with the
 // walk left out, its hit path folded away by the compiler.
 //
-// Dispatches stay the tiles of the image (`--tile`: no dispatch long enough for a driver
-// watchdog), so the lists are a pair per tile of BVH_TILE_BLOCKS × BVH_TILE_BLOCKS blocks, the
-// tiles row by row, BVH_TILES_X of them a row, as the host's PixelGrid::tiles orders them.
-// Layout (words): per tile t and list k a dispatch command (num_groups_x, y = 1, z = 1,
-// padding) at words 4·(2t + k) — the host writes (0, 1, 1, 0) into every one before the entry
-// pass — then per tile and list its blocks, from word 8·BVH_TILES + (2t + k)·BVH_TILE_BLOCKS²
-// on (the first num_groups_x of them used).
+// The lists cover the whole image, one indirect dispatch each, whatever `--tile` splits the other
+// kernels into: per-tile pairs of lists, each dispatched with its tile as a uniform, rendered
+// right on llvmpipe but not on Mesa 22.3's zink, where the second pass of a frame traced rays
+// that had ended (docs/design/frame.md, "The fused pass").
+// Layout (words): list k's dispatch command (num_groups_x, y = 1, z = 1, padding) at words 4k —
+// bvh/block_lists_reset.comp writes (0, 1, 1, 0) into both before the entry pass — then list k's
+// blocks from word 8 + k·BVH_ENTRY_TEXELS on (the first num_groups_x of them used).
 #ifndef BVH_BLOCK_LISTS_GLSL
 #define BVH_BLOCK_LISTS_GLSL
 layout(std430, binding = SSBO_BVH_BLOCK_LISTS) buffer BlockLists { uint blockWords[]; };
 
-// the word of list k of tile t where its entry i lies
-uint blockListWord(uint t, uint k, uint i)
-{
-    const uint capacity = uint(BVH_TILE_BLOCKS * BVH_TILE_BLOCKS);
-    return uint(8 * BVH_TILES) + (2u * t + k) * capacity + i;
-}
+// the word of list k where its entry i lies
+uint blockListWord(uint k, uint i) { return 8u + k * uint(BVH_ENTRY_TEXELS) + i; }
 #endif

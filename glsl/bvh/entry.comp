@@ -210,13 +210,11 @@ uvec4 blockEntry()
 #include "block_lists.glsl"
 // Block b into list 1 where none of its rays can hit (no active ray, or an empty walk:
 // node = end), else into list 0 (bvh/block_lists.glsl).
-void listBlock(ivec2 block, int b, bool rays, uvec4 entry)
+void listBlock(int b, bool rays, uvec4 entry)
 {
     uint list = !rays || (entry.x != 0u && entry.y == entry.z) ? 1u : 0u;
-    ivec2 tile = block / BVH_TILE_BLOCKS;
-    uint t = uint(tile.y * BVH_TILES_X + tile.x);
-    uint at = atomicAdd(blockWords[4u * (2u * t + list)], 1u);
-    blockWords[blockListWord(t, list, at)] = uint(b);
+    uint at = atomicAdd(blockWords[4u * list], 1u);
+    blockWords[blockListWord(list, at)] = uint(b);
 }
 #endif
 
@@ -229,6 +227,6 @@ void main()
     uvec4 entry = rays ? blockEntry() : uvec4(0u);
     imageStore(bvh, entryTexel(block), entry);
 #if BVH_BLOCK_LISTS
-    listBlock(block, b, rays, entry);
+    listBlock(b, rays, entry);
 #endif
 }

@@ -38,14 +38,12 @@
 #include "../common/pass_ray.glsl"
 #if BVH_BLOCK_LISTS
 #include "block_lists.glsl"
-// the tile whose list this dispatch runs over
-uniform int blockListTile;
 // the threads that split a dispatch's work groups in contiguous shares (PixelGrid::threads)
 uniform int blockListThreads;
 
 // The list entry of work group i of n: llvmpipe hands each of its N threads a contiguous 1/N
 // of the work groups, and a list in the order of the blocks would give one thread the rows of
-// the tile the object fills (as pixelPosition's row stride avoids, common/images.glsl); so
+// the image the object fills (as pixelPosition's row stride avoids, common/images.glsl); so
 // the first N·q entries (q = n / N) are dealt out in turn — work group a + N·b takes entry
 // a·q + b — and each share takes blocks from the whole tile.
 uint listEntry(uint i, uint n)
@@ -242,10 +240,9 @@ void trace(ivec2 storePos)
 void main()
 {
 #if BVH_BLOCK_LISTS
-    // a work group per block of this kernel's list of the tile (FUSED_MISS: the blocks without
-    // a hit)
+    // a work group per block of this kernel's list (FUSED_MISS: the blocks without a hit)
     uint i = listEntry(gl_WorkGroupID.x, gl_NumWorkGroups.x);
-    uint b = blockWords[blockListWord(uint(blockListTile), uint(FUSED_MISS), i)];
+    uint b = blockWords[blockListWord(uint(FUSED_MISS), i)];
     ivec2 storePos = ivec2(b % uint(BVH_BLOCKS_X), b / uint(BVH_BLOCKS_X)) * 8 + groupPixel();
 #else
     ivec2 storePos = pixelPosition();

@@ -198,9 +198,9 @@ pub struct FusedPasses {
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,
-    /// The side of a dispatch's tile in 8×8 blocks, where the pass runs over block lists, one
-    /// pair a tile (`glsl/bvh/block_lists.glsl`): one tree; `None` with `--bvh-instances`.
-    pub block_lists: Option<u32>,
+    /// Whether the pass runs over block lists (`glsl/bvh/block_lists.glsl`): one tree, not
+    /// with `--bvh-instances`.
+    pub block_lists: bool,
 }
 
 impl BuildContext<'_> {

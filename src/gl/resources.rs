@@ -198,23 +198,6 @@ impl Ssbo {
         };
     }
 
-    /// Write `words` from word `at` on (`glBufferSubData`: ordered with the GL commands before
-    /// and after it).
-    pub fn write_u32(&self, gl: &Gl, at: usize, words: &[u32]) {
-        assert!(
-            4 * (at + words.len()) <= self.bytes,
-            "{}: write past the end",
-            self.name
-        );
-        // SAFETY: writing inside an existing buffer of DYNAMIC_STORAGE_BIT storage.
-        unsafe {
-            gl.bind_buffer(glow::COPY_WRITE_BUFFER, Some(self.buffer.raw()));
-            let bytes: &[u8] = bytemuck::cast_slice(words);
-            gl.buffer_sub_data_u8_slice(glow::COPY_WRITE_BUFFER, 4 * at as i32, bytes);
-            gl.bind_buffer(glow::COPY_WRITE_BUFFER, None);
-        }
-    }
-
     /// `glClearBufferData` with a 32-bit value.
     pub fn clear_u32(&self, gl: &Gl, value: u32) {
         // SAFETY: binding an existing buffer.

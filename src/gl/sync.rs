@@ -27,7 +27,7 @@ use super::context::Gl;
 /// | `SHADER_STORAGE_BARRIER_BIT` | SSBO loads, stores and atomics of the next kernels |
 /// | `SHADER_IMAGE_ACCESS_BARRIER_BIT` | image loads and stores (the ray-state images, the BVH's image buffer) |
 /// | `TEXTURE_FETCH_BARRIER_BIT` | sampler and `texelFetch` reads, texture buffers included (the quads, Wagner's and the streaming tracer's textures) |
-/// | `BUFFER_UPDATE_BARRIER_BIT` | `glGetBufferSubData` (counters, grid totals), `glClearBufferData`, `glBufferSubData` (the BVH's block lists) |
+/// | `BUFFER_UPDATE_BARRIER_BIT` | `glGetBufferSubData` (counters, grid totals), `glClearBufferData` |
 /// | `TEXTURE_UPDATE_BARRIER_BIT` | `glGetTexImage` (frames, AOVs), `glClearTexImage` (the ray-state images each frame, the shadow flags each pass), `glCopyImageSubData` (the AOV copies) |
 /// | `FRAMEBUFFER_BARRIER_BIT` | rendering or clearing into a texture a shader stored into (Klee 2016's G-buffer diffuse texture, which the shadow pass shades in place) |
 /// | `COMMAND_BARRIER_BIT` | indirect dispatch commands (the SAH BVH's fused pass over the block lists its entry pass counts) |

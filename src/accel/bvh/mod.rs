@@ -24,7 +24,7 @@ use super::{
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
-use crate::gl::resources::{Ssbo, TexelData, TextureBuffers};
+use crate::gl::resources::{GpuTimers, Ssbo, TexelData, TextureBuffers};
 use crate::gl::slots::{image, ssbo};
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::scene::{transform_triangles, CameraRays, Scene};
@@ -146,56 +146,44 @@ fn fused_kernels(
     defs: &[(&'static str, String)],
     f: FusedPasses,
 ) -> Result<Vec<Kernel>> {
-    let lists = [(
-        "BVH_BLOCK_LISTS",
-        (f.block_lists.is_some() as i32).to_string(),
-    )];
+    let lists = [("BVH_BLOCK_LISTS", (f.block_lists as i32).to_string())];
     let kernel = |miss: bool, timer| {
         let miss = [("FUSED_MISS", (miss as i32).to_string())];
         fused_kernel(b, &[defs, &lists[..], &miss[..]].concat(), f, timer)
     };
     match f.block_lists {
-        Some(_) => Ok(vec![
+        true => Ok(vec![
             kernel(false, "fused_pass")?,
             kernel(true, "fused_miss")?,
         ]),
-        None => Ok(vec![kernel(false, "fused_pass")?]),
+        false => Ok(vec![kernel(false, "fused_pass")?]),
     }
 }
 
-/// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): a pair per tile of `side`×`side`
-/// blocks of the `blocks` (x, y) of the image.
+/// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): the image's blocks that may hit
+/// and those that cannot, each list a dispatch command and a word per block.
 struct BlockLists {
     buffer: Ssbo,
-    tiles: u32,
+    /// empties the lists before each entry pass (`glsl/bvh/block_lists_reset.comp`)
+    reset: Kernel,
 }
 
 impl BlockLists {
-    fn new(b: &BuildContext, blocks: (u32, u32), side: u32) -> Result<BlockLists> {
-        let tiles = blocks.0.div_ceil(side) * blocks.1.div_ceil(side);
-        let words = 8 * tiles as usize + 2 * (tiles * side * side) as usize;
+    fn new(b: &BuildContext, defs: &[(&'static str, String)], blocks: u32) -> Result<BlockLists> {
+        let words = 8 + 2 * blocks as usize;
         let max_block = b.info.max_ssbo_block_size;
         let buffer = Ssbo::new(b.gl, "bvh_block_lists", 4 * words, None, max_block)?;
-        Ok(BlockLists { buffer, tiles })
+        // timed with the entry pass, a part of intersect1: the pass' set-up
+        let reset = b.kernel("bvh/block_lists_reset.comp", defs, "intersect1")?;
+        Ok(BlockLists { buffer, reset })
     }
 
-    /// The entry kernel's #defines: the tiles' side in blocks, the tiles in a row, the tiles.
-    fn defines(blocks: (u32, u32), side: u32) -> [(&'static str, String); 3] {
-        [
-            ("BVH_TILE_BLOCKS", side.to_string()),
-            ("BVH_TILES_X", blocks.0.div_ceil(side).to_string()),
-            (
-                "BVH_TILES",
-                (blocks.0.div_ceil(side) * blocks.1.div_ceil(side)).to_string(),
-            ),
-        ]
-    }
-
-    /// Every list empty, for the entry pass to fill; bound for it and the fused kernels.
-    fn reset(&self, gl: &Gl) {
-        let empty = [0, 1, 1, 0].repeat(2 * self.tiles as usize);
-        self.buffer.write_u32(gl, 0, &empty);
+    /// Both lists emptied for the entry pass to fill, the buffer bound for it and the fused
+    /// kernels.
+    fn reset(&self, gl: &Gl, timers: &mut GpuTimers) {
         self.buffer.bind(gl, ssbo::BVH_BLOCK_LISTS);
+        self.reset.use_program();
+        self.reset.dispatch_1d(timers, 1);
     }
 }
 
@@ -312,16 +300,11 @@ impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
-        let side = b.fused.and_then(|f| f.block_lists);
-        let lists = side.map(|s| BlockLists::defines(blocks, s));
-        let defs = [
-            &kernel_defines(b.info, blocks)[..],
-            lists.as_ref().map_or(&[], |l| &l[..]),
-        ]
-        .concat();
+        let lists = b.fused.is_some_and(|f| f.block_lists);
+        let defs = kernel_defines(b.info, blocks);
         let entry_defs = [
             ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
-            ("BVH_BLOCK_LISTS", (side.is_some() as i32).to_string()),
+            ("BVH_BLOCK_LISTS", (lists as i32).to_string()),
         ];
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
@@ -338,7 +321,9 @@ impl Bvh {
                 Some(f) => fused_kernels(b, &defs, f)?,
                 None => Vec::new(),
             },
-            block_lists: side.map(|s| BlockLists::new(b, blocks, s)).transpose()?,
+            block_lists: lists
+                .then(|| BlockLists::new(b, &defs, blocks.0 * blocks.1))
+                .transpose()?,
             walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
             moving: Moving {
                 kernels: refit_kernels(b, &defs)?,
@@ -619,7 +604,7 @@ impl Accelerator for Bvh {
             return None;
         }
         if let Some(lists) = &self.block_lists {
-            lists.reset(f.gl);
+            lists.reset(f.gl, f.timers);
         }
         self.entry.use_program();
         set_pass_rays(&self.entry, eye);
@@ -634,15 +619,13 @@ impl Accelerator for Bvh {
     fn dispatch_fused(&mut self, f: &mut FrameContext) {
         match &self.block_lists {
             Some(lists) => {
-                // per tile (PixelGrid::tiles' order) the blocks that may hit, then the others
-                for t in 0..lists.tiles {
-                    for (list, k) in self.fused.iter().enumerate() {
-                        k.use_program();
-                        k.set_i32("blockListTile", t as i32);
-                        k.set_i32("blockListThreads", f.pixels.threads as i32);
-                        let command = 16 * (2 * t as i32 + list as i32);
-                        k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
-                    }
+                // the blocks that may hit, then the others: each list in one dispatch, whatever
+                // the tiles (glsl/bvh/block_lists.glsl)
+                for (list, k) in self.fused.iter().enumerate() {
+                    k.use_program();
+                    k.set_i32("blockListThreads", f.pixels.threads as i32);
+                    let command = 16 * list as i32;
+                    k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
                 }
             }
             None => {

@@ -26,7 +26,6 @@ use crate::accel::{
     LightTarget, TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
-use crate::gl::kernel::PIXEL_GROUP;
 use crate::gl::resources::GpuTimers;
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
 use crate::scene::{AreaLight, Camera, CameraRays, Scene};
@@ -352,10 +351,7 @@ impl RayTracer {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
-                block_lists: (!options.bvh_instances).then(|| match options.tile {
-                    0 => w.max(h).div_ceil(PIXEL_GROUP),
-                    tile => tile / PIXEL_GROUP,
-                }),
+                block_lists: !options.bvh_instances,
             }),
             scene_images: gpu_scene.vertex_images(),
             bvh_instances: options.bvh_instances,
