@@ -160,6 +160,15 @@ fn fused_kernels(
     }
 }
 
+/// `--fused-passes` (`glsl/bvh/fused_pass.comp`): the pass in one kernel, or with one tree in
+/// two over the block lists (the blocks that may hit, those that cannot); no kernel without.
+struct Fused {
+    kernels: Vec<Kernel>,
+    lists: Option<BlockLists>,
+    /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
+    walks_per_record: u64,
+}
+
 /// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): the image's blocks that may hit
 /// and those that cannot, each list a dispatch command and a word per block.
 struct BlockLists {
@@ -266,14 +275,8 @@ pub struct Bvh {
     blocks: u32,
     intersect1: Kernel,
     intersect2: Kernel,
-    /// `--fused-passes`: the pass in one kernel (`glsl/bvh/fused_pass.comp`), or in two over
-    /// the block lists (the blocks that may hit, those that cannot); none without
-    fused: Vec<Kernel>,
-    /// the block lists and their dispatch commands (`glsl/bvh/block_lists.glsl`), where the
-    /// fused pass runs over them
-    block_lists: Option<BlockLists>,
-    /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
-    walks_per_record: u64,
+    /// `--fused-passes`: the pass' kernels and block lists
+    fused: Fused,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
     /// one tree over the world-space scene, or a tree per object under instances
@@ -317,14 +320,16 @@ impl Bvh {
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
-            fused: match b.fused {
-                Some(f) => fused_kernels(b, &defs, f)?,
-                None => Vec::new(),
+            fused: Fused {
+                kernels: match b.fused {
+                    Some(f) => fused_kernels(b, &defs, f)?,
+                    None => Vec::new(),
+                },
+                lists: lists
+                    .then(|| BlockLists::new(b, &defs, blocks.0 * blocks.1))
+                    .transpose()?,
+                walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
             },
-            block_lists: lists
-                .then(|| BlockLists::new(b, &defs, blocks.0 * blocks.1))
-                .transpose()?,
-            walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
             moving: Moving {
                 kernels: refit_kernels(b, &defs)?,
                 refit: None,
@@ -363,14 +368,14 @@ impl Bvh {
                 .zip(models.iter().copied()),
         ));
         let events = bvh.stats.nodes.max(bvh.tris.len()) as u64;
-        if events * self.walks_per_record > MAX_PIXEL_EVENTS {
+        if events * self.fused.walks_per_record > MAX_PIXEL_EVENTS {
             bail!(
                 "the BVH has {} nodes and {} leaf slots: {} walks of a pixel could count more than \
                  {MAX_PIXEL_EVENTS} events, beyond the per-pixel counts' 32 bits; use a smaller \
                  scene (or, with --fused-passes, fewer lights or light samples)",
                 bvh.stats.nodes,
                 bvh.tris.len(),
-                self.walks_per_record
+                self.fused.walks_per_record
             );
         }
         let buffers = upload(&self.gl, bvh.gpu_words(), self.blocks)?;
@@ -402,13 +407,13 @@ impl Bvh {
             }
             _ => {
                 let inst = Instances::new(&self.objects);
-                if inst.events() * self.walks_per_record > MAX_PIXEL_EVENTS {
+                if inst.events() * self.fused.walks_per_record > MAX_PIXEL_EVENTS {
                     bail!(
                         "the objects' trees have {} events a walk (instances, nodes, leaf slots): \
                          {} walks of a pixel could count more than {MAX_PIXEL_EVENTS}, beyond the \
                          per-pixel counts' 32 bits; use a smaller scene",
                         inst.events(),
-                        self.walks_per_record
+                        self.fused.walks_per_record
                     );
                 }
                 self.buffers = Some(upload(&self.gl, inst.gpu_words(models)?, self.blocks)?);
@@ -600,28 +605,29 @@ impl Accelerator for Bvh {
         pass: u32,
         eye: Option<&CameraRays>,
     ) -> Option<&[Kernel]> {
-        if self.fused.is_empty() {
+        if self.fused.kernels.is_empty() {
             return None;
         }
-        if let Some(lists) = &self.block_lists {
+        if let Some(lists) = &self.fused.lists {
             lists.reset(f.gl, f.timers);
         }
         self.entry.use_program();
         set_pass_rays(&self.entry, eye);
         self.closest_hit(f, pass);
-        for k in &self.fused {
+        for k in &self.fused.kernels {
             k.use_program();
             set_pass_rays(k, eye);
         }
-        Some(&self.fused)
+        Some(&self.fused.kernels)
     }
 
     fn dispatch_fused(&mut self, f: &mut FrameContext) {
-        match &self.block_lists {
+        let kernels = &self.fused.kernels;
+        match &self.fused.lists {
             Some(lists) => {
                 // the blocks that may hit, then the others: each list in one dispatch, whatever
                 // the tiles (glsl/bvh/block_lists.glsl)
-                for (list, k) in self.fused.iter().enumerate() {
+                for (list, k) in kernels.iter().enumerate() {
                     k.use_program();
                     k.set_i32("blockListThreads", f.pixels.threads as i32);
                     let command = 16 * list as i32;
@@ -629,7 +635,7 @@ impl Accelerator for Bvh {
                 }
             }
             None => {
-                let k = &self.fused[0];
+                let k = &kernels[0];
                 k.use_program();
                 k.dispatch_pixels(f.timers, f.pixels);
             }
