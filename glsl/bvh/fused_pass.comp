@@ -45,7 +45,7 @@ uniform int blockListThreads;
 // of the work groups, and a list in the order of the blocks would give one thread the rows of
 // the image the object fills (as pixelPosition's row stride avoids, common/images.glsl); so
 // the first N·q entries (q = n / N) are dealt out in turn — work group a + N·b takes entry
-// a·q + b — and each share takes blocks from the whole tile.
+// a·q + b — and each share takes blocks from the whole image.
 uint listEntry(uint i, uint n)
 {
     uint threads = uint(max(blockListThreads, 1)), q = n / threads;
@@ -196,8 +196,8 @@ void trace(ivec2 storePos)
         rayLast = int(dirTri.w);
         bestT = 1.0 / 0.0; // +inf
 #if FUSED_MISS
-        // a block whose rays all miss the root (bvh/block_lists.glsl): the walk of its empty
-        // entry, which visits nothing, left out
+        // a block whose rays all miss the root, or none is active (bvh/block_lists.glsl):
+        // the walk of its empty entry, which visits nothing, left out
         closestHitRecord = -1;
 #else
         float limit = bestT;
