@@ -9,11 +9,9 @@ layout(local_size_x = 2) in;
 
 void main()
 {
-    uint c = gl_GlobalInvocationID.x;
-    {
-        blockWords[4u * c] = 0u;
-        blockWords[4u * c + 1u] = 1u;
-        blockWords[4u * c + 2u] = 1u;
-        blockWords[4u * c + 3u] = 0u;
-    }
+    uint c = gl_GlobalInvocationID.x; // one work group: commands 0 and 1
+    blockWords[4u * c] = 0u;
+    blockWords[4u * c + 1u] = 1u;
+    blockWords[4u * c + 2u] = 1u;
+    blockWords[4u * c + 3u] = 0u;
 }

@@ -198,9 +198,6 @@ pub struct FusedPasses {
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,
-    /// Whether the pass runs over block lists (`glsl/bvh/block_lists.glsl`): one tree, not
-    /// with `--bvh-instances`.
-    pub block_lists: bool,
 }
 
 impl BuildContext<'_> {

@@ -138,20 +138,21 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
 /// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's counts in record 0 (the first
 /// light's beside the closest hit's where it is a point light), else the first light's at
 /// record 1; the other lights' at record 2 where the scene has more than one light
-/// (`pipeline::mueller2015::records`). With block lists ([`FusedPasses::block_lists`]) two
-/// kernels, a work group per block: the blocks whose rays may hit (`fused_pass`) and those
+/// (`pipeline::mueller2015::records`). With block lists (`lists`: one tree) two kernels, a
+/// work group per block: the blocks whose rays may hit (`fused_pass`) and those
 /// whose rays all miss (`FUSED_MISS`, timed as `fused_miss`; `glsl/bvh/block_lists.glsl`).
 fn fused_kernels(
     b: &BuildContext,
     defs: &[(&'static str, String)],
     f: FusedPasses,
+    lists: bool,
 ) -> Result<Vec<Kernel>> {
-    let lists = [("BVH_BLOCK_LISTS", (f.block_lists as i32).to_string())];
+    let lists_define = [("BVH_BLOCK_LISTS", (lists as i32).to_string())];
     let kernel = |miss: bool, timer| {
         let miss = [("FUSED_MISS", (miss as i32).to_string())];
-        fused_kernel(b, &[defs, &lists[..], &miss[..]].concat(), f, timer)
+        fused_kernel(b, &[defs, &lists_define[..], &miss[..]].concat(), f, timer)
     };
-    match f.block_lists {
+    match lists {
         true => Ok(vec![
             kernel(false, "fused_pass")?,
             kernel(true, "fused_miss")?,
@@ -303,7 +304,9 @@ impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
         let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
-        let lists = b.fused.is_some_and(|f| f.block_lists);
+        // the fused pass over block lists: with one tree (an instance's empty entry leaves the
+        // block's other instances to walk)
+        let lists = b.fused.is_some() && !b.bvh_instances;
         let defs = kernel_defines(b.info, blocks);
         let entry_defs = [
             ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
@@ -322,7 +325,7 @@ impl Bvh {
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             fused: Fused {
                 kernels: match b.fused {
-                    Some(f) => fused_kernels(b, &defs, f)?,
+                    Some(f) => fused_kernels(b, &defs, f, lists)?,
                     None => Vec::new(),
                 },
                 lists: lists

@@ -351,7 +351,6 @@ impl RayTracer {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
-                block_lists: !options.bvh_instances,
             }),
             scene_images: gpu_scene.vertex_images(),
             bvh_instances: options.bvh_instances,
