@@ -280,8 +280,9 @@ fn the_grid_boxes_hold_every_triangle_of_their_subtree() {
 }
 
 /// The paths for other GL implementations: without `GL_ARB_gpu_shader_int64` the records are
-/// stored as 32-bit words, and off llvmpipe `intersect1` loads no rays ahead
-/// (`RECORD_STORE_64`, `PREFETCH_RAYS`) — the same ids, colours and counts as the paths this
+/// stored as 32-bit words, without `GL_ARB_shader_ballot` the hit list is filled through a
+/// shared counter, and off llvmpipe `intersect1` loads no rays ahead (`RECORD_STORE_64`,
+/// `HIT_LIST_BALLOT`, `PREFETCH_RAYS`) — the same ids, colours and counts as the paths this
 /// machine takes, where the suite would otherwise never compile them.
 #[test]
 fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
@@ -290,6 +291,7 @@ fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
     let opts = bvh_options(47, 33, 1);
     let mut other = ctx.info.clone();
     other.int64 = false;
+    other.ballot = false;
     other.renderer = "another GL implementation".into();
     let shaders = gpgpu_rt::gl::ShaderSource::default();
     let mut tracer = gpgpu_rt::pipeline::mueller2015::RayTracer::new(
@@ -308,10 +310,44 @@ fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
     );
     // (a walk counted as truncated, where the prefetch folds in, makes the host refuse a frame)
     assert_eq!(plain.color, this.color);
+    let listed = |f: &gpgpu_rt::frame::Frame| f.stats.facts["hit_list_pixels"].clone();
+    assert_eq!(listed(&plain), listed(&this), "hit list");
     for kind in ["primary", "reflection", "shadow_first_light"] {
         let (a, b) = (&plain.stats.ray_kinds[kind], &this.stats.ray_kinds[kind]);
         for name in ["rays", "nodes_visited", "intersect1", "intersect2"] {
             assert_eq!(a.count(name), b.count(name), "{kind}: {name}");
         }
     }
+}
+
+/// The hit list (`glsl/bvh/hit_list.glsl`): the pixels whose ray hit something in a pass, which
+/// intersect2 traces the feelers of — no more (a miss has no feeler) and none twice; emptied
+/// for every pass and summed over a frame's passes anew each frame (`hit_list_pixels`).
+#[test]
+fn the_hit_list_holds_the_pixels_with_a_hit_in_every_pass() {
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let mut tracer = ray_tracer(&ctx, &scene, bvh_options(64, 48, 0));
+    for frame in 0..2 {
+        let f = tracer.render(&scene.camera).expect("frame");
+        let ids = &f.aovs.as_ref().unwrap().triangle_id;
+        let hits = ids.iter().filter(|&&id| id >= 0).count();
+        assert!(hits > 0 && hits < ids.len(), "{hits} of {}", ids.len());
+        assert_eq!(
+            f.stats.facts["hit_list_pixels"],
+            json!(hits),
+            "frame {frame}"
+        );
+    }
+    // the low-poly bunny mirrors itself: each reflection pass lists the reflected rays that hit
+    let scene = load("bunny_low.toml");
+    let f = render_gpu(&ctx, &scene, bvh_options(64, 48, 2));
+    let ids = &f.aovs.as_ref().unwrap().triangle_id;
+    let hits = ids.iter().filter(|&&id| id >= 0).count() as u64;
+    let reflected = f.stats.ray_kinds["reflection"].count("rays");
+    let listed = f.stats.facts["hit_list_pixels"].as_u64().unwrap();
+    assert!(
+        reflected > 0 && listed > hits && listed <= hits + reflected,
+        "{listed} listed, {hits} first hits, {reflected} reflected rays"
+    );
 }

@@ -8,6 +8,7 @@ mod common;
 use common::*;
 use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::frame::Frame;
+use gpgpu_rt::gl::GlInfo;
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
@@ -195,11 +196,11 @@ fn eye_rays_in_place_without_aovs() {
 }
 
 /// Two frames of `opts` on `scene` — the second with object 0 turned (a refit and the moved
-/// objects' transform) — on a GL that reports `units` image units.
-fn two_frames(scene: &Scene, opts: &RenderOptions, units: i32) -> (Frame, Frame) {
+/// objects' transform) — on a GL whose facts `gl` changes.
+fn two_frames(scene: &Scene, opts: &RenderOptions, gl: impl Fn(&mut GlInfo)) -> (Frame, Frame) {
     let ctx = context();
     let mut info = ctx.info.clone();
-    info.max_image_units = units;
+    gl(&mut info);
     let shaders = gpgpu_rt::gl::ShaderSource::default();
     let mut t = gpgpu_rt::pipeline::mueller2015::RayTracer::new(
         ctx.gl.clone(),
@@ -227,12 +228,51 @@ fn the_storage_buffer_reads_where_the_gl_has_only_8_image_units() {
             fused_passes,
             ..bvh(48, 40, 1)
         };
-        let (a, b) = (two_frames(&scene, &opts, 192), two_frames(&scene, &opts, 8));
+        let (a, b) = (
+            two_frames(&scene, &opts, |gl| gl.max_image_units = 192),
+            two_frames(&scene, &opts, |gl| gl.max_image_units = 8),
+        );
         for (x, y, frame) in [(&a.0, &b.0, "still"), (&a.1, &b.1, "turned")] {
             let what = format!("fused {fused_passes}, {frame}, 8 image units");
             assert_same_frame(x, y, &what);
             assert_same_counts(x, y, &what);
         }
         assert_ne!(a.0.color, a.1.color, "the turn changed nothing");
+    }
+}
+
+#[test]
+fn the_work_lists_take_rows_where_the_gl_allows_few_work_groups() {
+    // GL guarantees 65535 work groups a dimension (MAX_COMPUTE_WORK_GROUP_COUNT); a list whose
+    // dispatch needs more — the fused pass' block lists, the four kernels' hit list — is
+    // dispatched in rows of equal length (glsl/common/work_lists.glsl). A GL that allows 2, 3
+    // or 5 a row: every list takes rows, some with work groups too many — the same frames and
+    // counts
+    let mut scene = load("teapot1.toml");
+    ring_of_lights(&mut scene, 2);
+    for (fused_passes, row) in [false, true]
+        .into_iter()
+        .flat_map(|f| [(f, 2), (f, 3), (f, 5)])
+    {
+        let opts = RenderOptions {
+            fused_passes,
+            ..bvh(48, 40, 1)
+        };
+        let (a, b) = (
+            two_frames(&scene, &opts, |_| {}),
+            two_frames(&scene, &opts, |gl| gl.max_compute_work_group_count[0] = row),
+        );
+        for (x, y, frame) in [(&a.0, &b.0, "still"), (&a.1, &b.1, "turned")] {
+            let what = format!("fused {fused_passes}, {frame}, {row} work groups a row");
+            assert_same_frame(x, y, &what);
+            assert_same_counts(x, y, &what);
+            let listed = |f: &Frame| f.stats.facts.get("hit_list_pixels").cloned();
+            assert_eq!(listed(x), listed(y), "{what}");
+            assert_eq!(listed(x).is_some(), !fused_passes, "{what}");
+            // the hit lists of the two passes: each several rows of 64 entries a work group
+            if let Some(n) = listed(x) {
+                assert!(n.as_u64().unwrap() > 2 * 5 * 64, "{what}: {n} listed");
+            }
+        }
     }
 }

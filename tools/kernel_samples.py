@@ -12,6 +12,7 @@ entry, intersect1, evaluate_hit, pixel_counts, intersect2, pixel_counts, shading
 
     python3 tools/kernel_samples.py scenes/bunny.toml --tracer bvh --refl-depth 0 \\
         --width 512 --height 512 --frames 8 [--glsl-dir DIR]
+    python3 tools/kernel_samples.py --bin OTHER/gpgpu-rt scenes/bunny.toml ...
 """
 import subprocess
 import sys
@@ -51,6 +52,8 @@ def main():
     if not args or args[0] in ("-h", "--help"):
         sys.exit(__doc__)
     binary = str(ROOT / "target/release/gpgpu-rt")
+    if args[0] == "--bin":  # another build, e.g. the commit before a change, for pairs
+        binary, args = args[1], args[2:]
     with tempfile.TemporaryDirectory() as tmp:
         data = f"{tmp}/perf.data"
         subprocess.run(["perf", "record", "-q", "-e", "cpu-clock", "-F", str(HZ), "-g",

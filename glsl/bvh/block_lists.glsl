@@ -14,13 +14,17 @@
 // kernels into: per-tile pairs of lists, each dispatched with its tile as a uniform, rendered
 // right on llvmpipe but not on Mesa 22.3's zink, where the second pass of a frame traced rays
 // that had ended (docs/design/frame.md, "The fused pass").
-// Layout (words): list k's dispatch command (num_groups_x, y = 1, z = 1, padding) at words 4k —
-// bvh/block_lists_reset.comp writes (0, 1, 1, 0) into both before the entry pass — then list k's
-// blocks from word 8 + k·BVH_ENTRY_TEXELS on (the first num_groups_x of them used).
+// Layout (words): list k's dispatch command (num_groups_x, y, z, padding) at words 4k, which
+// bvh/block_lists.comp writes from the count after the entry pass (within GL's limit on work
+// groups per dimension: common/work_lists.glsl); list k's count at word BLOCK_LIST_COUNTS + k,
+// which it sets to 0 before the entry pass; list k's blocks from word 16 + k·BVH_ENTRY_TEXELS on.
 #ifndef BVH_BLOCK_LISTS_GLSL
 #define BVH_BLOCK_LISTS_GLSL
+#include "../common/work_lists.glsl"
 layout(std430, binding = SSBO_BVH_BLOCK_LISTS) buffer BlockLists { uint blockWords[]; };
 
+#define BLOCK_LIST_COUNTS 8
 // the word of list k where its entry i lies
-uint blockListWord(uint k, uint i) { return 8u + k * uint(BVH_ENTRY_TEXELS) + i; }
+uint blockListWord(uint k, uint i) { return 16u + k * uint(BVH_ENTRY_TEXELS) + i; }
+uint blockListCount(uint k) { return blockWords[BLOCK_LIST_COUNTS + k]; }
 #endif

@@ -213,7 +213,7 @@ uvec4 blockEntry()
 void listBlock(int b, bool rays, uvec4 entry)
 {
     uint list = !rays || (entry.x != 0u && entry.y == entry.z) ? 1u : 0u;
-    uint at = atomicAdd(blockWords[4u * list], 1u);
+    uint at = atomicAdd(blockWords[BLOCK_LIST_COUNTS + list], 1u);
     blockWords[blockListWord(list, at)] = uint(b);
 }
 #endif

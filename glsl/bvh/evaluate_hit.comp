@@ -5,7 +5,13 @@
 // ray-state textures, finds its closest hit (t, triangle id, u, v) again from the hit record
 // (bvh/hit_record.glsl), and evaluates it exactly as the thesis' intersect1 does; an inactive
 // ray (rayState <= 0) gets an empty colour buffer. The host dispatches it right after
-// intersect1, under the same ray kind, with the BVH's word buffer still bound.
+// intersect1, under the same ray kind, with the BVH's word buffer still bound. Ours too: it
+// appends the pixels with a hit — the feelers of the pass — to the hit list
+// (bvh/hit_list.glsl).
+#if HIT_LIST_BALLOT
+#extension GL_ARB_shader_ballot : require
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define SCENE_QUALIFIER readonly
@@ -17,20 +23,64 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // a hit record: a leaf-triangle address
 #include "hit_record.glsl"
 
+#include "hit_list.glsl"
+
+#if HIT_LIST_BALLOT
+// This invocation's pixel appended to the pass' hit list (bvh/hit_list.glsl) if its ray hit:
+// the SIMD group's hits as one mask (GL_ARB_shader_ballot, where the GL has it: GlInfo::ballot),
+// one global atomic for them all by the first lane with a hit, each hit's place its rank in
+// the mask — a run of entries is one SIMD group's 4×2 block. Every invocation calls it, in
+// uniform control flow, hit or not.
+void appendHit(ivec2 storePos, bool hit)
+{
+    uvec2 mask = unpackUint2x32(ballotARB(hit));
+    uvec2 below = mask & unpackUint2x32(gl_SubGroupLtMaskARB);
+    uint rank = uint(bitCount(below.x) + bitCount(below.y));
+    uint first = mask.x != 0u ? uint(findLSB(mask.x)) : 32u + uint(findLSB(mask.y));
+    uint base = 0u;
+    if (hit && rank == 0u)
+        base = atomicAdd(hitWords[HIT_LIST_COUNT], uint(bitCount(mask.x) + bitCount(mask.y)));
+    base = readInvocationARB(base, first);
+    if (hit) hitWords[HIT_LIST_ENTRIES + base + rank] = uint(pixelIndex(storePos));
+}
+#else
+// The same with a shared counter: each hit's place in the work group's run, one global atomic
+// the run's place in the list (every invocation of the work group calls it: its barriers).
+shared uint groupHits;
+shared uint groupBase;
+void appendHit(ivec2 storePos, bool hit)
+{
+    if (gl_LocalInvocationIndex == 0u) groupHits = 0u;
+    memoryBarrierShared();
+    barrier();
+    uint at = hit ? atomicAdd(groupHits, 1u) : 0u;
+    memoryBarrierShared();
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) groupBase = atomicAdd(hitWords[HIT_LIST_COUNT], groupHits);
+    memoryBarrierShared();
+    barrier();
+    if (hit) hitWords[HIT_LIST_ENTRIES + groupBase + at] = uint(pixelIndex(storePos));
+}
+#endif
+
 void main()
 {
     ivec2 storePos = pixelPosition();
-    if (!insideImage(storePos)) return;
-    vec4 originState = imageLoad(rayOriginTexture, storePos);
-    float rayState = originState.w;
-    if (rayState <= 0.0) {
-        emptyColorBuffer(storePos);
-        return;
+    bool hit = false;
+    if (insideImage(storePos)) {
+        vec4 originState = imageLoad(rayOriginTexture, storePos);
+        float rayState = originState.w;
+        if (rayState <= 0.0) {
+            emptyColorBuffer(storePos);
+        } else {
+            vec3 ro = originState.xyz;
+            vec3 rd = imageLoad(rayDirTexture, storePos).xyz;
+            float t, u, v;
+            int id;
+            hitFromRecord(int(pixelRecord[pixelIndex(storePos)].z), ro, rd, t, id, u, v);
+            evaluateHit(storePos, ro, rd, rayState, t, id, u, v);
+            hit = id >= 0;
+        }
     }
-    vec3 ro = originState.xyz;
-    vec3 rd = imageLoad(rayDirTexture, storePos).xyz;
-    float t, u, v;
-    int id;
-    hitFromRecord(int(pixelRecord[pixelIndex(storePos)].z), ro, rd, t, id, u, v);
-    evaluateHit(storePos, ro, rd, rayState, t, id, u, v);
+    appendHit(storePos, hit);
 }

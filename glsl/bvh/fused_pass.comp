@@ -38,19 +38,6 @@
 #include "../common/pass_ray.glsl"
 #if BVH_BLOCK_LISTS
 #include "block_lists.glsl"
-// the threads that split a dispatch's work groups in contiguous shares (PixelGrid::threads)
-uniform int blockListThreads;
-
-// The list entry of work group i of n: llvmpipe hands each of its N threads a contiguous 1/N
-// of the work groups, and a list in the order of the blocks would give one thread the rows of
-// the image the object fills (as pixelPosition's row stride avoids, common/images.glsl); so
-// the first N·q entries (q = n / N) are dealt out in turn — work group a + N·b takes entry
-// a·q + b — and each share takes blocks from the whole image.
-uint listEntry(uint i, uint n)
-{
-    uint threads = uint(max(blockListThreads, 1)), q = n / threads;
-    return i < threads * q ? (i % threads) * q + i / threads : i;
-}
 #endif
 
 uniform vec4 camPosition;
@@ -240,8 +227,10 @@ void trace(ivec2 storePos)
 void main()
 {
 #if BVH_BLOCK_LISTS
-    // a work group per block of this kernel's list (FUSED_MISS: the blocks without a hit)
-    uint i = listEntry(gl_WorkGroupID.x, gl_NumWorkGroups.x);
+    // a work group per block of this kernel's list (FUSED_MISS: the blocks without a hit); the
+    // last row of work groups may have more than the list (common/work_lists.glsl)
+    uint i = listGroup();
+    if (i >= blockListCount(uint(FUSED_MISS))) return;
     uint b = blockWords[blockListWord(uint(FUSED_MISS), i)];
     ivec2 storePos = ivec2(b % uint(BVH_BLOCKS_X), b / uint(BVH_BLOCKS_X)) * 8 + groupPixel();
 #else

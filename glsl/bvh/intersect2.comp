@@ -4,11 +4,15 @@
 // pruned) and tests the triangles of each leaf until the first occluder (any hit).
 // Deviations: see traverse.glsl; any number of lights.
 // Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
+// Ours: an invocation per pixel of the pass' hit list (bvh/hit_list.glsl), not per pixel.
 #if RECORD_STORE_64
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
 // the work counts stored per pixel (storePixelRecord), not added to the counters
 #define PIXEL_RECORDS
+// the feelers of the pixels in the pass' hit list, not of every pixel (bvh/hit_list.glsl)
+#define HIT_LIST
+#include "hit_list.glsl"
 #include "../common/intersect_head.glsl"
 #include "records.glsl"
 #include "traverse.glsl"

@@ -43,12 +43,20 @@ uvec4 recordCounts(int k)
 }
 #endif
 
+// Ours: with hitListed the records of an intersect2 dispatch over the hit list
+// (bvh/hit_list.glsl), one per list entry: the first `count` records, in a dispatch whose
+// command bvh/hit_list.comp wrote (work groups in rows: common/work_lists.glsl).
+uniform int hitListed;
+#include "hit_list.glsl"
+
 void main()
 {
     countersBegin();
     uvec4 sum = uvec4(0u);
-    int first = int(gl_GlobalInvocationID.x) * PIXELS_PER_INVOCATION;
-    int end = min(first + PIXELS_PER_INVOCATION, IMAGE_WIDTH * IMAGE_HEIGHT);
+    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    int first = int(group * gl_WorkGroupSize.x + gl_LocalInvocationIndex) * PIXELS_PER_INVOCATION;
+    int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
+    int end = min(first + PIXELS_PER_INVOCATION, records);
     for (int k = first; k < end; k++) sum += recordCounts(k);
     for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
     for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);

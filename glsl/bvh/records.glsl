@@ -46,12 +46,11 @@ uvec4 unpackCounts(uvec2 c)
 int pixelIndex(ivec2 storePos) { return storePos.y * IMAGE_WIDTH + storePos.x; }
 
 #ifdef PIXEL_RECORDS
-// The intersection kernels' store of their work (the hook of common/intersect_head.glsl's
-// traceAndCount): the pixel's counts, and in intersect1 its hit record too.
-void storePixelRecord(ivec2 storePos, int testsSlot)
+// The intersection kernels' store of their work in record `at` (the hook of
+// common/intersect_head.glsl's traceAndCount): the counts, and in intersect1 the hit record too.
+void storePixelRecord(int at, int testsSlot)
 {
     uvec2 counts = packCounts(tests, nodesVisited, truncated, raysTraced);
-    int at = pixelIndex(storePos);
     // (a constant condition: one of the two stores is compiled)
     if (testsSlot == COUNTER_INTERSECT1) {
 #if RECORD_STORE_64

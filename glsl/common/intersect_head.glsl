@@ -34,19 +34,29 @@ void trace(ivec2 storePos);
 // BVH: bvh/records.glsl, for bvh/pixel_counts.comp to add up) defines PIXEL_RECORDS before
 // including this file and storePixelRecord after it.
 #ifdef PIXEL_RECORDS
-void storePixelRecord(ivec2 storePos, int testsSlot);
+void storePixelRecord(int at, int testsSlot);
+int pixelIndex(ivec2 storePos);
 #endif
 
 // main() of every intersection kernel: trace this invocation's pixel, then add its work counts
 // to the 64-bit counters — its triangle tests to `testsSlot` (COUNTER_INTERSECT1 or 2) — or,
-// with PIXEL_RECORDS, store them.
+// with PIXEL_RECORDS, store them in the pixel's record. Ours: with HIT_LIST (the SAH BVH's
+// intersect2, which includes bvh/hit_list.glsl first) an invocation takes a pixel of the
+// pass' hit list instead, and its record is that of its list position.
 void traceAndCount(int testsSlot)
 {
-#ifdef PIXEL_RECORDS
+#if defined(PIXEL_RECORDS) && defined(HIT_LIST)
+    uint k = listGroup() * 64u + gl_LocalInvocationIndex;
+    if (k < hitCount()) {
+        uint p = hitWords[HIT_LIST_ENTRIES + k];
+        trace(ivec2(p % uint(IMAGE_WIDTH), p / uint(IMAGE_WIDTH)));
+        storePixelRecord(int(k), testsSlot);
+    }
+#elif defined(PIXEL_RECORDS)
     ivec2 storePos = pixelPosition();
     if (insideImage(storePos)) {
         trace(storePos);
-        storePixelRecord(storePos, testsSlot);
+        storePixelRecord(pixelIndex(storePos), testsSlot);
     }
 #else
     countersBegin();

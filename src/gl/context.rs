@@ -42,6 +42,9 @@ pub struct GlInfo {
     /// a pixel's record as two 64-bit words in one store, its intersect2 the counts as one
     /// word: `glsl/common/intersect_head.glsl`).
     pub int64: bool,
+    /// GL_ARB_shader_ballot with 64-bit integers: a SIMD group's votes as one mask (the SAH
+    /// BVH's hit list reserves a SIMD group's entries with one atomic: `glsl/bvh/hit_list.glsl`).
+    pub ballot: bool,
 }
 
 /// How Mesa's llvmpipe — and lavapipe, which zink runs on in software — treat long shader
@@ -74,6 +77,13 @@ impl GlInfo {
             iterations: 65535,
             lanes: vector_bits(&self.renderer).map_or(16, |b| b / 32),
         })
+    }
+
+    /// The most work groups of one dimension a dispatch may have (`GL_MAX_COMPUTE_WORK_GROUP_COUNT`
+    /// of x, at least 65535 by GL 4.6 §19): the GPU-written commands of work lists keep within
+    /// it (`MAX_GROUPS_X` in `glsl/common/work_lists.glsl`).
+    pub fn max_groups_x(&self) -> u32 {
+        self.max_compute_work_group_count[0].max(1) as u32
     }
 
     /// Whether this is Mesa's llvmpipe (GL_RENDERER names it): the CPU rasteriser whose loop
@@ -267,6 +277,7 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
         let indexed = |p: u32, i: u32| gl.get_parameter_indexed_i32(p, i);
         let mut timer_bits = 0i32;
         (gl.get_query_iv)(glow::TIME_ELAPSED, QUERY_COUNTER_BITS, &mut timer_bits);
+        let extensions = gl.supported_extensions();
         GlInfo {
             vendor: gl.get_parameter_string(glow::VENDOR),
             renderer: gl.get_parameter_string(glow::RENDERER),
@@ -290,9 +301,9 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
             max_image_units: int(glow::MAX_IMAGE_UNITS),
             max_array_texture_layers: int(glow::MAX_ARRAY_TEXTURE_LAYERS),
             timer_query_bits: timer_bits,
-            int64: gl
-                .supported_extensions()
-                .contains("GL_ARB_gpu_shader_int64"),
+            int64: extensions.contains("GL_ARB_gpu_shader_int64"),
+            ballot: extensions.contains("GL_ARB_gpu_shader_int64")
+                && extensions.contains("GL_ARB_shader_ballot"),
         }
     }
 }

@@ -64,6 +64,10 @@ slot_table! {
         /// that may hit and those without, and the two dispatches' work-group counts
         /// (glsl/bvh/block_lists.glsl)
         BVH_BLOCK_LISTS = 24,
+        /// the SAH BVH's hit list: the pixels whose ray hit something in the pass, which
+        /// its intersect2 dispatches work through, and their dispatch commands
+        /// (glsl/bvh/hit_list.glsl)
+        HIT_LIST = 25,
         // the SAH BVH's GPU refit (glsl/bvh/refit.glsl): the tree's topology as the host lays
         // it out once per build (src/accel/bvh/refit.rs), and every node's float box and
         // subtree SAH cost as the refit's passes write them

@@ -99,8 +99,9 @@ pub fn texel_index_mask() -> (&'static str, String) {
 /// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
 /// `glsl/bvh/intersect1_main.glsl`); the size of an instance ([`instances`]; whether the walks
 /// start at the instances is the pipeline's `BVH_INSTANCES`, which the hit evaluation needs too).
-fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 10] {
+fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 11] {
     [
+        ("MAX_GROUPS_X", info.max_groups_x().to_string()),
         ("BVH_INSTANCE_TEXELS", INSTANCE_TEXELS.to_string()),
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
@@ -171,29 +172,32 @@ struct Fused {
 }
 
 /// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): the image's blocks that may hit
-/// and those that cannot, each list a dispatch command and a word per block.
+/// and those that cannot, each list a dispatch command, a count and a word per block.
 struct BlockLists {
     buffer: Ssbo,
-    /// empties the lists before each entry pass (`glsl/bvh/block_lists_reset.comp`)
-    reset: Kernel,
+    /// empties the lists before each entry pass and writes their dispatch commands after it
+    /// (`glsl/bvh/block_lists.comp`)
+    kernel: Kernel,
 }
 
 impl BlockLists {
     fn new(b: &BuildContext, defs: &[(&'static str, String)], blocks: u32) -> Result<BlockLists> {
-        let words = 8 + 2 * blocks as usize;
+        let words = 16 + 2 * blocks as usize;
         let max_block = b.info.max_ssbo_block_size;
         let buffer = Ssbo::new(b.gl, "bvh_block_lists", 4 * words, None, max_block)?;
         // timed with the entry pass, a part of intersect1: the pass' set-up
-        let reset = b.kernel("bvh/block_lists_reset.comp", defs, "intersect1")?;
-        Ok(BlockLists { buffer, reset })
+        let kernel = b.kernel("bvh/block_lists.comp", defs, "intersect1")?;
+        Ok(BlockLists { buffer, kernel })
     }
 
-    /// Both lists emptied for the entry pass to fill, the buffer bound for it and the fused
-    /// kernels.
-    fn reset(&self, gl: &Gl, timers: &mut GpuTimers) {
+    /// Both lists emptied for the entry pass to fill (`finish` unset), or their dispatch
+    /// commands written from what it filled (set); the buffer bound for the entry pass and
+    /// the fused kernels.
+    fn step(&self, gl: &Gl, timers: &mut GpuTimers, finish: bool) {
         self.buffer.bind(gl, ssbo::BVH_BLOCK_LISTS);
-        self.reset.use_program();
-        self.reset.dispatch_1d(timers, 1);
+        self.kernel.use_program();
+        self.kernel.set_i32("finish", finish as i32);
+        self.kernel.dispatch_1d(timers, 1);
     }
 }
 
@@ -612,7 +616,7 @@ impl Accelerator for Bvh {
             return None;
         }
         if let Some(lists) = &self.fused.lists {
-            lists.reset(f.gl, f.timers);
+            lists.step(f.gl, f.timers, false);
         }
         self.entry.use_program();
         set_pass_rays(&self.entry, eye);
@@ -630,9 +634,10 @@ impl Accelerator for Bvh {
             Some(lists) => {
                 // the blocks that may hit, then the others: each list in one dispatch, whatever
                 // the tiles (glsl/bvh/block_lists.glsl)
+                lists.step(f.gl, f.timers, true);
                 for (list, k) in kernels.iter().enumerate() {
                     k.use_program();
-                    k.set_i32("blockListThreads", f.pixels.threads as i32);
+                    k.set_i32("listThreads", f.pixels.threads as i32);
                     let command = 16 * list as i32;
                     k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
                 }

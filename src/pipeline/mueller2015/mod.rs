@@ -457,9 +457,9 @@ impl RayTracer {
             self.counters.bind(f.gl, f.timers, Bank::occluded(light));
             let k = self.accel.occluded(&mut f, &target);
             target.set_uniforms(k);
-            k.dispatch_pixels(f.timers, f.pixels);
-            if let Some(r) = &self.records {
-                r.add_counts(f.timers, "intersect2");
+            match &self.records {
+                Some(r) => r.trace_feelers(k, f.timers, f.pixels.threads),
+                None => k.dispatch_pixels(f.timers, f.pixels),
             }
         }
         self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
@@ -572,6 +572,10 @@ impl RayTracer {
             }
         }
         self.accel.stats(&mut stats);
+        if let (Some(r), false) = (&self.records, self.options.fused_passes) {
+            let pixels = r.hit_list_pixels(&self.gl);
+            stats.facts.insert("hit_list_pixels".into(), json!(pixels));
+        }
         stats
     }
 }

@@ -62,10 +62,41 @@ pub struct Records {
     records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
+    hit_list: HitList,
     /// the records as an RGBA32UI image buffer for `pixel_counts` (`RECORD_IMAGE`), where the
     /// GL has the unit ([`Ssbo::texel_view`])
     view: Option<Owned<glow::Texture>>,
     pixels: u32,
+}
+
+/// Words before the hit list's entries: two dispatch commands and the count
+/// (`HIT_LIST_ENTRIES` in `glsl/bvh/hit_list.glsl`).
+const HIT_LIST_HEADER_WORDS: usize = 16;
+
+/// The pass' hit list (`glsl/bvh/hit_list.glsl`, ours): the pixels whose ray hit something,
+/// appended by `evaluate_hit`, which the pass' intersect2 dispatches and their counts work
+/// through by indirect dispatches instead of the image.
+struct HitList {
+    buffer: Ssbo,
+    /// empties the list before `evaluate_hit`, writes the dispatch commands after it
+    /// (`glsl/bvh/hit_list.comp`)
+    kernel: Kernel,
+}
+
+impl HitList {
+    /// Byte offsets of the two dispatch commands: intersect2's, then `pixel_counts`'.
+    const FEELERS: i32 = 0;
+    const COUNTS: i32 = 16;
+
+    /// Word of the frame's entries over its passes (`HIT_LIST_FRAME_ENTRIES`).
+    const FRAME_ENTRIES: usize = 9;
+
+    fn step(&self, timers: &mut GpuTimers, finish: bool, first_pass: bool) {
+        self.kernel.use_program();
+        self.kernel.set_i32("finish", finish as i32);
+        self.kernel.set_i32("firstPass", first_pass as i32);
+        self.kernel.dispatch_1d(timers, 1);
+    }
 }
 
 /// The counter slot of `name` (an entry of [`COUNTERS`]).
@@ -100,14 +131,22 @@ impl Records {
             // 32-bit stores only: these two kernels do not enable 64-bit integers
             .set("RECORD_STORE_64", 0)
             .set("RECORD_IMAGE", view.is_some() as i32)
+            .set("MAX_GROUPS_X", info.max_groups_x())
+            .set("HIT_LIST_BALLOT", info.ballot as i32)
             .set(mask, mask_value)
             // evaluate_hit's hit records of two levels (glsl/bvh/words.glsl's instanceRay)
             .set("BVH_INSTANCE_TEXELS", crate::accel::bvh::INSTANCE_TEXELS);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
+        let list_bytes = 4 * (HIT_LIST_HEADER_WORDS + (w as usize) * (h as usize));
         Ok(Records {
             records,
             evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: compute("bvh/pixel_counts.comp", "pixel_counts")?,
+            hit_list: HitList {
+                buffer: Ssbo::new(gl, "hit list", list_bytes, None, max)?,
+                // the list is a part of the hit's evaluation: timed with it
+                kernel: compute("bvh/hit_list.comp", "evaluate_hit")?,
+            },
             view,
             pixels: w * h,
         })
@@ -115,13 +154,14 @@ impl Records {
 
     pub fn bind(&self, gl: &Gl) {
         self.records.bind(gl, ssbo::PIXEL_RECORDS);
+        self.hit_list.buffer.bind(gl, ssbo::HIT_LIST);
         if let Some(v) = &self.view {
             let (access, format) = (glow::READ_ONLY, glow::RGBA32UI);
             bind_image_unit(gl, image::PIXEL_RECORDS, v.raw(), access, format);
         }
     }
 
-    /// After intersect1: evaluate the hits (Listings 13, 14), then count.
+    /// After intersect1: evaluate the hits (Listings 13, 14) into the hit list, then count.
     pub fn after_closest_hit(
         &self,
         timers: &mut GpuTimers,
@@ -129,12 +169,34 @@ impl Records {
         background: [f32; 3],
         first_pass: bool,
     ) {
+        self.hit_list.step(timers, false, first_pass);
         let k = &self.evaluate_hit;
         k.use_program();
         k.set_vec4("backgroundColor", background, 1.0);
         k.set_i32("storePrimaryHit", first_pass as i32);
         k.dispatch_pixels(timers, grid);
+        self.hit_list.step(timers, true, first_pass);
         self.add_counts(timers, "intersect1");
+    }
+
+    /// An intersect2 dispatch (`feelers`, in use, its light's uniforms set) over the pass' hit
+    /// list — one dispatch, whatever the tiles of the other kernels: its work is the hits' —
+    /// then its counts, the triangle tests under intersect2.
+    pub fn trace_feelers(&self, feelers: &Kernel, timers: &mut GpuTimers, threads: u32) {
+        let buffer = self.hit_list.buffer.buffer.raw();
+        feelers.set_i32("listThreads", threads as i32);
+        feelers.dispatch_indirect(timers, buffer, HitList::FEELERS);
+        let k = self.counts_program(Record::Packed(0), true);
+        k.set_ivec4("countSlots", count_slots("intersect2"));
+        k.dispatch_indirect(timers, buffer, HitList::COUNTS);
+    }
+
+    /// The pixels the frame's hit lists held, over all its passes: those whose feelers
+    /// intersect2 traced (read back after the frame).
+    pub fn hit_list_pixels(&self, gl: &Gl) -> u32 {
+        let mut words = [0u8; 4 * (HitList::FRAME_ENTRIES + 1)];
+        self.hit_list.buffer.read_bytes(gl, &mut words);
+        bytemuck::pod_read_unaligned(&words[4 * HitList::FRAME_ENTRIES..])
     }
 
     /// After an intersection dispatch whose triangle tests count under `tests`: add every
@@ -146,6 +208,17 @@ impl Records {
     /// Add every pixel's `record` (the fused pass keeps three a pixel:
     /// `glsl/bvh/fused_pass.comp`) to the bound bank, its triangle tests under `tests`.
     pub fn add_record_counts(&self, timers: &mut GpuTimers, tests: &str, record: Record) {
+        let k = self.counts_program(record, false);
+        k.set_ivec4("countSlots", count_slots(tests));
+        k.dispatch_1d(
+            timers,
+            self.pixels.div_ceil(PIXELS_PER_INVOCATION * COUNT_GROUP),
+        );
+    }
+
+    /// `pixel_counts` in use, set to sum `record` of every pixel or, with `listed`, the hit
+    /// list's records (`glsl/bvh/pixel_counts.comp`).
+    fn counts_program(&self, record: Record, listed: bool) -> &Kernel {
         let k = &self.pixel_counts;
         k.use_program();
         let (index, plain, high) = match record {
@@ -156,18 +229,17 @@ impl Records {
         k.set_i32("recordBase", (index * self.pixels) as i32);
         k.set_i32("plainRecords", plain as i32);
         k.set_i32("packedHigh", high as i32);
-        k.set_ivec4(
-            "countSlots",
-            [
-                slot(tests),
-                slot("nodes_visited"),
-                slot("truncated_rays"),
-                slot("rays"),
-            ],
-        );
-        k.dispatch_1d(
-            timers,
-            self.pixels.div_ceil(PIXELS_PER_INVOCATION * COUNT_GROUP),
-        );
+        k.set_i32("hitListed", listed as i32);
+        k
     }
+}
+
+/// The counter slots of a record's four counts, its triangle tests under `tests`.
+fn count_slots(tests: &str) -> [i32; 4] {
+    [
+        slot(tests),
+        slot("nodes_visited"),
+        slot("truncated_rays"),
+        slot("rays"),
+    ]
 }
