@@ -276,3 +276,51 @@ fn the_work_lists_take_rows_where_the_gl_allows_few_work_groups() {
         }
     }
 }
+
+#[test]
+fn the_first_pass_leaves_its_miss_blocks_to_clears() {
+    // without AOVs the first pass does not dispatch the blocks whose eye rays all miss: their
+    // output colour is filled with the background and their records with a ray traced that
+    // visited nothing (RayTracer::fused_pass), and the frame clears only the ray origins, where a
+    // reflection pass reads them (RayTracer::clear_images) — the same colours and counts in
+    // every record layout: one point light (packed beside the closest hit), three (the other
+    // lights' record), an area light as the first light (a record of its own), with and
+    // without reflections, in two frames, the second with object 0 turned (blocks that hit
+    // in the first miss in the second: their ray state of the first frame must not live on)
+    let mut teapot = load("teapot1.toml");
+    ring_of_lights(&mut teapot, 3);
+    let mut area = load("cow_area.toml");
+    area.lights.clear();
+    let cases = [
+        (load("bunny.toml"), 0, "bunny"),
+        (load("bunny_low.toml"), 2, "bunny_low, 2 reflections"),
+        (teapot, 1, "teapot1, 3 lights"),
+        (area, 1, "cow_area, its area light alone"),
+    ];
+    let ctx = context();
+    for (scene, refl_depth, what) in cases {
+        let opts = RenderOptions {
+            aovs: false,
+            light_samples: (2, 2),
+            ..bvh(64, 48, refl_depth)
+        };
+        let fused_opts = RenderOptions {
+            fused_passes: true,
+            ..opts.clone()
+        };
+        let mut four = ray_tracer(&ctx, &scene, opts);
+        let mut fused = ray_tracer(&ctx, &scene, fused_opts);
+        for frame in 0..2 {
+            if frame == 1 {
+                let turned = scene.objects[0].model * glam::Mat4::from_rotation_y(1.2);
+                four.set_model(0, turned).unwrap();
+                fused.set_model(0, turned).unwrap();
+            }
+            let a = four.render(&scene.camera).expect("frame");
+            let b = fused.render(&scene.camera).expect("frame");
+            let what = format!("{what}, frame {frame}");
+            assert_eq!(a.color, b.color, "{what}: colours");
+            assert_same_counts(&a, &b, &what);
+        }
+    }
+}

@@ -85,8 +85,15 @@ pub trait Accelerator {
     ) -> Option<&[Kernel]> {
         None
     }
-    /// Dispatch the kernels [`Accelerator::fused_pass`] returned, their uniforms set.
-    fn dispatch_fused(&mut self, _f: &mut FrameContext) {}
+    /// Whether the fused pass runs the blocks whose rays all miss in a kernel of their own
+    /// (the SAH BVH's block lists), which [`Accelerator::dispatch_fused`] can leave out.
+    fn fused_misses_apart(&self) -> bool {
+        false
+    }
+    /// Dispatch the kernels [`Accelerator::fused_pass`] returned, their uniforms set; without
+    /// `misses` not the one for the blocks whose rays all miss (where
+    /// [`Accelerator::fused_misses_apart`]: the pipeline filled their pixels by clears).
+    fn dispatch_fused(&mut self, _f: &mut FrameContext, _misses: bool) {}
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
 }

@@ -628,14 +628,19 @@ impl Accelerator for Bvh {
         Some(&self.fused.kernels)
     }
 
-    fn dispatch_fused(&mut self, f: &mut FrameContext) {
+    fn fused_misses_apart(&self) -> bool {
+        self.fused.lists.is_some()
+    }
+
+    fn dispatch_fused(&mut self, f: &mut FrameContext, misses: bool) {
         let kernels = &self.fused.kernels;
         match &self.fused.lists {
             Some(lists) => {
                 // the blocks that may hit, then the others: each list in one dispatch, whatever
                 // the tiles (glsl/bvh/block_lists.glsl)
                 lists.step(f.gl, f.timers, true);
-                for (list, k) in kernels.iter().enumerate() {
+                let dispatched = if misses { 2 } else { 1 };
+                for (list, k) in kernels.iter().enumerate().take(dispatched) {
                     k.use_program();
                     k.set_i32("listThreads", f.pixels.threads as i32);
                     let command = 16 * list as i32;

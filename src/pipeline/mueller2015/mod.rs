@@ -472,6 +472,25 @@ impl RayTracer {
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
 
+    /// The frame's clear of the ray-state images (Müller 2015, ch. 3.1.3: once a frame), timed
+    /// as `image_clear` — on llvmpipe a memset of every texel, 5–9 ms for the seven images at
+    /// 512². Ours: the fused pass with its eye rays in place writes every pixel's output colour
+    /// in its first pass, and the ray state of every pixel a reflection pass reads but those of
+    /// the blocks left to clears (`fused_misses_apart`, [`RayTracer::fused_pass`]), which an
+    /// inactive ray origin must mark; it reads no other image before writing it (the AOVs'
+    /// images are only written where the host keeps AOVs, and then no eye ray is in place) —
+    /// so it clears the ray origins where a reflection pass follows, and nothing else.
+    fn clear_images(&mut self) {
+        let (gl, images) = (&self.gl, &self.images);
+        let origins_only = self.eye_in_place(0);
+        let reflections = self.options.refl_depth > 0;
+        self.timers.time(gl, "image_clear", || match origins_only {
+            false => images.clear(gl),
+            true if reflections => images.ray_origin.clear(gl),
+            true => {}
+        });
+    }
+
     /// Whether pass `pass` computes its eye rays in place (the fused pass' first, where no
     /// AOVs keep the rays: `glsl/common/pass_ray.glsl`), so no eye-ray kernel runs.
     fn eye_in_place(&self, pass: u32) -> bool {
@@ -506,27 +525,36 @@ impl RayTracer {
             k.set_i32("lightCount", l.lights.len() as i32);
             k.set_vec4_slice("areaLight", &l.area_uniform());
         }
-        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
-        self.counters.bind(f.gl, f.timers, Bank::Frame);
-        self.accel.dispatch_fused(&mut f);
-        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         let r = self
             .records
             .as_ref()
             .expect("the fused pass stores records");
+        let feelers = feeler_records(
+            self.fused
+                .expect("fused_pass runs with --fused-passes only"),
+        );
+        // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
+        // miss the tree (the accelerator's miss list) ends as the clears leave it: the output
+        // colour the background at full weight (Listing 16's addToFinal on a miss: every such
+        // pixel's), its record a ray traced that visited nothing; where no AOVs keep the first
+        // hits (eye rays in place) and no texel of the ray state needs storing — the frame's
+        // clear left them inactive (docs/design/frame.md, "The fused pass")
+        let clears = eye && self.accel.fused_misses_apart();
+        if clears {
+            let (final_color, bg) = (&self.images.final_color, l.background);
+            let mut kinds = vec![Record::Packed(0)];
+            kinds.extend(feelers.iter().map(|(_, r)| *r));
+            f.timers.time(f.gl, "fused_miss", || {
+                final_color.fill_f32(f.gl, [bg[0], bg[1], bg[2], 1.0]);
+                r.fill_misses(f.gl, &kinds);
+            });
+        }
+        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
+        self.counters.bind(f.gl, f.timers, Bank::Frame);
+        self.accel.dispatch_fused(&mut f, !clears);
+        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         r.add_record_counts(f.timers, "intersect1", Record::Packed(0));
-        let fused = self
-            .fused
-            .expect("fused_pass runs with --fused-passes only");
-        let first = match fused.first_light_point {
-            true => Record::PackedHigh(0),
-            false => Record::Plain(1),
-        };
-        let kinds = [
-            (Bank::occluded(0), first),
-            (Bank::occluded(1), Record::Plain(2)),
-        ];
-        for (bank, record) in kinds.into_iter().take(fused.lights.min(2) as usize) {
+        for (bank, record) in feelers {
             self.counters.bind(&self.gl, &mut self.timers, bank);
             r.add_record_counts(&mut self.timers, "intersect2", record);
         }
@@ -580,6 +608,24 @@ impl RayTracer {
     }
 }
 
+/// The fused pass' feeler records a pass sums, each under its bank: the first light's (packed
+/// in record 0 beside the closest hit's where it is a point light, else record 1) and the
+/// other lights' (record 2) — `glsl/bvh/fused_pass.comp`.
+fn feeler_records(fused: FusedPasses) -> Vec<(Bank, Record)> {
+    let first = match fused.first_light_point {
+        true => Record::PackedHigh(0),
+        false => Record::Plain(1),
+    };
+    let kinds = [
+        (Bank::occluded(0), first),
+        (Bank::occluded(1), Record::Plain(2)),
+    ];
+    kinds
+        .into_iter()
+        .take(fused.lights.min(2) as usize)
+        .collect()
+}
+
 impl Renderer for RayTracer {
     fn name(&self) -> &'static str {
         self.options.tracer.name()
@@ -612,7 +658,7 @@ impl Renderer for RayTracer {
             pixels: self.pixels,
             models: &self.models,
         })?;
-        self.images.clear(&gl);
+        self.clear_images();
         self.images.bind(&gl);
         if let Some(r) = &self.records {
             r.bind(&gl);

@@ -199,6 +199,34 @@ impl Records {
         bytemuck::pod_read_unaligned(&words[4 * HitList::FRAME_ENTRIES..])
     }
 
+    /// The fused pass' first pass without its miss kernel (ours; `RayTracer::fused_pass`):
+    /// every pixel's `records` set to what that kernel stores for an eye ray that misses —
+    /// record 0 a ray traced that visited nothing (its first light's counts, packed beside,
+    /// none), the unpacked feeler records nothing — before the hit blocks' kernel overwrites
+    /// its own pixels'.
+    pub fn fill_misses(&self, gl: &Gl, records: &[Record]) {
+        let bytes = std::mem::size_of::<PixelRecord>() * self.pixels as usize;
+        let traced = PixelRecord {
+            tests_truncated: 0,
+            nodes_traced: 1 << 31,
+            hit: 0,
+            unused: 0,
+        };
+        let mut filled = Vec::new();
+        for r in records {
+            let (index, value) = match *r {
+                Record::Packed(i) | Record::PackedHigh(i) => (i, traced),
+                Record::Plain(i) => (i, PixelRecord::zeroed()),
+            };
+            if !filled.contains(&index) {
+                let value = bytemuck::cast(value);
+                let offset = index as usize * bytes;
+                self.records.fill_range_u32x4(gl, offset, bytes, value);
+                filled.push(index);
+            }
+        }
+    }
+
     /// After an intersection dispatch whose triangle tests count under `tests`: add every
     /// pixel's counts to the bound bank.
     pub fn add_counts(&self, timers: &mut GpuTimers, tests: &str) {
