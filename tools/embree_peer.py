@@ -13,8 +13,9 @@ triangle-id order) and `gpgpu-rt info --json` (light positions, shadow offset). 
 - the shadow feelers of intersect2 (any hit) from o + t·d towards every point light, where
   N·L > 0 (the kernel does not trace the others), from the shadow offset to the light: Mrays/s
   = feelers / seconds, ours = feelers / gpu_ms.intersect2; agreement with shadow.npy;
-- the whole frame: our GPU time of every kernel of the frame (`gpu_ms_total`: transform, eye
-  rays, searches, hit evaluation, counts, shading) against Embree's time for the primary rays
+- the whole frame: our GPU time of every kernel of the frame (`gpu_ms_total`: the image
+  clears, transform, eye rays, searches, hit evaluation, counts, shading) against Embree's
+  time for the primary rays
   plus the feelers, with each kernel's share of ours; for `--tracer bvh --bvh-variant sah`
   also the frame with `--fused-passes` (each pass in one kernel), rendered in the same rounds.
 
@@ -514,8 +515,9 @@ def frame_lines(results, threads):
     if not rows:
         return []
     lines = ["", "## The whole frame", "",
-             f"Ours: every kernel of the last frame (`gpu_ms_total`: transform, eye rays, the "
-             f"searches, hit evaluation, counts, shading); Embree: the same primary rays plus "
+             f"Ours: every kernel of the last frame (`gpu_ms_total`: the image clears, "
+             f"transform, eye rays, the searches, hit evaluation, counts, shading); Embree: "
+             f"the same primary rays plus "
              f"feelers on {threads} processes, nothing else (no shading). Time ratio ours / "
              "Embree per round (> 1: ours slower); the shares are each kernel's part of ours.", "",
              "| scene | ours ms | Embree ms (primary + feelers) | ours / Embree: median (range) "
