@@ -36,7 +36,9 @@ void appendHit(ivec2 storePos, bool hit)
     uvec2 mask = unpackUint2x32(ballotARB(hit));
     uvec2 below = mask & unpackUint2x32(gl_SubGroupLtMaskARB);
     uint rank = uint(bitCount(below.x) + bitCount(below.y));
-    uint first = mask.x != 0u ? uint(findLSB(mask.x)) : 32u + uint(findLSB(mask.y));
+    // the lowest lane with a hit (lane 0 where none has one: its base is not used)
+    uint first = mask.x != 0u ? uint(findLSB(mask.x))
+               : mask.y != 0u ? 32u + uint(findLSB(mask.y)) : 0u;
     uint base = 0u;
     if (hit && rank == 0u)
         base = atomicAdd(hitWords[HIT_LIST_COUNT], uint(bitCount(mask.x) + bitCount(mask.y)));

@@ -621,6 +621,10 @@ impl Accelerator for Bvh {
         self.entry.use_program();
         set_pass_rays(&self.entry, eye);
         self.closest_hit(f, pass);
+        if let Some(lists) = &self.fused.lists {
+            // the lists' dispatch commands from what the entry pass counted
+            lists.step(f.gl, f.timers, true);
+        }
         for k in &self.fused.kernels {
             k.use_program();
             set_pass_rays(k, eye);
@@ -638,7 +642,6 @@ impl Accelerator for Bvh {
             Some(lists) => {
                 // the blocks that may hit, then the others: each list in one dispatch, whatever
                 // the tiles (glsl/bvh/block_lists.glsl)
-                lists.step(f.gl, f.timers, true);
                 let dispatched = if misses { 2 } else { 1 };
                 for (list, k) in kernels.iter().enumerate().take(dispatched) {
                     k.use_program();

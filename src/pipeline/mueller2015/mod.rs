@@ -533,6 +533,9 @@ impl RayTracer {
             self.fused
                 .expect("fused_pass runs with --fused-passes only"),
         );
+        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
+        // (and the clears stand for the miss kernel)
+        self.counters.bind(f.gl, f.timers, Bank::Frame);
         // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
         // miss the tree (the accelerator's miss list) ends as the clears leave it: the output
         // colour the background at full weight (Listing 16's addToFinal on a miss: every such
@@ -549,8 +552,6 @@ impl RayTracer {
                 r.fill_misses(f.gl, &kinds);
             });
         }
-        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
-        self.counters.bind(f.gl, f.timers, Bank::Frame);
         self.accel.dispatch_fused(&mut f, !clears);
         self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
         r.add_record_counts(f.timers, "intersect1", Record::Packed(0));

@@ -128,7 +128,8 @@ impl Records {
             .clone()
             .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
             .set("COUNT_GROUP", COUNT_GROUP)
-            // 32-bit stores only: these two kernels do not enable 64-bit integers
+            // 32-bit record stores only: these kernels do not store records (evaluate_hit
+            // enables 64-bit integers for its ballot alone: HIT_LIST_BALLOT)
             .set("RECORD_STORE_64", 0)
             .set("RECORD_IMAGE", view.is_some() as i32)
             .set("MAX_GROUPS_X", info.max_groups_x())
