@@ -53,7 +53,11 @@ def main():
         sys.exit(__doc__)
     binary = str(ROOT / "target/release/gpgpu-rt")
     if args[0] == "--bin":  # another build, e.g. the commit before a change, for pairs
+        if len(args) < 3:
+            sys.exit("--bin needs a binary and then the render arguments")
         binary, args = args[1], args[2:]
+    if not Path(binary).is_file():
+        sys.exit(f"{binary} not found: cargo build --release (or --bin)")
     with tempfile.TemporaryDirectory() as tmp:
         data = f"{tmp}/perf.data"
         subprocess.run(["perf", "record", "-q", "-e", "cpu-clock", "-F", str(HZ), "-g",

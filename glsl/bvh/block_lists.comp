@@ -14,9 +14,6 @@ void main()
 {
     uint k = gl_GlobalInvocationID.x; // list k, its command at word 4k
     if (finish == 0) blockWords[BLOCK_LIST_COUNTS + k] = 0u;
-    uvec3 c = groupsCommand(finish != 0 ? blockListCount(k) : 0u);
-    blockWords[4u * k] = c.x;
-    blockWords[4u * k + 1u] = c.y;
-    blockWords[4u * k + 2u] = c.z;
-    blockWords[4u * k + 3u] = 0u;
+    uvec4 command = groupsCommand(finish != 0 ? blockListCount(k) : 0u);
+    for (uint w = 0u; w < 4u; w++) blockWords[4u * k + w] = command[w];
 }

@@ -2,7 +2,7 @@
 // invocation: before it (finish 0) the list emptied — a kernel rather than a glBufferSubData,
 // so that its stores are ordered after the last pass' reads by the barrier between passes, as
 // every pass is (src/gl/sync.rs); after it (finish 1) the dispatch commands of the pass'
-// intersect2 (a work group of 64 per 64 entries) and of its counts (bvh/pixel_counts.comp:
+// intersect2 (a work group per HIT_LIST_GROUP entries) and of its counts (bvh/pixel_counts.comp:
 // PIXELS_PER_INVOCATION entries an invocation, COUNT_GROUP invocations a work group) written
 // from the count, within GL's limit on work groups per dimension (common/work_lists.glsl), and
 // the count added to the frame's.
@@ -16,11 +16,8 @@ uniform int firstPass;
 
 void setCommand(uint word, uint groups)
 {
-    uvec3 c = groupsCommand(groups);
-    hitWords[word] = c.x;
-    hitWords[word + 1u] = c.y;
-    hitWords[word + 2u] = c.z;
-    hitWords[word + 3u] = 0u;
+    uvec4 command = groupsCommand(groups);
+    for (uint w = 0u; w < 4u; w++) hitWords[word + w] = command[w];
 }
 
 void main()
@@ -30,6 +27,6 @@ void main()
     if (finish == 0 && firstPass != 0) hitWords[HIT_LIST_FRAME_ENTRIES] = 0u;
     if (finish != 0) hitWords[HIT_LIST_FRAME_ENTRIES] += n;
     uint perCountGroup = uint(PIXELS_PER_INVOCATION * COUNT_GROUP);
-    setCommand(0u, (n + 63u) / 64u);
+    setCommand(0u, (n + HIT_LIST_GROUP - 1u) / HIT_LIST_GROUP);
     setCommand(4u, (n + perCountGroup - 1u) / perCountGroup);
 }

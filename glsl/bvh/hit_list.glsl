@@ -23,7 +23,15 @@
 #define HIT_LIST_COUNT 8
 #define HIT_LIST_FRAME_ENTRIES 9
 #define HIT_LIST_ENTRIES 16
+// the entries of one intersect2 work group (its 8×8 invocations: common/intersect_head.glsl)
+#define HIT_LIST_GROUP 64u
 layout(std430, binding = SSBO_HIT_LIST) buffer HitList { uint hitWords[]; };
 
 uint hitCount() { return hitWords[HIT_LIST_COUNT]; }
+// the pixel of entry k (the inverse of bvh/records.glsl's pixelIndex)
+ivec2 hitPixel(uint k)
+{
+    uint p = hitWords[HIT_LIST_ENTRIES + k];
+    return ivec2(p % uint(IMAGE_WIDTH), p / uint(IMAGE_WIDTH));
+}
 #endif

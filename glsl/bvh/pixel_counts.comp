@@ -53,8 +53,8 @@ void main()
 {
     countersBegin();
     uvec4 sum = uvec4(0u);
-    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-    int first = int(group * gl_WorkGroupSize.x + gl_LocalInvocationIndex) * PIXELS_PER_INVOCATION;
+    uint invocation = linearGroup() * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+    int first = int(invocation) * PIXELS_PER_INVOCATION;
     int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
     int end = min(first + PIXELS_PER_INVOCATION, records);
     for (int k = first; k < end; k++) sum += recordCounts(k);

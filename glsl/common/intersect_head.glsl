@@ -46,10 +46,9 @@ int pixelIndex(ivec2 storePos);
 void traceAndCount(int testsSlot)
 {
 #if defined(PIXEL_RECORDS) && defined(HIT_LIST)
-    uint k = listGroup() * 64u + gl_LocalInvocationIndex;
+    uint k = listGroup() * HIT_LIST_GROUP + gl_LocalInvocationIndex;
     if (k < hitCount()) {
-        uint p = hitWords[HIT_LIST_ENTRIES + k];
-        trace(ivec2(p % uint(IMAGE_WIDTH), p / uint(IMAGE_WIDTH)));
+        trace(hitPixel(k));
         storePixelRecord(int(k), testsSlot);
     }
 #elif defined(PIXEL_RECORDS)

@@ -7,16 +7,20 @@
 #ifndef WORK_LISTS_GLSL
 #define WORK_LISTS_GLSL
 
-// The dispatch command (num_groups_x, y, z) for `groups` work groups: one row where it fits,
-// else as many rows as needed of equal length — at most rows − 1 work groups more than
-// `groups`, which find no entry and return.
-uvec3 groupsCommand(uint groups)
+// The dispatch command (num_groups_x, y, z, padding) for `groups` work groups, as the four
+// words a list's buffer holds it in: one row where it fits, else as many rows as needed of
+// equal length — at most rows − 1 work groups more than `groups`, which find no entry and
+// return.
+uvec4 groupsCommand(uint groups)
 {
     uint maxX = uint(MAX_GROUPS_X);
-    if (groups <= maxX) return uvec3(groups, 1u, 1u);
+    if (groups <= maxX) return uvec4(groups, 1u, 1u, 0u);
     uint rows = (groups + maxX - 1u) / maxX;
-    return uvec3((groups + rows - 1u) / rows, rows, 1u);
+    return uvec4((groups + rows - 1u) / rows, rows, 1u, 0u);
 }
+
+// This work group's index in a dispatch of rows (x first).
+uint linearGroup() { return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x; }
 
 // the threads that split a dispatch's work groups in contiguous shares (PixelGrid::threads)
 uniform int listThreads;
@@ -29,8 +33,7 @@ uniform int listThreads;
 // share takes entries from the whole list. A one-to-one map of [0, n): any GPU is served.
 uint listGroup()
 {
-    uint n = gl_NumWorkGroups.x * gl_NumWorkGroups.y;
-    uint i = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    uint n = gl_NumWorkGroups.x * gl_NumWorkGroups.y, i = linearGroup();
     uint threads = uint(max(listThreads, 1)), q = n / threads;
     return i < threads * q ? (i % threads) * q + i / threads : i;
 }

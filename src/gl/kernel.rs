@@ -247,8 +247,6 @@ impl Kernel {
         sync::barrier(gl);
     }
 
-    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, between
-    /// two barriers ([`sync`]).
     /// Dispatch the work groups of the indirect command at byte `offset` of `commands`
     /// (`glDispatchComputeIndirect`), which an earlier kernel wrote, between the two barriers.
     pub fn dispatch_indirect(&self, timers: &mut GpuTimers, commands: glow::Buffer, offset: i32) {
@@ -264,6 +262,8 @@ impl Kernel {
         sync::barrier(gl);
     }
 
+    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, between
+    /// two barriers ([`sync`]).
     pub fn dispatch_1d(&self, timers: &mut GpuTimers, groups: u32) {
         let gl = &self.gl;
         sync::barrier(gl);

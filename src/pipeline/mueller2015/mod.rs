@@ -545,8 +545,7 @@ impl RayTracer {
         let clears = eye && self.accel.fused_misses_apart();
         if clears {
             let (final_color, bg) = (&self.images.final_color, l.background);
-            let mut kinds = vec![Record::Packed(0)];
-            kinds.extend(feelers.iter().map(|(_, r)| *r));
+            let kinds: Vec<Record> = feelers.iter().map(|(_, r)| *r).collect();
             f.timers.time(f.gl, "fused_miss", || {
                 final_color.fill_f32(f.gl, [bg[0], bg[1], bg[2], 1.0]);
                 r.fill_misses(f.gl, &kinds);

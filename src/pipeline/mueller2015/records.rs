@@ -201,29 +201,25 @@ impl Records {
     }
 
     /// The fused pass' first pass without its miss kernel (ours; `RayTracer::fused_pass`):
-    /// every pixel's `records` set to what that kernel stores for an eye ray that misses —
-    /// record 0 a ray traced that visited nothing (its first light's counts, packed beside,
-    /// none), the unpacked feeler records nothing — before the hit blocks' kernel overwrites
-    /// its own pixels'.
-    pub fn fill_misses(&self, gl: &Gl, records: &[Record]) {
+    /// every pixel's records set to what that kernel stores for an eye ray that misses —
+    /// record 0 a ray traced that visited nothing (a first point light's counts, packed beside
+    /// in words 2–3, none), the unpacked feeler records among `feelers` nothing — before the
+    /// hit blocks' kernel overwrites its own pixels'.
+    pub fn fill_misses(&self, gl: &Gl, feelers: &[Record]) {
         let bytes = std::mem::size_of::<PixelRecord>() * self.pixels as usize;
         let traced = PixelRecord {
-            tests_truncated: 0,
             nodes_traced: 1 << 31,
-            hit: 0,
-            unused: 0,
+            ..PixelRecord::zeroed()
         };
-        let mut filled = Vec::new();
-        for r in records {
-            let (index, value) = match *r {
-                Record::Packed(i) | Record::PackedHigh(i) => (i, traced),
-                Record::Plain(i) => (i, PixelRecord::zeroed()),
-            };
-            if !filled.contains(&index) {
-                let value = bytemuck::cast(value);
-                let offset = index as usize * bytes;
-                self.records.fill_range_u32x4(gl, offset, bytes, value);
-                filled.push(index);
+        let fill = |index: u32, value: PixelRecord| {
+            let offset = index as usize * bytes;
+            self.records
+                .fill_range_u32x4(gl, offset, bytes, bytemuck::cast(value));
+        };
+        fill(0, traced);
+        for r in feelers {
+            if let Record::Plain(i) = *r {
+                fill(i, PixelRecord::zeroed());
             }
         }
     }
