@@ -1,9 +1,10 @@
 // One pass of Müller 2015's Fig. 8 loop in one kernel, for the SAH BVH (ours; the documented
 // variant `--fused-passes`, docs/listings.md): per pixel the closest hit (intersect1, the SAH
 // BVH's walk of bvh/intersect1.comp), its evaluation (Listings 13 and 14:
-// common/intersect1_hit.glsl's hitTexels, from the hit record as bvh/evaluate_hit.comp finds
-// it), a shadow feeler towards every light and light sample (Listing 15:
-// common/feeler.glsl, the walk of bvh/intersect2.comp) and the shading (Listing 16:
+// common/intersect1_hit.glsl's hitTexels, with the t, u and v the walk's test of the closest
+// triangle found — bvh/evaluate_hit.comp finds the same again from the hit record), a shadow
+// feeler towards every light and light sample (Listing 15: common/feeler.glsl, the walk of
+// bvh/intersect2.comp) and the shading (Listing 16:
 // mueller2015/shade.glsl) — the same functions on the same values as the four kernels, so the
 // same image and counts. What it saves is the traffic between them: the four-kernel pass
 // stores the hit's four ray-state texels, loads them again in every intersect2 dispatch and in
@@ -76,6 +77,8 @@ float rayLight = 0.0;
 float bestT = 0.0;
 int bestID = -1;
 int bestAt = -1;
+// the closest hit's barycentrics, as its test found them (ours: kept for the hit's evaluation)
+float bestU = 0.0, bestV = 0.0;
 
 bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float limit)
 {
@@ -88,6 +91,8 @@ bool triangleHit(int at, int tri, vec3 v0, vec3 edge1, vec3 edge2, inout float l
         bestT = t;
         bestID = tri;
         bestAt = at;
+        bestU = u;
+        bestV = v;
     }
     limit = bestT;
     return false;
@@ -193,9 +198,12 @@ void trace(ivec2 storePos)
 #endif
         primary = takeCounts();
 
-        float t, u, v;
-        int id;
+        float t = bestT, u = bestU, v = bestV;
+        int id = bestID;
+#if BVH_INSTANCES
+        // the hit's instance sets the normal matrix (t, u and v come out as the walk's)
         hitFromRecord(closestHitRecord, ro, rd, t, id, u, v);
+#endif
         storeFirstHit(storePos, t, id, u, v);
         vec4 hitPoint, dirOut, normal, colorWeight, mat;
         hitTexels(ro, rd, rayState, t, id, u, v, hitPoint, dirOut, normal, colorWeight, mat);

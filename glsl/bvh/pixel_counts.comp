@@ -1,9 +1,9 @@
 // The per-pixel work counts of an intersection dispatch added to the 64-bit counters (ours;
 // bvh/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
-// counts — (ray–triangle tests, BVH nodes visited, loops cut short, rays traced) — and adds the
-// sums to the counter slots `countSlots` through common/counters.glsl (one global atomic per
-// work group and counter). A pixel's counts are below 2^32 / PIXELS_PER_INVOCATION, so the
-// sums fit: a ray visits each node and tests each leaf triangle at most once, and the host refuses
+// counts (or an 8×8 block's: blockListed, below) — (ray–triangle tests, BVH nodes visited,
+// loops cut short, rays traced) — and adds the sums to the counter slots `countSlots` through
+// common/counters.glsl (one global atomic per work group and counter). A pixel's counts are
+// below 2^32 / 64, so the sums fit: a ray visits each node and tests each leaf triangle at most once, and the host refuses
 // a structure with more of them (MAX_PIXEL_EVENTS in src/accel/mod.rs).
 // PIXELS_PER_INVOCATION and COUNT_GROUP: #defines of the host (src/pipeline/mueller2015/records.rs)
 layout(local_size_x = COUNT_GROUP) in;
@@ -49,15 +49,53 @@ uvec4 recordCounts(int k)
 uniform int hitListed;
 #include "hit_list.glsl"
 
+// Ours: with blockListed the records of a fused pass over the block lists (bvh/block_lists.glsl,
+// bound by the accelerator for the pass; a list's blocks as bvh/fused_pass.comp takes them), an
+// invocation per 8×8 block of the image: list 0's blocks (those whose rays may hit) and then
+// list 1's, each block's pixels' records summed. With missesCleared (the first pass, whose
+// miss blocks the host's clears stand for: RayTracer::fused_pass) list 1's records are not
+// read, as no kernel wrote them: every pixel of such a block traced its eye ray, which visited
+// nothing (record 0's closest-hit counts: one ray each), and no feeler (every other record).
+// Why: the miss blocks are most of an image the object fills a part of, and the records they
+// would read (and the fill they would need) cost as much as the hit blocks' (docs/design/frame.md).
+uniform int blockListed;
+uniform int missesCleared;
+#include "block_lists.glsl"
+
+// The counts of the block at list position i (of both lists' BVH_ENTRY_TEXELS, list 0 first).
+uvec4 blockCounts(uint i)
+{
+    uint hitBlocks = blockListCount(0u);
+    uint list = i < hitBlocks ? 0u : 1u;
+    uint b = blockWords[blockListWord(list, i - list * hitBlocks)];
+    ivec2 origin = ivec2(b % uint(BVH_BLOCKS_X), b / uint(BVH_BLOCKS_X)) * 8;
+    ivec2 size = min(ivec2(IMAGE_WIDTH, IMAGE_HEIGHT) - origin, ivec2(8));
+    uvec4 sum = uvec4(0u);
+    if (list == 1u && missesCleared != 0) {
+        bool closestHit = recordBase == 0 && plainRecords == 0 && packedHigh == 0;
+        sum.w = closestHit ? uint(size.x * size.y) : 0u; // (tests, nodes, truncated, traced)
+    } else {
+        for (int y = 0; y < size.y; y++) {
+            int row = (origin.y + y) * IMAGE_WIDTH + origin.x;
+            for (int x = 0; x < size.x; x++) sum += recordCounts(row + x);
+        }
+    }
+    return sum;
+}
+
 void main()
 {
     countersBegin();
     uvec4 sum = uvec4(0u);
     uint invocation = linearGroup() * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
-    int first = int(invocation) * PIXELS_PER_INVOCATION;
-    int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
-    int end = min(first + PIXELS_PER_INVOCATION, records);
-    for (int k = first; k < end; k++) sum += recordCounts(k);
+    if (blockListed != 0) {
+        if (invocation < uint(BVH_ENTRY_TEXELS)) sum = blockCounts(invocation);
+    } else {
+        int first = int(invocation) * PIXELS_PER_INVOCATION;
+        int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
+        int end = min(first + PIXELS_PER_INVOCATION, records);
+        for (int k = first; k < end; k++) sum += recordCounts(k);
+    }
     for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
     for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);
 }

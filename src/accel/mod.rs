@@ -44,9 +44,16 @@ use crate::scene::{CameraRays, Scene};
 /// a #define of `pipeline::mueller2015::records`), for the accelerators whose kernels store
 /// per-pixel counts ([`Accelerator::records`]).
 pub const PIXELS_PER_INVOCATION: u32 = 16;
+/// The most pixels one invocation of `pixel_counts.comp` sums: [`PIXELS_PER_INVOCATION`], or
+/// over the fused pass' block lists an 8×8 block's.
+const PIXELS_PER_SUM: u32 = if PIXELS_PER_INVOCATION > 64 {
+    PIXELS_PER_INVOCATION
+} else {
+    64
+};
 /// The most events one pixel's walk may count (node visits, triangle tests) so that those sums
 /// fit in 32 bits: such an accelerator checks its structure against it.
-pub const MAX_PIXEL_EVENTS: u64 = (1 << 32) / PIXELS_PER_INVOCATION as u64 - 1;
+pub const MAX_PIXEL_EVENTS: u64 = (1 << 32) / PIXELS_PER_SUM as u64 - 1;
 
 /// The GPU side of an accelerator.
 pub trait Accelerator {

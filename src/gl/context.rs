@@ -311,8 +311,6 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
 const QUERY_COUNTER_BITS: u32 = 0x8864;
 
 type ClearBufferDataFn = unsafe extern "system" fn(u32, u32, u32, u32, *const c_void);
-type ClearBufferSubDataFn =
-    unsafe extern "system" fn(u32, u32, isize, isize, u32, u32, *const c_void);
 type ClearTexImageFn = unsafe extern "system" fn(u32, i32, u32, u32, *const c_void);
 type GetQueryIvFn = unsafe extern "system" fn(u32, u32, *mut i32);
 type GetQueryObjectU64Fn = unsafe extern "system" fn(u32, u32, *mut u64);
@@ -320,11 +318,10 @@ type TexBufferFn = unsafe extern "system" fn(u32, u32, u32);
 
 /// The GL functions: glow's, plus the few GL 4.4/4.5 entry points glow does not wrap
 /// (`glClearBufferData` — the thesis clears its grid lists with it every frame —,
-/// `glClearBufferSubData`, `glClearTexImage` and `glGetQueryiv`).
+/// `glClearTexImage` and `glGetQueryiv`).
 pub struct Gl {
     glow: glow::Context,
     clear_buffer_data: ClearBufferDataFn,
-    clear_buffer_sub_data: ClearBufferSubDataFn,
     clear_tex_image: ClearTexImageFn,
     get_query_iv: GetQueryIvFn,
     get_query_object_u64: GetQueryObjectU64Fn,
@@ -396,7 +393,6 @@ impl Gl {
             }
         };
         let clear_buffer_data = get("glClearBufferData")?;
-        let clear_buffer_sub_data = get("glClearBufferSubData")?;
         let clear_tex_image = get("glClearTexImage")?;
         let get_query_iv = get("glGetQueryiv")?;
         let get_query_object_u64 = get("glGetQueryObjectui64v")?;
@@ -406,9 +402,6 @@ impl Gl {
             // SAFETY: the pointers are the named GL entry points with these signatures.
             clear_buffer_data: std::mem::transmute::<*const c_void, ClearBufferDataFn>(
                 clear_buffer_data,
-            ),
-            clear_buffer_sub_data: std::mem::transmute::<*const c_void, ClearBufferSubDataFn>(
-                clear_buffer_sub_data,
             ),
             clear_tex_image: std::mem::transmute::<*const c_void, ClearTexImageFn>(clear_tex_image),
             get_query_iv: std::mem::transmute::<*const c_void, GetQueryIvFn>(get_query_iv),
@@ -430,30 +423,6 @@ impl Gl {
                 glow::RED_INTEGER,
                 glow::UNSIGNED_INT,
                 &value as *const u32 as *const c_void,
-            )
-        }
-    }
-
-    /// `glClearBufferSubData(target, GL_RGBA32UI, offset, size, GL_RGBA_INTEGER,
-    /// GL_UNSIGNED_INT, &value)` on the buffer bound to `target`: every 16 bytes of the range
-    /// (offset and size multiples of 16) become `value`.
-    pub fn clear_buffer_range_u32x4(
-        &self,
-        target: u32,
-        offset: usize,
-        size: usize,
-        value: [u32; 4],
-    ) {
-        // SAFETY: value outlives the call; the format describes four u32.
-        unsafe {
-            (self.clear_buffer_sub_data)(
-                target,
-                glow::RGBA32UI,
-                offset as isize,
-                size as isize,
-                glow::RGBA_INTEGER,
-                glow::UNSIGNED_INT,
-                value.as_ptr() as *const c_void,
             )
         }
     }

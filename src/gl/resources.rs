@@ -206,20 +206,6 @@ impl Ssbo {
         unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None) };
     }
 
-    /// `bytes` bytes from `offset` on (both multiples of 16) filled with `value`
-    /// (`glClearBufferSubData`).
-    pub fn fill_range_u32x4(&self, gl: &Gl, offset: usize, bytes: usize, value: [u32; 4]) {
-        assert!(
-            offset + bytes <= self.bytes,
-            "{}: fill past the end",
-            self.name
-        );
-        // SAFETY: binding an existing buffer.
-        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, Some(self.buffer.raw())) };
-        gl.clear_buffer_range_u32x4(glow::SHADER_STORAGE_BUFFER, offset, bytes, value);
-        unsafe { gl.bind_buffer(glow::SHADER_STORAGE_BUFFER, None) };
-    }
-
     pub fn read_u32(&self, gl: &Gl) -> Vec<u32> {
         let mut bytes = vec![0u8; self.bytes];
         self.read_bytes(gl, &mut bytes);

@@ -90,6 +90,12 @@ pub fn texel_index_mask() -> (&'static str, String) {
     )
 }
 
+/// The 8×8 blocks of a `width` × `height` image, columns and rows: each has an entry point
+/// (`glsl/bvh/entry.comp`) and, with the fused pass' block lists, a place in one of them.
+pub fn image_blocks(width: u32, height: u32) -> (u32, u32) {
+    (width.div_ceil(BLOCK), height.div_ceil(BLOCK))
+}
+
 /// The kernels' #defines: the word buffer's record sizes ([`HEADER_WORDS`], [`NODE_WORDS`],
 /// [`TRIANGLE_WORDS`]), leaf references ([`LEAF_COUNT_BITS`]), texel indices
 /// ([`TEXEL_INDEX_BITS`]) and its last texels, the entries of the image's blocks (columns ×
@@ -307,7 +313,7 @@ pub struct Bvh {
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.max_image_units)?;
-        let blocks = (b.width.div_ceil(BLOCK), b.height.div_ceil(BLOCK));
+        let blocks = image_blocks(b.width, b.height);
         // the fused pass over block lists: with one tree (an instance's empty entry leaves the
         // block's other instances to walk)
         let lists = b.fused.is_some() && !b.bvh_instances;

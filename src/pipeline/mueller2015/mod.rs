@@ -537,26 +537,31 @@ impl RayTracer {
         // (and the clears stand for the miss kernel)
         self.counters.bind(f.gl, f.timers, Bank::Frame);
         // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
-        // miss the tree (the accelerator's miss list) ends as the clears leave it: the output
+        // miss the tree (the accelerator's miss list) ends as a clear leaves it: the output
         // colour the background at full weight (Listing 16's addToFinal on a miss: every such
-        // pixel's), its record a ray traced that visited nothing; where no AOVs keep the first
-        // hits (eye rays in place) and no texel of the ray state needs storing — the frame's
-        // clear left them inactive (docs/design/frame.md, "The fused pass")
-        let clears = eye && self.accel.fused_misses_apart();
+        // pixel's), its counts one ray traced that visited nothing a pixel, which pixel_counts
+        // adds without a record; where no AOVs keep the first hits (eye rays in place) and no
+        // texel of the ray state needs storing — the frame's clear left them inactive
+        // (docs/design/frame.md, "The fused pass")
+        let lists = self.accel.fused_misses_apart();
+        let clears = eye && lists;
         if clears {
             let (final_color, bg) = (&self.images.final_color, l.background);
-            let kinds: Vec<Record> = feelers.iter().map(|(_, r)| *r).collect();
             f.timers.time(f.gl, "fused_miss", || {
-                final_color.fill_f32(f.gl, [bg[0], bg[1], bg[2], 1.0]);
-                r.fill_misses(f.gl, &kinds);
+                final_color.fill_f32(f.gl, [bg[0], bg[1], bg[2], 1.0])
             });
         }
         self.accel.dispatch_fused(&mut f, !clears);
-        self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
-        r.add_record_counts(f.timers, "intersect1", Record::Packed(0));
-        for (bank, record) in feelers {
+        let kinds = [(Bank::closest_hit(pass), "intersect1", Record::Packed(0))].into_iter();
+        let feelers = feelers.into_iter().map(|(b, r)| (b, "intersect2", r));
+        for (bank, tests, record) in kinds.chain(feelers) {
             self.counters.bind(&self.gl, &mut self.timers, bank);
-            r.add_record_counts(&mut self.timers, "intersect2", record);
+            match lists {
+                // the records over the block lists: only the hit blocks' where the clears
+                // stood for the miss kernel
+                true => r.add_block_counts(&mut self.timers, tests, record, clears),
+                false => r.add_record_counts(&mut self.timers, tests, record),
+            }
         }
         self.counters.bind(&self.gl, &mut self.timers, Bank::Frame);
     }

@@ -67,6 +67,8 @@ pub struct Records {
     /// GL has the unit ([`Ssbo::texel_view`])
     view: Option<Owned<glow::Texture>>,
     pixels: u32,
+    /// the image's 8×8 blocks (the fused pass' block lists hold each once)
+    blocks: u32,
 }
 
 /// Words before the hit list's entries: two dispatch commands and the count
@@ -124,6 +126,8 @@ impl Records {
             glow::RGBA32UI,
         )?;
         let (mask, mask_value) = crate::accel::bvh::texel_index_mask();
+        // the fused pass' block lists, which pixel_counts may sum over (blockListed)
+        let blocks = crate::accel::bvh::image_blocks(w, h);
         let defines = defines
             .clone()
             .set("PIXELS_PER_INVOCATION", PIXELS_PER_INVOCATION)
@@ -136,7 +140,9 @@ impl Records {
             .set("HIT_LIST_BALLOT", info.ballot as i32)
             .set(mask, mask_value)
             // evaluate_hit's hit records of two levels (glsl/bvh/words.glsl's instanceRay)
-            .set("BVH_INSTANCE_TEXELS", crate::accel::bvh::INSTANCE_TEXELS);
+            .set("BVH_INSTANCE_TEXELS", crate::accel::bvh::INSTANCE_TEXELS)
+            .set("BVH_BLOCKS_X", blocks.0)
+            .set("BVH_ENTRY_TEXELS", blocks.0 * blocks.1);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
         let list_bytes = 4 * (HIT_LIST_HEADER_WORDS + (w as usize) * (h as usize));
         Ok(Records {
@@ -150,6 +156,7 @@ impl Records {
             },
             view,
             pixels: w * h,
+            blocks: blocks.0 * blocks.1,
         })
     }
 
@@ -200,30 +207,6 @@ impl Records {
         bytemuck::pod_read_unaligned(&words[4 * HitList::FRAME_ENTRIES..])
     }
 
-    /// The fused pass' first pass without its miss kernel (ours; `RayTracer::fused_pass`):
-    /// every pixel's records set to what that kernel stores for an eye ray that misses —
-    /// record 0 a ray traced that visited nothing (a first point light's counts, packed beside
-    /// in words 2–3, none), the unpacked feeler records among `feelers` nothing — before the
-    /// hit blocks' kernel overwrites its own pixels'.
-    pub fn fill_misses(&self, gl: &Gl, feelers: &[Record]) {
-        let bytes = std::mem::size_of::<PixelRecord>() * self.pixels as usize;
-        let traced = PixelRecord {
-            nodes_traced: 1 << 31,
-            ..PixelRecord::zeroed()
-        };
-        let fill = |index: u32, value: PixelRecord| {
-            let offset = index as usize * bytes;
-            self.records
-                .fill_range_u32x4(gl, offset, bytes, bytemuck::cast(value));
-        };
-        fill(0, traced);
-        for r in feelers {
-            if let Record::Plain(i) = *r {
-                fill(i, PixelRecord::zeroed());
-            }
-        }
-    }
-
     /// After an intersection dispatch whose triangle tests count under `tests`: add every
     /// pixel's counts to the bound bank.
     pub fn add_counts(&self, timers: &mut GpuTimers, tests: &str) {
@@ -241,6 +224,26 @@ impl Records {
         );
     }
 
+    /// The fused pass' `record` added to the bound bank over its block lists (`blockListed` in
+    /// `glsl/bvh/pixel_counts.comp`; the accelerator's lists bound), the triangle tests under
+    /// `tests`: the hit blocks' pixels' records, and the miss blocks' — or, where
+    /// `misses_cleared` (the first pass' clears stood for the miss kernel, which wrote no
+    /// record), for each miss-block pixel an eye ray traced that visited nothing in record 0,
+    /// nothing in the others.
+    pub fn add_block_counts(
+        &self,
+        timers: &mut GpuTimers,
+        tests: &str,
+        record: Record,
+        misses_cleared: bool,
+    ) {
+        let k = self.counts_program(record, false);
+        k.set_i32("blockListed", 1);
+        k.set_i32("missesCleared", misses_cleared as i32);
+        k.set_ivec4("countSlots", count_slots(tests));
+        k.dispatch_1d(timers, self.blocks.div_ceil(COUNT_GROUP));
+    }
+
     /// `pixel_counts` in use, set to sum `record` of every pixel or, with `listed`, the hit
     /// list's records (`glsl/bvh/pixel_counts.comp`).
     fn counts_program(&self, record: Record, listed: bool) -> &Kernel {
@@ -255,6 +258,7 @@ impl Records {
         k.set_i32("plainRecords", plain as i32);
         k.set_i32("packedHigh", high as i32);
         k.set_i32("hitListed", listed as i32);
+        k.set_i32("blockListed", 0);
         k
     }
 }
