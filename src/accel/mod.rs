@@ -82,8 +82,8 @@ pub trait Accelerator {
     /// kernels as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
     /// bind) and return them — one, or the SAH BVH's two over its block lists — for the
     /// pipeline to set the pass' uniforms on each; `None` for a design without one. `eye`: the
-    /// camera where the pass computes its eye rays in place (`eyeRays`,
-    /// `glsl/common/pass_ray.glsl`) instead of loading the eye-ray kernel's texels.
+    /// camera where the pass computes its eye rays in place (the kernels' `PASS_EYE_RAYS`
+    /// variant, `glsl/common/pass_ray.glsl`) instead of loading the eye-ray kernel's texels.
     fn fused_pass(
         &mut self,
         _f: &mut FrameContext,
@@ -111,15 +111,6 @@ pub fn set_camera(k: &Kernel, cam: &CameraRays) {
     k.set_vec4("camImgOffset", cam.cam_img_offset.into(), 0.0);
     k.set_vec4("camWidth", cam.cam_width.into(), 0.0);
     k.set_vec4("camHeight", cam.cam_height.into(), 0.0);
-}
-
-/// Whether `k` (the program in use, with `glsl/common/pass_ray.glsl`) computes the eye rays in
-/// place — with `eye`'s camera — or loads the pass' rays from the ray-state images.
-pub fn set_pass_rays(k: &Kernel, eye: Option<&CameraRays>) {
-    k.set_i32("eyeRays", eye.is_some() as i32);
-    if let Some(cam) = eye {
-        set_camera(k, cam);
-    }
 }
 
 /// What the shadow feelers of one intersect2 dispatch aim at (`glsl/common/light_target.glsl`).
@@ -212,6 +203,18 @@ pub struct FusedPasses {
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,
+    /// Which passes' rays the kernels take (`PASS_EYE_RAYS`, `glsl/common/pass_ray.glsl`):
+    /// eye rays computed in place (the first pass, where no AOVs keep the rays), and the
+    /// ray-state images (a first pass with AOVs, or reflection passes). Each is a variant of
+    /// the kernels of its own, compiled only where some pass needs it.
+    pub rays: PassRays,
+}
+
+/// The kind of rays the passes of a frame take (see [`FusedPasses::rays`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PassRays {
+    pub eye_in_place: bool,
+    pub loaded: bool,
 }
 
 impl BuildContext<'_> {

@@ -19,7 +19,7 @@ use glow::HasContext;
 use serde_json::json;
 
 use super::{
-    set_pass_rays, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions,
+    set_camera, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions,
     LightTarget, TracerKind, MAX_PIXEL_EVENTS,
 };
 use crate::frame::FrameStats;
@@ -148,16 +148,21 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
 /// (`pipeline::mueller2015::records`). With block lists (`lists`: one tree) two kernels, a
 /// work group per block: the blocks whose rays may hit (`fused_pass`) and those
 /// whose rays all miss (`FUSED_MISS`, timed as `fused_miss`; `glsl/bvh/block_lists.glsl`).
+/// `eye`: the variant that computes the eye rays in place (`PASS_EYE_RAYS`).
 fn fused_kernels(
     b: &BuildContext,
     defs: &[(&'static str, String)],
     f: FusedPasses,
     lists: bool,
+    eye: bool,
 ) -> Result<Vec<Kernel>> {
-    let lists_define = [("BVH_BLOCK_LISTS", (lists as i32).to_string())];
+    let variant = [
+        ("BVH_BLOCK_LISTS", (lists as i32).to_string()),
+        ("PASS_EYE_RAYS", (eye as i32).to_string()),
+    ];
     let kernel = |miss: bool, timer| {
         let miss = [("FUSED_MISS", (miss as i32).to_string())];
-        fused_kernel(b, &[defs, &lists_define[..], &miss[..]].concat(), f, timer)
+        fused_kernel(b, &[defs, &variant[..], &miss[..]].concat(), f, timer)
     };
     match lists {
         true => Ok(vec![
@@ -171,10 +176,32 @@ fn fused_kernels(
 /// `--fused-passes` (`glsl/bvh/fused_pass.comp`): the pass in one kernel, or with one tree in
 /// two over the block lists (the blocks that may hit, those that cannot); no kernel without.
 struct Fused {
-    kernels: Vec<Kernel>,
+    /// the kernels of the passes whose rays are in the ray-state images, and of the first pass
+    /// computing its eye rays in place (`PASS_EYE_RAYS`): each compiled only where some pass
+    /// takes it ([`FusedPasses::rays`]; empty without `--fused-passes`)
+    loaded: Vec<Kernel>,
+    eye: Vec<Kernel>,
+    /// the entry pass of the first pass computing its eye rays in place (where one does; the
+    /// other passes' is [`Bvh::entry`])
+    eye_entry: Option<Kernel>,
+    /// whether the pass [`Accelerator::fused_pass`] prepared last computes its eye rays in place
+    in_place: bool,
     lists: Option<BlockLists>,
     /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
     walks_per_record: u64,
+}
+
+impl Fused {
+    /// The kernels of the pass [`Accelerator::fused_pass`] prepared last.
+    fn pass_kernels(&self) -> &[Kernel] {
+        let kernels = if self.in_place {
+            &self.eye
+        } else {
+            &self.loaded
+        };
+        assert!(!kernels.is_empty(), "no fused kernels for this pass' rays");
+        kernels
+    }
 }
 
 /// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): the image's blocks that may hit
@@ -322,22 +349,36 @@ impl Bvh {
             ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
             ("BVH_BLOCK_LISTS", (lists as i32).to_string()),
         ];
+        // timed as a part of intersect1: the closest-hit search of the passes
+        let entry = |eye: bool| {
+            let pass = [("PASS_EYE_RAYS", (eye as i32).to_string())];
+            b.kernel(
+                "bvh/entry.comp",
+                &[&defs[..], &entry_defs[..], &pass[..]].concat(),
+                "intersect1",
+            )
+        };
+        let rays = b.fused.map(|f| f.rays);
+        let fused = |eye: bool| match b.fused {
+            Some(f) if (eye && f.rays.eye_in_place) || (!eye && f.rays.loaded) => {
+                fused_kernels(b, &defs, f, lists, eye)
+            }
+            _ => Ok(Vec::new()),
+        };
         Ok(Box::new(Bvh {
             gl: b.gl.clone(),
-            // timed as a part of intersect1: the closest-hit search of the passes
-            entry: b.kernel(
-                "bvh/entry.comp",
-                &[&defs[..], &entry_defs[..]].concat(),
-                "intersect1",
-            )?,
+            entry: entry(false)?,
             blocks: blocks.0 * blocks.1,
             intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
             intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
             fused: Fused {
-                kernels: match b.fused {
-                    Some(f) => fused_kernels(b, &defs, f, lists)?,
-                    None => Vec::new(),
-                },
+                loaded: fused(false)?,
+                eye: fused(true)?,
+                eye_entry: rays
+                    .is_some_and(|r| r.eye_in_place)
+                    .then(|| entry(true))
+                    .transpose()?,
+                in_place: false,
                 lists: lists
                     .then(|| BlockLists::new(b, &defs, blocks.0 * blocks.1))
                     .transpose()?,
@@ -615,27 +656,40 @@ impl Accelerator for Bvh {
     fn fused_pass(
         &mut self,
         f: &mut FrameContext,
-        pass: u32,
+        _pass: u32,
         eye: Option<&CameraRays>,
     ) -> Option<&[Kernel]> {
-        if self.fused.kernels.is_empty() {
+        if self.fused.loaded.is_empty() && self.fused.eye.is_empty() {
             return None;
         }
+        self.fused.in_place = eye.is_some();
         if let Some(lists) = &self.fused.lists {
             lists.step(f.gl, f.timers, false);
         }
-        self.entry.use_program();
-        set_pass_rays(&self.entry, eye);
-        self.closest_hit(f, pass);
+        let entry = match eye {
+            Some(_) => self.fused.eye_entry.as_ref(),
+            None => Some(&self.entry),
+        };
+        let entry = entry.expect("the entry pass of the rays the frame's passes take");
+        self.bind(f.gl, glow::READ_WRITE);
+        entry.use_program();
+        if let Some(cam) = eye {
+            set_camera(entry, cam);
+        }
+        entry.dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+        self.bind(f.gl, glow::READ_ONLY);
         if let Some(lists) = &self.fused.lists {
             // the lists' dispatch commands from what the entry pass counted
             lists.step(f.gl, f.timers, true);
         }
-        for k in &self.fused.kernels {
+        let kernels = self.fused.pass_kernels();
+        for k in kernels {
             k.use_program();
-            set_pass_rays(k, eye);
+            if let Some(cam) = eye {
+                set_camera(k, cam);
+            }
         }
-        Some(&self.fused.kernels)
+        Some(kernels)
     }
 
     fn fused_misses_apart(&self) -> bool {
@@ -643,7 +697,7 @@ impl Accelerator for Bvh {
     }
 
     fn dispatch_fused(&mut self, f: &mut FrameContext, misses: bool) {
-        let kernels = &self.fused.kernels;
+        let kernels = self.fused.pass_kernels();
         match &self.fused.lists {
             Some(lists) => {
                 // the blocks that may hit, then the others: each list in one dispatch, whatever

@@ -23,7 +23,7 @@ use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
     self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, FusedPasses, GridOptions,
-    LightTarget, TracerKind,
+    LightTarget, PassRays, TracerKind,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
@@ -351,6 +351,10 @@ impl RayTracer {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
+                rays: PassRays {
+                    eye_in_place: !options.aovs,
+                    loaded: options.aovs || options.refl_depth > 0,
+                },
             }),
             scene_images: gpu_scene.vertex_images(),
             bvh_instances: options.bvh_instances,
