@@ -3,8 +3,9 @@
 // counts (or an 8×8 block's: blockListed, below) — (ray–triangle tests, BVH nodes visited,
 // loops cut short, rays traced) — and adds the sums to the counter slots `countSlots` through
 // common/counters.glsl (one global atomic per work group and counter). A pixel's counts are
-// below 2^32 / 64, so the sums fit: a ray visits each node and tests each leaf triangle at most once, and the host refuses
-// a structure with more of them (MAX_PIXEL_EVENTS in src/accel/mod.rs).
+// below 2^32 / 64, so an invocation's sums fit: a ray visits each node and tests each leaf
+// triangle at most once, and the host refuses a structure with more of them
+// (MAX_PIXEL_EVENTS in src/accel/mod.rs).
 // PIXELS_PER_INVOCATION and COUNT_GROUP: #defines of the host (src/pipeline/mueller2015/records.rs)
 layout(local_size_x = COUNT_GROUP) in;
 
