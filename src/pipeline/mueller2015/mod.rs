@@ -350,6 +350,7 @@ impl RayTracer {
             fused: options.fused_passes.then(|| FusedPasses {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
+                point_lights: scene.lights.len() as u32,
                 first_light_point: !scene.lights.is_empty(),
                 rays: PassRays {
                     eye_in_place: !options.aovs,
@@ -526,7 +527,6 @@ impl RayTracer {
             k.set_i32("firstPass", (pass == 0) as i32);
             k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
             k.set_vec4("ambientColor", l.ambient, 1.0);
-            k.set_i32("lightCount", l.lights.len() as i32);
             k.set_vec4_slice("areaLight", &l.area_uniform());
         }
         let r = self
