@@ -43,10 +43,10 @@
 
 uniform vec4 camPosition;
 uniform vec4 ambientColor;
-// the point lights (POINT_LIGHTS: a #define of the host, as AREA_LIGHTS; ours: as a uniform,
-// llvmpipe kept the light loops around the feelers' walk as loops, their lane masks and
-// passes under an empty mask included — 0.93–0.94 of the JIT instructions of a frame with one
-// light, docs/design/frame.md)
+// the point lights (POINT_LIGHTS: a #define of the pipeline, as AREA_LIGHTS; ours: as a
+// uniform, llvmpipe kept the light loops around the feelers' walk as loops, their lane masks
+// and passes under an empty mask included — 0.93–0.94 of the JIT instructions of a frame with
+// one light, docs/design/frame.md)
 const int lightCount = POINT_LIGHTS;
 #if AREA_LIGHTS > 0 && !SHADOW_BITS
 #error "area lights need the bitwise shadow flags (a bit per light sample)"

@@ -2,8 +2,8 @@
 // shading.comp (ours, after Klee 2016) — as functions of the values shading.comp loads from
 // the ray-state textures, so that the SAH BVH's fused pass (bvh/fused_pass.comp, ours) lights
 // a hit with the same code from the values it holds in registers. The including kernel
-// declares the uniforms camPosition, ambientColor, lightCount and (with area lights)
-// areaLight, and pointLightPos / pointLightColor.
+// declares the uniforms camPosition, ambientColor and (with area lights) areaLight, the
+// point-light count lightCount, and pointLightPos / pointLightColor.
 
 // The Phong terms of Listing 16's loop for a light from direction L.
 vec3 phong(vec3 n, vec3 L, vec3 view, vec4 mat, vec3 albedo)

@@ -16,7 +16,10 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 uniform vec4 camPosition;
 uniform vec4 ambientColor;
-uniform int lightCount;
+// the point lights (POINT_LIGHTS: a #define of the pipeline; ours: Listing 16 loops over a
+// uniform count, which llvmpipe kept as a loop with its lane masks — as a constant it unrolls,
+// docs/design/frame.md)
+const int lightCount = POINT_LIGHTS;
 #if AREA_LIGHTS > 0 && !SHADOW_BITS
 #error "area lights need the bitwise shadow flags (a bit per light sample)"
 #endif

@@ -200,8 +200,6 @@ pub struct FusedPasses {
     /// The lights (point and area lights): their feelers count under the first light's kind
     /// and, past the first, the other lights' (`pipeline::ray_kinds::Bank::occluded`).
     pub lights: u32,
-    /// The point lights (the fused kernel's `POINT_LIGHTS`).
-    pub point_lights: u32,
     /// Whether the first light is a point light (one feeler a hit: its counts packed beside
     /// the closest hit's).
     pub first_light_point: bool,

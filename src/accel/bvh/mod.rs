@@ -243,7 +243,6 @@ fn fused_kernel(
     let extra = [
         ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
         ("RECORD_FIRST_LIGHT", "1".to_string()),
-        ("POINT_LIGHTS", f.point_lights.to_string()),
         (
             "RECORD_OTHER_LIGHTS",
             if f.lights > 1 { "2" } else { "0" }.to_string(),

@@ -140,6 +140,9 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         .set("SAMPLES_U", options.light_samples.0)
         .set("SAMPLES_V", options.light_samples.1)
         .set("AREA_LIGHTS", scene.area_lights.len())
+        // and the point lights (shading.comp, the fused pass): a constant, so that llvmpipe
+        // unrolls the light loops (docs/design/frame.md)
+        .set("POINT_LIGHTS", scene.lights.len())
         .set("BVH_INSTANCES", options.bvh_instances as i32)
         // and how many instances it has: one per object with triangles (accel::bvh::instances)
         .set(
@@ -350,7 +353,6 @@ impl RayTracer {
             fused: options.fused_passes.then(|| FusedPasses {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
-                point_lights: scene.lights.len() as u32,
                 first_light_point: !scene.lights.is_empty(),
                 rays: PassRays {
                     eye_in_place: !options.aovs,
@@ -472,7 +474,6 @@ impl RayTracer {
         k.use_program();
         k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
         k.set_vec4("ambientColor", self.lighting.ambient, 1.0);
-        k.set_i32("lightCount", self.lighting.lights.len() as i32);
         k.set_vec4_slice("areaLight", &self.lighting.area_uniform());
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
