@@ -280,8 +280,8 @@ fn the_work_lists_take_rows_where_the_gl_allows_few_work_groups() {
 #[test]
 fn the_first_pass_leaves_its_miss_blocks_to_clears() {
     // without AOVs the first pass does not dispatch the blocks whose eye rays all miss: their
-    // output colour is filled with the background and their records with a ray traced that
-    // visited nothing (RayTracer::fused_pass), and the frame clears only the ray origins, where a
+    // output colour is filled with the background and pixel_counts counts each pixel a ray
+    // traced that visited nothing (RayTracer::fused_pass), and the frame clears only the ray origins, where a
     // reflection pass reads them (RayTracer::clear_images) — the same colours and counts in
     // every record layout: one point light (packed beside the closest hit), three (the other
     // lights' record), an area light as the first light (a record of its own), with and
@@ -291,18 +291,25 @@ fn the_first_pass_leaves_its_miss_blocks_to_clears() {
     ring_of_lights(&mut teapot, 3);
     let mut area = load("cow_area.toml");
     area.lights.clear();
+    // (61 × 45: blocks at the right and bottom edges only partly inside the image)
     let cases = [
-        (load("bunny.toml"), 0, "bunny"),
-        (load("bunny_low.toml"), 2, "bunny_low, 2 reflections"),
-        (teapot, 1, "teapot1, 3 lights"),
-        (area, 1, "cow_area, its area light alone"),
+        (load("bunny.toml"), 0, (64, 48), "bunny"),
+        (load("bunny.toml"), 0, (61, 45), "bunny, 61 × 45"),
+        (
+            load("bunny_low.toml"),
+            2,
+            (64, 48),
+            "bunny_low, 2 reflections",
+        ),
+        (teapot, 1, (61, 45), "teapot1, 3 lights, 61 × 45"),
+        (area, 1, (64, 48), "cow_area, its area light alone"),
     ];
     let ctx = context();
-    for (scene, refl_depth, what) in cases {
+    for (scene, refl_depth, (w, h), what) in cases {
         let opts = RenderOptions {
             aovs: false,
             light_samples: (2, 2),
-            ..bvh(64, 48, refl_depth)
+            ..bvh(w, h, refl_depth)
         };
         let fused_opts = RenderOptions {
             fused_passes: true,

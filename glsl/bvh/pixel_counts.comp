@@ -1,11 +1,11 @@
 // The per-pixel work counts of an intersection dispatch added to the 64-bit counters (ours;
 // bvh/records.glsl). Each invocation sums PIXELS_PER_INVOCATION consecutive pixels'
-// counts (or an 8×8 block's: blockListed, below) — (ray–triangle tests, BVH nodes visited,
+// counts (or an 8×8 block's: BLOCK_LISTED, below) — (ray–triangle tests, BVH nodes visited,
 // loops cut short, rays traced) — and adds the sums to the counter slots `countSlots` through
 // common/counters.glsl (one global atomic per work group and counter). A pixel's counts are
-// below 2^32 / 64, so an invocation's sums fit: a ray visits each node and tests each leaf
-// triangle at most once, and the host refuses a structure with more of them
-// (MAX_PIXEL_EVENTS in src/accel/mod.rs).
+// below 2^32 over the pixels an invocation sums, so its sums fit: a ray visits each node and
+// tests each leaf triangle at most once, and the host refuses a structure with more of them
+// (max_pixel_events in src/accel/mod.rs).
 // PIXELS_PER_INVOCATION and COUNT_GROUP: #defines of the host (src/pipeline/mueller2015/records.rs)
 layout(local_size_x = COUNT_GROUP) in;
 
@@ -50,8 +50,10 @@ uvec4 recordCounts(int k)
 uniform int hitListed;
 #include "hit_list.glsl"
 
-// Ours: with blockListed the records of a fused pass over the block lists (bvh/block_lists.glsl,
-// bound by the accelerator for the pass; a list's blocks as bvh/fused_pass.comp takes them), an
+// Ours: with BLOCK_LISTED (a variant of its own, src/pipeline/mueller2015/records.rs: only it
+// declares the lists' buffer, which the accelerator binds for a fused pass over its lists; and
+// llvmpipe would run both sides of a uniform choice) the records of a fused pass over the block
+// lists (bvh/block_lists.glsl; a list's blocks as bvh/fused_pass.comp takes them), an
 // invocation per 8×8 block of the image: list 0's blocks (those whose rays may hit) and then
 // list 1's, each block's pixels' records summed. With missesCleared (the first pass, whose
 // miss blocks the host's clears stand for: RayTracer::fused_pass) list 1's records are not
@@ -59,7 +61,7 @@ uniform int hitListed;
 // nothing (record 0's closest-hit counts: one ray each), and no feeler (every other record).
 // Why: the miss blocks are most of an image the object fills a part of, and the records they
 // would read (and the fill they would need) cost as much as the hit blocks' (docs/design/frame.md).
-uniform int blockListed;
+#if BLOCK_LISTED
 uniform int missesCleared;
 #include "block_lists.glsl"
 
@@ -83,20 +85,21 @@ uvec4 blockCounts(uint i)
     }
     return sum;
 }
+#endif
 
 void main()
 {
     countersBegin();
     uvec4 sum = uvec4(0u);
     uint invocation = linearGroup() * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
-    if (blockListed != 0) {
-        if (invocation < uint(BVH_ENTRY_TEXELS)) sum = blockCounts(invocation);
-    } else {
-        int first = int(invocation) * PIXELS_PER_INVOCATION;
-        int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
-        int end = min(first + PIXELS_PER_INVOCATION, records);
-        for (int k = first; k < end; k++) sum += recordCounts(k);
-    }
+#if BLOCK_LISTED
+    if (invocation < uint(BVH_ENTRY_TEXELS)) sum = blockCounts(invocation);
+#else
+    int first = int(invocation) * PIXELS_PER_INVOCATION;
+    int records = hitListed != 0 ? int(hitCount()) : IMAGE_WIDTH * IMAGE_HEIGHT;
+    int end = min(first + PIXELS_PER_INVOCATION, records);
+    for (int k = first; k < end; k++) sum += recordCounts(k);
+#endif
     for (int c = 0; c < 4; c++) countAdd(c, sum[c]);
     for (int c = 0; c < 4; c++) countersEnd(c, countSlots[c]);
 }

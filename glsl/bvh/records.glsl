@@ -30,8 +30,9 @@ layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordWords {
 #endif
 
 // A pixel's counts in two words, as each stored component costs a loop over the 8 lanes on
-// llvmpipe: (tests | truncated << 31, nodes | traced << 31). A pixel counts fewer than 2^26 tests
-// and nodes (MAX_PIXEL_EVENTS in src/accel/mod.rs), and truncated and traced are 0 or 1.
+// llvmpipe: (tests | truncated << 31, nodes | traced << 31). A pixel counts fewer than 2^28 tests
+// and nodes (2^26 where bvh/pixel_counts.comp sums 64 pixels: max_pixel_events in
+// src/accel/mod.rs), and truncated and traced are 0 or 1.
 uvec2 packCounts(uint tests, uint nodes, uint truncated, uint traced)
 {
     return uvec2(tests | (truncated << 31), nodes | (traced << 31));

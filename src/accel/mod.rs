@@ -44,16 +44,13 @@ use crate::scene::{CameraRays, Scene};
 /// a #define of `pipeline::mueller2015::records`), for the accelerators whose kernels store
 /// per-pixel counts ([`Accelerator::records`]).
 pub const PIXELS_PER_INVOCATION: u32 = 16;
-/// The most pixels one invocation of `pixel_counts.comp` sums: [`PIXELS_PER_INVOCATION`], or
-/// over the fused pass' block lists an 8×8 block's.
-const PIXELS_PER_SUM: u32 = if PIXELS_PER_INVOCATION > 64 {
-    PIXELS_PER_INVOCATION
-} else {
-    64
-};
-/// The most events one pixel's walk may count (node visits, triangle tests) so that those sums
-/// fit in 32 bits: such an accelerator checks its structure against it.
-pub const MAX_PIXEL_EVENTS: u64 = (1 << 32) / PIXELS_PER_SUM as u64 - 1;
+/// The most events one pixel's walk may count (node visits, triangle tests) so that the sums of
+/// `pixels` pixels (one invocation of `pixel_counts.comp`: [`PIXELS_PER_INVOCATION`], or over
+/// the fused pass' block lists an 8×8 block's) fit in 32 bits: such an accelerator checks its
+/// structure against it.
+pub const fn max_pixel_events(pixels: u32) -> u64 {
+    (1 << 32) / pixels as u64 - 1
+}
 
 /// The GPU side of an accelerator.
 pub trait Accelerator {
@@ -195,7 +192,7 @@ pub struct BuildContext<'a> {
 pub struct FusedPasses {
     /// The shadow feelers of a hit: one per point light and area-light sample. A pixel's
     /// feeler records sum their counts (`glsl/bvh/pixel_counts.comp`), so the structure must
-    /// keep that many walks' events under [`MAX_PIXEL_EVENTS`].
+    /// keep that many walks' events under [`max_pixel_events`].
     pub feelers: u32,
     /// The lights (point and area lights): their feelers count under the first light's kind
     /// and, past the first, the other lights' (`pipeline::ray_kinds::Bank::occluded`).

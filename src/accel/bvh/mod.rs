@@ -19,8 +19,8 @@ use glow::HasContext;
 use serde_json::json;
 
 use super::{
-    set_camera, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, GridOptions,
-    LightTarget, TracerKind, MAX_PIXEL_EVENTS,
+    max_pixel_events, set_camera, Accelerator, BuildContext, Entry, FrameContext, FusedPasses,
+    GridOptions, LightTarget, TracerKind, PIXELS_PER_INVOCATION,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
@@ -176,10 +176,10 @@ fn fused_kernels(
 /// `--fused-passes` (`glsl/bvh/fused_pass.comp`): the pass in one kernel, or with one tree in
 /// two over the block lists (the blocks that may hit, those that cannot); no kernel without.
 struct Fused {
-    /// the kernels of the passes whose rays are in the ray-state images, and of the first pass
-    /// computing its eye rays in place (`PASS_EYE_RAYS`): each compiled only where some pass
-    /// takes it ([`FusedPasses::rays`]; empty without `--fused-passes`)
+    /// the kernels of the passes whose rays are in the ray-state images, compiled only where
+    /// some pass takes them ([`FusedPasses::rays`]; empty without `--fused-passes`)
     loaded: Vec<Kernel>,
+    /// those of the first pass computing its eye rays in place (`PASS_EYE_RAYS`), likewise
     eye: Vec<Kernel>,
     /// the entry pass of the first pass computing its eye rays in place (where one does; the
     /// other passes' is [`Bvh::entry`])
@@ -189,6 +189,9 @@ struct Fused {
     lists: Option<BlockLists>,
     /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
     walks_per_record: u64,
+    /// the most events those walks may count (`max_pixel_events`: the counts over the block
+    /// lists sum a block's 64 pixels, the others 16)
+    max_events: u64,
 }
 
 impl Fused {
@@ -224,8 +227,8 @@ impl BlockLists {
     }
 
     /// Both lists emptied for the entry pass to fill (`finish` unset), or their dispatch
-    /// commands written from what it filled (set); the buffer bound for the entry pass and
-    /// the fused kernels.
+    /// commands written from what it filled (set); the buffer bound for the entry pass, the
+    /// fused kernels and the pass' counts over the lists (`pixel_counts`' `BLOCK_LISTED`).
     fn step(&self, gl: &Gl, timers: &mut GpuTimers, finish: bool) {
         self.buffer.bind(gl, ssbo::BVH_BLOCK_LISTS);
         self.kernel.use_program();
@@ -383,6 +386,10 @@ impl Bvh {
                     .then(|| BlockLists::new(b, &defs, blocks.0 * blocks.1))
                     .transpose()?,
                 walks_per_record: b.fused.map_or(1, |f| f.feelers.max(1)) as u64,
+                max_events: max_pixel_events(match lists {
+                    true => BLOCK * BLOCK,
+                    false => PIXELS_PER_INVOCATION,
+                }),
             },
             moving: Moving {
                 kernels: refit_kernels(b, &defs)?,
@@ -422,14 +429,15 @@ impl Bvh {
                 .zip(models.iter().copied()),
         ));
         let events = bvh.stats.nodes.max(bvh.tris.len()) as u64;
-        if events * self.fused.walks_per_record > MAX_PIXEL_EVENTS {
+        if events * self.fused.walks_per_record > self.fused.max_events {
             bail!(
                 "the BVH has {} nodes and {} leaf slots: {} walks of a pixel could count more than \
-                 {MAX_PIXEL_EVENTS} events, beyond the per-pixel counts' 32 bits; use a smaller \
-                 scene (or, with --fused-passes, fewer lights or light samples)",
+                 {} events, beyond the per-pixel counts' 32 bits; use a smaller scene (or, with \
+                 --fused-passes, fewer lights or light samples)",
                 bvh.stats.nodes,
                 bvh.tris.len(),
-                self.fused.walks_per_record
+                self.fused.walks_per_record,
+                self.fused.max_events
             );
         }
         let buffers = upload(&self.gl, bvh.gpu_words(), self.blocks)?;
@@ -461,13 +469,14 @@ impl Bvh {
             }
             _ => {
                 let inst = Instances::new(&self.objects);
-                if inst.events() * self.fused.walks_per_record > MAX_PIXEL_EVENTS {
+                if inst.events() * self.fused.walks_per_record > self.fused.max_events {
                     bail!(
                         "the objects' trees have {} events a walk (instances, nodes, leaf slots): \
-                         {} walks of a pixel could count more than {MAX_PIXEL_EVENTS}, beyond the \
-                         per-pixel counts' 32 bits; use a smaller scene",
+                         {} walks of a pixel could count more than {}, beyond the per-pixel \
+                         counts' 32 bits; use a smaller scene",
                         inst.events(),
-                        self.fused.walks_per_record
+                        self.fused.walks_per_record,
+                        self.fused.max_events
                     );
                 }
                 self.buffers = Some(upload(&self.gl, inst.gpu_words(models)?, self.blocks)?);

@@ -539,7 +539,7 @@ impl RayTracer {
                 .expect("fused_pass runs with --fused-passes only"),
         );
         // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
-        // (and the clears stand for the miss kernel)
+        // (and the colour's clear stands for the miss kernel)
         self.counters.bind(f.gl, f.timers, Bank::Frame);
         // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
         // miss the tree (the accelerator's miss list) ends as a clear leaves it: the output

@@ -62,6 +62,8 @@ pub struct Records {
     records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
+    /// its variant over the fused pass' block lists (`BLOCK_LISTED`)
+    block_counts: Kernel,
     hit_list: HitList,
     /// the records as an RGBA32UI image buffer for `pixel_counts` (`RECORD_IMAGE`), where the
     /// GL has the unit ([`Ssbo::texel_view`])
@@ -126,7 +128,7 @@ impl Records {
             glow::RGBA32UI,
         )?;
         let (mask, mask_value) = crate::accel::bvh::texel_index_mask();
-        // the fused pass' block lists, which pixel_counts may sum over (blockListed)
+        // the fused pass' block lists, which pixel_counts' BLOCK_LISTED variant sums over
         let blocks = crate::accel::bvh::image_blocks(w, h);
         let defines = defines
             .clone()
@@ -144,11 +146,16 @@ impl Records {
             .set("BVH_BLOCKS_X", blocks.0)
             .set("BVH_ENTRY_TEXELS", blocks.0 * blocks.1);
         let compute = |file, timer| Kernel::compute(gl, shaders, file, &defines, timer);
+        let counts = |listed: bool| {
+            let d = defines.clone().set("BLOCK_LISTED", listed as i32);
+            Kernel::compute(gl, shaders, "bvh/pixel_counts.comp", &d, "pixel_counts")
+        };
         let list_bytes = 4 * (HIT_LIST_HEADER_WORDS + (w as usize) * (h as usize));
         Ok(Records {
             records,
             evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
-            pixel_counts: compute("bvh/pixel_counts.comp", "pixel_counts")?,
+            pixel_counts: counts(false)?,
+            block_counts: counts(true)?,
             hit_list: HitList {
                 buffer: Ssbo::new(gl, "hit list", list_bytes, None, max)?,
                 // the list is a part of the hit's evaluation: timed with it
@@ -194,7 +201,7 @@ impl Records {
         let buffer = self.hit_list.buffer.buffer.raw();
         feelers.set_i32("listThreads", threads as i32);
         feelers.dispatch_indirect(timers, buffer, HitList::FEELERS);
-        let k = self.counts_program(Record::Packed(0), true);
+        let k = self.counts_program(&self.pixel_counts, Record::Packed(0), true);
         k.set_ivec4("countSlots", count_slots("intersect2"));
         k.dispatch_indirect(timers, buffer, HitList::COUNTS);
     }
@@ -216,7 +223,7 @@ impl Records {
     /// Add every pixel's `record` (the fused pass keeps three a pixel:
     /// `glsl/bvh/fused_pass.comp`) to the bound bank, its triangle tests under `tests`.
     pub fn add_record_counts(&self, timers: &mut GpuTimers, tests: &str, record: Record) {
-        let k = self.counts_program(record, false);
+        let k = self.counts_program(&self.pixel_counts, record, false);
         k.set_ivec4("countSlots", count_slots(tests));
         k.dispatch_1d(
             timers,
@@ -224,8 +231,8 @@ impl Records {
         );
     }
 
-    /// The fused pass' `record` added to the bound bank over its block lists (`blockListed` in
-    /// `glsl/bvh/pixel_counts.comp`; the accelerator's lists bound), the triangle tests under
+    /// The fused pass' `record` added to the bound bank over its block lists (`BLOCK_LISTED` in
+    /// `glsl/bvh/pixel_counts.comp`; the accelerator's lists bound: `BlockLists::step`), the triangle tests under
     /// `tests`: the hit blocks' pixels' records, and the miss blocks' — or, where
     /// `misses_cleared` (the first pass' clears stood for the miss kernel, which wrote no
     /// record), for each miss-block pixel an eye ray traced that visited nothing in record 0,
@@ -237,17 +244,15 @@ impl Records {
         record: Record,
         misses_cleared: bool,
     ) {
-        let k = self.counts_program(record, false);
-        k.set_i32("blockListed", 1);
+        let k = self.counts_program(&self.block_counts, record, false);
         k.set_i32("missesCleared", misses_cleared as i32);
         k.set_ivec4("countSlots", count_slots(tests));
         k.dispatch_1d(timers, self.blocks.div_ceil(COUNT_GROUP));
     }
 
-    /// `pixel_counts` in use, set to sum `record` of every pixel or, with `listed`, the hit
-    /// list's records (`glsl/bvh/pixel_counts.comp`).
-    fn counts_program(&self, record: Record, listed: bool) -> &Kernel {
-        let k = &self.pixel_counts;
+    /// `k` (a variant of `glsl/bvh/pixel_counts.comp`) in use, set to sum `record` of every
+    /// pixel or, with `listed`, the hit list's records.
+    fn counts_program<'k>(&self, k: &'k Kernel, record: Record, listed: bool) -> &'k Kernel {
         k.use_program();
         let (index, plain, high) = match record {
             Record::Packed(i) => (i, false, false),
@@ -258,7 +263,6 @@ impl Records {
         k.set_i32("plainRecords", plain as i32);
         k.set_i32("packedHigh", high as i32);
         k.set_i32("hitListed", listed as i32);
-        k.set_i32("blockListed", 0);
         k
     }
 }
