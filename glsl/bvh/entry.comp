@@ -48,8 +48,7 @@ vec3 gridOrigin = vec3(0.0), gridStep = vec3(0.0);
 // for llvmpipe: per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose
 // inverses are the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding
 // keeps the order — so that a ray costs no division; inactive rays, and pixels out of the
-// image, count for nothing (tested: imageLoad reads them as zeros, rayState 0, but an eye ray
-// computed in place, PASS_EYE_RAYS, would be active there).
+// image (inactive: common/pass_ray.glsl), count for nothing.
 bool bound(ivec2 block)
 {
     const float inf = 1.0 / 0.0;
@@ -60,7 +59,7 @@ bool bound(ivec2 block)
         vec4 originState, dirTri;
         passRay(p, originState, dirTri);
         vec3 d = safeDivisors(dirTri.xyz);
-        if (originState.w > 0.0 && insideImage(p)) { // active, as intersect1 traces it
+        if (originState.w > 0.0) { // active, as intersect1 traces it
             dLo = min(dLo, d); dHi = max(dHi, d);
             roLo = min(roLo, originState.xyz); roHi = max(roHi, originState.xyz);
         }

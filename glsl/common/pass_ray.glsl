@@ -12,6 +12,9 @@ void passRay(ivec2 storePos, out vec4 originState, out vec4 dirTri)
 {
 #if PASS_EYE_RAYS
     eyeRay(storePos, originState, dirTri);
+    // no ray outside the image, as the texels read there (imageLoad gives zeros: rayState 0) —
+    // the entry pass bounds a block's rays by what passRay gives for all its 64 pixels
+    if (!insideImage(storePos)) originState.w = 0.0;
 #else
     originState = imageLoad(rayOriginTexture, storePos);
     dirTri = imageLoad(rayDirTexture, storePos);

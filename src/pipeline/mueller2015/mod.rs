@@ -370,7 +370,10 @@ impl RayTracer {
         };
         let records = accel
             .records()
-            .then(|| Records::new(&gl, info, shaders, &images, (w, h), per_pixel))
+            .then(|| {
+                let lists = accel.fused_misses_apart();
+                Records::new(&gl, info, shaders, &images, (w, h), per_pixel, lists)
+            })
             .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {

@@ -62,8 +62,9 @@ pub struct Records {
     records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
-    /// its variant over the fused pass' block lists (`BLOCK_LISTED`)
-    block_counts: Kernel,
+    /// its variant over the fused pass' block lists (`BLOCK_LISTED`), where the accelerator
+    /// has them (`Accelerator::fused_misses_apart`)
+    block_counts: Option<Kernel>,
     hit_list: HitList,
     /// the records as an RGBA32UI image buffer for `pixel_counts` (`RECORD_IMAGE`), where the
     /// GL has the unit ([`Ssbo::texel_view`])
@@ -116,6 +117,7 @@ impl Records {
         defines: &Defines,
         (w, h): (u32, u32),
         per_pixel: u32,
+        block_lists: bool,
     ) -> Result<Records> {
         let count = (w as usize) * (h as usize) * per_pixel as usize;
         let max = info.max_ssbo_block_size;
@@ -155,7 +157,7 @@ impl Records {
             records,
             evaluate_hit: compute("bvh/evaluate_hit.comp", "evaluate_hit")?,
             pixel_counts: counts(false)?,
-            block_counts: counts(true)?,
+            block_counts: block_lists.then(|| counts(true)).transpose()?,
             hit_list: HitList {
                 buffer: Ssbo::new(gl, "hit list", list_bytes, None, max)?,
                 // the list is a part of the hit's evaluation: timed with it
@@ -244,7 +246,9 @@ impl Records {
         record: Record,
         misses_cleared: bool,
     ) {
-        let k = self.counts_program(&self.block_counts, record, false);
+        let k = self.block_counts.as_ref();
+        let k = k.expect("block counts where the accelerator keeps block lists");
+        let k = self.counts_program(k, record, false);
         k.set_i32("missesCleared", misses_cleared as i32);
         k.set_ivec4("countSlots", count_slots(tests));
         k.dispatch_1d(timers, self.blocks.div_ceil(COUNT_GROUP));
