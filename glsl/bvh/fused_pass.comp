@@ -55,10 +55,19 @@ const int lightCount = POINT_LIGHTS;
 // per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
 uniform vec4 areaLight[4 * AREA_LIGHTS];
 #endif
+#if PASS_EYE_RAYS
+// the eye rays in place: the first pass, whose ray state is stored where a reflection pass
+// follows (ours: as constants, llvmpipe leaves out the output colour's load and the stores
+// where they are not needed instead of running them under an empty lane mask; the loaded
+// variant, which serves the first pass with AOVs and the reflection passes, takes uniforms)
+const int storeRayState = EYE_PASS_STORES_RAYS;
+const int firstPass = 1;
+#else
 // 1 where a reflection pass follows this one: the rays' state is stored for it
 uniform int storeRayState;
 // 1 in the first pass of a frame
 uniform int firstPass;
+#endif
 
 // the point lights, as shading.comp reads them
 #if SCENE_IMAGES

@@ -212,6 +212,10 @@ pub struct FusedPasses {
 pub struct PassRays {
     pub eye_in_place: bool,
     pub loaded: bool,
+    /// Whether a reflection pass follows the first: the eye-ray variant, always the first
+    /// pass, then stores the ray state (`EYE_PASS_STORES_RAYS`, with `firstPass` a constant;
+    /// the loaded variant takes both as uniforms).
+    pub eye_pass_stores_rays: bool,
 }
 
 impl BuildContext<'_> {

@@ -159,6 +159,10 @@ fn fused_kernels(
     let variant = [
         ("BVH_BLOCK_LISTS", (lists as i32).to_string()),
         ("PASS_EYE_RAYS", (eye as i32).to_string()),
+        (
+            "EYE_PASS_STORES_RAYS",
+            (f.rays.eye_pass_stores_rays as i32).to_string(),
+        ),
     ];
     let kernel = |miss: bool, timer| {
         let miss = [("FUSED_MISS", (miss as i32).to_string())];

@@ -357,6 +357,7 @@ impl RayTracer {
                 rays: PassRays {
                     eye_in_place: !options.aovs,
                     loaded: options.aovs || options.refl_depth > 0,
+                    eye_pass_stores_rays: options.refl_depth > 0,
                 },
             }),
             scene_images: gpu_scene.vertex_images(),
