@@ -259,7 +259,15 @@ fn counts_past_two_to_the_32_carry_into_the_high_word() {
     let defines = Defines::new().set("COUNTER_SLOTS_PER_KERNEL", 1);
     let k = Kernel::compute(&ctx.gl, &shaders, "counter_probe.comp", &defines, "probe").unwrap();
     let gl = &ctx.gl;
-    for (high, per) in [(0u32, 1i32), (7, 2), (0xFFFF_FFFE, 3)] {
+    // the last two: a work group's 64 invocations sum past 2^32 in shared memory already
+    let cases = [
+        (0u32, 1u32),
+        (7, 2),
+        (0xFFFF_FFFE, 3),
+        (5, 0x7000_0001),
+        (9, u32::MAX),
+    ];
+    for (high, per) in cases {
         let start = ((high as u64) << 32) | (u32::MAX - 1000) as u64;
         let words = [start as u32, (start >> 32) as u32];
         let mut back = [0u32; 2];
@@ -278,7 +286,7 @@ fn counts_past_two_to_the_32_carry_into_the_high_word() {
                 Some(b),
             );
             k.use_program();
-            k.set_i32("perInvocation", per);
+            k.set_i32("perInvocation", per as i32);
             gl.dispatch_compute(16, 1, 1);
             gl.memory_barrier(glow::BUFFER_UPDATE_BARRIER_BIT);
             gl.get_buffer_sub_data(

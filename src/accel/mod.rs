@@ -47,7 +47,8 @@ pub const PIXELS_PER_INVOCATION: u32 = 16;
 /// The most events one pixel's walk may count (node visits, triangle tests) so that the sums of
 /// `pixels` pixels (one invocation of `pixel_counts.comp`: [`PIXELS_PER_INVOCATION`], or over
 /// the fused pass' block lists an 8×8 block's) fit in 32 bits: such an accelerator checks its
-/// structure against it.
+/// structure against it. (A work group's sum of those sums carries into the counter's high
+/// word: `glsl/common/counters.glsl`.)
 pub const fn max_pixel_events(pixels: u32) -> u64 {
     (1 << 32) / pixels as u64 - 1
 }
