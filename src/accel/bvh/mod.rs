@@ -589,6 +589,19 @@ impl Bvh {
         Ok(())
     }
 
+    /// The blocks' entry pass `entry` (`glsl/bvh/entry.comp`; with `eye`'s camera where it
+    /// computes the eye rays in place), the word buffer bound for it to write its entries and
+    /// then for the walks to read them.
+    fn dispatch_entry(&self, f: &mut FrameContext, entry: &Kernel, eye: Option<&CameraRays>) {
+        self.bind(f.gl, glow::READ_WRITE);
+        entry.use_program();
+        if let Some(cam) = eye {
+            set_camera(entry, cam);
+        }
+        entry.dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
+        self.bind(f.gl, glow::READ_ONLY);
+    }
+
     /// Bind the word buffer with `access`: the entry kernel writes its last texels
     /// (`glow::READ_WRITE`), the others only read it (`glow::READ_ONLY`).
     fn bind(&self, gl: &Gl, access: u32) {
@@ -624,11 +637,7 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
-        self.bind(f.gl, glow::READ_WRITE);
-        self.entry.use_program();
-        self.entry
-            .dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
-        self.bind(f.gl, glow::READ_ONLY);
+        self.dispatch_entry(f, &self.entry, None);
         self.intersect1.use_program();
         &self.intersect1
     }
@@ -684,13 +693,7 @@ impl Accelerator for Bvh {
             None => Some(&self.entry),
         };
         let entry = entry.expect("the entry pass of the rays the frame's passes take");
-        self.bind(f.gl, glow::READ_WRITE);
-        entry.use_program();
-        if let Some(cam) = eye {
-            set_camera(entry, cam);
-        }
-        entry.dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
-        self.bind(f.gl, glow::READ_ONLY);
+        self.dispatch_entry(f, entry, eye);
         if let Some(lists) = &self.fused.lists {
             // the lists' dispatch commands from what the entry pass counted
             lists.step(f.gl, f.timers, true);
