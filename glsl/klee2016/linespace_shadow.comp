@@ -50,7 +50,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define N NTREE_N
-#define COUNTER_SLOTS_PER_KERNEL 15
+#define COUNTER_SLOTS_PER_KERNEL 16
 #include "../common/counters.glsl"
 #include "../common/light_samples.glsl"
 
@@ -906,7 +906,10 @@ void main()
     countAdd(COUNTER_RAYS_BLOCKED_TRIANGLE, raysBlockedTriangle);
     countAdd(COUNTER_TRIANGLES_CULLED, trianglesCulled);
     countAdd(COUNTER_LOOP_ITERATIONS, loopIterations);
-    if (loopIterations > 0u) atomicMax(groupCount[COUNTER_LOOP_ITERATIONS_GROUP_MAX], loopIterations);
+    if (loopIterations > 0u) {
+        atomicMax(groupCount[COUNTER_LOOP_ITERATIONS_GROUP_MAX], loopIterations);
+        atomicMax(groupCount[COUNTER_LOOP_ITERATIONS_MAX], loopIterations);
+    }
     countersEnd(COUNTER_TRIANGLE_TESTS, COUNTER_TRIANGLE_TESTS);
     countersEnd(COUNTER_LINESPACE_LOOKUPS, COUNTER_LINESPACE_LOOKUPS);
     countersEnd(COUNTER_NODES_VISITED, COUNTER_NODES_VISITED);
@@ -922,4 +925,8 @@ void main()
     countersEnd(COUNTER_TRIANGLES_CULLED, COUNTER_TRIANGLES_CULLED);
     countersEnd(COUNTER_LOOP_ITERATIONS, COUNTER_LOOP_ITERATIONS);
     countersEnd(COUNTER_LOOP_ITERATIONS_GROUP_MAX, COUNTER_LOOP_ITERATIONS_GROUP_MAX);
+    // the most iterations one invocation ran: a maximum over the work groups, in the low word
+    // (the shared maxima above were made visible by countersEnd's barriers)
+    if (gl_LocalInvocationIndex == 0u && groupCount[COUNTER_LOOP_ITERATIONS_MAX] > 0u)
+        atomicMax(counters[2 * COUNTER_LOOP_ITERATIONS_MAX], groupCount[COUNTER_LOOP_ITERATIONS_MAX]);
 }

@@ -10,7 +10,7 @@
 
 use std::any::Any;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, LightTarget, TracerKind};
 use crate::frame::FrameStats;
@@ -28,10 +28,11 @@ pub const ENTRY: Entry = Entry {
 /// iterations per invocation, with room for the few other loop iterations of a kernel.
 pub const TRIANGLES_PER_DISPATCH: u32 = 60_000;
 
-/// The triangles one dispatch tests on this GL implementation: [`TRIANGLES_PER_DISPATCH`] on
-/// Mesa's llvmpipe (GL_RENDERER names it), else all of them (`u32::MAX`).
+/// The triangles one dispatch tests under the profile: [`TRIANGLES_PER_DISPATCH`] where it
+/// keeps a loop limit (llvmpipe), else all of them (`u32::MAX`).
 pub fn triangles_per_dispatch(info: &GlInfo) -> u32 {
-    info.loop_limit()
+    info.profile
+        .loop_limit
         .map_or(u32::MAX, |_| TRIANGLES_PER_DISPATCH)
 }
 
@@ -65,10 +66,28 @@ impl BruteForce {
         let per = b
             .triangles_per_dispatch
             .unwrap_or_else(|| triangles_per_dispatch(b.info));
+        let triangles = scene.triangle_count() as u32;
+        if b.triangles_per_dispatch.is_none() && triangles > TRIANGLES_PER_DISPATCH {
+            if let Some(l) = b
+                .info
+                .profile
+                .unbounded_loops_on_bounded_implementation(b.info)
+            {
+                bail!(
+                    "the {} profile tests all {triangles} triangles in one loop of the base \
+                     tracer's kernels, and this GL implementation ({}) ends loops after {} \
+                     iterations; use GPGPU_RT_PROFILE=auto (or llvmpipe), or a scene of at most \
+                     {TRIANGLES_PER_DISPATCH} triangles",
+                    b.info.profile.name.as_str(),
+                    b.info.renderer,
+                    l.iterations
+                );
+            }
+        }
         Ok(Box::new(BruteForce {
             intersect1: b.kernel("brute_force/intersect1.comp", &[], "intersect1")?,
             intersect2: b.kernel("brute_force/intersect2.comp", &[], "intersect2")?,
-            ranges: dispatch_ranges(scene.triangle_count() as u32, per),
+            ranges: dispatch_ranges(triangles, per),
         }))
     }
 

@@ -127,8 +127,12 @@ fn info(scene: Option<PathBuf>, json: bool, gpu: args::GpuArgs) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
     } else if let serde_json::Value::Object(m) = doc {
-        for (k, v) in m {
+        for (k, v) in m.iter().filter(|(k, _)| *k != "profile") {
             println!("{k:36} {v}");
+        }
+        // the adaptations to the implementation, one a line (GPGPU_RT_PROFILE overrides them)
+        for line in ctx.info.profile.describe() {
+            println!("{line}");
         }
     }
     Ok(())

@@ -16,6 +16,8 @@ use glutin::config::{ConfigSurfaceTypes, ConfigTemplateBuilder};
 use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
 use glutin::prelude::*;
 
+use super::profile::{Profile, ProfileChoice};
+
 /// Facts about the GL implementation, printed by `info` and stored in the statistics.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GlInfo {
@@ -36,6 +38,8 @@ pub struct GlInfo {
     pub max_vertex_shader_storage_blocks: i32,
     pub max_compute_shader_storage_blocks: i32,
     pub max_image_units: i32,
+    /// GL_MAX_COMPUTE_IMAGE_UNIFORMS: the image uniforms one compute kernel may declare.
+    pub max_compute_image_uniforms: i32,
     pub max_array_texture_layers: i32,
     pub timer_query_bits: i32,
     /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH's intersect1 stores
@@ -45,19 +49,25 @@ pub struct GlInfo {
     /// GL_ARB_shader_ballot with 64-bit integers: a SIMD group's votes as one mask (the SAH
     /// BVH's hit list reserves a SIMD group's entries with one atomic: `glsl/bvh/hit_list.glsl`).
     pub ballot: bool,
+    /// Every choice adapted to this implementation ([`Profile`]), made once from the facts
+    /// above (and `GPGPU_RT_PROFILE`).
+    pub profile: Profile,
 }
 
 /// How Mesa's llvmpipe — and lavapipe, which zink runs on in software — treat long shader
 /// loops: a SIMD vector of `lanes` invocations stops every loop after `iterations` iterations
 /// in total (gallivm's guard against endless loops), silently. A vector iterates while any of
 /// its lanes does, so divergent nested loops cost it the sum of its lanes' iterations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct LoopLimit {
     pub iterations: u32,
     pub lanes: u32,
 }
 
 impl LoopLimit {
+    /// gallivm's bound on a SIMD vector's loop iterations (Mesa 22.3, `LP_MAX_TGSI_LOOP_ITERATIONS`).
+    pub const LLVMPIPE_ITERATIONS: u32 = 65535;
+
     /// The iterations one invocation may run, every loop counted, so that no vector reaches
     /// the limit whatever its lanes do.
     pub fn per_invocation(&self) -> u32 {
@@ -66,17 +76,33 @@ impl LoopLimit {
 }
 
 impl GlInfo {
-    /// The loop limit of a GL implementation that has one: llvmpipe, alone or under zink
-    /// (GL_RENDERER names it, with the width of its vectors: "llvmpipe (LLVM 15.0.6, 256 bits)",
-    /// 8 lanes of 32 bits; 16 lanes where the width cannot be read). `None` elsewhere.
-    pub fn loop_limit(&self) -> Option<LoopLimit> {
-        if !self.is_llvmpipe() {
+    /// The loop limit the implementation has, whatever the profile: llvmpipe's, alone or under
+    /// zink (GL_RENDERER names it, with the width of its vectors: "llvmpipe (LLVM 15.0.6, 256
+    /// bits)", 8 lanes of 32 bits; 16 lanes where the width cannot be read). `None` elsewhere.
+    /// The kernels keep within [`Profile::loop_limit`], which the profile chooses from this.
+    pub fn implementation_loop_limit(&self) -> Option<LoopLimit> {
+        if !self.renderer.contains("llvmpipe") {
             return None;
         }
         Some(LoopLimit {
-            iterations: 65535,
+            iterations: LoopLimit::LLVMPIPE_ITERATIONS,
             lanes: vector_bits(&self.renderer).map_or(16, |b| b / 32),
         })
+    }
+
+    /// Whether GL_RENDERER names one of Mesa's CPU rasterisers (llvmpipe, alone or under zink
+    /// over lavapipe; softpipe): a fact for the profile's automatic choice and for reports.
+    pub fn is_software_rasteriser(&self) -> bool {
+        let r = &self.renderer;
+        r.contains("llvmpipe") || r.contains("softpipe") || r.contains("lavapipe")
+    }
+
+    /// The same facts under the profile `choice` (the tests run the GPU's choices on llvmpipe
+    /// this way, as `GPGPU_RT_PROFILE` does for the program).
+    pub fn with_profile(&self, choice: ProfileChoice) -> GlInfo {
+        let mut info = self.clone();
+        info.profile = Profile::new(self, choice);
+        info
     }
 
     /// The most work groups of one dimension a dispatch may have (`GL_MAX_COMPUTE_WORK_GROUP_COUNT`
@@ -84,33 +110,6 @@ impl GlInfo {
     /// it (`MAX_GROUPS_X` in `glsl/common/work_lists.glsl`).
     pub fn max_groups_x(&self) -> u32 {
         self.max_compute_work_group_count[0].max(1) as u32
-    }
-
-    /// Whether this is Mesa's llvmpipe (GL_RENDERER names it): the CPU rasteriser whose loop
-    /// limit and code generation some kernels adapt to.
-    pub fn is_llvmpipe(&self) -> bool {
-        self.renderer.contains("llvmpipe")
-    }
-
-    /// The threads among which the implementation splits a dispatch's work groups, each taking
-    /// one contiguous share of them in the order x, then y ([`PixelGrid::row_stride`] spreads
-    /// the tile's rows over the shares): for llvmpipe its compute threads as Mesa 22.3 counts
-    /// them (`lp_screen.c`: `LP_NUM_THREADS`, else the CPUs where there are more than one — we
-    /// take those of `std::thread::available_parallelism` — and at most `LP_MAX_THREADS`: we
-    /// cap at 16, the bound of older releases, where later ones allow 32;
-    /// with 0 the calling thread runs them all), 1 elsewhere: a GPU hands its work groups out
-    /// as they finish. A count that misses Mesa's changes only how evenly the shares are
-    /// loaded.
-    pub fn dispatch_threads(&self) -> u32 {
-        if !self.is_llvmpipe() {
-            return 1;
-        }
-        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
-        let threads = std::env::var("LP_NUM_THREADS")
-            .ok()
-            .and_then(|v| v.trim().parse::<u32>().ok())
-            .unwrap_or(if cpus > 1 { cpus } else { 0 });
-        threads.clamp(1, 16)
     }
 }
 
@@ -156,6 +155,7 @@ impl GlContext {
     /// names, where it names one ([`super::driver`]).
     pub fn headless(device: Option<usize>) -> Result<GlContext> {
         let driver = super::driver::apply_from_env()?;
+        let choice = ProfileChoice::from_env()?;
         let devices: Vec<Device> = Device::query_devices()
             .map_err(|e| {
                 anyhow!(
@@ -184,7 +184,7 @@ impl GlContext {
         };
         let mut failures = Vec::new();
         for i in candidates {
-            match Self::open(&devices[i], i) {
+            match Self::open(&devices[i], i, choice) {
                 Ok(ctx) if driver.matches(&ctx.info.renderer) => return Ok(ctx),
                 Ok(ctx) => failures.push(format!(
                     "{}: {}, not {}",
@@ -208,7 +208,7 @@ impl GlContext {
         bail!("no EGL device gives {what}:\n  {}", failures.join("\n  "))
     }
 
-    fn open(device: &Device, index: usize) -> Result<GlContext> {
+    fn open(device: &Device, index: usize, choice: ProfileChoice) -> Result<GlContext> {
         // SAFETY: no native display handle is passed; the device comes from query_devices.
         let display = unsafe { Display::with_device(device, None) }
             .map_err(|e| anyhow!("cannot create an EGL display: {e}"))?;
@@ -233,7 +233,8 @@ impl GlContext {
             .map_err(|e| anyhow!("cannot make the context current without a surface: {e}"))?;
         // SAFETY: the context is current; symbols come from its display.
         let gl = unsafe { load_gl(|name| display.get_proc_address(name), "the context") }?;
-        let info = query_info(&gl, index, device.name().or(device.vendor()).unwrap_or(""));
+        let name = device.name().or(device.vendor()).unwrap_or("");
+        let info = query_info(&gl, index, name, choice);
         Ok(GlContext {
             gl: Arc::new(gl),
             info,
@@ -270,9 +271,9 @@ pub unsafe fn load_gl(get_proc_address: impl Fn(&CStr) -> *const c_void, what: &
 
 /// Query the facts of `GlInfo` on a current context (headless or a window's); `device` and
 /// `device_name` name where the context comes from.
-pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
+pub fn query_info(gl: &Gl, device: usize, device_name: &str, choice: ProfileChoice) -> GlInfo {
     // SAFETY: plain queries on a current context.
-    unsafe {
+    let mut info = unsafe {
         let int = |p: u32| gl.get_parameter_i32(p);
         let indexed = |p: u32, i: u32| gl.get_parameter_indexed_i32(p, i);
         let mut timer_bits = 0i32;
@@ -299,13 +300,17 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str) -> GlInfo {
             max_vertex_shader_storage_blocks: int(glow::MAX_VERTEX_SHADER_STORAGE_BLOCKS),
             max_compute_shader_storage_blocks: int(glow::MAX_COMPUTE_SHADER_STORAGE_BLOCKS),
             max_image_units: int(glow::MAX_IMAGE_UNITS),
+            max_compute_image_uniforms: int(glow::MAX_COMPUTE_IMAGE_UNIFORMS),
             max_array_texture_layers: int(glow::MAX_ARRAY_TEXTURE_LAYERS),
             timer_query_bits: timer_bits,
             int64: extensions.contains("GL_ARB_gpu_shader_int64"),
             ballot: extensions.contains("GL_ARB_gpu_shader_int64")
                 && extensions.contains("GL_ARB_shader_ballot"),
+            profile: Profile::UNSET,
         }
-    }
+    };
+    info.profile = Profile::new(&info, choice);
+    info
 }
 
 const QUERY_COUNTER_BITS: u32 = 0x8864;

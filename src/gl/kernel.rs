@@ -36,7 +36,7 @@ pub struct PixelGrid {
     /// Dispatches cover at most tile×tile pixels (0: the whole image in one dispatch).
     pub tile: u32,
     /// The threads that split a dispatch's work groups in contiguous shares
-    /// ([`super::GlInfo::dispatch_threads`]).
+    /// ([`super::Profile::dispatch_threads`]).
     pub threads: u32,
 }
 

@@ -4,6 +4,7 @@ pub mod context;
 pub mod crash;
 pub mod driver;
 pub mod kernel;
+pub mod profile;
 pub mod program;
 pub mod resources;
 pub mod slots;
@@ -11,4 +12,5 @@ pub mod sync;
 
 pub use context::{alloc_error, check_alloc, check_error, gl_error_name, Gl, GlContext, GlInfo};
 pub use kernel::{Kernel, PixelGrid};
+pub use profile::{Profile, ProfileChoice, ProfileName, PROFILE_ENV};
 pub use program::{compile_program, Defines, ShaderSource, GLSL_DIR_ENV};

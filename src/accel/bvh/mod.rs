@@ -101,8 +101,8 @@ pub fn image_blocks(width: u32, height: u32) -> (u32, u32) {
 /// ([`TEXEL_INDEX_BITS`]) and its last texels, the entries of the image's blocks (columns ×
 /// rows: `BVH_BLOCKS_X` × `BVH_ENTRY_TEXELS / BVH_BLOCKS_X`); the kernels store hit records and
 /// per-pixel counts (`Accelerator::records`, `glsl/bvh/records.glsl`), in one store of two 64-bit
-/// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); on llvmpipe
-/// intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
+/// words where the GL implementation has 64-bit integers (`RECORD_STORE_64`); where the
+/// profile asks for it (llvmpipe) intersect1 loads the next work group's rays ahead (`PREFETCH_RAYS`,
 /// `glsl/bvh/intersect1_main.glsl`); the size of an instance ([`instances`]; whether the walks
 /// start at the instances is the pipeline's `BVH_INSTANCES`, which the hit evaluation needs too).
 fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String); 11] {
@@ -112,7 +112,10 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
         ("RECORD_STORE_64", (info.int64 as i32).to_string()),
-        ("PREFETCH_RAYS", (info.is_llvmpipe() as i32).to_string()),
+        (
+            "PREFETCH_RAYS",
+            (info.profile.prefetch_rays as i32).to_string(),
+        ),
         ("BVH_HEADER_WORDS", HEADER_WORDS.to_string()),
         texel_index_mask(),
         ("BVH_NODE_WORDS", NODE_WORDS.to_string()),
@@ -130,7 +133,7 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
         // the records' pass reads through image buffers where the units exist (Refit::run)
         (
             "REFIT_VIEWS",
-            ((b.info.max_image_units as u32 > image::REFIT_BOXES) as i32).to_string(),
+            ((b.info.profile.image_units as u32 > image::REFIT_BOXES) as i32).to_string(),
         ),
         ("BVH_GRID_STEPS", GRID_STEPS.to_string()),
     ];
@@ -346,7 +349,7 @@ pub struct Bvh {
 
 impl Bvh {
     fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        image_units_suffice(b.info.max_image_units)?;
+        image_units_suffice(b.info.profile.image_units)?;
         let blocks = image_blocks(b.width, b.height);
         // the fused pass over block lists: with one tree (an instance's empty entry leaves the
         // block's other instances to walk)
@@ -402,7 +405,7 @@ impl Bvh {
                 cost: Cell::new(0.0),
                 pending: Cell::new(None),
                 max_block: b.info.max_ssbo_block_size,
-                max_units: b.info.max_image_units,
+                max_units: b.info.profile.image_units,
             },
             objects: scene
                 .objects

@@ -161,7 +161,13 @@ impl GlWindow {
                 "the window's context",
             )
         }?;
-        let info = query_info(&gl, 0, &format!("window ({})", display.version_string()));
+        let choice = gpgpu_rt::gl::ProfileChoice::from_env()?;
+        let info = query_info(
+            &gl,
+            0,
+            &format!("window ({})", display.version_string()),
+            choice,
+        );
         // SAFETY: state changes on the current context: colours reach the window unchanged.
         unsafe {
             gl.disable(glow::FRAMEBUFFER_SRGB);

@@ -33,7 +33,7 @@ impl LinespaceBuild {
     /// Whether the GPU builds the line spaces on the GL implementation `info`.
     pub fn on_gpu(self, info: &GlInfo) -> bool {
         match self {
-            LinespaceBuild::Auto => !info.is_llvmpipe(),
+            LinespaceBuild::Auto => info.profile.linespace_build_on_gpu,
             LinespaceBuild::Cpu => false,
             LinespaceBuild::Gpu => true,
         }

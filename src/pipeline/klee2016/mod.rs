@@ -148,10 +148,34 @@ pub struct SoftShadowRenderer {
     /// The batches of the last frame's last attempt (more than `ray_batches` where pixels hit
     /// llvmpipe's loop limit and were computed again).
     last_batches: u32,
-    /// The GL implementation's loop limit (the shadow kernel's budget follows from it).
+    /// The loop limit the profile keeps (the shadow kernel's budget follows from it).
     loop_limit: Option<LoopLimit>,
+    /// The implementation's loop limit where the profile does not keep it (the `gpu` profile
+    /// on llvmpipe): a frame whose loops may have reached it is refused.
+    unkept_limit: Option<LoopLimit>,
     /// The camera and the statistics of the last frame drawn.
     last: Option<(Camera, FrameStats)>,
+}
+
+/// Refuse a frame of the `gpu` profile on an implementation with a loop limit (llvmpipe) where
+/// an invocation ran more loop iterations than its lane's share of the limit: its SIMD vector
+/// may have been cut short silently (a vector that reaches the limit has a lane past its share,
+/// so no cut frame passes).
+fn refuse_unkept_limit(limit: Option<LoopLimit>, counts: &shadow_pass::ShadowCounts) -> Result<()> {
+    let Some(l) = limit else { return Ok(()) };
+    let most = counts.get("loop_iterations_max");
+    if most > l.per_invocation() as u64 {
+        bail!(
+            "the gpu profile sets no loop budget for the shadow pass, and an invocation ran {most} \
+             loop iterations, past its share ({}) of this GL implementation's limit of {} per \
+             SIMD vector of {} lanes: the frame may be cut short; use GPGPU_RT_PROFILE=auto (or \
+             llvmpipe), or fewer light samples",
+            l.per_invocation(),
+            l.iterations,
+            l.lanes
+        );
+    }
+    Ok(())
 }
 
 /// The tree's line spaces in the 3D texture layout of Listing 3: built on the GPU when the
@@ -231,11 +255,11 @@ impl SoftShadowRenderer {
             options.width,
             options.height,
             options.tile,
-            info.dispatch_threads(),
+            info.profile.dispatch_threads,
         )?;
         let (linespace_texture, packed) = linespaces(&gl, info, shaders, &mut tree)?;
         let samples = (options.samples_u, options.samples_v);
-        let limit = info.loop_limit();
+        let limit = info.profile.loop_limit;
         let kernel = shadow_kernel(&gl, shaders, &tree, options.mode, samples, limit)?;
         let (w, h) = (options.width, options.height);
         let triangles = scene.world_triangles();
@@ -265,6 +289,7 @@ impl SoftShadowRenderer {
             ray_batches: 1,
             last_batches: 1,
             loop_limit: limit,
+            unkept_limit: info.profile.unbounded_loops_on_bounded_implementation(info),
             last: None,
             gl,
         })
@@ -369,6 +394,7 @@ impl SoftShadowRenderer {
         )?;
         self.last_batches = last_batches;
         crate::gl::check_error(&self.gl, "the shadow pass")?;
+        refuse_unkept_limit(self.unkept_limit, &counts)?;
         self.present
             .draw(&mut self.timers, self.gbuffer.textures()[2]);
         crate::gl::check_error(&self.gl, "the screen-filling quad")?;

@@ -24,8 +24,10 @@ use crate::scene::{AreaLight, ShadowMode};
 /// descents by the near-origin rule and by a set bit, the (ray, leaf) pairs whose triangles are
 /// tested, what blocked the rays, the triangles a packet's plane test skipped
 /// (`linespace-fast`), and the loop iterations: their sum, and the sum over work groups of the
-/// group's largest (a SIMD vector iterates while any lane does: the ratio is the divergence).
-pub const COUNTERS: [&str; 15] = [
+/// group's largest (a SIMD vector iterates while any lane does: the ratio is the divergence),
+/// and the most any invocation ran (a maximum, not a sum: the `gpu` profile's frames on
+/// llvmpipe are checked against its loop limit with it).
+pub const COUNTERS: [&str; 16] = [
     "triangle_tests",
     "linespace_lookups",
     "nodes_visited",
@@ -41,10 +43,11 @@ pub const COUNTERS: [&str; 15] = [
     "triangles_culled",
     "loop_iterations",
     "loop_iterations_group_max",
+    "loop_iterations_max",
 ];
 
 /// The counters `render --stats` reports as events (all but the ones reported elsewhere).
-pub const EVENTS: std::ops::Range<usize> = 5..15;
+pub const EVENTS: std::ops::Range<usize> = 5..16;
 
 /// The shadow kernel for a mode and a number of samples (the defines of Algorithm 1).
 pub fn shadow_kernel(

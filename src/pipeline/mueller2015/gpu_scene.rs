@@ -85,7 +85,7 @@ impl MovedTransform {
                 gl,
                 vbo.raw(),
                 floats,
-                info.max_image_units,
+                info.profile.image_units,
                 unit,
                 glow::R32F,
             )
@@ -331,7 +331,7 @@ fn vertex_views(
     };
     let mut made = Vec::new();
     for (b, unit) in views {
-        match ssbo(b).texel_view(gl, info.max_image_units, unit, glow::RGBA32F)? {
+        match ssbo(b).texel_view(gl, info.profile.image_units, unit, glow::RGBA32F)? {
             Some(t) => made.push((unit, t)),
             // all four or none: the kernels read all of them one way
             None => return Ok(Vec::new()),

@@ -266,7 +266,7 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
     if w == 0 || h == 0 || w > max_tex || h > max_tex {
         bail!("image size {w}x{h} outside 1..={max_tex} (GL_MAX_TEXTURE_SIZE)");
     }
-    PixelGrid::new(w, h, options.tile, info.dispatch_threads())
+    PixelGrid::new(w, h, options.tile, info.profile.dispatch_threads)
 }
 
 /// Area lights need a flag bit per sample: the bitwise layout, with room for every sample.

@@ -125,7 +125,7 @@ impl Records {
         let records = Ssbo::new(gl, "pixel records", bytes, None, max)?;
         let view = records.texel_view(
             gl,
-            info.max_image_units,
+            info.profile.image_units,
             image::PIXEL_RECORDS,
             glow::RGBA32UI,
         )?;
@@ -141,7 +141,7 @@ impl Records {
             .set("RECORD_STORE_64", 0)
             .set("RECORD_IMAGE", view.is_some() as i32)
             .set("MAX_GROUPS_X", info.max_groups_x())
-            .set("HIT_LIST_BALLOT", info.ballot as i32)
+            .set("HIT_LIST_BALLOT", info.profile.hit_list_ballot as i32)
             .set(mask, mask_value)
             // evaluate_hit's hit records of two levels (glsl/bvh/words.glsl's instanceRay)
             .set("BVH_INSTANCE_TEXELS", crate::accel::bvh::INSTANCE_TEXELS)

@@ -182,7 +182,7 @@ fn check(info: &GlInfo, scene: &Scene, o: &WagnerOptions) -> Result<PixelGrid> {
             o.tile
         );
     }
-    PixelGrid::new(w, h, o.tile, info.dispatch_threads())
+    PixelGrid::new(w, h, o.tile, info.profile.dispatch_threads)
 }
 
 impl WagnerRenderer {
