@@ -13,6 +13,7 @@ use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::Bvh;
 use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::gl::{ProfileChoice, ProfileName};
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use serde_json::json;
@@ -281,18 +282,19 @@ fn the_grid_boxes_hold_every_triangle_of_their_subtree() {
 
 /// The paths for other GL implementations: without `GL_ARB_gpu_shader_int64` the records are
 /// stored as 32-bit words, without `GL_ARB_shader_ballot` the hit list is filled through a
-/// shared counter, and off llvmpipe `intersect1` loads no rays ahead (`RECORD_STORE_64`,
-/// `HIT_LIST_BALLOT`, `PREFETCH_RAYS`) — the same ids, colours and counts as the paths this
-/// machine takes, where the suite would otherwise never compile them.
+/// shared counter, and under the `gpu` profile `intersect1` loads no rays ahead
+/// (`RECORD_STORE_64`, `HIT_LIST_BALLOT`, `PREFETCH_RAYS`) — the same ids, colours and counts as
+/// the paths this machine takes, where the suite would otherwise never compile them.
 #[test]
 fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
     let ctx = context();
     let scene = load("bunny.toml");
     let opts = bvh_options(47, 33, 1);
-    let mut other = ctx.info.clone();
+    let mut other = ctx
+        .info
+        .with_profile(ProfileChoice::Forced(ProfileName::Gpu));
     other.int64 = false;
-    other.ballot = false;
-    other.renderer = "another GL implementation".into();
+    other.profile.hit_list_ballot = false;
     let shaders = gpgpu_rt::gl::ShaderSource::default();
     let mut tracer = gpgpu_rt::pipeline::mueller2015::RayTracer::new(
         ctx.gl.clone(),
@@ -350,4 +352,48 @@ fn the_hit_list_holds_the_pixels_with_a_hit_in_every_pass() {
         reflected > 0 && listed > hits && listed <= hits + reflected,
         "{listed} listed, {hits} first hits, {reflected} reflected rays"
     );
+}
+
+/// The hit list holds exactly the pixels whose primary ray hit something, each once, whichever
+/// way it is filled: the subgroup ballot (one reservation a subgroup, `HIT_LIST_BALLOT`) or the
+/// work group's shared counter, under both profiles; at 512² (many work groups appending at
+/// once) and at 61×47 (work groups cut by the image's edges). A wrong reservation overwrites
+/// entries while the count stays right: the set is compared, not the count.
+#[test]
+fn the_hit_list_holds_exactly_the_hit_pixels_each_once() {
+    let ctx = context();
+    let scene = load("bunny.toml");
+    let gpu = ctx
+        .info
+        .with_profile(ProfileChoice::Forced(ProfileName::Gpu));
+    let mut shared = gpu.clone();
+    shared.profile.hit_list_ballot = false;
+    let llvmpipe = ctx
+        .info
+        .with_profile(ProfileChoice::Forced(ProfileName::Llvmpipe));
+    let shaders = gpgpu_rt::gl::ShaderSource::default();
+    for (w, h) in [(512, 512), (61, 47)] {
+        for (what, info) in [("gpu", &gpu), ("llvmpipe", &llvmpipe), ("shared", &shared)] {
+            let mut t =
+                RayTracer::new(ctx.gl.clone(), info, &scene, &shaders, bvh_options(w, h, 0))
+                    .expect("a tracer");
+            let f = t.render(&scene.camera).expect("frame");
+            let ids = &f.aovs.as_ref().unwrap().triangle_id;
+            // the hit pixels as the kernels index them: GL rows, row 0 at the bottom
+            let want: std::collections::BTreeSet<u32> = (0..w * h)
+                .filter(|&i| ids[((h - 1 - i / w) * w + i % w) as usize] >= 0)
+                .collect();
+            let listed = t
+                .hit_list()
+                .expect("the BVH's four kernels keep a hit list");
+            let set: std::collections::BTreeSet<u32> = listed.iter().copied().collect();
+            assert!(want.len() > 100, "{what} {w}x{h}: {} hits", want.len());
+            assert_eq!(
+                listed.len(),
+                set.len(),
+                "{what} {w}x{h}: a pixel listed twice"
+            );
+            assert_eq!(set, want, "{what} {w}x{h}: the listed pixels");
+        }
+    }
 }

@@ -131,6 +131,36 @@ fn the_refitted_records_hold_the_turned_triangles() {
     }
 }
 
+/// A refit cut short (its boxes pass over half the leaves, then nothing) leaves no trace in the
+/// next: the arrival counts are cleared at every refit, so the refit after it leaves its twin's
+/// words, bit for bit, and two refits later still do (counts that relied on their parity
+/// across refits were wrong from the abandoned one on).
+#[test]
+fn a_refit_after_an_abandoned_one_is_whole() {
+    let ctx = context();
+    let mut scene = load("teapot1.toml");
+    let mut tracer = ray_tracer(&ctx, &scene, bvh_options(24, 24));
+    tracer.render(&scene.camera).unwrap();
+    let mut twin = BvhTree::new(world_triangles(&scene));
+    for (frame, degrees) in [(1, 25.0), (2, 50.0)] {
+        let model = turned(&scene, 1, degrees);
+        if frame == 1 {
+            bvh(&tracer).abandon_next_refit_halfway();
+        }
+        tracer.set_model(1, model).unwrap();
+        tracer.render(&scene.camera).unwrap();
+        assert_eq!(
+            bvh(&tracer).refits(),
+            frame,
+            "frame {frame}: a refit, no rebuild"
+        );
+        scene.objects[1].model = model;
+        twin.refit(world_triangles(&scene));
+        let what = format!("frame {frame}: the refit after an abandoned one");
+        assert_words(&bvh(&tracer).words(), &twin.gpu_words(), &what);
+    }
+}
+
 /// The first `want.len()` words of `words` are `want` (the block entries follow them).
 fn assert_words(words: &[u32], want: &[u32], what: &str) {
     assert!(words.len() >= want.len(), "{what}: {} words", words.len());

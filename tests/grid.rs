@@ -228,6 +228,15 @@ fn list_differences(
         assert_eq!(f.stats.events.get(lost).copied().unwrap_or(0), 0, "{lost}");
     }
     let (lists, center, scale) = read_lists(&t);
+    // the exact grid's count and fill passes agree on every overlap (precise arithmetic in
+    // both programs): every list slot count reserved is written, none past it
+    if let Some(g) = t.accelerator().as_any().downcast_ref::<ExactGrid>() {
+        assert_eq!(
+            g.count_fill_mismatches(t.gl()),
+            0,
+            "voxels count and fill disagree on"
+        );
+    }
     let n = grid.resolution.unwrap();
     let g = GridSpace { n };
     let mut expected = vec![Vec::new(); (n * n * n) as usize];

@@ -27,10 +27,18 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 #if HIT_LIST_BALLOT
 // This invocation's pixel appended to the pass' hit list (bvh/hit_list.glsl) if its ray hit:
-// the SIMD group's hits as one mask (GL_ARB_shader_ballot, where the GL has it: GlInfo::ballot),
-// one global atomic for them all by the first lane with a hit, each hit's place its rank in
-// the mask — a run of entries is one SIMD group's 4×2 block. Every invocation calls it, in
-// uniform control flow, hit or not.
+// the subgroup's hits as one mask (GL_ARB_shader_ballot, where the profile takes it:
+// Profile::hit_list_ballot), one reservation for them all, each hit's place its rank in the
+// mask — a run of entries is one subgroup's block. Every invocation calls it, in uniform
+// control flow, hit or not.
+// Safe by construction (ours): GL_ARB_shader_ballot defines readInvocationARB's result only
+// where the lane read is active, and says nothing of when lanes that took different sides of
+// a branch run together again (NVIDIA's subgroups of 32 schedule their lanes independently,
+// Volta on; SPIR-V under zink promises no reconvergence at a merge). So no branch stands
+// between the ballot and the read: the only branch, on `total`, is uniform (the ballot's
+// value is the same in every lane), and every lane of the subgroup runs the atomic — the
+// first lane with a hit adds the subgroup's count, the others 0 — so the lane read, which
+// has a hit, is active at the read whatever the scheduling.
 void appendHit(ivec2 storePos, bool hit)
 {
     uvec2 mask = unpackUint2x32(ballotARB(hit));
@@ -39,11 +47,12 @@ void appendHit(ivec2 storePos, bool hit)
     // the lowest lane with a hit (lane 0 where none has one: its base is not used)
     uint first = mask.x != 0u ? uint(findLSB(mask.x))
                : mask.y != 0u ? 32u + uint(findLSB(mask.y)) : 0u;
-    uint base = 0u;
-    if (hit && rank == 0u)
-        base = atomicAdd(hitWords[HIT_LIST_COUNT], uint(bitCount(mask.x) + bitCount(mask.y)));
-    base = readInvocationARB(base, first);
-    if (hit) hitWords[HIT_LIST_ENTRIES + base + rank] = uint(pixelIndex(storePos));
+    uint total = uint(bitCount(mask.x) + bitCount(mask.y));
+    if (total > 0u) {
+        uint mine = atomicAdd(hitWords[HIT_LIST_COUNT], (hit && rank == 0u) ? total : 0u);
+        uint base = readInvocationARB(mine, first);
+        if (hit) hitWords[HIT_LIST_ENTRIES + base + rank] = uint(pixelIndex(storePos));
+    }
 }
 #else
 // The same with a shared counter: each hit's place in the work group's run, one global atomic

@@ -15,7 +15,8 @@
 // waits for its ray (docs/design/frame.md; docs/design/bvh.md, step 21). One group ahead, not
 // two; in intersect1 only. Their values are folded into `truncated` through
 // prefetchZero, a uniform the host never sets (GL makes it 0 at link time), so that the
-// compiler must keep the loads and nothing changes. Out of the image, imageLoad reads zeros.
+// compiler must keep the loads and nothing changes. Out of the image the loads are invalid
+// (GL 4.6 §8.26: R, G, B zero, A undefined): no result depends on their values.
 #if PREFETCH_RAYS
 uniform uint prefetchZero;
 #endif

@@ -13,8 +13,10 @@
 #include "../common/scene.glsl"
 #include "refit.glsl"
 
-// Two arrivals per inner node and refit: the count is odd after the first of this refit, so
-// the counts never need clearing (zeros when the build's buffers were made).
+// Two arrivals per inner node and refit: the first (the old count 0) stops, the second goes on.
+// The host clears the counts before every refit (Refit::run), so that no refit depends on the
+// ones before it: a refit that did not run to its end (a lost context, a dispatch cut short)
+// would otherwise leave some counts odd and every later refit climbing from the wrong child.
 layout(std430, binding = SSBO_REFIT_ARRIVALS) coherent buffer RefitArrivals { uint arrivals[]; };
 
 uniform float pad;
@@ -63,7 +65,7 @@ void main()
         // does and more: Mesa 22.3's zink on lavapipe counted no arrival past a
         // memoryBarrierBuffer() in this divergent loop.
         memoryBarrier();
-        if ((atomicAdd(arrivals[p], 1u) & 1u) == 0u) return;
+        if (atomicAdd(arrivals[p], 1u) == 0u) return;
         // acquire: the sibling's box is read after its arrival was seen
         memoryBarrier();
         int c = nodeFirst(p);

@@ -10,7 +10,12 @@ uniform float gridScale;  // 2 / (largest extent of the bounds, slightly enlarge
 // length of a voxel edge (Listing 19)
 const float vx_edge = 2.0 / float(voxel_amount);
 
-vec3 toGridSpace(vec3 p) { return (p - gridCenter.xyz) * gridScale; }
+// (precise: the exact grid's count and fill passes must map a vertex alike, exact_grid/tribox.glsl)
+vec3 toGridSpace(vec3 p)
+{
+    precise vec3 g = (p - gridCenter.xyz) * gridScale;
+    return g;
+}
 
 // Listing 18: the voxel containing a grid-space point. A point on a voxel face belongs to the
 // voxel whose front, left or bottom face it is (Eq. 6). floor() rather than the listing's
@@ -18,8 +23,9 @@ vec3 toGridSpace(vec3 p) { return (p - gridCenter.xyz) * gridScale; }
 ivec3 getVoxel(vec3 coords)
 {
     // shift [-1, 1) -> [0, 2)
-    coords += vec3(1.0);
-    return ivec3(floor(coords / vx_edge));
+    precise vec3 shifted = coords + vec3(1.0);
+    precise vec3 cells = shifted / vx_edge;
+    return ivec3(floor(cells));
 }
 
 ivec3 clampVoxel(ivec3 v) { return clamp(v, ivec3(0), ivec3(voxel_amount - 1)); }

@@ -12,11 +12,12 @@ void passRay(ivec2 storePos, out vec4 originState, out vec4 dirTri)
 {
 #if PASS_EYE_RAYS
     eyeRay(storePos, originState, dirTri);
-    // no ray outside the image, as the texels read there (imageLoad gives zeros: rayState 0) —
-    // the entry pass bounds a block's rays by what passRay gives for all its 64 pixels
-    if (!insideImage(storePos)) originState.w = 0.0;
 #else
     originState = imageLoad(rayOriginTexture, storePos);
     dirTri = imageLoad(rayDirTexture, storePos);
 #endif
+    // no ray outside the image — the entry pass bounds a block's rays by what passRay gives for
+    // all its 64 pixels. Said here, not left to the load: GL 4.6 §8.26 gives an out-of-range
+    // imageLoad zeros in R, G and B only, its A (the ray state) is undefined.
+    if (!insideImage(storePos)) originState.w = 0.0;
 }

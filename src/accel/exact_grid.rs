@@ -234,6 +234,15 @@ impl ExactGrid {
         (lists, self.frame.mapping)
     }
 
+    /// The voxels of the last build whose fill pass registered another number of triangles than
+    /// the count pass reserved (fewer leaves list slots unwritten, more is counted as
+    /// truncated): 0 where the two programs agree on every overlap. For tests and inspection.
+    pub fn count_fill_mismatches(&self, gl: &Gl) -> usize {
+        let count = self.lists.voxel_count.read_u32(gl);
+        let fill = self.lists.voxel_fill.read_u32(gl);
+        count.iter().zip(&fill).filter(|(c, f)| c != f).count()
+    }
+
     pub fn resolution(&self) -> u32 {
         self.frame.n
     }

@@ -310,8 +310,10 @@ struct Moving {
     pending: Cell<Option<glow::Fence>>,
     /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
     max_block: i64,
-    /// `GL_MAX_IMAGE_UNITS`, for the refit's image-buffer views
+    /// the compute image units of the profile, for the refit's image-buffer views
     max_units: i32,
+    /// the next refit is preceded by one abandoned halfway ([`Bvh::abandon_next_refit_halfway`])
+    abandon_next: Cell<bool>,
 }
 
 pub struct Bvh {
@@ -406,6 +408,7 @@ impl Bvh {
                 pending: Cell::new(None),
                 max_block: b.info.max_ssbo_block_size,
                 max_units: b.info.profile.image_units,
+                abandon_next: Cell::new(false),
             },
             objects: scene
                 .objects
@@ -517,6 +520,13 @@ impl Bvh {
         b.map(|b| b.read_u32(&self.gl, 0)).unwrap_or_default()
     }
 
+    /// For tests: the next refit is preceded by one whose boxes pass covers half the leaves and
+    /// stops there, as a refit cut short would leave the buffers; the next must be whole.
+    #[doc(hidden)]
+    pub fn abandon_next_refit_halfway(&self) {
+        self.moving.abandon_next.set(true);
+    }
+
     /// The number of refits since the last build.
     pub fn refits(&self) -> u64 {
         self.moving.refits
@@ -580,6 +590,9 @@ impl Bvh {
         self.bind(f.gl, glow::READ_WRITE);
         let buffers = self.buffers.as_ref().expect("a built tree's buffers");
         let storage = buffers.bind_storage(f.gl, 0, ssbo::BVH_WORDS, self.moving.max_block);
+        if self.moving.abandon_next.take() {
+            refit.run_abandoned(f.gl, f.timers, &self.moving.kernels);
+        }
         refit.run(f.gl, f.timers, &self.moving.kernels, storage);
         self.drop_pending();
         // SAFETY: a fence on a current context; deleted in read_cost or drop_pending.

@@ -229,6 +229,27 @@ impl Refit {
     /// `words_storage`: the word buffer is bound as the storage buffer `BVH_WORDS` too (the
     /// passes store through it, else as image texels; `glsl/bvh/refit.glsl`).
     pub fn run(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels, words_storage: bool) {
+        self.run_leaves(gl, timers, k, words_storage, self.leaves);
+    }
+
+    /// A refit whose boxes pass covers the first `leaves` leaves only: a refit abandoned
+    /// halfway, as a lost dispatch would leave it, for the tests that the next one is whole.
+    #[doc(hidden)]
+    pub fn run_abandoned(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels) {
+        self.run_leaves(gl, timers, k, false, self.leaves / 2);
+    }
+
+    fn run_leaves(
+        &self,
+        gl: &Gl,
+        timers: &mut GpuTimers,
+        k: &RefitKernels,
+        words_storage: bool,
+        leaves: u32,
+    ) {
+        // every refit counts its arrivals from zero (glsl/bvh/refit_leaves.comp); the barrier
+        // after the last refit's passes ordered its atomics before this clear
+        self.arrivals.clear_u32(gl, 0);
         self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
         self.boxes.bind(gl, ssbo::REFIT_BOXES);
         self.arrivals.bind(gl, ssbo::REFIT_ARRIVALS);
@@ -250,7 +271,7 @@ impl Refit {
         }
         sync::barrier(gl);
         timers.time(gl, REFIT_TIMER, || {
-            for (kernel, count) in [(&k.leaves, self.leaves), (&k.records, self.nodes)] {
+            for (kernel, count) in [(&k.leaves, leaves), (&k.records, self.nodes)] {
                 kernel.use_program();
                 kernel.set_i32("nodeCount", self.nodes as i32);
                 kernel.set_i32("orderCount", count as i32);

@@ -430,6 +430,16 @@ impl RayTracer {
         &self.gl
     }
 
+    /// The pixels the last pass' hit list held (the SAH BVH's four kernels: pixel indices
+    /// `y · width + x`, GL rows, in the order `evaluate_hit` appended them); `None` for an
+    /// accelerator without one. For tests and inspection, after a frame.
+    pub fn hit_list(&self) -> Option<Vec<u32>> {
+        match (&self.records, self.options.fused_passes) {
+            (Some(r), false) => Some(r.hit_list_entries(&self.gl)),
+            _ => None,
+        }
+    }
+
     /// The eye rays (Listing 11).
     fn eye_rays(&mut self, cam: &CameraRays) {
         let k = &self.kernels.eye_ray_generation;

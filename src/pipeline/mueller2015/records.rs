@@ -93,6 +93,8 @@ impl HitList {
     const FEELERS: i32 = 0;
     const COUNTS: i32 = 16;
 
+    /// Word of the pass' count (`HIT_LIST_COUNT`).
+    const COUNT: usize = 8;
     /// Word of the frame's entries over its passes (`HIT_LIST_FRAME_ENTRIES`).
     const FRAME_ENTRIES: usize = 9;
 
@@ -214,6 +216,23 @@ impl Records {
         let mut words = [0u8; 4 * (HitList::FRAME_ENTRIES + 1)];
         self.hit_list.buffer.read_bytes(gl, &mut words);
         bytemuck::pod_read_unaligned(&words[4 * HitList::FRAME_ENTRIES..])
+    }
+
+    /// The pixel indices (`y · width + x`, GL rows) the last pass' hit list holds, in the
+    /// order they were appended (read back after the frame).
+    pub fn hit_list_entries(&self, gl: &Gl) -> Vec<u32> {
+        let mut head = [0u8; 4 * HIT_LIST_HEADER_WORDS];
+        self.hit_list.buffer.read_bytes(gl, &mut head);
+        let count: u32 = bytemuck::pod_read_unaligned(&head[4 * HitList::COUNT..][..4]);
+        // a count past the pixels would be a kernel's fault: read no more than the list holds
+        let n = count.min(self.pixels) as usize;
+        let mut bytes = vec![0u8; 4 * (HIT_LIST_HEADER_WORDS + n)];
+        self.hit_list.buffer.read_bytes(gl, &mut bytes);
+        let mut entries: Vec<u32> =
+            bytemuck::pod_collect_to_vec(&bytes[4 * HIT_LIST_HEADER_WORDS..]);
+        // a count past the pixels is kept visible as entries no pixel has
+        entries.resize(count as usize, u32::MAX);
+        entries
     }
 
     /// After an intersection dispatch whose triangle tests count under `tests`: add every
