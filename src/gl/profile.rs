@@ -170,7 +170,7 @@ impl Profile {
     /// `info`'s lines for the profile: the name and how it was chosen, then each choice.
     pub fn describe(&self) -> Vec<String> {
         let how = match self.forced {
-            true => format!("{PROFILE_ENV}"),
+            true => PROFILE_ENV.to_string(),
             false => "GL_RENDERER".to_string(),
         };
         let limit = match self.loop_limit {
