@@ -225,12 +225,14 @@ impl GlContext {
             .with_profile(GlProfile::Core)
             .with_debug(gl_debug_requested())
             .build(None);
+        let held = gl_strings_lock();
         // SAFETY: the config belongs to this display.
         let context = unsafe { display.create_context(&config, &attributes) }
             .map_err(|e| anyhow!("cannot create a GL 4.5 core context: {e}"))?;
         let context = context
             .make_current_surfaceless()
             .map_err(|e| anyhow!("cannot make the context current without a surface: {e}"))?;
+        drop(held);
         // SAFETY: the context is current; symbols come from its display.
         let gl = unsafe { load_gl(|name| display.get_proc_address(name), "the context") }?;
         let name = device.name().or(device.vendor()).unwrap_or("");
@@ -269,6 +271,29 @@ pub unsafe fn load_gl(get_proc_address: impl Fn(&CStr) -> *const c_void, what: &
     Ok(gl)
 }
 
+/// One lock for every GL string query and every context creation in the process. Mesa 22.3's
+/// zink formats GL_RENDERER into one static buffer at every query (`zink_get_name`), so a query
+/// in another thread at the same moment reads it half rewritten — "" or "\0ink (…" (glibc's
+/// snprintf clears the first byte before it writes) — and a context was taken for one of
+/// another driver ("device 0: , not zink", about one run in six of a test file whose threads
+/// made their contexts together; four threads of `tests/gl_strings.rs` read it torn 14,289
+/// times in 800,000 queries without the lock). Context creation takes the lock too: Mesa
+/// reads the name while it sets up a context.
+static GL_STRINGS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn gl_strings_lock() -> std::sync::MutexGuard<'static, ()> {
+    // a panic while held leaves nothing half done: the lock guards Mesa's buffer, not ours
+    GL_STRINGS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// `glGetString(name)` of the current context, whole whatever other threads query
+/// ([`GL_STRINGS`]).
+pub fn gl_string(gl: &Gl, name: u32) -> String {
+    let _held = gl_strings_lock();
+    // SAFETY: a plain query on the current context.
+    unsafe { gl.get_parameter_string(name) }
+}
+
 /// Query the facts of `GlInfo` on a current context (headless or a window's); `device` and
 /// `device_name` name where the context comes from.
 pub fn query_info(gl: &Gl, device: usize, device_name: &str, choice: ProfileChoice) -> GlInfo {
@@ -280,10 +305,10 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str, choice: ProfileChoi
         (gl.get_query_iv)(glow::TIME_ELAPSED, QUERY_COUNTER_BITS, &mut timer_bits);
         let extensions = gl.supported_extensions();
         GlInfo {
-            vendor: gl.get_parameter_string(glow::VENDOR),
-            renderer: gl.get_parameter_string(glow::RENDERER),
-            version: gl.get_parameter_string(glow::VERSION),
-            glsl_version: gl.get_parameter_string(glow::SHADING_LANGUAGE_VERSION),
+            vendor: gl_string(gl, glow::VENDOR),
+            renderer: gl_string(gl, glow::RENDERER),
+            version: gl_string(gl, glow::VERSION),
+            glsl_version: gl_string(gl, glow::SHADING_LANGUAGE_VERSION),
             egl_device: device,
             egl_device_name: device_name.to_string(),
             max_ssbo_block_size: gl.get_parameter_i64(glow::MAX_SHADER_STORAGE_BLOCK_SIZE),

@@ -129,8 +129,7 @@ impl Kernel {
             .map(|(_, f)| shaders.display_name(f))
             .collect();
         let files: Vec<&str> = files.iter().map(String::as_str).collect();
-        // SAFETY: a plain query on the current context.
-        let renderer = unsafe { gl.get_parameter_string(glow::RENDERER) };
+        let renderer = super::context::gl_string(gl, glow::RENDERER);
         let crash_note = crash::keep(&crash::message(timer, &files, &renderer));
         // SAFETY: queries of the program we just linked.
         let uniforms = unsafe {
