@@ -73,7 +73,51 @@ fn llvmpipe_and_zink_render_every_design_alike() {
         report.contains("| soft-linespace-dda.bunny-area | 1024 | 0 |"),
         "{report}"
     );
+    // the cases that look where a GPU could go wrong: every one compared, the colour too
+    for case in [
+        "| bvh-fused.teapot1 | 1024 | 0 | 0 | 0 | 0 | 0 |",
+        "| bvh-instances.teapot3-turning-in-flight | 1024 | 0 |",
+        "| bvh.teapot1-tile64 | 13600 | 0 |",
+        "| bvh-wagner.teapot1-61x47 | 2867 | 0 |",
+        "| base.teapot1-colour | 1024 | 0 | 0 | 0 | 0 | 0 |",
+        "| soft-exact.bunny-area-5x5 | 1024 | 0 |",
+        "| bvh.teapot1-512-run5 | 262144 | 0 |",
+    ] {
+        assert!(report.contains(case), "{case}: {report}");
+    }
     assert!(report.contains("Every case agrees."), "{report}");
+}
+
+/// `parity --list`: every case, one a line, with the options it is rendered with — the GPU's
+/// cases among them (fused passes, instances, tiles, an odd size, 5×5 soft shadows, frames in
+/// flight, the colour image, the repeated 512² case).
+#[test]
+fn parity_lists_its_cases_with_their_options() {
+    let o = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args(["parity", "--list"])
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let list = String::from_utf8_lossy(&o.stdout);
+    for (case, options) in [
+        ("bvh-fused.teapot1 ", "--fused-passes (colour compared)"),
+        (
+            "bvh-instances.teapot3-turning-in-flight ",
+            "--bvh-instances (frames in flight)",
+        ),
+        (
+            "grid-exact.teapot1-tile64 ",
+            "136x100 --tracer grid --grid-variant exact --tile 64",
+        ),
+        ("stream.teapot1-61x47 ", "61x47 --tracer stream"),
+        ("soft-linespace.bunny-area-5x5 ", "--light-samples 5x5"),
+        ("bvh.teapot1-colour ", "(colour compared)"),
+        ("bvh.teapot1-512-run5 ", "512x512 --tracer bvh"),
+    ] {
+        let line = list.lines().find(|l| l.starts_with(case));
+        assert!(line.is_some_and(|l| l.contains(options)), "{case}: {list}");
+    }
+    assert_eq!(list.lines().filter(|l| l.contains("-512-run")).count(), 5);
 }
 
 /// `--driver` and `GPGPU_RT_DRIVER` pick the driver `info` reports; a name that is no driver

@@ -26,8 +26,8 @@ use crate::args::{DesignArgs, GpuArgs};
 pub struct ParityArgs {
     /// Folder for this driver's results (one folder per case: triangle_id.npy, hit_t.npy,
     /// shadow.npy, stats.json; made if missing).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
+    #[arg(long, value_name = "DIR", required_unless_present = "list")]
+    pub out: Option<PathBuf>,
     /// Another driver's `--out` folder to compare with; the exit status is 1 where they differ.
     #[arg(long, value_name = "DIR")]
     pub against: Option<PathBuf>,
@@ -37,6 +37,9 @@ pub struct ParityArgs {
     /// Only the cases whose name contains this text.
     #[arg(long, value_name = "TEXT")]
     pub only: Option<String>,
+    /// Print the cases, one a line with the options they are rendered with, and exit.
+    #[arg(long)]
+    pub list: bool,
     /// Share of a case's pixels whose first hit may differ (0: none may). Drivers that contract
     /// a·b + c into one rounding (fma, which GLSL allows) can disagree on rays that graze an
     /// edge; CI's llvmpipe/zink comparison allows none.
@@ -160,49 +163,111 @@ struct CaseRecord {
     skipped: String,
 }
 
-/// The point-light ray tracer of `case`, the first hits kept, without tiles.
+/// How a case is rendered beyond its design and scene.
+#[derive(Clone, Copy)]
+struct Render {
+    width: u32,
+    height: u32,
+    /// `--tile` (0: the whole image in one dispatch)
+    tile: u32,
+    /// options beyond the row's (`--fused-passes`, `--bvh-instances`)
+    options: &'static [&'static str],
+    /// the soft shadows' light samples, n×n
+    samples: u32,
+    /// a turning scene's frames drawn one after another, the image read back after the last
+    /// only (the bench's and the viewer's path: frames in flight)
+    in_flight: bool,
+    /// the colour image compared too, not only first hits and shadows
+    colour: bool,
+}
+
+impl Render {
+    fn square(size: u32) -> Render {
+        Render {
+            width: size,
+            height: size,
+            tile: 0,
+            options: &[],
+            samples: 3,
+            in_flight: false,
+            colour: false,
+        }
+    }
+
+    /// The options as `--list` prints them.
+    fn describe(&self, case: &Case) -> String {
+        let mut words = vec![format!("{}x{}", self.width, self.height)];
+        words.extend(case.row.select.iter().map(|(o, v)| format!("--{o} {v}")));
+        if case.clouds {
+            words.push("--proximity-clouds".into());
+        }
+        if let Some(mode) = case.mode {
+            words.push(format!("--shadows {}", mode.name()));
+            words.push(format!("--light-samples {0}x{0}", self.samples));
+        }
+        words.push(format!("--tile {}", self.tile));
+        words.extend(self.options.iter().map(|o| o.to_string()));
+        if self.in_flight {
+            words.push("(frames in flight)".into());
+        }
+        if self.colour {
+            words.push("(colour compared)".into());
+        }
+        words.join(" ")
+    }
+}
+
+/// The point-light ray tracer of `case`, the first hits kept.
 fn ray_tracer(
     ctx: &GlContext,
     scene: &Scene,
     shaders: &ShaderSource,
     case: Case,
-    size: u32,
+    how: &Render,
 ) -> Result<Box<dyn Renderer>> {
     let clouds: &[&str] = if case.clouds {
         &["--proximity-clouds"]
     } else {
         &[]
     };
-    let args = DesignArgs::of_row(case.row, &[&["--tile", "0"], clouds].concat())?;
-    let design = args.tracer_design(case.row, (size, size), scene.settings.refl_depth, true);
+    let tile = how.tile.to_string();
+    let args = DesignArgs::of_row(
+        case.row,
+        &[&["--tile", &tile], clouds, how.options].concat(),
+    )?;
+    let size = (how.width, how.height);
+    let design = args.tracer_design(case.row, size, scene.settings.refl_depth, true);
     design.renderer(ctx.gl.clone(), &ctx.info, scene, shaders)
 }
 
-/// The soft-shadow renderer in `mode` (3×3 rays): the one of the case before, switched to the
-/// mode, where it has the scene — its N-tree and line spaces are built once for the three
-/// modes.
+/// The soft-shadow renderer in `mode`: the one of the case before, switched to the mode and the
+/// samples, where it has the scene and the size — its N-tree and line spaces are built once for
+/// the modes.
 fn soft_renderer<'a>(
     kept: &'a mut Option<(&'static str, SoftShadowRenderer)>,
     ctx: &GlContext,
     (file, scene): (&'static str, &Scene),
     shaders: &ShaderSource,
     mode: ShadowMode,
-    size: u32,
+    how: &Render,
 ) -> Result<&'a mut SoftShadowRenderer> {
+    let n = how.samples;
     match kept {
-        Some((f, r)) if *f == file => r.reconfigure(shaders, mode, 3, 3)?,
+        Some((f, r)) if *f == file && r.size() == (how.width, how.height) => {
+            r.reconfigure(shaders, mode, n, n)?
+        }
         _ => {
             let options = SoftShadowOptions {
                 mode,
-                samples_u: 3,
-                samples_v: 3,
+                samples_u: n,
+                samples_v: n,
                 ntree_n: 10,
                 ntree_depth: 3,
                 shading: Default::default(),
                 linespace_build: Default::default(),
-                width: size,
-                height: size,
-                tile: 0,
+                width: how.width,
+                height: how.height,
+                tile: how.tile,
             };
             let r = SoftShadowRenderer::new(ctx.gl.clone(), &ctx.info, scene, shaders, options)?;
             *kept = Some((file, r));
@@ -211,19 +276,28 @@ fn soft_renderer<'a>(
     Ok(&mut kept.as_mut().expect("made above").1)
 }
 
-/// Render the case's frames (three where an object turns) and return the last.
-fn render_case(r: &mut dyn Renderer, scene: &Scene, turning: Option<usize>) -> Result<Frame> {
+/// Render the case's frames (three where an object turns; in flight, only the last read back)
+/// and return the last.
+fn render_case(
+    r: &mut dyn Renderer,
+    scene: &Scene,
+    turning: Option<usize>,
+    in_flight: bool,
+) -> Result<Frame> {
     let Some(object) = turning else {
         return r.render(&scene.camera);
     };
     let model = scene.objects[object].model;
-    let mut frame = None;
     for k in 1..=3 {
         let turn = Mat4::from_axis_angle(Vec3::Y, (15.0 * k as f32).to_radians());
         r.set_model(object, model * turn)?;
-        frame = Some(r.render(&scene.camera)?);
+        if k < 3 && in_flight {
+            r.draw(&scene.camera)?;
+        } else if k < 3 {
+            r.render(&scene.camera)?;
+        }
     }
-    Ok(frame.expect("three frames"))
+    r.render(&scene.camera)
 }
 
 /// The counts of a frame that a second driver must reproduce, and why none are where they
@@ -253,7 +327,7 @@ fn counts_of(case: Case, frame: &Frame) -> (BTreeMap<String, u64>, String) {
 }
 
 /// A case's folder: its record and, where it ran, the frame's first hits and shadows.
-fn write_case(dir: &Path, frame: Option<&Frame>, record: &CaseRecord) -> Result<()> {
+fn write_case(dir: &Path, frame: Option<&Frame>, record: &CaseRecord, colour: bool) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot make {}", dir.display()))?;
     if let Some((frame, a)) = frame.and_then(|f| f.aovs.as_ref().map(|a| (f, a))) {
         let shape = [frame.height as u64, frame.width as u64];
@@ -266,14 +340,167 @@ fn write_case(dir: &Path, frame: Option<&Frame>, record: &CaseRecord) -> Result<
         if let Some(s) = &a.shadow {
             write_npy(&dir.join("shadow.npy"), &shape, s.iter().copied())?;
         }
+        if colour {
+            let rgb = [shape[0], shape[1], 3];
+            let values = frame.color.iter().flat_map(|c| [c[0], c[1], c[2]]);
+            write_npy(&dir.join("color.npy"), &rgb, values)?;
+        }
     }
     let json = serde_json::to_string_pretty(record)?;
     std::fs::write(dir.join("stats.json"), json)
         .with_context(|| format!("cannot write {}", dir.join("stats.json").display()))
 }
 
-/// Every case of the matrix: (folder name, design, scene).
-fn cases(only: Option<&str>) -> Vec<(String, Case, &'static SceneCase)> {
+/// One case: its folder name, design, scene and how it is rendered.
+struct Spec {
+    name: String,
+    design: Case,
+    scene: &'static SceneCase,
+    how: Render,
+}
+
+/// The row of the registry named `name`.
+fn row(name: &str) -> &'static Row {
+    design::REGISTRY
+        .iter()
+        .find(|r| r.name == name)
+        .expect("a row of the registry")
+}
+
+/// The ray-tracing scene named `name` of [`RAY_SCENES`].
+fn ray_scene(name: &str) -> &'static SceneCase {
+    RAY_SCENES
+        .iter()
+        .find(|s| s.name == name)
+        .expect("a parity scene")
+}
+
+/// How often the race case is repeated: races show as runs that differ.
+const REPEATS: u32 = 5;
+
+/// The cases that look where a GPU could go wrong and the plain matrix does not: the fused
+/// pass' block lists and GPU-written dispatches, the instances' two levels, tiles, an odd size
+/// (partial work groups, reads past the image's edge), 5×5 soft shadows, a turning scene's
+/// frames in flight, the colour image after reflections, and one 512² case run
+/// [`REPEATS`] times.
+fn gpu_cases(size: u32) -> Vec<Spec> {
+    let plain = |name| Case {
+        row: row(name),
+        clouds: false,
+        mode: None,
+    };
+    let square = Render::square(size);
+    let spec = |name: String, design, scene, how| Spec {
+        name,
+        design,
+        scene,
+        how,
+    };
+    let mut v = Vec::new();
+    let fused = Render {
+        options: &["--fused-passes"],
+        colour: true,
+        ..square
+    };
+    for scene in ["teapot1", "bunny"] {
+        v.push(spec(
+            format!("bvh-fused.{scene}"),
+            plain("bvh"),
+            ray_scene(scene),
+            fused,
+        ));
+    }
+    let turning = ray_scene("teapot3-turning");
+    let in_flight = Render {
+        in_flight: true,
+        ..square
+    };
+    let instances = Render {
+        options: &["--bvh-instances"],
+        ..in_flight
+    };
+    v.push(spec(
+        "bvh-instances.teapot3-turning-in-flight".into(),
+        plain("bvh"),
+        turning,
+        instances,
+    ));
+    for name in ["bvh", "grid-exact", "bvh-wagner"] {
+        let n = format!("{name}.teapot3-turning-in-flight");
+        v.push(spec(n, plain(name), turning, in_flight));
+    }
+    let tiles = Render {
+        width: 136,
+        height: 100,
+        tile: 64,
+        ..square
+    };
+    let odd = Render {
+        width: 61,
+        height: 47,
+        ..square
+    };
+    let colour = Render {
+        colour: true,
+        ..square
+    };
+    for name in ["base", "grid-exact", "bvh", "bvh-wagner"] {
+        let teapot = ray_scene("teapot1");
+        v.push(spec(
+            format!("{name}.teapot1-tile64"),
+            plain(name),
+            teapot,
+            tiles,
+        ));
+        v.push(spec(
+            format!("{name}.teapot1-61x47"),
+            plain(name),
+            teapot,
+            odd,
+        ));
+        v.push(spec(
+            format!("{name}.teapot1-colour"),
+            plain(name),
+            teapot,
+            colour,
+        ));
+    }
+    for name in ["grid-thesis", "stream"] {
+        v.push(spec(
+            format!("{name}.teapot1-61x47"),
+            plain(name),
+            ray_scene("teapot1"),
+            odd,
+        ));
+    }
+    let soft = Render {
+        samples: 5,
+        ..square
+    };
+    for mode in [ShadowMode::Exact, ShadowMode::Linespace] {
+        let case = Case {
+            row: row("linespace"),
+            clouds: false,
+            mode: Some(mode),
+        };
+        v.push(spec(
+            format!("{}.bunny-area-5x5", case.name()),
+            case,
+            &SOFT_SCENES[0],
+            soft,
+        ));
+    }
+    let large = Render::square(512);
+    for k in 1..=REPEATS {
+        let n = format!("bvh.teapot1-512-run{k}");
+        v.push(spec(n, plain("bvh"), ray_scene("teapot1"), large));
+    }
+    v
+}
+
+/// Every case: the matrix of designs × scenes at `size`², then [`gpu_cases`]; those whose name
+/// contains `only`, where given.
+fn cases(only: Option<&str>, size: u32) -> Vec<Spec> {
     let mut out = Vec::new();
     for design in designs() {
         let scenes: &'static [SceneCase] = match design.mode {
@@ -281,22 +508,27 @@ fn cases(only: Option<&str>) -> Vec<(String, Case, &'static SceneCase)> {
             None => &RAY_SCENES,
         };
         for s in scenes {
-            let case = format!("{}.{}", design.name(), s.name);
-            if only.is_none_or(|o| case.contains(o)) {
-                out.push((case, design, s));
-            }
+            out.push(Spec {
+                name: format!("{}.{}", design.name(), s.name),
+                design,
+                scene: s,
+                how: Render::square(size),
+            });
         }
     }
+    out.extend(gpu_cases(size));
+    out.retain(|c| only.is_none_or(|o| c.name.contains(o)));
     out
 }
 
-/// Render every case on this driver into `args.out`.
-fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
+/// Render every case on this driver into `out`.
+fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
     let shaders = ShaderSource::from_dir(args.gpu.glsl_dir.clone())?;
     let dir = crate::bench::runner::find_scenes_dir(None)?;
     let mut scenes: BTreeMap<&str, Scene> = BTreeMap::new();
     let mut soft = None;
-    for (case, design, s) in cases(args.only.as_deref()) {
+    for spec in cases(args.only.as_deref(), args.size) {
+        let (case, design, s, how) = (&spec.name, spec.design, spec.scene, &spec.how);
         if !scenes.contains_key(s.file) {
             scenes.insert(s.file, Scene::load(&dir.join(s.file))?);
         }
@@ -304,27 +536,27 @@ fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
         let t0 = std::time::Instant::now();
         let mut ray;
         let r: &mut dyn Renderer = match design.mode {
-            Some(mode) => soft_renderer(&mut soft, ctx, (s.file, scene), &shaders, mode, args.size)
+            Some(mode) => soft_renderer(&mut soft, ctx, (s.file, scene), &shaders, mode, how)
                 .with_context(|| format!("parity case {case}"))?,
             None => {
-                ray = ray_tracer(ctx, scene, &shaders, design, args.size)
+                ray = ray_tracer(ctx, scene, &shaders, design, how)
                     .with_context(|| format!("parity case {case}"))?;
                 ray.as_mut()
             }
         };
-        let frame = match render_case(r, scene, s.turning) {
+        let frame = match render_case(r, scene, s.turning, how.in_flight) {
             Ok(f) => f,
             // a static design (seed 004's grid, Klee's N-tree) refuses moving objects: skipped
             Err(e) if s.turning.is_some() => {
                 let record = CaseRecord {
                     renderer: ctx.info.renderer.clone(),
-                    width: args.size,
-                    height: args.size,
+                    width: how.width,
+                    height: how.height,
                     counts: BTreeMap::new(),
                     counts_depend_on_order: String::new(),
                     skipped: format!("{e:#}"),
                 };
-                write_case(&args.out.join(&case), None, &record)?;
+                write_case(&out.join(case), None, &record, how.colour)?;
                 eprintln!("{case}: skipped ({e:#})");
                 continue;
             }
@@ -339,7 +571,7 @@ fn record(ctx: &GlContext, args: &ParityArgs) -> Result<()> {
             counts_depend_on_order: why,
             skipped: String::new(),
         };
-        write_case(&args.out.join(&case), Some(&frame), &record)?;
+        write_case(&out.join(case), Some(&frame), &record, how.colour)?;
         eprintln!("{case}: rendered ({:.1} s)", t0.elapsed().as_secs_f64());
     }
     Ok(())
@@ -351,6 +583,8 @@ struct Recorded {
     triangle_id: Vec<i32>,
     hit_t: Vec<f32>,
     shadow: Option<Vec<f32>>,
+    /// rgb per pixel, where the case compares the colour image
+    color: Option<Vec<f32>>,
 }
 
 fn read_npy<T: npyz::Deserialize>(path: &Path) -> Result<Vec<T>> {
@@ -372,6 +606,7 @@ fn load(dir: &Path) -> Result<Recorded> {
             triangle_id: Vec::new(),
             hit_t: Vec::new(),
             shadow: None,
+            color: None,
         });
     }
     // every array of the case holds one value per pixel of its record's size
@@ -403,10 +638,19 @@ fn load(dir: &Path) -> Result<Recorded> {
     } else {
         None
     };
+    let color = dir.join("color.npy");
+    let color = if color.exists() {
+        let v: Vec<f32> = read_npy(&color)?;
+        sized(color, v.len() / 3)?;
+        Some(v)
+    } else {
+        None
+    };
     Ok(Recorded {
         triangle_id,
         hit_t,
         shadow,
+        color,
         record,
     })
 }
@@ -421,6 +665,9 @@ struct Difference {
     ties: usize,
     /// Pixels with the same first hit but another shadow value.
     shadows: usize,
+    /// Pixels with the same first hit but another colour (a channel off by more than
+    /// [`COLOUR_TOLERANCE`]), where the case compares colours.
+    colours: Option<usize>,
     /// Counts that differ, as `name a → b`.
     counts: Vec<String>,
     /// The largest relative difference of a count.
@@ -430,6 +677,13 @@ struct Difference {
     /// references): differences are reported, not failed.
     order_dependent: bool,
 }
+
+/// How far one channel of two drivers' colours may differ. Both compute the shading of
+/// Listing 16 in f32 from the same first hit; GLSL lets a compiler contract a·b + c into one
+/// rounding, which moves a colour by about 1e-6 a step, 1e-5 over a reflection's shading. A
+/// quarter of an 8-bit step (1/1020) is a hundred times that, and invisible in a PNG; a lost
+/// shadow, a wrong reflection or an unwritten pixel moves a channel by 0.05 or more.
+const COLOUR_TOLERANCE: f32 = 1.0 / 1020.0;
 
 /// The same distance along the ray, to the rounding of either driver.
 fn same_distance(a: f32, b: f32) -> bool {
@@ -452,6 +706,10 @@ fn compare(a: &Recorded, b: &Recorded) -> Result<Difference> {
             a.record.width, a.record.height, b.record.width, b.record.height
         );
     }
+    let colours = a.color.as_ref().zip(b.color.as_ref());
+    if colours.is_some() {
+        d.colours = Some(0);
+    }
     for i in 0..d.pixels {
         let (ia, ib) = (a.triangle_id[i], b.triangle_id[i]);
         if ia == ib {
@@ -460,6 +718,10 @@ fn compare(a: &Recorded, b: &Recorded) -> Result<Difference> {
                 if (sa[i] - sb[i]).abs() > 1e-6 {
                     d.shadows += 1;
                 }
+            }
+            if let (Some((ca, cb)), Some(n)) = (colours, d.colours.as_mut()) {
+                let off = (0..3).any(|c| (ca[3 * i + c] - cb[3 * i + c]).abs() > COLOUR_TOLERANCE);
+                *n += off as usize;
             }
         } else if ia >= 0 && ib >= 0 && same_distance(a.hit_t[i], b.hit_t[i]) {
             d.ties += 1;
@@ -505,17 +767,19 @@ fn compare(a: &Recorded, b: &Recorded) -> Result<Difference> {
     Ok(d)
 }
 
-/// Compare every case of `args.out` with `against`; print a table, write `report.md` into
-/// `args.out`, and fail where the drivers disagree.
-fn compare_all(args: &ParityArgs, against: &Path) -> Result<()> {
+/// Compare every case of `out` with `against`; print a table, write `report.md` into `out`,
+/// and fail where the drivers disagree.
+fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
     let mut lines = vec![
-        "| case | pixels | other first hit | edge ties | other shadow | counts |".to_string(),
-        "|---|---|---|---|---|---|".to_string(),
+        "| case | pixels | allowed | other first hit | edge ties | other shadow | other colour | counts |"
+            .to_string(),
+        "|---|---|---|---|---|---|---|---|".to_string(),
     ];
     let mut failed = Vec::new();
     let (mut renderer_a, mut renderer_b) = (String::new(), String::new());
-    for (case, _, _) in cases(args.only.as_deref()) {
-        let ours = load(&args.out.join(&case))?;
+    for spec in cases(args.only.as_deref(), args.size) {
+        let case = spec.name;
+        let ours = load(&out.join(&case))?;
         let theirs = load(&against.join(&case)).with_context(|| {
             format!(
                 "{} has no case {case}: record it with the same gpgpu-rt",
@@ -535,23 +799,29 @@ fn compare_all(args: &ParityArgs, against: &Path) -> Result<()> {
             }
             (false, _) => d.counts.join("; "),
         };
-        let pixels_ok = d.order_dependent || (d.hits <= allowed && d.shadows <= allowed);
+        let colours = d.colours.unwrap_or(0);
+        let pixels_ok =
+            d.order_dependent || (d.hits <= allowed && d.shadows <= allowed && colours <= allowed);
         if !pixels_ok || !counts_ok {
             failed.push(case.clone());
         }
+        let colour = d.colours.map_or("-".to_string(), |n| n.to_string());
         lines.push(format!(
-            "| {case} | {} | {} | {} | {} | {counts} |",
+            "| {case} | {} | {allowed} | {} | {} | {} | {colour} | {counts} |",
             d.pixels, d.hits, d.ties, d.shadows
         ));
     }
     let report = format!(
-        "# Driver parity\n\n`{}` (this run) against `{}` (`{}`), {}² pixels; pixels that may \
-         differ: {} of each case's; counts: within {} of each other.\n\n{}\n\n{}\n",
+        "# Driver parity\n\n`{}` (this run) against `{}` (`{}`), {}² pixels where a case names \
+         no other size; pixels that may differ (`allowed`, in first hit, shadow and colour \
+         each): {} of each case's; a colour differs where a channel is off by more than {:.2e} \
+         (a quarter of an 8-bit step); counts: within {} of each other.\n\n{}\n\n{}\n",
         renderer_a,
         renderer_b,
         against.display(),
         args.size,
         args.tolerance,
+        COLOUR_TOLERANCE,
         args.count_tolerance,
         lines.join("\n"),
         if failed.is_empty() {
@@ -560,8 +830,8 @@ fn compare_all(args: &ParityArgs, against: &Path) -> Result<()> {
             format!("Differ: {}.", failed.join(", "))
         }
     );
-    std::fs::write(args.out.join("report.md"), &report)
-        .with_context(|| format!("cannot write {}", args.out.join("report.md").display()))?;
+    std::fs::write(out.join("report.md"), &report)
+        .with_context(|| format!("cannot write {}", out.join("report.md").display()))?;
     println!("{report}");
     if !failed.is_empty() {
         bail!(
@@ -574,11 +844,26 @@ fn compare_all(args: &ParityArgs, against: &Path) -> Result<()> {
 }
 
 pub fn run(args: ParityArgs) -> Result<()> {
+    if args.list {
+        for c in cases(args.only.as_deref(), args.size) {
+            println!("{:44} {}", c.name, c.how.describe(&c.design));
+        }
+        return Ok(());
+    }
+    let out = args
+        .out
+        .clone()
+        .expect("clap requires --out without --list");
     let ctx = GlContext::headless(args.gpu.device)?;
-    eprintln!("parity on {} ({})", ctx.info.renderer, ctx.info.version);
-    record(&ctx, &args)?;
+    eprintln!(
+        "parity on {} ({}), profile {}",
+        ctx.info.renderer,
+        ctx.info.version,
+        ctx.info.profile.name.as_str()
+    );
+    record(&ctx, &args, &out)?;
     if let Some(against) = &args.against {
-        compare_all(&args, against)?;
+        compare_all(&args, &out, against)?;
     }
     Ok(())
 }
@@ -600,6 +885,7 @@ mod tests {
             triangle_id: ids.to_vec(),
             hit_t: t.to_vec(),
             shadow: Some(shadow.to_vec()),
+            color: None,
         }
     }
 
@@ -654,7 +940,7 @@ mod tests {
             }),
             stats: Default::default(),
         };
-        write_case(dir.path(), Some(&frame), &r.record).unwrap();
+        write_case(dir.path(), Some(&frame), &r.record, false).unwrap();
         // a folder cut short: three ids for the record's four pixels
         write_npy(&dir.path().join("triangle_id.npy"), &[3], [1, 2, 3]).unwrap();
         let e = load(dir.path())
