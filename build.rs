@@ -19,10 +19,50 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The commit the binary is built from (`git rev-parse --short=12 HEAD`), with `-dirty` where
+/// tracked files differ from it; "unknown" without git or outside a checkout. `--version` and
+/// every report name it, so that a committed result says which code made it.
+fn commit(manifest: &Path) -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(manifest)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let Some(head) = git(&["rev-parse", "--short=12", "HEAD"]) else {
+        return "unknown".to_string();
+    };
+    let dirty =
+        git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+    format!("{head}{}", if dirty { "-dirty" } else { "" })
+}
+
 fn main() {
     // the manifest folder of this build (read at run time: a build script compiled for one
     // checkout must not embed another checkout's kernels)
     let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    println!(
+        "cargo:rustc-env=GPGPU_RT_COMMIT={}",
+        commit(Path::new(&manifest))
+    );
+    // again after a commit, a checkout or a change of a tracked source (only paths that exist:
+    // a missing one would run this script at every build)
+    for p in [
+        ".git/HEAD",
+        ".git/index",
+        "src",
+        "Cargo.toml",
+        "Cargo.lock",
+        "build.rs",
+    ] {
+        let path = Path::new(&manifest).join(p);
+        if path.exists() {
+            println!("cargo:rerun-if-changed={}", path.display());
+        }
+    }
     let root = Path::new(&manifest).join("glsl");
     println!("cargo:rerun-if-changed={}", root.display());
     let mut files = Vec::new();

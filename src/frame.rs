@@ -46,7 +46,8 @@ pub struct FrameStats {
     pub events: BTreeMap<String, u64>,
     /// Design-specific facts (grid: grid_resolution, grid_bytes, grid_build_ms, ...).
     pub facts: BTreeMap<String, serde_json::Value>,
-    /// Wall-clock time of the frame on the host, in milliseconds (includes waiting for the GPU).
+    /// Wall-clock time of the frame on the host, in milliseconds, to after `glFinish`: the whole
+    /// frame, the gaps between dispatches that `gpu_ms` leaves out included.
     pub wall_ms: f64,
     /// The work of each kind of rays apart ("primary", "shadow_first_light",
     /// "shadow_other_lights", "reflection"): Müller 2015's and seed 004's pipelines (see

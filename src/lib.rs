@@ -11,3 +11,12 @@ pub mod pipeline;
 pub mod progress;
 pub mod reference;
 pub mod scene;
+
+/// The version and the commit the binary was built from (`-dirty` where tracked files had
+/// changes; `build.rs`): `gpgpu-rt --version`, and every report and statistics file.
+pub const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("GPGPU_RT_COMMIT"),
+    ")"
+);

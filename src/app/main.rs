@@ -20,7 +20,7 @@ use gpgpu_rt::scene::Scene;
 #[derive(clap::Parser)]
 #[command(
     name = "gpgpu-rt",
-    version,
+    version = gpgpu_rt::VERSION,
     about = "GPU ray tracing in OpenGL 4.5 compute shaders (after Müller 2015 and related works)"
 )]
 struct Cli {

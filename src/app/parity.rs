@@ -40,6 +40,10 @@ pub struct ParityArgs {
     /// Print the cases, one a line with the options they are rendered with, and exit.
     #[arg(long)]
     pub list: bool,
+    /// Compare with a record of another version or commit of gpgpu-rt (refused otherwise: a
+    /// difference could be the code's, not the driver's).
+    #[arg(long)]
+    pub any_commit: bool,
     /// Share of a case's pixels whose first hit may differ (0: none may). Drivers that contract
     /// a·b + c into one rounding (fma, which GLSL allows) can disagree on rays that graze an
     /// edge; CI's llvmpipe/zink comparison allows none.
@@ -161,6 +165,13 @@ struct CaseRecord {
     counts_depend_on_order: String,
     /// Why the case did not run on this driver ("" where it did).
     skipped: String,
+    /// The version and commit of the binary that recorded it (`gpgpu_rt::VERSION`): two
+    /// records are compared only where they agree, unless `--any-commit`.
+    #[serde(default)]
+    version: String,
+    /// The implementation profile it ran under (`gl::profile`).
+    #[serde(default)]
+    profile: String,
 }
 
 /// How a case is rendered beyond its design and scene.
@@ -555,6 +566,8 @@ fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
                     counts: BTreeMap::new(),
                     counts_depend_on_order: String::new(),
                     skipped: format!("{e:#}"),
+                    version: gpgpu_rt::VERSION.into(),
+                    profile: ctx.info.profile.name.as_str().into(),
                 };
                 write_case(&out.join(case), None, &record, how.colour)?;
                 eprintln!("{case}: skipped ({e:#})");
@@ -570,6 +583,8 @@ fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
             counts,
             counts_depend_on_order: why,
             skipped: String::new(),
+            version: gpgpu_rt::VERSION.into(),
+            profile: ctx.info.profile.name.as_str().into(),
         };
         write_case(&out.join(case), Some(&frame), &record, how.colour)?;
         eprintln!("{case}: rendered ({:.1} s)", t0.elapsed().as_secs_f64());
@@ -767,6 +782,15 @@ fn compare(a: &Recorded, b: &Recorded) -> Result<Difference> {
     Ok(d)
 }
 
+/// A recorded version, or what an older record without one is.
+fn or_unknown(version: &str) -> &str {
+    if version.is_empty() {
+        "(a version that did not record itself)"
+    } else {
+        version
+    }
+}
+
 /// Compare every case of `out` with `against`; print a table, write `report.md` into `out`,
 /// and fail where the drivers disagree.
 fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
@@ -777,6 +801,7 @@ fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
     ];
     let mut failed = Vec::new();
     let (mut renderer_a, mut renderer_b) = (String::new(), String::new());
+    let (mut version, mut profiles) = (String::new(), String::new());
     for spec in cases(args.only.as_deref(), args.size) {
         let case = spec.name;
         let ours = load(&out.join(&case))?;
@@ -786,8 +811,19 @@ fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
                 against.display()
             )
         })?;
+        if ours.record.version != theirs.record.version && !args.any_commit {
+            bail!(
+                "{}: recorded by gpgpu-rt {}, this is {}: record both with the same build, or \
+                 pass --any-commit",
+                against.join(&case).display(),
+                or_unknown(&theirs.record.version),
+                ours.record.version
+            );
+        }
         renderer_a.clone_from(&ours.record.renderer);
         renderer_b.clone_from(&theirs.record.renderer);
+        version.clone_from(&ours.record.version);
+        profiles = format!("{} against {}", ours.record.profile, theirs.record.profile);
         let d = compare(&theirs, &ours)?;
         let allowed = (args.tolerance * d.pixels as f64).floor() as usize;
         let counts_ok = d.worst <= args.count_tolerance;
@@ -812,7 +848,8 @@ fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
         ));
     }
     let report = format!(
-        "# Driver parity\n\n`{}` (this run) against `{}` (`{}`), {}² pixels where a case names \
+        "# Driver parity\n\ngpgpu-rt {version}, profiles {profiles}.\n\n`{}` (this run) against \
+         `{}` (`{}`), {}² pixels where a case names \
          no other size; pixels that may differ (`allowed`, in first hit, shadow and colour \
          each): {} of each case's; a colour differs where a channel is off by more than {:.2e} \
          (a quarter of an 8-bit step); counts: within {} of each other.\n\n{}\n\n{}\n",
@@ -881,6 +918,8 @@ mod tests {
                 counts: counts.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
                 counts_depend_on_order: String::new(),
                 skipped: String::new(),
+                version: String::new(),
+                profile: String::new(),
             },
             triangle_id: ids.to_vec(),
             hit_t: t.to_vec(),

@@ -81,6 +81,8 @@ pub fn stats_doc(ctx: &GlContext, scene: &Scene, r: &dyn Renderer, f: &Frame) ->
         "gpu_ms": s.gpu_ms,
         "gpu_ms_total": s.total_gpu_ms(),
         "wall_ms": s.wall_ms,
+        "gpgpu_rt_version": gpgpu_rt::VERSION,
+        "profile": ctx.info.profile.name.as_str(),
     });
     if !s.ray_kinds.is_empty() {
         doc["ray_kinds"] = json!(s.ray_kinds);

@@ -233,16 +233,18 @@ impl Kernel {
     pub fn dispatch_pixel_groups(&self, timers: &mut GpuTimers, grid: PixelGrid, group: u32) {
         let gl = &self.gl;
         sync::barrier(gl);
-        for (tx, ty, tw, th) in grid.tiles() {
-            self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
-            let rows = th.div_ceil(group);
-            let stride = PixelGrid::row_stride(rows, grid.threads);
-            self.set_i32("tileRowStride", stride as i32);
-            timers.time(gl, self.timer, || {
+        // one pair of timer queries around all the tiles: a query pair per tile would add its
+        // own cost to every tile on a GPU, where a tile takes microseconds
+        timers.time(gl, self.timer, || {
+            for (tx, ty, tw, th) in grid.tiles() {
+                self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
+                let rows = th.div_ceil(group);
+                let stride = PixelGrid::row_stride(rows, grid.threads);
+                self.set_i32("tileRowStride", stride as i32);
                 // SAFETY: dispatch of the program in use.
                 unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
-            });
-        }
+            }
+        });
         sync::barrier(gl);
     }
 

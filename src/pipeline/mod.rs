@@ -25,11 +25,21 @@ use crate::gl::{check_error, Gl};
 use crate::scene::Camera;
 
 /// The end of every frame's draw: a GL error fails the frame (naming what was rendered), and
-/// the wall time since `start` goes into the statistics.
+/// the wall time since `start` goes into the statistics, taken after `glFinish` — the whole
+/// frame, the gaps between its dispatches included, which `gpu_ms` (the sum of the timed
+/// dispatches) leaves out.
 pub(crate) fn end_of_frame(gl: &Gl, stats: &mut FrameStats, start: Instant) -> Result<()> {
+    finish(gl);
     check_error(gl, "rendering a frame").map_err(|e| anyhow!("{e:#}"))?;
     stats.wall_ms = start.elapsed().as_secs_f64() * 1e3;
     Ok(())
+}
+
+/// `glFinish`: every command issued so far has completed.
+pub(crate) fn finish(gl: &Gl) {
+    use glow::HasContext;
+    // SAFETY: a plain command on the current context.
+    unsafe { gl.finish() };
 }
 
 /// What [`Renderer::draw`] kept of the last frame, for [`Renderer::read_back`].

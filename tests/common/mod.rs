@@ -13,10 +13,14 @@ use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::{Light, Scene};
 
+/// A shipped scene's path: below `GPGPU_RT_TEST_ROOT` where it is set (a test executable
+/// carried to another machine, `scripts/gpu-check.sh --tests`), else below the checkout the
+/// tests were built in.
 pub fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
+    let root = std::env::var_os("GPGPU_RT_TEST_ROOT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")));
+    root.join("scenes").join(name)
 }
 
 pub fn load(name: &str) -> Scene {

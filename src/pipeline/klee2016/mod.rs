@@ -535,6 +535,7 @@ impl Renderer for SoftShadowRenderer {
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
         let mut stats = self.draw_passes(camera)?;
+        super::finish(&self.gl);
         stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)

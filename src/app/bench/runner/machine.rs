@@ -51,7 +51,7 @@ impl Machine {
                 .unwrap_or(1),
             os: os_description(),
             date: utc_now(),
-            gpgpu_rt_version: env!("CARGO_PKG_VERSION").to_string(),
+            gpgpu_rt_version: gpgpu_rt::VERSION.to_string(),
         }
     }
 
