@@ -293,7 +293,7 @@ fn the_paths_without_int64_or_llvmpipe_give_the_same_frame() {
     let mut other = ctx
         .info
         .with_profile(ProfileChoice::Forced(ProfileName::Gpu));
-    other.int64 = false;
+    other.profile.record_store_64 = false;
     other.profile.hit_list_ballot = false;
     let shaders = gpgpu_rt::gl::ShaderSource::default();
     let mut tracer = gpgpu_rt::pipeline::mueller2015::RayTracer::new(

@@ -92,6 +92,10 @@ pub struct Profile {
     /// GL_ARB_shader_ballot (`HIT_LIST_BALLOT`, `glsl/bvh/evaluate_hit.comp`), where the
     /// implementation has it with 64-bit integers; else a work group's shared counter.
     pub hit_list_ballot: bool,
+    /// The SAH BVH's kernels store a pixel's record as two 64-bit words in one store
+    /// (`RECORD_STORE_64`, `glsl/common/intersect_head.glsl`), where the implementation has
+    /// GL_ARB_gpu_shader_int64; else as 32-bit words.
+    pub record_store_64: bool,
     /// The image units a compute kernel may bind: units `0..image_units` (the least of
     /// `GL_MAX_IMAGE_UNITS` and `GL_MAX_COMPUTE_IMAGE_UNIFORMS`, so that a kernel with an image
     /// at each unit it binds stays within both). The `gpu` profile forced on a software
@@ -110,6 +114,7 @@ impl Profile {
         dispatch_threads: 1,
         linespace_build_on_gpu: false,
         hit_list_ballot: false,
+        record_store_64: false,
         image_units: GUARANTEED_IMAGE_UNITS,
     };
 
@@ -134,6 +139,7 @@ impl Profile {
                 dispatch_threads: llvmpipe_threads(),
                 linespace_build_on_gpu: false,
                 hit_list_ballot: info.ballot,
+                record_store_64: info.int64,
                 image_units: units,
             },
             ProfileName::Gpu => Profile {
@@ -144,6 +150,7 @@ impl Profile {
                 dispatch_threads: 1,
                 linespace_build_on_gpu: true,
                 hit_list_ballot: info.ballot,
+                record_store_64: info.int64,
                 image_units: match software {
                     true => units.min(GUARANTEED_IMAGE_UNITS),
                     false => units,
@@ -205,6 +212,7 @@ impl Profile {
                     "shared counter"
                 }
             ),
+            format!("  64-bit record stores: {}", yes(self.record_store_64)),
             format!("  compute image units: {}", self.image_units),
         ]
     }
