@@ -12,7 +12,13 @@ fn gpu_check_stops_when_its_budget_is_spent_and_names_what_it_skipped() {
     let t0 = Instant::now();
     let o = Command::new("bash")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["scripts/gpu-check.sh", "--dry-run", "--budget", "30", "--bin"])
+        .args([
+            "scripts/gpu-check.sh",
+            "--dry-run",
+            "--budget",
+            "30",
+            "--bin",
+        ])
         .arg(env!("CARGO_BIN_EXE_gpgpu-rt"))
         .arg("--out")
         .arg(out.path())
@@ -21,11 +27,17 @@ fn gpu_check_stops_when_its_budget_is_spent_and_names_what_it_skipped() {
     let took = t0.elapsed().as_secs_f64();
     let log = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "a cut run fails: {log}");
-    assert!(took < 30.0 + 15.0, "{took:.0} s for a budget of 30 s: {log}");
+    assert!(
+        took < 30.0 + 15.0,
+        "{took:.0} s for a budget of 30 s: {log}"
+    );
     let summary = std::fs::read_to_string(out.path().join("summary.md")).expect("summary.md");
     assert!(summary.contains("| test accel | ok |"), "{summary}");
     assert!(summary.contains("skipped: no time left"), "{summary}");
-    assert!(summary.contains("(commit "), "the version with its commit: {summary}");
+    assert!(
+        summary.contains("(commit "),
+        "the version with its commit: {summary}"
+    );
     let info = std::fs::read_to_string(out.path().join("info.txt")).expect("info.txt");
     assert!(info.contains("profile: "), "{info}");
 }

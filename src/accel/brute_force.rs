@@ -36,6 +36,26 @@ pub fn triangles_per_dispatch(info: &GlInfo) -> u32 {
         .map_or(u32::MAX, |_| TRIANGLES_PER_DISPATCH)
 }
 
+/// Refuse what the `gpu` profile asks of an implementation with a loop limit (llvmpipe): all of
+/// `triangles` in one loop, past the limit, which would cut the loop short.
+fn refuse_unkept_loop_limit(info: &GlInfo, triangles: u32) -> Result<()> {
+    let unkept = info
+        .profile
+        .unbounded_loops_on_bounded_implementation(info.implementation_loop_limit());
+    match unkept {
+        Some(l) if triangles > TRIANGLES_PER_DISPATCH => bail!(
+            "the {} profile tests all {triangles} triangles in one loop of the base tracer's \
+             kernels, and this GL implementation ({}) ends loops after {} iterations; use \
+             GPGPU_RT_PROFILE=auto (or llvmpipe), or a scene of at most \
+             {TRIANGLES_PER_DISPATCH} triangles",
+            info.profile.name.as_str(),
+            info.renderer,
+            l.iterations
+        ),
+        _ => Ok(()),
+    }
+}
+
 /// The triangle ranges `first..end` of the dispatches over `count` triangles, at most `per`
 /// each; one (empty) range for no triangles.
 pub fn dispatch_ranges(count: u32, per: u32) -> Vec<(u32, u32)> {
@@ -67,22 +87,8 @@ impl BruteForce {
             .triangles_per_dispatch
             .unwrap_or_else(|| triangles_per_dispatch(b.info));
         let triangles = scene.triangle_count() as u32;
-        if b.triangles_per_dispatch.is_none() && triangles > TRIANGLES_PER_DISPATCH {
-            if let Some(l) = b
-                .info
-                .profile
-                .unbounded_loops_on_bounded_implementation(b.info)
-            {
-                bail!(
-                    "the {} profile tests all {triangles} triangles in one loop of the base \
-                     tracer's kernels, and this GL implementation ({}) ends loops after {} \
-                     iterations; use GPGPU_RT_PROFILE=auto (or llvmpipe), or a scene of at most \
-                     {TRIANGLES_PER_DISPATCH} triangles",
-                    b.info.profile.name.as_str(),
-                    b.info.renderer,
-                    l.iterations
-                );
-            }
+        if b.triangles_per_dispatch.is_none() {
+            refuse_unkept_loop_limit(b.info, triangles)?;
         }
         Ok(Box::new(BruteForce {
             intersect1: b.kernel("brute_force/intersect1.comp", &[], "intersect1")?,

@@ -389,24 +389,27 @@ fn ray_scene(name: &str) -> &'static SceneCase {
 /// How often the race case is repeated: races show as runs that differ.
 const REPEATS: u32 = 5;
 
+/// A point-light case of row `row` on `scene`, named `<row>.<suffix>`.
+fn point_case(row_name: &str, suffix: &str, scene: &str, how: Render) -> Spec {
+    Spec {
+        name: format!("{row_name}.{suffix}"),
+        design: Case {
+            row: row(row_name),
+            clouds: false,
+            mode: None,
+        },
+        scene: ray_scene(scene),
+        how,
+    }
+}
+
 /// The cases that look where a GPU could go wrong and the plain matrix does not: the fused
 /// pass' block lists and GPU-written dispatches, the instances' two levels, tiles, an odd size
 /// (partial work groups, reads past the image's edge), 5×5 soft shadows, a turning scene's
 /// frames in flight, the colour image after reflections, and one 512² case run
 /// [`REPEATS`] times.
 fn gpu_cases(size: u32) -> Vec<Spec> {
-    let plain = |name| Case {
-        row: row(name),
-        clouds: false,
-        mode: None,
-    };
     let square = Render::square(size);
-    let spec = |name: String, design, scene, how| Spec {
-        name,
-        design,
-        scene,
-        how,
-    };
     let mut v = Vec::new();
     let fused = Render {
         options: &["--fused-passes"],
@@ -414,32 +417,42 @@ fn gpu_cases(size: u32) -> Vec<Spec> {
         ..square
     };
     for scene in ["teapot1", "bunny"] {
-        v.push(spec(
-            format!("bvh-fused.{scene}"),
-            plain("bvh"),
-            ray_scene(scene),
-            fused,
-        ));
+        let mut c = point_case("bvh", scene, scene, fused);
+        c.name = format!("bvh-fused.{scene}");
+        v.push(c);
     }
-    let turning = ray_scene("teapot3-turning");
     let in_flight = Render {
         in_flight: true,
         ..square
     };
+    let turning = "teapot3-turning";
     let instances = Render {
         options: &["--bvh-instances"],
         ..in_flight
     };
-    v.push(spec(
-        "bvh-instances.teapot3-turning-in-flight".into(),
-        plain("bvh"),
-        turning,
-        instances,
-    ));
+    let mut c = point_case("bvh", "", turning, instances);
+    c.name = format!("bvh-instances.{turning}-in-flight");
+    v.push(c);
     for name in ["bvh", "grid-exact", "bvh-wagner"] {
-        let n = format!("{name}.teapot3-turning-in-flight");
-        v.push(spec(n, plain(name), turning, in_flight));
+        v.push(point_case(
+            name,
+            "teapot3-turning-in-flight",
+            turning,
+            in_flight,
+        ));
     }
+    v.extend(edge_cases(square));
+    v.extend(soft_cases(square));
+    for k in 1..=REPEATS {
+        let run = format!("teapot1-512-run{k}");
+        v.push(point_case("bvh", &run, "teapot1", Render::square(512)));
+    }
+    v
+}
+
+/// Tiles of 64² over 136×100, an image of 61×47 and the colour image, on the teapot with its
+/// reflection.
+fn edge_cases(square: Render) -> Vec<Spec> {
     let tiles = Render {
         width: 136,
         height: 100,
@@ -455,58 +468,39 @@ fn gpu_cases(size: u32) -> Vec<Spec> {
         colour: true,
         ..square
     };
+    let mut v = Vec::new();
     for name in ["base", "grid-exact", "bvh", "bvh-wagner"] {
-        let teapot = ray_scene("teapot1");
-        v.push(spec(
-            format!("{name}.teapot1-tile64"),
-            plain(name),
-            teapot,
-            tiles,
-        ));
-        v.push(spec(
-            format!("{name}.teapot1-61x47"),
-            plain(name),
-            teapot,
-            odd,
-        ));
-        v.push(spec(
-            format!("{name}.teapot1-colour"),
-            plain(name),
-            teapot,
-            colour,
-        ));
+        v.push(point_case(name, "teapot1-tile64", "teapot1", tiles));
+        v.push(point_case(name, "teapot1-61x47", "teapot1", odd));
+        v.push(point_case(name, "teapot1-colour", "teapot1", colour));
     }
     for name in ["grid-thesis", "stream"] {
-        v.push(spec(
-            format!("{name}.teapot1-61x47"),
-            plain(name),
-            ray_scene("teapot1"),
-            odd,
-        ));
+        v.push(point_case(name, "teapot1-61x47", "teapot1", odd));
     }
+    v
+}
+
+/// Soft shadows at 5×5 rays (the matrix takes 3×3), exact and by the line spaces.
+fn soft_cases(square: Render) -> Vec<Spec> {
     let soft = Render {
         samples: 5,
         ..square
     };
-    for mode in [ShadowMode::Exact, ShadowMode::Linespace] {
-        let case = Case {
-            row: row("linespace"),
-            clouds: false,
-            mode: Some(mode),
-        };
-        v.push(spec(
-            format!("{}.bunny-area-5x5", case.name()),
-            case,
-            &SOFT_SCENES[0],
-            soft,
-        ));
-    }
-    let large = Render::square(512);
-    for k in 1..=REPEATS {
-        let n = format!("bvh.teapot1-512-run{k}");
-        v.push(spec(n, plain("bvh"), ray_scene("teapot1"), large));
-    }
-    v
+    [ShadowMode::Exact, ShadowMode::Linespace]
+        .map(|mode| {
+            let design = Case {
+                row: row("linespace"),
+                clouds: false,
+                mode: Some(mode),
+            };
+            Spec {
+                name: format!("{}.bunny-area-5x5", design.name()),
+                design,
+                scene: &SOFT_SCENES[0],
+                how: soft,
+            }
+        })
+        .into()
 }
 
 /// Every case: the matrix of designs × scenes at `size`², then [`gpu_cases`]; those whose name

@@ -16,7 +16,8 @@ use glutin::config::{ConfigSurfaceTypes, ConfigTemplateBuilder};
 use glutin::context::{ContextApi, ContextAttributesBuilder, GlProfile, Version};
 use glutin::prelude::*;
 
-use super::profile::{Profile, ProfileChoice};
+pub use super::profile::LoopLimit;
+use super::profile::{Profile, ProfileChoice, ProfileName, GUARANTEED_IMAGE_UNITS};
 
 /// Facts about the GL implementation, printed by `info` and stored in the statistics.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -54,27 +55,6 @@ pub struct GlInfo {
     pub profile: Profile,
 }
 
-/// How Mesa's llvmpipe — and lavapipe, which zink runs on in software — treat long shader
-/// loops: a SIMD vector of `lanes` invocations stops every loop after `iterations` iterations
-/// in total (gallivm's guard against endless loops), silently. A vector iterates while any of
-/// its lanes does, so divergent nested loops cost it the sum of its lanes' iterations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub struct LoopLimit {
-    pub iterations: u32,
-    pub lanes: u32,
-}
-
-impl LoopLimit {
-    /// gallivm's bound on a SIMD vector's loop iterations (Mesa 22.3, `LP_MAX_TGSI_LOOP_ITERATIONS`).
-    pub const LLVMPIPE_ITERATIONS: u32 = 65535;
-
-    /// The iterations one invocation may run, every loop counted, so that no vector reaches
-    /// the limit whatever its lanes do.
-    pub fn per_invocation(&self) -> u32 {
-        self.iterations / self.lanes.max(1)
-    }
-}
-
 impl GlInfo {
     /// The loop limit the implementation has, whatever the profile: llvmpipe's, alone or under
     /// zink (GL_RENDERER names it, with the width of its vectors: "llvmpipe (LLVM 15.0.6, 256
@@ -101,8 +81,50 @@ impl GlInfo {
     /// this way, as `GPGPU_RT_PROFILE` does for the program).
     pub fn with_profile(&self, choice: ProfileChoice) -> GlInfo {
         let mut info = self.clone();
-        info.profile = Profile::new(self, choice);
+        info.profile = self.choose_profile(choice);
         info
+    }
+
+    /// The profile of this implementation as `choice` asks for it.
+    pub fn choose_profile(&self, choice: ProfileChoice) -> Profile {
+        let info = self;
+        let software = info.is_software_rasteriser();
+        let (name, forced) = match choice {
+            ProfileChoice::Auto if software => (ProfileName::Llvmpipe, false),
+            ProfileChoice::Auto => (ProfileName::Gpu, false),
+            ProfileChoice::Forced(n) => (n, true),
+        };
+        let units = info.max_image_units.min(info.max_compute_image_uniforms);
+        match name {
+            ProfileName::Llvmpipe => Profile {
+                name,
+                forced,
+                loop_limit: Some(info.implementation_loop_limit().unwrap_or(LoopLimit {
+                    iterations: LoopLimit::LLVMPIPE_ITERATIONS,
+                    lanes: 16,
+                })),
+                prefetch_rays: true,
+                dispatch_threads: super::profile::llvmpipe_threads(),
+                linespace_build_on_gpu: false,
+                hit_list_ballot: info.ballot,
+                record_store_64: info.int64,
+                image_units: units,
+            },
+            ProfileName::Gpu => Profile {
+                name,
+                forced,
+                loop_limit: None,
+                prefetch_rays: false,
+                dispatch_threads: 1,
+                linespace_build_on_gpu: true,
+                hit_list_ballot: info.ballot,
+                record_store_64: info.int64,
+                image_units: match software {
+                    true => units.min(GUARANTEED_IMAGE_UNITS),
+                    false => units,
+                },
+            },
+        }
     }
 
     /// The most work groups of one dimension a dispatch may have (`GL_MAX_COMPUTE_WORK_GROUP_COUNT`
@@ -334,7 +356,7 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str, choice: ProfileChoi
             profile: Profile::UNSET,
         }
     };
-    info.profile = Profile::new(&info, choice);
+    info.profile = info.choose_profile(choice);
     info
 }
 

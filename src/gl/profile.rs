@@ -12,8 +12,6 @@
 
 use anyhow::{bail, Result};
 
-use super::context::{GlInfo, LoopLimit};
-
 /// The environment variable that overrides the profile (`auto`, the default, reads GL_RENDERER).
 pub const PROFILE_ENV: &str = "GPGPU_RT_PROFILE";
 
@@ -64,6 +62,27 @@ impl ProfileChoice {
             "llvmpipe" => ProfileChoice::Forced(ProfileName::Llvmpipe),
             other => bail!("{PROFILE_ENV}={other}: not a profile (auto, gpu or llvmpipe)"),
         })
+    }
+}
+
+/// How Mesa's llvmpipe — and lavapipe, which zink runs on in software — treat long shader
+/// loops: a SIMD vector of `lanes` invocations stops every loop after `iterations` iterations
+/// in total (gallivm's guard against endless loops), silently. A vector iterates while any of
+/// its lanes does, so divergent nested loops cost it the sum of its lanes' iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct LoopLimit {
+    pub iterations: u32,
+    pub lanes: u32,
+}
+
+impl LoopLimit {
+    /// gallivm's bound on a SIMD vector's loop iterations (Mesa 22.3, `LP_MAX_TGSI_LOOP_ITERATIONS`).
+    pub const LLVMPIPE_ITERATIONS: u32 = 65535;
+
+    /// The iterations one invocation may run, every loop counted, so that no vector reaches
+    /// the limit whatever its lanes do.
+    pub fn per_invocation(&self) -> u32 {
+        self.iterations / self.lanes.max(1)
     }
 }
 
@@ -118,47 +137,6 @@ impl Profile {
         image_units: GUARANTEED_IMAGE_UNITS,
     };
 
-    /// The profile of `info`'s implementation as `choice` asks for it.
-    pub fn new(info: &GlInfo, choice: ProfileChoice) -> Profile {
-        let software = info.is_software_rasteriser();
-        let (name, forced) = match choice {
-            ProfileChoice::Auto if software => (ProfileName::Llvmpipe, false),
-            ProfileChoice::Auto => (ProfileName::Gpu, false),
-            ProfileChoice::Forced(n) => (n, true),
-        };
-        let units = info.max_image_units.min(info.max_compute_image_uniforms);
-        match name {
-            ProfileName::Llvmpipe => Profile {
-                name,
-                forced,
-                loop_limit: Some(info.implementation_loop_limit().unwrap_or(LoopLimit {
-                    iterations: LoopLimit::LLVMPIPE_ITERATIONS,
-                    lanes: 16,
-                })),
-                prefetch_rays: true,
-                dispatch_threads: llvmpipe_threads(),
-                linespace_build_on_gpu: false,
-                hit_list_ballot: info.ballot,
-                record_store_64: info.int64,
-                image_units: units,
-            },
-            ProfileName::Gpu => Profile {
-                name,
-                forced,
-                loop_limit: None,
-                prefetch_rays: false,
-                dispatch_threads: 1,
-                linespace_build_on_gpu: true,
-                hit_list_ballot: info.ballot,
-                record_store_64: info.int64,
-                image_units: match software {
-                    true => units.min(GUARANTEED_IMAGE_UNITS),
-                    false => units,
-                },
-            },
-        }
-    }
-
     /// Whether image unit `unit` may be bound by a compute kernel.
     pub fn has_image_unit(&self, unit: u32) -> bool {
         (unit as i64) < self.image_units as i64
@@ -167,10 +145,13 @@ impl Profile {
     /// The loop limit of the implementation where this profile's kernels do not keep within it
     /// (the `gpu` profile on llvmpipe or zink): the designs whose loops may pass it check their
     /// work against it and refuse, naming it, rather than give an image cut short.
-    pub fn unbounded_loops_on_bounded_implementation(&self, info: &GlInfo) -> Option<LoopLimit> {
+    pub fn unbounded_loops_on_bounded_implementation(
+        &self,
+        implementation: Option<LoopLimit>,
+    ) -> Option<LoopLimit> {
         match self.loop_limit {
             Some(_) => None,
-            None => info.implementation_loop_limit(),
+            None => implementation,
         }
     }
 
@@ -223,7 +204,7 @@ impl Profile {
 /// `std::thread::available_parallelism` — and at most `LP_MAX_THREADS`: we cap at 16, the bound
 /// of older releases, where later ones allow 32; with 0 the calling thread runs them all). A
 /// count that misses Mesa's changes only how evenly the shares are loaded.
-fn llvmpipe_threads() -> u32 {
+pub(crate) fn llvmpipe_threads() -> u32 {
     let cpus = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
     let threads = std::env::var("LP_NUM_THREADS")
         .ok()

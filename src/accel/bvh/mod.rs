@@ -111,7 +111,10 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
         ("BVH_INSTANCE_TEXELS", INSTANCE_TEXELS.to_string()),
         ("BVH_ENTRY_TEXELS", (blocks.0 * blocks.1).to_string()),
         ("BVH_BLOCKS_X", blocks.0.to_string()),
-        ("RECORD_STORE_64", (info.profile.record_store_64 as i32).to_string()),
+        (
+            "RECORD_STORE_64",
+            (info.profile.record_store_64 as i32).to_string(),
+        ),
         (
             "PREFETCH_RAYS",
             (info.profile.prefetch_rays as i32).to_string(),
