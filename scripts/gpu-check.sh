@@ -169,6 +169,14 @@ if [ -n "$reference" ]; then
         --out "$out/parity" --against "$reference" $any_commit \
         > /dev/null 2>>"$out/gpu-check.log" || say "parity: see $out/parity/report.md"
     rm -rf "$out/parity-llvmpipe"
+    # the barrier bits (gl::sync): every bit before every access against the bits each access
+    # needs, on this device — no run on llvmpipe or lavapipe can show a missing bit
+    if [ -d "$out/parity" ]; then
+        say "parity: every barrier bit against the minimal ones"
+        GPGPU_RT_BARRIERS=all step "parity, every barrier bit against the minimal ones" 240 \
+            "$bin" parity --size "$size" --out "$out/parity-all-barriers" --against "$out/parity" \
+            > /dev/null 2>>"$out/gpu-check.log" || say "barriers: see $out/parity-all-barriers/report.md"
+    fi
 fi
 
 # 5. the four sources' protocols, each bounded by an equal share of what is left

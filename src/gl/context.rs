@@ -373,6 +373,8 @@ type TexBufferFn = unsafe extern "system" fn(u32, u32, u32);
 /// `glClearTexImage` and `glGetQueryiv`).
 pub struct Gl {
     glow: glow::Context,
+    /// The barrier bits not issued since the last pass that ran shaders ([`super::sync`]).
+    pending_barriers: std::sync::atomic::AtomicU32,
     clear_buffer_data: ClearBufferDataFn,
     clear_tex_image: ClearTexImageFn,
     get_query_iv: GetQueryIvFn,
@@ -452,6 +454,7 @@ impl Gl {
         Ok(Gl {
             glow: glow::Context::from_loader_function(|n| load(n)),
             // SAFETY: the pointers are the named GL entry points with these signatures.
+            pending_barriers: std::sync::atomic::AtomicU32::new(super::sync::ALL),
             clear_buffer_data: std::mem::transmute::<*const c_void, ClearBufferDataFn>(
                 clear_buffer_data,
             ),
@@ -464,9 +467,30 @@ impl Gl {
         })
     }
 
+    /// The pending barrier bits of `kinds`, taken: they are issued by the caller
+    /// ([`super::sync::before`]).
+    pub(crate) fn take_pending_barriers(&self, kinds: u32) -> u32 {
+        use std::sync::atomic::Ordering;
+        self.pending_barriers.fetch_and(!kinds, Ordering::Relaxed) & kinds
+    }
+
+    /// The pending barrier bits, left pending.
+    pub(crate) fn peek_pending_barriers(&self) -> u32 {
+        self.pending_barriers
+            .load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Every barrier bit pending again: a pass ran shaders ([`super::sync::after_pass`]).
+    pub(crate) fn set_all_barriers_pending(&self) {
+        use std::sync::atomic::Ordering;
+        self.pending_barriers
+            .store(super::sync::ALL, Ordering::Relaxed);
+    }
+
     /// `glClearBufferData(target, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value)` on the
     /// buffer bound to `target`: every 32-bit word of it becomes `value`.
     pub fn clear_buffer_u32(&self, target: u32, value: u32) {
+        super::sync::before(self, glow::BUFFER_UPDATE_BARRIER_BIT);
         // SAFETY: value outlives the call; the format describes one u32.
         unsafe {
             (self.clear_buffer_data)(
@@ -498,6 +522,7 @@ impl Gl {
 
     /// `glClearTexImage` of level 0 with four floats (RGBA32F textures).
     pub fn clear_tex_f32(&self, texture: glow::Texture, value: [f32; 4]) {
+        super::sync::before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
         // SAFETY: value outlives the call.
         unsafe {
             (self.clear_tex_image)(
@@ -512,6 +537,7 @@ impl Gl {
 
     /// `glClearTexImage` of level 0 with four unsigned integers (RGBA32UI / R32UI textures).
     pub fn clear_tex_u32(&self, texture: glow::Texture, format: u32, value: [u32; 4]) {
+        super::sync::before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
         // SAFETY: value outlives the call.
         unsafe {
             (self.clear_tex_image)(

@@ -232,7 +232,7 @@ impl Kernel {
     /// 16×16); the tiles should be multiples of `group`.
     pub fn dispatch_pixel_groups(&self, timers: &mut GpuTimers, grid: PixelGrid, group: u32) {
         let gl = &self.gl;
-        sync::barrier(gl);
+        sync::before(gl, sync::SHADER);
         // one pair of timer queries around all the tiles: a query pair per tile would add its
         // own cost to every tile on a GPU, where a tile takes microseconds
         timers.time(gl, self.timer, || {
@@ -245,14 +245,15 @@ impl Kernel {
                 unsafe { gl.dispatch_compute(tw.div_ceil(group), th.div_ceil(group), 1) }
             }
         });
-        sync::barrier(gl);
+        sync::after_pass(gl);
     }
 
     /// Dispatch the work groups of the indirect command at byte `offset` of `commands`
-    /// (`glDispatchComputeIndirect`), which an earlier kernel wrote, between the two barriers.
+    /// (`glDispatchComputeIndirect`), which an earlier kernel wrote ([`sync`]: the command's
+    /// bit too).
     pub fn dispatch_indirect(&self, timers: &mut GpuTimers, commands: glow::Buffer, offset: i32) {
         let gl = &self.gl;
-        sync::barrier(gl);
+        sync::before(gl, sync::SHADER | glow::COMMAND_BARRIER_BIT);
         // SAFETY: an existing buffer bound as the indirect command buffer, the command inside
         // it; the program in use.
         timers.time(gl, self.timer, || unsafe {
@@ -260,21 +261,21 @@ impl Kernel {
             gl.dispatch_compute_indirect(offset);
             gl.bind_buffer(glow::DISPATCH_INDIRECT_BUFFER, None);
         });
-        sync::barrier(gl);
+        sync::after_pass(gl);
     }
 
-    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, between
-    /// two barriers ([`sync`]).
+    /// Dispatch this kernel (in use) with `groups` one-dimensional work groups, timed, with the
+    /// barriers of [`sync`].
     pub fn dispatch_1d(&self, timers: &mut GpuTimers, groups: u32) {
         let gl = &self.gl;
-        sync::barrier(gl);
+        sync::before(gl, sync::SHADER);
         if groups > 0 {
             // SAFETY: dispatch of the program in use.
             timers.time(gl, self.timer, || unsafe {
                 gl.dispatch_compute(groups, 1, 1)
             });
         }
-        sync::barrier(gl);
+        sync::after_pass(gl);
     }
 }
 

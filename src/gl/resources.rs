@@ -226,6 +226,7 @@ impl Ssbo {
 /// The first `bytes.len()` bytes of `buffer`, which must hold at least as many (bound to
 /// GL_COPY_READ_BUFFER, which no kernel binding uses).
 fn read_buffer(gl: &Gl, buffer: glow::Buffer, bytes: &mut [u8]) {
+    super::sync::before(gl, glow::BUFFER_UPDATE_BARRIER_BIT);
     // SAFETY: reading an existing buffer of at least bytes.len() bytes; unbound again.
     unsafe {
         gl.bind_buffer(glow::COPY_READ_BUFFER, Some(buffer));
@@ -328,6 +329,7 @@ impl Image2d {
 
     /// Copy the texels of `src` (same size and format) into this image, on the GPU.
     pub fn copy_from(&self, gl: &Gl, src: &Image2d) {
+        super::sync::before(gl, glow::TEXTURE_UPDATE_BARRIER_BIT);
         // SAFETY: glCopyImageSubData between two of our textures of the same size and format.
         unsafe {
             gl.copy_image_sub_data(
@@ -357,6 +359,7 @@ impl Image2d {
 
     /// Read back RGBA32UI texels, row 0 = the bottom row (GL order).
     pub fn read_u32(&self, gl: &Gl) -> Vec<[u32; 4]> {
+        super::sync::before(gl, glow::TEXTURE_UPDATE_BARRIER_BIT);
         let mut data = vec![[0u32; 4]; (self.width * self.height) as usize];
         // SAFETY: the slice holds w·h RGBA uints.
         unsafe {
@@ -551,6 +554,8 @@ impl TextureBuffers {
     /// fit in it. Dispatches issued later read them (GL orders a buffer update before the
     /// commands after it).
     pub fn write_u32(&self, gl: &Gl, index: usize, words: &[u32]) {
+        // after kernels that stored into the buffer (gl::sync)
+        super::sync::before(gl, glow::BUFFER_UPDATE_BARRIER_BIT);
         let t = &self.0[index].0;
         assert!(4 * words.len() <= t.bytes, "a write within the buffer");
         // SAFETY: an update of our own buffer within its size.
@@ -609,6 +614,7 @@ pub fn read_tex_image<T: bytemuck::Pod>(
     (target, format, ty): (u32, u32, u32),
     data: &mut [T],
 ) {
+    super::sync::before(gl, glow::TEXTURE_UPDATE_BARRIER_BIT);
     // SAFETY: the caller's slice holds the whole level; the texture is unbound again.
     unsafe {
         gl.bind_texture(target, Some(texture));

@@ -8,13 +8,27 @@
 //! access issued before it has completed (a write after a read, or after a render). Ordinary GL
 //! commands — rendering, clears, copies, uploads — are ordered among themselves.
 //!
-//! The rule this program follows: every pass whose shaders write memory — every compute
-//! dispatch, and the draws whose vertex or fragment shaders store or count (Müller 2015's
-//! transform pass, seed 004's passes with their counters) — is issued between two calls of
-//! [`barrier`], before it and after it; passes whose shaders only read (the G-buffer, the
-//! screen-filling quads) need none of their own. [`barrier`] sets the bit of every kind of
-//! access this program makes to memory a shader may have written, so no reader needs a
-//! barrier of its own and no pass needs to know who reads its output.
+//! The rule this program follows: **each access to memory a shader may have written issues,
+//! just before it, the barrier bits of its own kind that no barrier has issued since the last
+//! pass that ran shaders** ([`before`]); every pass that runs shaders — a compute dispatch, a
+//! draw — marks every bit pending again after it ([`after_pass`]). So a bit is issued once
+//! between a pass and the accesses after it, and only the bits those accesses need:
+//!
+//! | access | its kind | where |
+//! |---|---|---|
+//! | a compute dispatch (SSBO, image and texture reads and writes) | [`SHADER`]: `SHADER_STORAGE`, `SHADER_IMAGE_ACCESS`, `TEXTURE_FETCH` | `Kernel::dispatch_*`, the BVH refit's passes |
+//! | an indirect dispatch's command | `COMMAND` | `Kernel::dispatch_indirect` |
+//! | a draw whose shaders store (Müller 2015's transform pass, seed 004's passes) | [`SHADER`] (seed 004's: [`ALL`]) | `GpuScene::transform`, `stream::targets` |
+//! | rendering into a texture a shader stored into (Klee 2016's G-buffer) | `FRAMEBUFFER` and [`SHADER`] | `GBuffer::draw` |
+//! | sampling what a shader stored (the screen-filling quads) | `TEXTURE_FETCH` | `Present::draw`, the viewer |
+//! | `glGetBufferSubData`, `glClearBufferData`, `glBufferSubData` | `BUFFER_UPDATE` | `resources::read_buffer`, `Gl::clear_buffer_u32`, texture-buffer uploads |
+//! | `glGetTexImage`, `glClearTexImage`, `glCopyImageSubData`, `glTexSubImage*` | `TEXTURE_UPDATE` | `resources`, `Gl::clear_tex_*` |
+//!
+//! A pass's own kinds before it also order its stores after the reads of the passes before
+//! (GL 4.6 §7.13.2: stores of a kind issued after a barrier with its bit are not visible to
+//! accesses issued before it). `GPGPU_RT_BARRIERS=all` issues every bit before every access
+//! instead: a GPU run compares the two (`scripts/gpu-check.sh`), since no run on llvmpipe or
+//! lavapipe — whose barriers finish all work whatever the bits — can show a missing bit.
 
 use glow::HasContext;
 
@@ -42,8 +56,45 @@ pub const SHADER_WRITE_READERS: u32 = glow::SHADER_STORAGE_BARRIER_BIT
     | glow::FRAMEBUFFER_BARRIER_BIT
     | glow::COMMAND_BARRIER_BIT;
 
-/// The barrier between passes (see the module's rule).
+/// What a compute kernel may access: storage buffers, images, textures (and texture buffers).
+pub const SHADER: u32 = glow::SHADER_STORAGE_BARRIER_BIT
+    | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
+    | glow::TEXTURE_FETCH_BARRIER_BIT;
+
+/// Every bit this program may need ([`SHADER_WRITE_READERS`]).
+pub const ALL: u32 = SHADER_WRITE_READERS;
+
+/// The environment variable that makes every access issue every bit (`all`).
+pub const BARRIERS_ENV: &str = "GPGPU_RT_BARRIERS";
+
+fn every_bit_always() -> bool {
+    static ALL_BITS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ALL_BITS.get_or_init(|| std::env::var(BARRIERS_ENV).is_ok_and(|v| v.trim() == "all"))
+}
+
+/// Before an access of `kinds` to memory a shader may have written: the bits of `kinds` not
+/// issued since the last pass that ran shaders (see the module's rule).
+pub fn before(gl: &Gl, kinds: u32) {
+    let kinds = if every_bit_always() { ALL } else { kinds };
+    let bits = gl.take_pending_barriers(kinds);
+    if bits != 0 {
+        // SAFETY: glMemoryBarrier on a current context.
+        unsafe { gl.memory_barrier(bits) };
+    }
+}
+
+/// The bits pending on `gl`'s context: shader writes may not yet be visible to those kinds of
+/// access (for tests and inspection).
+pub fn pending(gl: &Gl) -> u32 {
+    gl.peek_pending_barriers()
+}
+
+/// After a pass that ran shaders: every bit pending again.
+pub fn after_pass(gl: &Gl) {
+    gl.set_all_barriers_pending();
+}
+
+/// Before and after a pass whose shaders access every kind (seed 004's fragment passes).
 pub fn barrier(gl: &Gl) {
-    // SAFETY: glMemoryBarrier on a current context.
-    unsafe { gl.memory_barrier(SHADER_WRITE_READERS) };
+    before(gl, ALL);
 }

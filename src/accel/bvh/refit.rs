@@ -269,9 +269,9 @@ impl Refit {
                 glow::RGBA32F,
             );
         }
-        sync::barrier(gl);
         timers.time(gl, REFIT_TIMER, || {
             for (kernel, count) in [(&k.leaves, leaves), (&k.records, self.nodes)] {
+                sync::before(gl, sync::SHADER);
                 kernel.use_program();
                 kernel.set_i32("nodeCount", self.nodes as i32);
                 kernel.set_i32("orderCount", count as i32);
@@ -282,7 +282,7 @@ impl Refit {
                 }
                 // SAFETY: dispatch of the program in use.
                 unsafe { gl.dispatch_compute(count.div_ceil(REFIT_GROUP).max(1), 1, 1) };
-                sync::barrier(gl);
+                sync::after_pass(gl);
             }
         });
     }

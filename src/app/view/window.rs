@@ -326,6 +326,8 @@ impl ScreenQuad {
     /// `texture` into `viewport`.
     pub fn draw(&self, texture: glow::Texture, size: (u32, u32), viewport: Viewport) {
         let gl = &self.gl;
+        // sampling the output texture the kernels stored into (gl::sync)
+        gpgpu_rt::gl::sync::before(gl, glow::TEXTURE_FETCH_BARRIER_BIT);
         // SAFETY: drawing with our own objects on the current context.
         unsafe {
             gl.viewport(0, 0, size.0 as i32, size.1 as i32);

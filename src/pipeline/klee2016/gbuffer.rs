@@ -169,6 +169,8 @@ impl GBuffer {
         self.raster
             .set_mat4("viewProjection", &view_projection.to_cols_array());
         self.raster.set_vec3("cameraPosition", eye.to_array());
+        // clearing and rendering into the diffuse texture the last shadow pass stored into
+        crate::gl::sync::before(gl, glow::FRAMEBUFFER_BARRIER_BIT | crate::gl::sync::SHADER);
         timers.time(gl, "gbuffer", || {
             // SAFETY: drawing with our program, VAO and FBO.
             unsafe {
@@ -187,6 +189,7 @@ impl GBuffer {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         });
+        crate::gl::sync::after_pass(gl);
     }
 
     /// The position (w: 1 = geometry), normal (w: triangle id) and diffuse (RGBA32F)

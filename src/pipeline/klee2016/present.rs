@@ -86,6 +86,8 @@ impl Present {
     pub fn draw(&self, timers: &mut GpuTimers, color: glow::Texture) {
         let gl = &self.gl;
         self.quad.use_program();
+        // sampling what the shadow pass stored
+        crate::gl::sync::before(gl, glow::TEXTURE_FETCH_BARRIER_BIT);
         timers.time(gl, self.quad.timer(), || {
             // SAFETY: drawing the quad with our program into our FBO.
             unsafe {
@@ -100,5 +102,6 @@ impl Present {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         });
+        crate::gl::sync::after_pass(gl);
     }
 }

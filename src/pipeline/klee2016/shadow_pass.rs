@@ -150,6 +150,7 @@ pub fn linespace_texture(gl: &Arc<Gl>, packed: &PackedLinespaces) -> Result<Owne
         packed.tex_y_res as i32,
         packed.tex_z_res as i32,
     );
+    crate::gl::sync::before(gl, glow::TEXTURE_UPDATE_BARRIER_BIT);
     // SAFETY: upload into our texture; the slice holds x·y·z texels.
     unsafe {
         gl.bind_texture(glow::TEXTURE_3D, Some(t.raw()));

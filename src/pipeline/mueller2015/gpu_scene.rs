@@ -509,10 +509,10 @@ impl GpuScene {
         let k = &self.transform;
         k.use_program();
         // a pass whose vertex shader stores into the scene's buffers, which the last frame's
-        // kernels read: between two barriers (gl::sync). GL 4.6 §7.12 leaves open how often a
-        // vertex shader runs for a vertex; the stores are idempotent, so any count gives the
+        // kernels read: a pass with the barriers of gl::sync. GL 4.6 §7.12 leaves open how often
+        // a vertex shader runs for a vertex; the stores are idempotent, so any count gives the
         // same buffers
-        crate::gl::sync::barrier(gl);
+        crate::gl::sync::before(gl, crate::gl::sync::SHADER);
         timers.time(gl, k.timer(), || {
             // SAFETY: draws with our program and VAOs; rasterization is discarded.
             unsafe {
@@ -538,7 +538,7 @@ impl GpuScene {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         });
-        crate::gl::sync::barrier(gl);
+        crate::gl::sync::after_pass(gl);
         self.written = Some(models.to_vec());
     }
 }

@@ -177,7 +177,8 @@ impl Targets {
 
     /// Draw the viewport-sized quad with `kernel` (in use, its textures bound) into `fbo`,
     /// timed under the kernel's name.
-    /// Its fragment shaders add to the counters (atomics): between two barriers (gl::sync).
+    /// Its fragment shaders read textures and images and add to the counters (atomics): every
+    /// bit before it (gl::sync).
     pub fn draw(&self, gl: &Gl, timers: &mut GpuTimers, kernel: &Kernel, fbo: glow::Framebuffer) {
         crate::gl::sync::barrier(gl);
         timers.time(gl, kernel.timer(), || {
@@ -191,7 +192,7 @@ impl Targets {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
             }
         });
-        crate::gl::sync::barrier(gl);
+        crate::gl::sync::after_pass(gl);
     }
 
     /// Ray textures by number: 0 and 1 the eye or reflection rays, 2 the shadow rays.
