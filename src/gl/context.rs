@@ -87,27 +87,26 @@ impl GlInfo {
 
     /// The profile of this implementation as `choice` asks for it.
     pub fn choose_profile(&self, choice: ProfileChoice) -> Profile {
-        let info = self;
-        let software = info.is_software_rasteriser();
+        let software = self.is_software_rasteriser();
         let (name, forced) = match choice {
             ProfileChoice::Auto if software => (ProfileName::Llvmpipe, false),
             ProfileChoice::Auto => (ProfileName::Gpu, false),
             ProfileChoice::Forced(n) => (n, true),
         };
-        let units = info.max_image_units.min(info.max_compute_image_uniforms);
+        let units = self.max_image_units.min(self.max_compute_image_uniforms);
         match name {
             ProfileName::Llvmpipe => Profile {
                 name,
                 forced,
-                loop_limit: Some(info.implementation_loop_limit().unwrap_or(LoopLimit {
+                loop_limit: Some(self.implementation_loop_limit().unwrap_or(LoopLimit {
                     iterations: LoopLimit::LLVMPIPE_ITERATIONS,
                     lanes: 16,
                 })),
                 prefetch_rays: true,
                 dispatch_threads: super::profile::llvmpipe_threads(),
                 linespace_build_on_gpu: false,
-                hit_list_ballot: info.ballot,
-                record_store_64: info.int64,
+                hit_list_ballot: self.ballot,
+                record_store_64: self.int64,
                 image_units: units,
             },
             ProfileName::Gpu => Profile {
@@ -117,8 +116,8 @@ impl GlInfo {
                 prefetch_rays: false,
                 dispatch_threads: 1,
                 linespace_build_on_gpu: true,
-                hit_list_ballot: info.ballot,
-                record_store_64: info.int64,
+                hit_list_ballot: self.ballot,
+                record_store_64: self.int64,
                 image_units: match software {
                     true => units.min(GUARANTEED_IMAGE_UNITS),
                     false => units,

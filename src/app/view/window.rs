@@ -348,6 +348,8 @@ impl ScreenQuad {
             gl.bind_texture(glow::TEXTURE_2D, None);
             gl.use_program(None);
         }
+        // its texture fetches: a later kernel's stores into the texture wait for them (gl::sync)
+        gpgpu_rt::gl::sync::after_pass(gl);
     }
 
     /// Draw `texture` at `width`×`height` into an offscreen RGBA8 framebuffer and read it back
