@@ -90,7 +90,8 @@ if [ -z "$bin" ]; then
         bin=target/release/gpgpu-rt
     elif command -v cargo >/dev/null 2>&1; then
         say "building (no current binary)"
-        timeout -k 5 "$(( $(left) / 2 ))" cargo build --release --quiet || { say "the build failed or ran out of time"; exit 1; }
+        t=$(( $(left) / 2 )); [ "$t" -lt 1 ] && t=1
+        timeout -k 5 "$t" cargo build --release --quiet || { say "the build failed or ran out of time"; exit 1; }
         bin=target/release/gpgpu-rt
     else
         say "no binary: run scripts/gpu-bundle.sh where cargo is and carry target/gpu-check, or pass --bin"
@@ -124,7 +125,9 @@ printf '%s\n' "$version" > "$out/version.txt"
 command -v nvidia-smi >/dev/null 2>&1 && timeout 20 nvidia-smi > "$out/nvidia-smi.txt" 2>&1
 
 # 3. the tests of the designs' GPU paths, run by their executables (carried: no cargo here)
-if [ "$dry_run" = 1 ]; then size=32; else size=48; fi
+# the parity's image side: the bundle's record is made at 48 (scripts/gpu-bundle.sh); a dry run
+# that records its own reference takes 32
+if [ "$dry_run" = 1 ] && [ -z "$reference" ]; then size=32; else size=48; fi
 # the executable of test file $1: in --tests (or the bundle), else the newest cargo built here
 test_exe() {
     if [ -n "$tests_dir" ]; then echo "$tests_dir/$1"; return; fi
@@ -148,11 +151,12 @@ fi
 if [ -z "$reference" ] && [ -f "$bundle/parity-llvmpipe.tar.gz" ] && [ "$dry_run" = 0 ]; then
     reference="$bundle/parity-llvmpipe.tar.gz"
 fi
+unpacked=0
 case "$reference" in
     *.tar.gz)
         mkdir -p "$out/parity-llvmpipe"
         tar -C "$out" -xzf "$reference" || { say "cannot unpack $reference"; exit 1; }
-        reference="$out/parity-llvmpipe" ;;
+        reference="$out/parity-llvmpipe"; unpacked=1 ;;
 esac
 if [ -z "$reference" ]; then
     reference="$out/parity-llvmpipe"
@@ -168,7 +172,8 @@ if [ -n "$reference" ]; then
     step "parity against llvmpipe" 240 "$bin" parity --size "$size" --tolerance "$tolerance" \
         --out "$out/parity" --against "$reference" $any_commit \
         > /dev/null 2>>"$out/gpu-check.log" || say "parity: see $out/parity/report.md"
-    rm -rf "$out/parity-llvmpipe"
+    # the bundle's record unpacked here is the bundle's to keep; one recorded here stays
+    [ "$unpacked" = 1 ] && rm -rf "$out/parity-llvmpipe"
     # the barrier bits (gl::sync): every bit before every access against the bits each access
     # needs, on this device — no run on llvmpipe or lavapipe can show a missing bit
     if [ -d "$out/parity" ]; then

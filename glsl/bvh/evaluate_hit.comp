@@ -49,7 +49,8 @@ void appendHit(ivec2 storePos, bool hit)
                : mask.y != 0u ? 32u + uint(findLSB(mask.y)) : 0u;
     uint total = uint(bitCount(mask.x) + bitCount(mask.y));
     if (total > 0u) {
-        uint mine = atomicAdd(hitWords[HIT_LIST_COUNT], (hit && rank == 0u) ? total : 0u);
+        uint mine = atomicAdd(hitWords[HIT_LIST_COUNT],
+                              total * uint(gl_SubGroupInvocationARB == first));
         uint base = readInvocationARB(mine, first);
         if (hit) hitWords[HIT_LIST_ENTRIES + base + rank] = uint(pixelIndex(storePos));
     }

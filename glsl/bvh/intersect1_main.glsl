@@ -6,8 +6,8 @@
 // empties an inactive ray's colour buffer. And on llvmpipe it loads the next work group's rays
 // ahead.
 
-// Latency hiding on llvmpipe (ours; PREFETCH_RAYS, set by the host where GL_RENDERER names
-// llvmpipe — the grids' intersect1 keep the thesis' loads): each
+// Latency hiding on llvmpipe (ours; PREFETCH_RAYS, set where the implementation's profile asks
+// for it, Profile::prefetch_rays — the grids' intersect1 keep the thesis' loads): each
 // invocation also loads the ray texels of its place in the next work group, 8
 // pixels on in x — the group the same llvmpipe thread runs next (its share of a dispatch is a
 // contiguous run of work groups, row by row) — so that they are in the core's caches when that

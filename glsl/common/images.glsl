@@ -33,7 +33,7 @@ uniform ivec2 tileOffset;
 //   divide the rows the stride is N, which gives thread t the rows t, t + N, t + 2N, … —
 //   neighbours of the other threads' rows, so every share costs about the same; else a stride
 //   coprime to rows − 1 near (rows − 1)/φ, which spreads every contiguous share over the tile
-//   (PixelGrid::row_stride, GlInfo::dispatch_threads; examples/walk_schedule.rs weighs the
+//   (PixelGrid::row_stride, Profile::dispatch_threads; examples/walk_schedule.rs weighs the
 //   shares; docs/design/frame.md).
 // - llvmpipe runs 8 invocations of consecutive x as one SIMD group; they take a 4×2 block of
 //   pixels instead of a row of 8, whose rays diverge less (docs/design/frame.md).

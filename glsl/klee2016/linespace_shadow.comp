@@ -32,7 +32,7 @@
 // any of its lanes does, so nested loops that diverge cost the vector the sum of its lanes'
 // iterations. The kernel stays below the limit instead of detecting it: every loop iteration
 // is counted (WITHIN_BUDGET; initShaft's NUM_RAYS by the host) and an invocation stops past
-// LOOP_BUDGET, which the host sets to the limit's share of one lane (GlInfo::loop_limit; no
+// LOOP_BUDGET, which the host sets to the limit's share of one lane (Profile::loop_limit; no
 // bound elsewhere), so no vector reaches the limit. (A sentinel loop after the work, which
 // ended early if the limit had been reached, proved no guard: on zink the traversal's loops
 // were cut while the sentinel still ran whole, and 174 of 2,294 pixels of the bunny at 10x10

@@ -230,9 +230,12 @@ impl GlContext {
     }
 
     fn open(device: &Device, index: usize, choice: ProfileChoice) -> Result<GlContext> {
+        // (eglInitialize sets up Mesa's screen, which names the renderer: under the lock too)
+        let held = gl_strings_lock();
         // SAFETY: no native display handle is passed; the device comes from query_devices.
         let display = unsafe { Display::with_device(device, None) }
             .map_err(|e| anyhow!("cannot create an EGL display: {e}"))?;
+        drop(held);
         let template = ConfigTemplateBuilder::new()
             .with_surface_type(ConfigSurfaceTypes::empty())
             .build();

@@ -221,8 +221,8 @@ impl Kernel {
         unsafe { self.gl.uniform_matrix_4_f32_slice(self.loc(name), false, m) };
     }
 
-    /// Dispatch this kernel (in use) over the image in tiles of `grid`, each dispatch timed,
-    /// the tile's origin in the uniform `tileOffset`, the tiles between two barriers ([`sync`]:
+    /// Dispatch this kernel (in use) over the image in tiles of `grid`, timed together, the
+    /// tile's origin in the uniform `tileOffset`; one barrier before the first tile ([`sync`]:
     /// the tiles write disjoint pixels).
     pub fn dispatch_pixels(&self, timers: &mut GpuTimers, grid: PixelGrid) {
         self.dispatch_pixel_groups(timers, grid, PIXEL_GROUP);

@@ -137,11 +137,6 @@ impl Profile {
         image_units: GUARANTEED_IMAGE_UNITS,
     };
 
-    /// Whether image unit `unit` may be bound by a compute kernel.
-    pub fn has_image_unit(&self, unit: u32) -> bool {
-        (unit as i64) < self.image_units as i64
-    }
-
     /// The loop limit of the implementation where this profile's kernels do not keep within it
     /// (the `gpu` profile on llvmpipe or zink): the designs whose loops may pass it check their
     /// work against it and refuse, naming it, rather than give an image cut short.

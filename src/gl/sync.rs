@@ -26,8 +26,8 @@
 //!
 //! A pass's own kinds before it also order its stores after the reads of the passes before
 //! (GL 4.6 §7.13.2: stores of a kind issued after a barrier with its bit are not visible to
-//! accesses issued before it). `GPGPU_RT_BARRIERS=all` issues every bit before every access
-//! instead: a GPU run compares the two (`scripts/gpu-check.sh`), since no run on llvmpipe or
+//! accesses issued before it). `GPGPU_RT_BARRIERS=all` issues every pending bit at the first
+//! access after a pass instead, whatever its kind: a GPU run compares the two (`scripts/gpu-check.sh`), since no run on llvmpipe or
 //! lavapipe — whose barriers finish all work whatever the bits — can show a missing bit.
 
 use glow::HasContext;
@@ -94,7 +94,7 @@ pub fn after_pass(gl: &Gl) {
     gl.set_all_barriers_pending();
 }
 
-/// Before and after a pass whose shaders access every kind (seed 004's fragment passes).
+/// Before a pass whose shaders access every kind (seed 004's fragment passes).
 pub fn barrier(gl: &Gl) {
     before(gl, ALL);
 }

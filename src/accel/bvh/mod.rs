@@ -282,8 +282,9 @@ fn image_units_suffice(max_image_units: i32) -> Result<()> {
     let needed = image::BVH as i32 + 1;
     if max_image_units < needed {
         bail!(
-            "--tracer bvh binds image units up to {}, and this GL implementation has {max_image_units} \
-             (GL_MAX_IMAGE_UNITS); use --tracer base or grid",
+            "--tracer bvh binds image units up to {}, and a compute kernel may bind \
+             {max_image_units} here (the least of GL_MAX_IMAGE_UNITS and \
+             GL_MAX_COMPUTE_IMAGE_UNIFORMS); use --tracer base or grid",
             needed - 1
         );
     }

@@ -186,7 +186,7 @@ pub struct Refit {
 
 impl Refit {
     /// The buffers of `tree`'s refit.
-    /// `max_units`: `GL_MAX_IMAGE_UNITS`, for the records' pass' views.
+    /// `max_units`: the profile's compute image units, for the records' pass' views.
     pub fn new(gl: &Arc<Gl>, tree: &BvhTree, max_block: i64, max_units: i32) -> Result<Refit> {
         let t = Topology::of(tree);
         // whole texels, so that the records' pass' view holds every word it reads
@@ -223,8 +223,9 @@ impl Refit {
     }
 
     /// Run the refit's two passes (the BVH's word buffer bound for reading and writing, the
-    /// scene's `vertex` SSBO holding this frame's world-space vertices), a barrier after each:
-    /// the records' pass reads the boxes the boxes' pass wrote (GL 4.6 §7.13). Timed together as
+    /// scene's `vertex` SSBO holding this frame's world-space vertices), the shader bits pending
+    /// before each (`gl::sync`): the records' pass reads the boxes the boxes' pass wrote (GL 4.6
+    /// §7.13). Timed together as
     /// [`REFIT_TIMER`].
     /// `words_storage`: the word buffer is bound as the storage buffer `BVH_WORDS` too (the
     /// passes store through it, else as image texels; `glsl/bvh/refit.glsl`).
@@ -247,8 +248,8 @@ impl Refit {
         words_storage: bool,
         leaves: u32,
     ) {
-        // every refit counts its arrivals from zero (glsl/bvh/refit_leaves.comp); the barrier
-        // after the last refit's passes ordered its atomics before this clear
+        // every refit counts its arrivals from zero (glsl/bvh/refit_leaves.comp); the clear's
+        // own barrier (BUFFER_UPDATE, gl::sync) orders the last refit's atomics before it
         self.arrivals.clear_u32(gl, 0);
         self.topology.bind(gl, ssbo::REFIT_TOPOLOGY);
         self.boxes.bind(gl, ssbo::REFIT_BOXES);
