@@ -153,3 +153,62 @@ fn the_driver_is_picked_by_flag_or_environment() {
         "{err}"
     );
 }
+
+/// A comparison never writes what it compares against, and an `--against` record that cannot
+/// be compared is refused before anything renders: `--out` the same folder, a folder inside
+/// it or a link to it is refused and the record left as it was; a missing folder and a record
+/// that lacks cases are refused with every missing case named, no `--out` folder made.
+#[test]
+fn parity_refuses_to_overwrite_or_to_compare_with_an_incomplete_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = dir.path().join("record");
+    let parity = |out: &Path, against: &Path, only: &str| {
+        Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["parity", "--size", "16", "--only", only, "--out"])
+            .arg(out)
+            .arg("--against")
+            .arg(against)
+            .output()
+            .expect("the binary runs")
+    };
+    let o = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["parity", "--size", "16", "--only", "teapot1-61x47", "--out"])
+        .arg(&record)
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stats = record.join("bvh.teapot1-61x47/stats.json");
+    let before = std::fs::read(&stats).unwrap();
+    let link = dir.path().join("link");
+    std::os::unix::fs::symlink(&record, &link).unwrap();
+    for out in [record.clone(), record.join("inside"), link] {
+        let o = parity(&out, &record, "teapot1-61x47");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{}: {err}", out.display());
+        assert!(err.contains("overwrite the record"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read(&stats).unwrap(),
+        before,
+        "the record is untouched"
+    );
+    assert!(!record.join("inside").exists());
+    let fresh = dir.path().join("fresh");
+    let o = parity(&fresh, &dir.path().join("missing"), "teapot1-61x47");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no such folder"));
+    // the record holds the 61×47 cases only: the plain teapot1 cases are missing
+    let o = parity(&fresh, &record, "teapot1");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("bvh.teapot1:") && err.contains("bvh-fused.teapot1:"),
+        "{err}"
+    );
+    assert!(
+        !fresh.exists(),
+        "refused before anything was rendered or written"
+    );
+}

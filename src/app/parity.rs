@@ -874,6 +874,74 @@ fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The folder `path` names, with its links resolved; a path not made yet (`--out`) resolved
+/// through the nearest folder above it that exists.
+fn resolved(path: &Path) -> PathBuf {
+    let mut missing = Vec::new();
+    let mut p = path.to_path_buf();
+    loop {
+        if let Ok(real) = std::fs::canonicalize(&p) {
+            return missing.iter().rev().fold(real, |acc, part| acc.join(part));
+        }
+        match (p.file_name().map(|n| n.to_owned()), p.parent()) {
+            (Some(name), Some(parent)) => {
+                missing.push(name);
+                p = if parent.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    parent.to_path_buf()
+                };
+            }
+            _ => return path.to_path_buf(),
+        }
+    }
+}
+
+/// Before anything renders: `--out` is not `--against` nor inside it or around it (the run
+/// would overwrite the record it is compared with), and every case of `--against` is there
+/// and readable — all that is wrong named at once.
+fn check_against(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
+    let (o, a) = (resolved(out), resolved(against));
+    if o.starts_with(&a) || a.starts_with(&o) {
+        bail!(
+            "--out {} and --against {} are the same folder or one holds the other: the run would \
+             overwrite the record it is compared with; record into another folder",
+            out.display(),
+            against.display()
+        );
+    }
+    if !against.is_dir() {
+        bail!("--against {}: no such folder", against.display());
+    }
+    let broken: Vec<String> = cases(args.only.as_deref(), args.size)
+        .iter()
+        .filter_map(|c| {
+            let why = match load(&against.join(&c.name)) {
+                Err(e) => format!("{e:#}"),
+                Ok(r) if !r.record.skipped.is_empty() => return None,
+                Ok(r) if (r.record.width, r.record.height) != (c.how.width, c.how.height) => {
+                    format!(
+                        "recorded at {}x{}, this run renders {}x{}",
+                        r.record.width, r.record.height, c.how.width, c.how.height
+                    )
+                }
+                Ok(_) => return None,
+            };
+            Some(format!("{}: {why}", c.name))
+        })
+        .collect();
+    if !broken.is_empty() {
+        bail!(
+            "--against {}: {} of its cases cannot be compared (record them with the same \
+             gpgpu-rt and --size):\n  {}",
+            against.display(),
+            broken.len(),
+            broken.join("\n  ")
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: ParityArgs) -> Result<()> {
     if args.list {
         for c in cases(args.only.as_deref(), args.size) {
@@ -885,6 +953,9 @@ pub fn run(args: ParityArgs) -> Result<()> {
         .out
         .clone()
         .expect("clap requires --out without --list");
+    if let Some(against) = &args.against {
+        check_against(&args, &out, against)?;
+    }
     let ctx = GlContext::headless(args.gpu.device)?;
     eprintln!(
         "parity on {} ({}), profile {}",
