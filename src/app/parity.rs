@@ -600,8 +600,15 @@ fn read_npy<T: npyz::Deserialize>(path: &Path) -> Result<Vec<T>> {
     let bytes = gpgpu_rt::scene::file::read(path)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
     let npy = npyz::NpyFile::new(&bytes[..]).with_context(|| format!("{}", path.display()))?;
-    npy.into_vec::<T>()
-        .with_context(|| format!("{}", path.display()))
+    let promised: u64 = npy.shape().iter().product();
+    npy.into_vec::<T>().map_err(|e| match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => anyhow::anyhow!(
+            "{}: truncated ({} bytes, its header promises {promised} values)",
+            path.display(),
+            bytes.len()
+        ),
+        _ => anyhow::anyhow!("{}: {e}", path.display()),
+    })
 }
 
 fn load(dir: &Path) -> Result<Recorded> {
