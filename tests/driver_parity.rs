@@ -211,4 +211,13 @@ fn parity_refuses_to_overwrite_or_to_compare_with_an_incomplete_record() {
         !fresh.exists(),
         "refused before anything was rendered or written"
     );
+    // a case whose array was cut short is named as truncated
+    let hit_t = record.join("bvh.teapot1-61x47/hit_t.npy");
+    let bytes = std::fs::read(&hit_t).unwrap();
+    std::fs::write(&hit_t, &bytes[..bytes.len() / 2]).unwrap();
+    let o = parity(&fresh, &record, "teapot1-61x47");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("hit_t.npy: truncated"), "{err}");
+    assert!(!fresh.exists());
 }
