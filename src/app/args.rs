@@ -240,6 +240,30 @@ pub enum TracerArg {
 }
 
 /// The command-line name of a value (`base`, `linespace-dda`).
+/// A command-line number that is finite: NaN and ±inf (also "1e39", infinite as an f32) are
+/// refused with what was given, before anything uses them (clap names the option).
+pub fn finite_f32(text: &str) -> Result<f32, String> {
+    let v: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{text:?} is not a finite number"))
+    }
+}
+
+/// [`finite_f32`] for a share between 0 and 1.
+pub fn share_f64(text: &str) -> Result<f64, String> {
+    let v = finite_f32(text)? as f64;
+    if (0.0..=1.0).contains(&v) {
+        Ok(text.trim().parse().unwrap_or(v))
+    } else {
+        Err(format!("{text} is not between 0 and 1"))
+    }
+}
+
 pub fn value_name<T: ValueEnum>(v: T) -> String {
     v.to_possible_value()
         .map(|v| v.get_name().to_string())

@@ -47,14 +47,14 @@ pub struct ParityArgs {
     /// Share of a case's pixels whose first hit may differ (0: none may). Drivers that contract
     /// a·b + c into one rounding (fma, which GLSL allows) can disagree on rays that graze an
     /// edge; CI's llvmpipe/zink comparison allows none.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::args::share_f64)]
     pub tolerance: f64,
     /// Relative difference two drivers' counts may have. The counts of traversals that step by
     /// float comparisons (ray–box slabs, cell boundaries) follow the rounding, and GLSL lets a
     /// compiler contract a·b + c into one fma: on llvmpipe and zink Wagner's node visits differ
     /// by up to 0.3 % and its shadow tests by up to 1.3 % (the turning teapots at 48²), the
     /// stream's cells by one in 92,000, the proximity clouds' jumps by one.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, value_parser = crate::args::share_f64)]
     pub count_tolerance: f64,
     #[command(flatten)]
     pub gpu: GpuArgs,

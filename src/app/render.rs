@@ -53,7 +53,8 @@ pub struct RenderArgs {
         default_value_t = 1.0,
         value_name = "DEG",
         requires = "rotate",
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = crate::args::finite_f32
     )]
     turn: f32,
     #[command(flatten)]
@@ -215,7 +216,7 @@ fn turn(
     i: u32,
 ) -> Result<Camera> {
     match table {
-        Some(t) => t.turn(&mut |k, m| r.set_model(k, m), (args.turn * i as f32) as f64),
+        Some(t) => t.turn(&mut |k, m| r.set_model(k, m), args.turn as f64 * i as f64),
         None => Ok(scene.camera),
     }
 }

@@ -534,6 +534,9 @@ impl<'a> Turntable<'a> {
         set_model: &mut dyn FnMut(usize, Mat4) -> Result<()>,
         angle: f64,
     ) -> Result<Camera> {
+        // a whole number of turns changes nothing: the pose stays finite and exact for any
+        // count of frames (a frame count times the step may pass what an f32 holds)
+        let angle = angle.rem_euclid(360.0);
         Ok(match self.rotate {
             // at 0° before any turn the objects stay where they are: a static tracer (seed
             // 004's stream, which refuses moving objects) renders fixed configurations
