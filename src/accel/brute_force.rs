@@ -39,10 +39,7 @@ pub fn triangles_per_dispatch(info: &GlInfo) -> u32 {
 /// Refuse what the `gpu` profile asks of an implementation with a loop limit (llvmpipe): all of
 /// `triangles` in one loop, past the limit, which would cut the loop short.
 fn refuse_unkept_loop_limit(info: &GlInfo, triangles: u32) -> Result<()> {
-    let unkept = info
-        .profile
-        .unbounded_loops_on_bounded_implementation(info.implementation_loop_limit());
-    match unkept {
+    match info.unkept_loop_limit() {
         Some(l) if triangles > TRIANGLES_PER_DISPATCH => bail!(
             "the {} profile tests all {triangles} triangles in one loop of the base tracer's \
              kernels, and this GL implementation ({}) ends loops after {} iterations; use \

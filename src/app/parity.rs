@@ -302,9 +302,12 @@ fn render_case(
     for k in 1..=3 {
         let turn = Mat4::from_axis_angle(Vec3::Y, (15.0 * k as f32).to_radians());
         r.set_model(object, model * turn)?;
-        if k < 3 && in_flight {
+        if k == 3 {
+            break;
+        }
+        if in_flight {
             r.draw(&scene.camera)?;
-        } else if k < 3 {
+        } else {
             r.render(&scene.camera)?;
         }
     }
@@ -389,10 +392,10 @@ fn ray_scene(name: &str) -> &'static SceneCase {
 /// How often the race case is repeated: races show as runs that differ.
 const REPEATS: u32 = 5;
 
-/// A point-light case of row `row` on `scene`, named `<row>.<suffix>`.
-fn point_case(row_name: &str, suffix: &str, scene: &str, how: Render) -> Spec {
+/// The point-light case `name` of row `row_name` on `scene`.
+fn point_case(name: String, row_name: &str, scene: &str, how: Render) -> Spec {
     Spec {
-        name: format!("{row_name}.{suffix}"),
+        name,
         design: Case {
             row: row(row_name),
             clouds: false,
@@ -417,9 +420,12 @@ fn gpu_cases(size: u32) -> Vec<Spec> {
         ..square
     };
     for scene in ["teapot1", "bunny"] {
-        let mut c = point_case("bvh", scene, scene, fused);
-        c.name = format!("bvh-fused.{scene}");
-        v.push(c);
+        v.push(point_case(
+            format!("bvh-fused.{scene}"),
+            "bvh",
+            scene,
+            fused,
+        ));
     }
     let in_flight = Render {
         in_flight: true,
@@ -430,22 +436,17 @@ fn gpu_cases(size: u32) -> Vec<Spec> {
         options: &["--bvh-instances"],
         ..in_flight
     };
-    let mut c = point_case("bvh", "", turning, instances);
-    c.name = format!("bvh-instances.{turning}-in-flight");
-    v.push(c);
+    let name = format!("bvh-instances.{turning}-in-flight");
+    v.push(point_case(name, "bvh", turning, instances));
     for name in ["bvh", "grid-exact", "bvh-wagner"] {
-        v.push(point_case(
-            name,
-            "teapot3-turning-in-flight",
-            turning,
-            in_flight,
-        ));
+        let case = format!("{name}.{turning}-in-flight");
+        v.push(point_case(case, name, turning, in_flight));
     }
     v.extend(edge_cases(square));
     v.extend(soft_cases(square));
     for k in 1..=REPEATS {
-        let run = format!("teapot1-512-run{k}");
-        v.push(point_case("bvh", &run, "teapot1", Render::square(512)));
+        let case = format!("bvh.teapot1-512-run{k}");
+        v.push(point_case(case, "bvh", "teapot1", Render::square(512)));
     }
     v
 }
@@ -470,12 +471,22 @@ fn edge_cases(square: Render) -> Vec<Spec> {
     };
     let mut v = Vec::new();
     for name in ["base", "grid-exact", "bvh", "bvh-wagner"] {
-        v.push(point_case(name, "teapot1-tile64", "teapot1", tiles));
-        v.push(point_case(name, "teapot1-61x47", "teapot1", odd));
-        v.push(point_case(name, "teapot1-colour", "teapot1", colour));
+        for (suffix, how) in [("tile64", tiles), ("61x47", odd), ("colour", colour)] {
+            v.push(point_case(
+                format!("{name}.teapot1-{suffix}"),
+                name,
+                "teapot1",
+                how,
+            ));
+        }
     }
     for name in ["grid-thesis", "stream"] {
-        v.push(point_case(name, "teapot1-61x47", "teapot1", odd));
+        v.push(point_case(
+            format!("{name}.teapot1-61x47"),
+            name,
+            "teapot1",
+            odd,
+        ));
     }
     v
 }
@@ -625,12 +636,12 @@ fn load(dir: &Path) -> Result<Recorded> {
             color: None,
         });
     }
-    // every array of the case holds one value per pixel of its record's size
+    // every array of the case holds `per_pixel` values per pixel of its record's size
     let pixels = record.width as usize * record.height as usize;
-    let sized = |path: PathBuf, len: usize| -> Result<()> {
-        if len != pixels {
+    let sized = |path: PathBuf, len: usize, per_pixel: usize| -> Result<()> {
+        if len != per_pixel * pixels {
             bail!(
-                "{}: {len} values, but the case is {}x{} pixels",
+                "{}: {len} values, but the case is {}x{} pixels of {per_pixel}",
                 path.display(),
                 record.width,
                 record.height
@@ -644,12 +655,12 @@ fn load(dir: &Path) -> Result<Recorded> {
         dir.join("shadow.npy"),
     );
     let triangle_id: Vec<i32> = read_npy(&ids)?;
-    sized(ids, triangle_id.len())?;
+    sized(ids, triangle_id.len(), 1)?;
     let hit_t: Vec<f32> = read_npy(&t)?;
-    sized(t, hit_t.len())?;
+    sized(t, hit_t.len(), 1)?;
     let shadow = if shadow.exists() {
         let v: Vec<f32> = read_npy(&shadow)?;
-        sized(shadow, v.len())?;
+        sized(shadow, v.len(), 1)?;
         Some(v)
     } else {
         None
@@ -657,7 +668,7 @@ fn load(dir: &Path) -> Result<Recorded> {
     let color = dir.join("color.npy");
     let color = if color.exists() {
         let v: Vec<f32> = read_npy(&color)?;
-        sized(color, v.len() / 3)?;
+        sized(color, v.len(), 3)?;
         Some(v)
     } else {
         None
@@ -794,7 +805,12 @@ fn or_unknown(version: &str) -> &str {
 
 /// Compare every case of `out` with `against`; print a table, write `report.md` into `out`,
 /// and fail where the drivers disagree.
-fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
+fn compare_all(
+    args: &ParityArgs,
+    out: &Path,
+    against: &Path,
+    mut theirs: BTreeMap<String, Recorded>,
+) -> Result<()> {
     let mut lines = vec![
         "| case | pixels | allowed | other first hit | edge ties | other shadow | other colour | counts |"
             .to_string(),
@@ -806,12 +822,7 @@ fn compare_all(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
     for spec in cases(args.only.as_deref(), args.size) {
         let case = spec.name;
         let ours = load(&out.join(&case))?;
-        let theirs = load(&against.join(&case)).with_context(|| {
-            format!(
-                "{} has no case {case}: record it with the same gpgpu-rt",
-                against.display()
-            )
-        })?;
+        let theirs = theirs.remove(&case).expect("check_against read every case");
         if ours.record.version != theirs.record.version && !args.any_commit {
             bail!(
                 "{}: recorded by gpgpu-rt {}, this is {}: record both with the same build, or \
@@ -906,8 +917,12 @@ fn resolved(path: &Path) -> PathBuf {
 
 /// Before anything renders: `--out` is not `--against` nor inside it or around it (the run
 /// would overwrite the record it is compared with), and every case of `--against` is there
-/// and readable — all that is wrong named at once.
-fn check_against(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
+/// and readable — all that is wrong named at once. The cases read, by name.
+fn check_against(
+    args: &ParityArgs,
+    out: &Path,
+    against: &Path,
+) -> Result<BTreeMap<String, Recorded>> {
     let (o, a) = (resolved(out), resolved(against));
     if o.starts_with(&a) || a.starts_with(&o) {
         bail!(
@@ -920,23 +935,24 @@ fn check_against(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
     if !against.is_dir() {
         bail!("--against {}: no such folder", against.display());
     }
-    let broken: Vec<String> = cases(args.only.as_deref(), args.size)
-        .iter()
-        .filter_map(|c| {
-            let why = match load(&against.join(&c.name)) {
-                Err(e) => format!("{e:#}"),
-                Ok(r) if !r.record.skipped.is_empty() => return None,
-                Ok(r) if (r.record.width, r.record.height) != (c.how.width, c.how.height) => {
-                    format!(
-                        "recorded at {}x{}, this run renders {}x{}",
-                        r.record.width, r.record.height, c.how.width, c.how.height
-                    )
-                }
-                Ok(_) => return None,
-            };
-            Some(format!("{}: {why}", c.name))
-        })
-        .collect();
+    let (mut read, mut broken) = (BTreeMap::new(), Vec::new());
+    for c in cases(args.only.as_deref(), args.size) {
+        match load(&against.join(&c.name)) {
+            Err(e) => broken.push(format!("{}: {e:#}", c.name)),
+            Ok(r)
+                if r.record.skipped.is_empty()
+                    && (r.record.width, r.record.height) != (c.how.width, c.how.height) =>
+            {
+                broken.push(format!(
+                    "{}: recorded at {}x{}, this run renders {}x{}",
+                    c.name, r.record.width, r.record.height, c.how.width, c.how.height
+                ))
+            }
+            Ok(r) => {
+                read.insert(c.name, r);
+            }
+        }
+    }
     if !broken.is_empty() {
         bail!(
             "--against {}: {} of its cases cannot be compared (record them with the same \
@@ -946,7 +962,7 @@ fn check_against(args: &ParityArgs, out: &Path, against: &Path) -> Result<()> {
             broken.join("\n  ")
         );
     }
-    Ok(())
+    Ok(read)
 }
 
 pub fn run(args: ParityArgs) -> Result<()> {
@@ -960,9 +976,10 @@ pub fn run(args: ParityArgs) -> Result<()> {
         .out
         .clone()
         .expect("clap requires --out without --list");
-    if let Some(against) = &args.against {
-        check_against(&args, &out, against)?;
-    }
+    let theirs = match &args.against {
+        Some(against) => Some(check_against(&args, &out, against)?),
+        None => None,
+    };
     let ctx = GlContext::headless(args.gpu.device)?;
     eprintln!(
         "parity on {} ({}), profile {}",
@@ -971,8 +988,8 @@ pub fn run(args: ParityArgs) -> Result<()> {
         ctx.info.profile.name.as_str()
     );
     record(&ctx, &args, &out)?;
-    if let Some(against) = &args.against {
-        compare_all(&args, &out, against)?;
+    if let (Some(against), Some(theirs)) = (&args.against, theirs) {
+        compare_all(&args, &out, against, theirs)?;
     }
     Ok(())
 }

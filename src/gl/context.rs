@@ -70,6 +70,16 @@ impl GlInfo {
         })
     }
 
+    /// The implementation's loop limit where the profile's kernels do not keep within it (the
+    /// `gpu` profile on llvmpipe or zink): the designs whose loops may pass it check their work
+    /// against it and refuse, naming it, rather than give an image cut short.
+    pub fn unkept_loop_limit(&self) -> Option<LoopLimit> {
+        match self.profile.loop_limit {
+            Some(_) => None,
+            None => self.implementation_loop_limit(),
+        }
+    }
+
     /// Whether GL_RENDERER names one of Mesa's CPU rasterisers (llvmpipe, alone or under zink
     /// over lavapipe; softpipe): a fact for the profile's automatic choice and for reports.
     pub fn is_software_rasteriser(&self) -> bool {

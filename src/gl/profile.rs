@@ -8,7 +8,7 @@
 //! choices a GPU makes run, and are tested, on llvmpipe and zink. Where the `gpu` profile asks
 //! for what llvmpipe cannot do at all (a loop past its limit), the design that would need it
 //! refuses with a message naming the limit; it never gives a wrong image
-//! ([`Profile::unbounded_loops_on_bounded_implementation`]).
+//! ([`super::GlInfo::unkept_loop_limit`]).
 
 use anyhow::{bail, Result};
 
@@ -136,19 +136,6 @@ impl Profile {
         record_store_64: false,
         image_units: GUARANTEED_IMAGE_UNITS,
     };
-
-    /// The loop limit of the implementation where this profile's kernels do not keep within it
-    /// (the `gpu` profile on llvmpipe or zink): the designs whose loops may pass it check their
-    /// work against it and refuse, naming it, rather than give an image cut short.
-    pub fn unbounded_loops_on_bounded_implementation(
-        &self,
-        implementation: Option<LoopLimit>,
-    ) -> Option<LoopLimit> {
-        match self.loop_limit {
-            Some(_) => None,
-            None => implementation,
-        }
-    }
 
     /// `info`'s lines for the profile: the name and how it was chosen, then each choice.
     pub fn describe(&self) -> Vec<String> {

@@ -48,7 +48,7 @@ use super::context::Gl;
 ///
 /// Not needed: no vertex or index data written by shaders, no atomic counter buffers, pixel
 /// buffers, uniform buffers or transform feedback.
-pub const SHADER_WRITE_READERS: u32 = glow::SHADER_STORAGE_BARRIER_BIT
+pub const ALL: u32 = glow::SHADER_STORAGE_BARRIER_BIT
     | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
     | glow::TEXTURE_FETCH_BARRIER_BIT
     | glow::BUFFER_UPDATE_BARRIER_BIT
@@ -60,9 +60,6 @@ pub const SHADER_WRITE_READERS: u32 = glow::SHADER_STORAGE_BARRIER_BIT
 pub const SHADER: u32 = glow::SHADER_STORAGE_BARRIER_BIT
     | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
     | glow::TEXTURE_FETCH_BARRIER_BIT;
-
-/// Every bit this program may need ([`SHADER_WRITE_READERS`]).
-pub const ALL: u32 = SHADER_WRITE_READERS;
 
 /// The environment variable that makes every access issue every bit (`all`).
 pub const BARRIERS_ENV: &str = "GPGPU_RT_BARRIERS";

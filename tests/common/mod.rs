@@ -31,7 +31,7 @@ pub fn load(name: &str) -> Scene {
 /// lives (below); elsewhere the tests of a file render in parallel.
 pub struct TestContext {
     ctx: GlContext,
-    _turn: Option<std::sync::MutexGuard<'static, ()>>,
+    turn: Option<std::sync::MutexGuard<'static, ()>>,
 }
 
 impl std::ops::Deref for TestContext {
@@ -60,12 +60,12 @@ pub fn context() -> TestContext {
         HOLDS_TURN.set(true);
         held
     });
-    TestContext { ctx, _turn: turn }
+    TestContext { ctx, turn }
 }
 
 impl Drop for TestContext {
     fn drop(&mut self) {
-        if self._turn.is_some() {
+        if self.turn.is_some() {
             HOLDS_TURN.set(false);
         }
     }

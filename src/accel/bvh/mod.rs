@@ -595,7 +595,7 @@ impl Bvh {
         let buffers = self.buffers.as_ref().expect("a built tree's buffers");
         let storage = buffers.bind_storage(f.gl, 0, ssbo::BVH_WORDS, self.moving.max_block);
         if self.moving.abandon_next.take() {
-            refit.run_abandoned(f.gl, f.timers, &self.moving.kernels);
+            refit.run_abandoned(f.gl, f.timers, &self.moving.kernels, storage);
         }
         refit.run(f.gl, f.timers, &self.moving.kernels, storage);
         self.drop_pending();

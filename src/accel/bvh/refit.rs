@@ -236,8 +236,14 @@ impl Refit {
     /// A refit whose boxes pass covers the first `leaves` leaves only: a refit abandoned
     /// halfway, as a lost dispatch would leave it, for the tests that the next one is whole.
     #[doc(hidden)]
-    pub fn run_abandoned(&self, gl: &Gl, timers: &mut GpuTimers, k: &RefitKernels) {
-        self.run_leaves(gl, timers, k, false, self.leaves / 2);
+    pub fn run_abandoned(
+        &self,
+        gl: &Gl,
+        timers: &mut GpuTimers,
+        k: &RefitKernels,
+        words_storage: bool,
+    ) {
+        self.run_leaves(gl, timers, k, words_storage, self.leaves / 2);
     }
 
     fn run_leaves(

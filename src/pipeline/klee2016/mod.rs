@@ -289,9 +289,7 @@ impl SoftShadowRenderer {
             ray_batches: 1,
             last_batches: 1,
             loop_limit: limit,
-            unkept_limit: info
-                .profile
-                .unbounded_loops_on_bounded_implementation(info.implementation_loop_limit()),
+            unkept_limit: info.unkept_loop_limit(),
             last: None,
             gl,
         })
