@@ -69,3 +69,150 @@ fn a_turning_pose_stays_finite_for_any_step() {
     let ids: Vec<i32> = npyz::NpyFile::new(&bytes[..]).unwrap().into_vec().unwrap();
     assert!(ids.iter().any(|&id| id >= 0), "the turned scene is hit");
 }
+
+// ---- output errors are errors, not panics ----
+
+/// A reader that closed the pipe ends the program quietly, killed by SIGPIPE as other Unix
+/// tools are; a full disk under standard output or standard error is exit status 1, never a
+/// panic (101). (Before: `info --json | true` and `> /dev/full` panicked with exit 101.)
+#[test]
+fn a_closed_pipe_or_a_full_disk_is_no_panic() {
+    use std::os::unix::process::ExitStatusExt as _;
+    use std::process::{Command, Stdio};
+    let bin = env!("CARGO_BIN_EXE_gpgpu-rt");
+    let mut child = Command::new(bin)
+        .args(["info", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // closed before the GL context exists, so before any write
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.signal(), Some(libc::SIGPIPE), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let scene = scene_path("teapot1.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("r.png");
+    let render = [
+        "render",
+        scene.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    let cases: [(&[&str], bool); 5] = [
+        (&["info", "--json"], true),
+        (&["info"], true),
+        (&["--help"], true),
+        (&["parity", "--list"], true),
+        (&render, false),
+    ];
+    for (args, to_stdout) in cases {
+        let mut c = Command::new(bin);
+        c.args(args);
+        match to_stdout {
+            true => c.stdout(full()).stderr(Stdio::piped()),
+            false => c.stdout(Stdio::null()).stderr(full()),
+        };
+        let o = c.output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        if to_stdout {
+            let e = stderr(&o);
+            assert!(
+                e.contains("writing to standard output") && e.contains("No space left"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    // the image was written before the summary line failed: only the terminal was full
+    assert!(png.exists());
+}
+
+// ---- a long run keeps what it finished ----
+
+/// `bench thesis-5.1 thesis-5.2`, interrupted while thesis-5.2 measures: thesis-5.1's CSVs,
+/// frames and a report that names thesis-5.2 as unfinished stay; nothing of thesis-5.2 and no
+/// staged file is left. (Before: "14 unfinished output(s) removed" and an empty folder.)
+#[test]
+fn an_interrupted_bench_keeps_the_protocols_it_finished() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args(["bench", "thesis-5.1", "thesis-5.2", "--quiet"])
+        .args(["--width", "8", "--height", "8", "--angles", "1"])
+        .args(["--warmup", "0", "--out", out.to_str().unwrap()])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !out.join("thesis-5.1_summary.csv").exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before 5.1 was kept"
+        );
+        assert!(start.elapsed() < Duration::from_secs(300), "5.1 never kept");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "thesis-5.2 finished before the interrupt: the test needs a slower protocol"
+    );
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let mut names: Vec<String> = walk(&out);
+    names.sort();
+    assert!(
+        names
+            .iter()
+            .all(|n| !n.contains("5.2") && !n.ends_with(".tmp")),
+        "{names:?}"
+    );
+    for kept in ["thesis-5.1.csv", "thesis-5.1_summary.csv", "report.md"] {
+        assert!(names.iter().any(|n| n == kept), "{kept} missing: {names:?}");
+    }
+    assert!(
+        names.iter().any(|n| n.starts_with("frames/thesis-5.1/")),
+        "{names:?}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("Unfinished run") && report.contains("thesis-5.2"),
+        "{report}"
+    );
+    let csv = std::fs::read_to_string(out.join("thesis-5.1_summary.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        10,
+        "nine configurations and the header: {csv}"
+    );
+}
+
+/// Every file below `root`, as a path relative to it.
+fn walk(root: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut dirs = vec![root.to_path_buf()];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            match p.is_dir() {
+                true => dirs.push(p),
+                false => out.push(p.strip_prefix(root).unwrap().display().to_string()),
+            }
+        }
+    }
+    out
+}

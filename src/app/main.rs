@@ -15,6 +15,8 @@ use clap::{ArgMatches, CommandFactory, FromArgMatches, Subcommand};
 use serde_json::json;
 
 use gpgpu_rt::gl::GlContext;
+use gpgpu_rt::outln;
+use gpgpu_rt::output::console;
 use gpgpu_rt::scene::Scene;
 
 #[derive(clap::Parser)]
@@ -69,24 +71,37 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     gpgpu_rt::gl::crash::install();
     gpgpu_rt::output::interrupt::install();
-    let matches = Cli::command().get_matches();
-    let cli = match Cli::from_arg_matches(&matches) {
-        Ok(cli) => cli,
-        Err(e) => e.exit(),
+    let parsed = Cli::command()
+        .try_get_matches()
+        .and_then(|m| Ok((Cli::from_arg_matches(&m)?, m)));
+    let (cli, matches) = match parsed {
+        Ok(p) => p,
+        Err(e) => return usage_exit(&e),
     };
     if let Some(d) = cli.driver {
         // before any thread or GL call: Mesa reads its variables when it loads the driver
         std::env::set_var(gpgpu_rt::gl::driver::DRIVER_ENV, d.name());
     }
     if let Err(e) = gpgpu_rt::scene::budget::check_limit_var() {
-        eprintln!("error: {e}");
-        return ExitCode::FAILURE;
+        return console::exit_for(&anyhow::anyhow!(e));
     }
     match run(cli, &matches) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+        Err(e) => console::exit_for(&e),
+    }
+}
+
+/// `--help`, `--version` or a usage error: clap's text, with its exit status; a text that
+/// cannot be written is a write error as any other (`output::console`).
+fn usage_exit(e: &clap::Error) -> ExitCode {
+    match e.print() {
+        Ok(()) => ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(1)),
+        Err(source) => {
+            let stream = match e.use_stderr() {
+                true => console::Stream::Stderr,
+                false => console::Stream::Stdout,
+            };
+            console::exit_for(&console::ConsoleError { stream, source }.into())
         }
     }
 }
@@ -125,14 +140,14 @@ fn info(scene: Option<PathBuf>, json: bool, gpu: args::GpuArgs) -> Result<()> {
         doc["textures"] = json!(s.textures.len());
     }
     if json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?)?;
     } else if let serde_json::Value::Object(m) = doc {
         for (k, v) in m.iter().filter(|(k, _)| *k != "profile") {
-            println!("{k:36} {v}");
+            outln!("{k:36} {v}")?;
         }
         // the adaptations to the implementation, one a line (GPGPU_RT_PROFILE overrides them)
         for line in ctx.info.profile.describe() {
-            println!("{line}");
+            outln!("{line}")?;
         }
     }
     Ok(())

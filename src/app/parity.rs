@@ -19,6 +19,7 @@ use gpgpu_rt::output::write_npy;
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{Scene, ShadowMode};
+use gpgpu_rt::{errln, outln};
 
 use crate::args::{DesignArgs, GpuArgs};
 
@@ -575,7 +576,7 @@ fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
                     profile: ctx.info.profile.name.as_str().into(),
                 };
                 write_case(&out.join(case), None, &record, how.colour)?;
-                eprintln!("{case}: skipped ({e:#})");
+                errln!("{case}: skipped ({e:#})")?;
                 continue;
             }
             Err(e) => return Err(e.context(format!("parity case {case}"))),
@@ -592,7 +593,7 @@ fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
             profile: ctx.info.profile.name.as_str().into(),
         };
         write_case(&out.join(case), Some(&frame), &record, how.colour)?;
-        eprintln!("{case}: rendered ({:.1} s)", t0.elapsed().as_secs_f64());
+        errln!("{case}: rendered ({:.1} s)", t0.elapsed().as_secs_f64())?;
     }
     Ok(())
 }
@@ -881,7 +882,7 @@ fn compare_all(
     );
     std::fs::write(out.join("report.md"), &report)
         .with_context(|| format!("cannot write {}", out.join("report.md").display()))?;
-    println!("{report}");
+    outln!("{report}")?;
     if !failed.is_empty() {
         bail!(
             "{} of the cases differ between the drivers: {}",
@@ -968,7 +969,7 @@ fn check_against(
 pub fn run(args: ParityArgs) -> Result<()> {
     if args.list {
         for c in cases(args.only.as_deref(), args.size) {
-            println!("{:44} {}", c.name, c.how.describe(&c.design));
+            outln!("{:44} {}", c.name, c.how.describe(&c.design))?;
         }
         return Ok(());
     }
@@ -981,12 +982,12 @@ pub fn run(args: ParityArgs) -> Result<()> {
         None => None,
     };
     let ctx = GlContext::headless(args.gpu.device)?;
-    eprintln!(
+    errln!(
         "parity on {} ({}), profile {}",
         ctx.info.renderer,
         ctx.info.version,
         ctx.info.profile.name.as_str()
-    );
+    )?;
     record(&ctx, &args, &out)?;
     if let (Some(against), Some(theirs)) = (&args.against, theirs) {
         compare_all(&args, &out, against, theirs)?;

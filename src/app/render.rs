@@ -202,7 +202,7 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let camera = turn(&args, &scene, &table, r.as_mut(), args.frames)?;
     let frame = r.render(&camera)?;
     write_outputs(&args, &ctx, &scene, r.as_ref(), &frame)?;
-    eprintln!("{}", summary(&ctx, &scene, &design, &args, &frame));
+    gpgpu_rt::errln!("{}", summary(&ctx, &scene, &design, &args, &frame))?;
     Ok(())
 }
 

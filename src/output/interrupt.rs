@@ -76,7 +76,9 @@ pub fn install() {
                     let n = r.entries.len();
                     r.remove_all();
                     let name = signal_hook::low_level::signal_name(sig).unwrap_or("a signal");
-                    eprintln!("interrupted by {name}: {n} unfinished output(s) removed");
+                    // (a write that fails must not keep the process from ending)
+                    let _ =
+                        crate::errln!("interrupted by {name}: {n} unfinished output(s) removed");
                     // _exit: no destructors or atexit handlers while other threads may be
                     // inside the GL driver; the registry stays held until the end
                     unsafe { libc::_exit(128 + sig) };

@@ -16,6 +16,7 @@
 //! regular file was written and before any is renamed.
 
 mod check;
+pub mod console;
 mod inputs;
 pub mod interrupt;
 mod stage;

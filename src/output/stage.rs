@@ -139,7 +139,7 @@ fn rename_all(temps: Vec<(NamedTempFile, PathBuf)>) -> Result<()> {
 /// file system has no hard links).
 fn keep_old(target: &Path) -> Option<NamedTempFile<()>> {
     let name = target.file_name()?.to_string_lossy();
-    let prefix = format!(".{name}.");
+    let prefix = format!(".{name}.{}", run_mark(std::process::id()));
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".old");
     let link = |p: &Path| fs::hard_link(target, p);
@@ -178,11 +178,70 @@ fn through_link(path: &Path) -> PathBuf {
     }
 }
 
-/// A temporary file `.NAME.XXXXXX.tmp` beside `target`, with `target`'s permissions if it
-/// exists, else those of a new file (0666 less the umask).
+/// What names a staged file as this process's: `gpgpu-rt-PID.` after the target's name.
+fn run_mark(pid: u32) -> String {
+    format!("{RUN_MARK}{pid}.")
+}
+
+const RUN_MARK: &str = "gpgpu-rt-";
+
+/// The process that staged the file `name` (`.NAME.gpgpu-rt-PID.XXXXXX.tmp` or `.old`).
+fn stager_of(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix('.')?;
+    if !(rest.ends_with(".tmp") || rest.ends_with(".old")) {
+        return None;
+    }
+    let (_, after) = rest.rsplit_once(RUN_MARK)?;
+    after.split_once('.')?.0.parse().ok()
+}
+
+/// Is the process `pid` still running? (Where it cannot be told, yes: nothing is removed.)
+fn alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return true;
+        };
+        // signal 0 checks only; ESRCH: no such process
+        let r = unsafe { libc::kill(pid, 0) };
+        r == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
+/// Remove from `dir` the staged files of runs that were killed before they could (SIGKILL, a
+/// power cut): each carries its process id, and a process that no longer runs will not commit
+/// it. Once per folder and process.
+fn sweep_litter(dir: &Path) {
+    static SWEPT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    let mut swept = SWEPT.lock().unwrap_or_else(|e| e.into_inner());
+    if swept.iter().any(|d| d == dir) {
+        return;
+    }
+    swept.push(dir.to_path_buf());
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let dead = stager_of(&name.to_string_lossy())
+            .is_some_and(|pid| pid != std::process::id() && !alive(pid));
+        if dead && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = fs::remove_file(e.path());
+        }
+    }
+}
+
+/// A temporary file `.NAME.gpgpu-rt-PID.XXXXXX.tmp` beside `target`, with `target`'s
+/// permissions if it exists, else those of a new file (0666 less the umask).
 fn temp_beside(target: &Path) -> Result<NamedTempFile> {
     let name = target.file_name().unwrap_or_default().to_string_lossy();
-    let prefix = format!(".{name}.");
+    sweep_litter(parent_of(target));
+    let prefix = format!(".{name}.{}", run_mark(std::process::id()));
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
@@ -233,6 +292,15 @@ impl Batch {
     pub fn commit(self) -> Result<()> {
         let staged = batch().take();
         staged.map_or(Ok(()), Staging::commit)
+    }
+
+    /// Put every file staged so far in place and go on staging into a new staging (a long
+    /// command keeps what it finished: an interrupt removes only what came after).
+    pub fn commit_so_far(&self) -> Result<()> {
+        let mut b = batch();
+        let done = b.replace(Staging::new());
+        drop(b); // the commit takes the interrupt registry, which a staging's files take first
+        done.map_or(Ok(()), Staging::commit)
     }
 
     /// Put in place only the staged files that replace nothing; the others are discarded.
@@ -300,5 +368,33 @@ mod tests {
             .collect();
         names.sort();
         assert_eq!(names, ["a.txt", "b.txt"]);
+    }
+
+    /// A staged file of a process that no longer runs (killed before it could remove it) is
+    /// removed by the next staging in its folder; one of a running process and files of other
+    /// names stay.
+    #[test]
+    fn staged_files_of_a_killed_run_are_swept() {
+        let d = tempfile::tempdir().unwrap();
+        let mut gone = std::process::Command::new("true").spawn().unwrap();
+        gone.wait().unwrap(); // its id names no process now (reaped)
+        let dead = format!(".report.md.{}abc123.tmp", run_mark(gone.id()));
+        let dead_old = format!(".a.csv.{}xyz789.old", run_mark(gone.id()));
+        let running = format!(".report.md.{}abc123.tmp", run_mark(1));
+        let other = ".notes.tmp".to_string();
+        for n in [&dead, &dead_old, &running, &other] {
+            fs::write(d.path().join(n), "x").unwrap();
+        }
+        assert_eq!(stager_of(&dead), Some(gone.id()));
+        assert_eq!(stager_of(&other), None);
+        write_file(&d.path().join("new.txt"), |w| Ok(w.write_all(b"new")?)).unwrap();
+        let mut names: Vec<String> = fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        let mut want = vec![other, running, "new.txt".to_string()];
+        want.sort();
+        assert_eq!(names, want);
     }
 }

@@ -67,6 +67,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use clap::Parser as _;
+use gpgpu_rt::errln;
 use gpgpu_rt::output::Batch;
 
 pub use protocols::{protocol_of, Protocol, Section, Units};
@@ -120,23 +121,32 @@ fn protocols(bench: &Bench) -> Vec<&'static Protocol> {
 /// Measure (or replay) every protocol and write `report.md`; its wall time is this run's plus
 /// `earlier_s` (a merge: the shards').
 fn report(bench: &mut Bench, start: Instant, earlier_s: f64) -> Result<()> {
-    eprintln!(
+    errln!(
         "bench on {} ({}), writing to {}",
         bench.machine.gl_renderer,
         bench.machine.gl_version,
         bench.out.display()
-    );
+    )?;
     let batch = Batch::begin();
-    let sections: Vec<Section> = protocols(bench)
-        .into_iter()
-        .map(|p| run_protocol(p, bench))
-        .collect();
+    let all = protocols(bench);
+    let mut sections: Vec<Section> = Vec::new();
+    for (n, p) in all.iter().enumerate() {
+        sections.push(run_protocol(p, bench)?);
+        // a finished protocol that measured something is put in place now, with a report of
+        // the protocols so far: an interrupt or a crash later loses only the unfinished one
+        let pending: Vec<&str> = all[n + 1..].iter().map(|p| p.name).collect();
+        if !pending.is_empty() && sections[n].measured > 0 {
+            let wall_s = earlier_s + start.elapsed().as_secs_f64();
+            report::write(bench, &sections, wall_s, &pending)?;
+            batch.commit_so_far()?;
+        }
+    }
     let wall_s = earlier_s + start.elapsed().as_secs_f64();
-    let path = report::write(bench, &sections, wall_s)?;
+    let path = report::write(bench, &sections, wall_s, &[])?;
     let failed: usize = sections.iter().map(|s| s.failures).sum();
     let measured: usize = sections.iter().map(|s| s.measured).sum();
     keep_if_measured(batch, measured, failed, &bench.out)?;
-    eprintln!("wrote {}", path.display());
+    errln!("wrote {}", path.display())?;
     if failed > 0 {
         bail!("{failed} configuration(s) failed; see {}", path.display());
     }
@@ -149,7 +159,7 @@ fn list(bench: &mut Bench) -> Result<()> {
         match p.units {
             Units::Whole => {
                 let (i, id) = bench.next_unit(p.name.to_string());
-                shard::print_list_line(i, &id, p.title);
+                shard::print_list_line(i, &id, p.title)?;
             }
             Units::Configs => match (p.run)(p, bench) {
                 Err(e) if e.is::<NotMeasuredHere>() => {}
@@ -165,15 +175,15 @@ fn list(bench: &mut Bench) -> Result<()> {
 
 /// `--shard K/N`: measure the units the shard takes, write their rows and `shard.json`.
 fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> {
-    eprintln!(
+    errln!(
         "bench shard {shard} on {}, writing to {}",
         bench.machine.gl_renderer,
         bench.out.display()
-    );
+    )?;
     let batch = Batch::begin();
     let (mut failed, mut measured) = (0, 0);
     for p in protocols(bench) {
-        let section = run_protocol(p, bench);
+        let section = run_protocol(p, bench)?;
         failed += section.failures;
         measured += section.measured;
     }
@@ -201,12 +211,12 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         _ => keep_if_measured(batch, measured, all_failed, &bench.out)?,
     }
     let done = manifest.configs.len() + manifest.sections.len();
-    eprintln!(
+    errln!(
         "shard {shard}: {done} of {} units measured; wrote {} (merge all {} shards with `gpgpu-rt bench merge DIR… --out DIR`)",
         manifest.units,
         path.display(),
         shard.n
-    );
+    )?;
     let failed = failed + failed_configs;
     if failed > 0 {
         bail!(
@@ -256,27 +266,38 @@ fn same_folder(a: &std::path::Path, b: &std::path::Path) -> bool {
 
 /// Run one protocol; a protocol that fails as a whole gets a section that says why. A whole
 /// protocol is one unit of work: a shard runs it or not, a merge takes its recorded section.
-fn run_protocol(p: &Protocol, bench: &mut Bench) -> Section {
+/// Fails only when the terminal cannot be written (`output::console`).
+fn run_protocol(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     if p.units == Units::Whole {
         let (i, id) = bench.next_unit(p.name.to_string());
         match &bench.mode {
-            Mode::Measure(Some(s)) if !s.takes(i) => return Section::new(p, String::new(), vec![]),
-            Mode::Replay(r) => return replayed_section(p, r, &id, &bench.out),
+            Mode::Measure(Some(s)) if !s.takes(i) => {
+                return Ok(Section::new(p, String::new(), vec![]))
+            }
+            Mode::Replay(r) => return Ok(replayed_section(p, r, &id, &bench.out)),
             _ => {}
         }
     }
-    eprintln!("{}: {}", p.name, p.title);
-    let section = (p.run)(p, bench).unwrap_or_else(|e| {
-        if e.is::<NotMeasuredHere>() {
-            return Section::new(p, String::new(), vec![]);
+    errln!("{}: {}", p.name, p.title)?;
+    let section = match (p.run)(p, bench) {
+        Ok(s) => s,
+        Err(e) if e.is::<NotMeasuredHere>() => Section::new(p, String::new(), vec![]),
+        Err(e) if is_console(&e) => return Err(e),
+        Err(e) => {
+            errln!("{}: failed: {e:#}", p.name)?;
+            Section::failed(p, &e)
         }
-        eprintln!("{}: failed: {e:#}", p.name);
-        Section::failed(p, &e)
-    });
+    };
     if p.units == Units::Whole && matches!(bench.mode, Mode::Measure(Some(_))) {
         bench.sections.insert(p.name.to_string(), section.clone());
     }
-    section
+    Ok(section)
+}
+
+/// Did `e` come from writing to the terminal? Such a protocol did not fail: the run ends.
+fn is_console(e: &anyhow::Error) -> bool {
+    e.chain()
+        .any(|c| c.is::<gpgpu_rt::output::console::ConsoleError>())
 }
 
 /// A whole protocol's section as a shard recorded it, its files copied into `out`.

@@ -300,7 +300,9 @@ fn light_samples(app: &mut App, press: &Press) {
         app.report(what, result);
     } else {
         app.design.samples = next;
-        println!("{what} (for the soft shadows; S shows them)");
+        app.say(gpgpu_rt::outln!(
+            "{what} (for the soft shadows; S shows them)"
+        ));
         app.notice = None;
         app.update_title(true);
     }
@@ -324,7 +326,7 @@ fn screenshot(app: &mut App, _: &Press) {
         height: 0,
     };
     if let Err(e) = app.save_screenshot(path.as_ref(), none) {
-        eprintln!("screenshot failed: {e:#}");
+        app.say(gpgpu_rt::errln!("screenshot failed: {e:#}"));
     }
     app.picture.dirty = true;
 }
@@ -333,8 +335,8 @@ fn reload(app: &mut App, _: &Press) {
     app.reload(None);
 }
 
-fn help(_: &mut App, _: &Press) {
-    println!("{}", controls());
+fn help(app: &mut App, _: &Press) {
+    app.say(gpgpu_rt::outln!("{}", controls()));
 }
 
 fn quit(_: &mut App, press: &Press) {

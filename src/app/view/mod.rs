@@ -42,8 +42,10 @@ use winit::window::WindowId;
 use crate::args::DesignArgs;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::limits;
+use gpgpu_rt::output::console::ConsoleError;
 use gpgpu_rt::output::{self, Format, Target};
 use gpgpu_rt::scene::{Camera, Scene};
+use gpgpu_rt::{errln, outln};
 
 use design::Design;
 use frames::{Clock, FrameCount, Picture};
@@ -251,6 +253,16 @@ impl App {
         }
     }
 
+    /// A line was printed, or not: a terminal that cannot be written any more ends the viewer
+    /// with that error at the next frame (`output::console`: quietly on a closed pipe).
+    fn say(&mut self, said: Result<(), ConsoleError>) {
+        if let Err(e) = said {
+            if self.result.is_ok() {
+                self.result = Err(e.into());
+            }
+        }
+    }
+
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         if self.result.is_ok() {
             self.result = Err(e);
@@ -291,7 +303,7 @@ impl App {
             Some(mode) => self.show_soft(mode, self.design.samples)?,
             None => self.show_tracer(self.design.kind, self.design.options.clone(), false)?,
         }
-        eprintln!(
+        let said = errln!(
             "{}: {} triangles, {} lights, {} area lights, {width}x{height}, {} on {} ({}, {})\n{}",
             self.scene.path.display(),
             self.scene.triangle_count(),
@@ -303,8 +315,10 @@ impl App {
             info.egl_device_name,
             keys::controls(),
         );
+        self.say(said);
         if let Some(w) = self.running.as_ref().and_then(|r| r.watcher.as_ref()) {
-            println!("watching {} for kernel changes", w.dir().display());
+            let said = outln!("watching {} for kernel changes", w.dir().display());
+            self.say(said);
         }
         Ok(())
     }
@@ -391,19 +405,22 @@ impl App {
         };
         match self.reload_kernels(quad) {
             Ok(took) => {
-                println!(
+                let said = outln!(
                     "reload ok: {what} ({} rebuilt in {:.0} ms)",
                     self.design.name(),
                     took.as_secs_f64() * 1e3
                 );
+                self.say(said);
                 self.notice = None;
                 self.frames.start_counting();
             }
             Err(e) => {
                 let msg = format!("{e:#}");
                 // one line on stdout (file:line of the first error), the whole log on stderr
-                println!("reload failed: {what}: {}", headline(&msg));
-                eprintln!("reload failed: {msg}\nthe last good kernels keep running");
+                self.say(outln!("reload failed: {what}: {}", headline(&msg)));
+                self.say(errln!(
+                    "reload failed: {msg}\nthe last good kernels keep running"
+                ));
                 self.notice = Some(format!("reload failed: {}", headline(&msg)));
                 self.picture.dirty = true;
             }
@@ -415,12 +432,12 @@ impl App {
     fn report(&mut self, what: String, result: Result<()>) {
         match result {
             Ok(()) => {
-                println!("{what}");
+                self.say(outln!("{what}"));
                 self.notice = None;
             }
             Err(e) => {
                 let msg = format!("{e:#}");
-                eprintln!("{what} failed: {msg}");
+                self.say(errln!("{what} failed: {msg}"));
                 self.notice = Some(format!("{what} failed: {}", headline(&msg)));
             }
         }
@@ -437,7 +454,9 @@ impl App {
             if let Some(r) = self.running.as_mut() {
                 r.renderers.forget_tracer();
             }
-            println!("{what} (for the ray tracer; soft shadows are shown, S switches)");
+            self.say(outln!(
+                "{what} (for the ray tracer; soft shadows are shown, S switches)"
+            ));
             self.update_title(true);
             return;
         }
@@ -455,7 +474,9 @@ impl App {
         if self.design.kind != used_by {
             self.design.options = options;
             let name = design::value_name(used_by);
-            println!("{what} (used by the {name} tracer; this tracer ignores it)");
+            self.say(outln!(
+                "{what} (used by the {name} tracer; this tracer ignores it)"
+            ));
             self.update_title(true);
         } else {
             self.change(self.design.kind, options, what);
@@ -493,6 +514,9 @@ impl App {
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        if self.result.is_err() {
+            return event_loop.exit();
+        }
         if self.frames.finished || self.running.is_none() {
             return;
         }
@@ -538,7 +562,7 @@ impl App {
                 if self.frames.has_target() {
                     bail!("rendering a frame failed: {msg}");
                 }
-                eprintln!("rendering a frame failed: {msg}");
+                self.say(errln!("rendering a frame failed: {msg}"));
                 self.notice = Some(format!("render failed: {}", headline(&msg)));
                 self.picture.render_failed = true;
             }
@@ -552,7 +576,8 @@ impl App {
         self.clock.frame();
         self.picture.has_frame = true;
         if self.args.log_frames {
-            println!("frame {n}: {}, {}", self.design.name(), stats.log());
+            let said = outln!("frame {n}: {}, {}", self.design.name(), stats.log());
+            self.say(said);
         }
         self.design.note(&stats);
         self.picture.last_stats = Some(stats);
@@ -591,11 +616,11 @@ impl App {
         };
         gpgpu_rt::gl::check_error(&running.window.gl, "reading the frame back")?;
         save_image(path, w, h, &pixels)?;
-        println!(
+        outln!(
             "screenshot: {} ({w}x{h}, frame {}, {from})",
             path.display(),
             self.frames.rendered
-        );
+        )?;
         Ok(())
     }
 

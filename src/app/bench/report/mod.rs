@@ -38,7 +38,14 @@ const WAGNER: &str = "Wagner 2018 (B.Sc. thesis, *Potenzialanalyse der GPU-Besch
                       Raytracing*), ch. 5 and appendix A";
 
 /// Write `<out>/report.md`.
-pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf> {
+/// `pending`: the protocols of the command line not run yet (a report written as each protocol
+/// ends says which are still to come, so a run cut short leaves a report true to its files).
+pub fn write(
+    bench: &Bench,
+    sections: &[Section],
+    wall_s: f64,
+    pending: &[&str],
+) -> Result<PathBuf> {
     // the sources whose protocols ran: the Müller-specific settings only where they apply
     let ran = |prefix: &str| sections.iter().any(|x| x.protocol.starts_with(prefix));
     let (muller, klee, wagner) = (ran("thesis-"), ran("klee-"), ran("wagner-"));
@@ -52,6 +59,14 @@ pub fn write(bench: &Bench, sections: &[Section], wall_s: f64) -> Result<PathBuf
     let command = bench.command.clone();
     let command = command.unwrap_or_else(|| std::env::args().collect::<Vec<_>>().join(" "));
     let mut s = heading(&cited, &command, &bench.machine, wall_s);
+    if !pending.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Unfinished run:** the sections below are the protocols it finished; it had yet to \
+             run {}.\n",
+            pending.join(", ")
+        );
+    }
     s.push_str(&machine(&bench.machine, muller));
     s.push_str(&shards(&bench.contributors));
     if muller {

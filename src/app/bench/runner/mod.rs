@@ -275,7 +275,7 @@ impl Bench {
             .collect();
         if let Mode::List = self.mode {
             for ((i, id), c) in units.iter().zip(configs) {
-                shard::print_list_line(*i, id, &c.label());
+                shard::print_list_line(*i, id, &c.label())?;
             }
             return Err(NotMeasuredHere("listed").into());
         }
@@ -320,7 +320,7 @@ impl Bench {
             let outcome = self.run_config(c, png, &pb);
             pb.set_position(before + c.frames());
             let line = outcome.summary_line();
-            pb.suspend(|| eprintln!("{protocol}: {line}"));
+            pb.suspend(|| gpgpu_rt::errln!("{protocol}: {line}"))?;
             if let Mode::Measure(Some(_)) = self.mode {
                 self.measured.insert(id.clone(), Measured::of(&outcome));
             }

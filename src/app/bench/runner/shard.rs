@@ -80,18 +80,14 @@ pub fn list_line(index: usize, id: &str, label: &str) -> String {
     format!("{}\t{id}\t{label}", index + 1)
 }
 
-/// Print a `--list` line to standard output. A reader that stopped reading (`bench --list |
-/// head`) ends the listing quietly, as Unix tools do: `--list` writes no files.
-pub fn print_list_line(index: usize, id: &str, label: &str) {
-    use std::io::Write as _;
-    let line = list_line(index, id, label);
-    if let Err(e) = writeln!(std::io::stdout().lock(), "{line}") {
-        if e.kind() == std::io::ErrorKind::BrokenPipe {
-            std::process::exit(0);
-        }
-        eprintln!("error: writing the list: {e}");
-        std::process::exit(1);
-    }
+/// Print a `--list` line to standard output (a reader that stopped reading, `bench --list |
+/// head`, ends the program quietly: `output::console`).
+pub fn print_list_line(
+    index: usize,
+    id: &str,
+    label: &str,
+) -> Result<(), gpgpu_rt::output::console::ConsoleError> {
+    gpgpu_rt::outln!("{}", list_line(index, id, label))
 }
 
 /// A configuration as a shard measured it (its [`super::config::Config`] comes back from the
