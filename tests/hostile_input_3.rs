@@ -216,3 +216,152 @@ fn walk(root: &std::path::Path) -> Vec<String> {
     }
     out
 }
+
+// ---- every limit before the memory ----
+
+/// The `gpgpu-rt` binary run with `args` in `dir` (and `env`): its exit code, standard error
+/// and peak resident memory in MB (from wait4, the child's own).
+fn run_measured(dir: &std::path::Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String, u64) {
+    let err_path = dir.join("stderr.txt");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(&err_path).unwrap())
+        .spawn()
+        .unwrap();
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    let code = if libc::WIFEXITED(status) {
+        libc::WEXITSTATUS(status)
+    } else {
+        -1
+    };
+    let err = std::fs::read_to_string(&err_path).unwrap();
+    (code, err, usage.ru_maxrss as u64 / 1024)
+}
+
+const HEAD: &str = "[camera]\nposition = [0.0, 1.2, 4.0]\nlook_at = [0.0, 0.7, 0.0]\n\
+                    up = [0.0, 1.0, 0.0]\nfov_y = 45.0\n[[light]]\nposition = [2.0, 4.0, 3.0]\n";
+
+/// Scenes whose size shows in the file are refused from their counts, a texture from its
+/// header: in well under 300 MB and a second each (before: 2.7 GB after 10 s for 3,000 teapots,
+/// 2.2 GB after 12.5 s for 200 bunnies, a 1.7 GB peak for a 16000² texture under a 300 MB
+/// limit, and `info` decoded the texture).
+#[test]
+fn limits_are_checked_before_the_memory_is_taken() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let models = scene_path("models");
+    let objects = |n: usize, def: &str| -> String {
+        let each = |i: usize| {
+            format!(
+                "[[object]]\n{def}\ntranslate = [{}.0, 0.0, {}.0]\n",
+                i % 50,
+                i / 50
+            )
+        };
+        HEAD.to_string() + &(0..n).map(each).collect::<String>()
+    };
+    let teapot = format!(
+        "type = \"teapot\"\npath = \"{}/teapot.bpt\"\ntessellation = 10",
+        models.display()
+    );
+    let bunny = format!(
+        "type = \"obj\"\npath = \"{}/stanford-bunny.obj\"",
+        models.display()
+    );
+    std::fs::write(dir.join("teapots.toml"), objects(3000, &teapot)).unwrap();
+    std::fs::write(dir.join("bunnies.toml"), objects(200, &bunny)).unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("huge.png"), png_header_only(16000, 16000)).unwrap();
+    std::fs::write(
+        dir.join("tex.toml"),
+        format!("{HEAD}[[object]]\ntype = \"obj\"\npath = \"tri.obj\"\ntexture = \"huge.png\"\n"),
+    )
+    .unwrap();
+    let render = |scene: &str| {
+        [
+            "render", scene, "--width", "16", "--height", "16", "-o", "o.png",
+        ]
+        .map(String::from)
+    };
+    let max_ssbo = {
+        let o = run(&["info", "--json"]);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["max_ssbo_block_size"].as_u64().unwrap()
+    };
+    let limited = [("GPGPU_RT_MEMORY_LIMIT", "300M")];
+    let bunny_bytes = 200 * 69_451 * 48;
+    let cases: Vec<(Vec<String>, &[(&str, &str)], &str)> = vec![
+        (
+            render("teapots.toml").into(),
+            &[],
+            "more than the 16777216 a scene may have",
+        ),
+        (
+            render("bunnies.toml").into(),
+            &limited,
+            "GPGPU_RT_MEMORY_LIMIT",
+        ),
+        (
+            render("tex.toml").into(),
+            &limited,
+            "16000x16000 texels (from the header)",
+        ),
+        (
+            render("tex.toml").into(),
+            &[],
+            "cannot load texture huge.png",
+        ),
+    ];
+    let gl_case = (
+        render("bunnies.toml").to_vec(),
+        &[][..],
+        "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
+    );
+    let gl_applies = bunny_bytes > max_ssbo;
+    for (args, env, says) in cases.into_iter().chain(gl_applies.then_some(gl_case)) {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, err, mb) = run_measured(dir, &args, env);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(mb < 300, "{args:?}: {mb} MB before the refusal");
+    }
+    assert!(!dir.join("o.png").exists());
+    // info reads the texture's header only: the image data (none here) is never decoded
+    let (code, err, mb) = run_measured(dir, &["info", "tex.toml"], &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(mb < 300, "info: {mb} MB");
+}
+
+/// A PNG of `w`×`h` RGBA texels by its header; its image data is a few zero bytes, not the
+/// image (a decoder fails on it, a header reader does not).
+fn png_header_only(w: u32, h: u32) -> Vec<u8> {
+    fn chunk(kind: &[u8], data: &[u8]) -> Vec<u8> {
+        let mut crc = flate2::Crc::new();
+        crc.update(kind);
+        crc.update(data);
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        c.extend_from_slice(kind);
+        c.extend_from_slice(data);
+        c.extend_from_slice(&crc.sum().to_be_bytes());
+        c
+    }
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]);
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut z, &[0; 64]).unwrap();
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(chunk(b"IHDR", &ihdr));
+    png.extend(chunk(b"IDAT", &z.finish().unwrap()));
+    png.extend(chunk(b"IEND", &[]));
+    png
+}

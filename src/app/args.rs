@@ -348,6 +348,13 @@ impl DesignArgs {
         design::select(false, |o| self.value(o)).expect("every --tracer has a design")
     }
 
+    /// Does the design the command line selects for a scene with `settings` upload Müller
+    /// 2015's scene buffers?
+    pub fn uses_scene_buffers(&self, settings: &gpgpu_rt::scene::RenderSettings) -> bool {
+        let soft = self.soft.clone().with_scene_defaults(settings);
+        soft.shadows.is_none() && self.tracer_row().pipeline == design::Pipeline::Mueller2015
+    }
+
     /// The design for `scene`: Klee 2016's soft shadows with `--shadows` (or the scene's
     /// render.shadows), else the point-light design `--tracer` selects; `size` and `aovs`
     /// as the command asks. `matches` (the command's): the options given explicitly, refused

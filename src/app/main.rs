@@ -119,7 +119,7 @@ fn run(cli: Cli, matches: &ArgMatches) -> Result<()> {
 
 /// `info`: the GL implementation and, for a scene, its counts.
 fn info(scene: Option<PathBuf>, json: bool, gpu: args::GpuArgs) -> Result<()> {
-    let scene = scene.as_deref().map(Scene::load).transpose()?;
+    let scene = scene.as_deref().map(Scene::load_counts).transpose()?;
     if gpu.glsl_dir.is_some() {
         bail!("--glsl-dir has no effect on info");
     }

@@ -14,6 +14,7 @@ use gpgpu_rt::design::Design;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output::{Format, Staging, Target};
+use gpgpu_rt::pipeline::mueller2015::gpu_scene;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Camera;
 use gpgpu_rt::scene::Scene;
@@ -181,6 +182,12 @@ fn summary(
 pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let targets = targets(&args);
     output::check(&targets)?;
+    // the GL limits from the scene file's counts, before its meshes take the memory
+    let (triangles, settings) = Scene::count_triangles(&args.scene)?;
+    let ctx = GlContext::headless(args.gpu.device)?;
+    if args.design.uses_scene_buffers(&settings) {
+        gpu_scene::check_counts(&ctx.info, &args.scene, triangles)?;
+    }
     let scene = Scene::load(&args.scene)?;
     output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     let shaders = ShaderSource::from_dir(args.gpu.glsl_dir.clone())?;
@@ -191,7 +198,6 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let design = args
         .design
         .design(&scene, size, args.aov_dir.is_some(), matches)?;
-    let ctx = GlContext::headless(args.gpu.device)?;
     let mut r = design.renderer(ctx.gl.clone(), &ctx.info, &scene, &shaders)?;
     // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
     let table = args.rotate.map(|how| Turntable::new(&scene, how));

@@ -37,6 +37,12 @@ pub fn teapot(path: &Path, n: u32) -> Result<Mesh, SceneError> {
     Ok(mesh)
 }
 
+/// The patches a patch file's header claims (checked against its length when it is parsed).
+pub fn patch_count(path: &Path) -> Result<u64, SceneError> {
+    let text = read_model_text(path, "teapot patches")?;
+    Ok(parse_bpt(path, &text)?.len() as u64)
+}
+
 /// A model file as text, its length checked against the host's memory first.
 pub(super) fn read_model_text(path: &Path, what: &str) -> Result<String, SceneError> {
     super::file::read_text(path)

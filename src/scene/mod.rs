@@ -120,14 +120,46 @@ impl Object {
     }
 }
 
+/// Whether a scene's textures are decoded or only their headers read ([`Scene::load_counts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Textures {
+    Decode,
+    HeadersOnly,
+}
+
+/// Copies of a texture's RGBA8 texels the way to the GPU makes: the decoded image, its RGBA8
+/// conversion, the flipped (and resized) layer, the upload's copy in the driver, and one for a
+/// decoder that works in 16 bits a channel.
+const TEXTURE_COPIES: u64 = 5;
+
 /// Decode a texture within [`crate::limits::TEXTURE_SIDE`] texels a side and
-/// [`crate::limits::TEXTURE_BYTES`] bytes of memory (a small file can claim a huge image).
-fn decode_texture(path: &Path) -> Result<image::RgbaImage, String> {
+/// [`crate::limits::TEXTURE_BYTES`] bytes of memory (a small file can claim a huge image). The
+/// size is read from the header and checked, with the host memory its copies take, before
+/// anything is decoded.
+fn decode_texture(path: &Path, textures: Textures) -> Result<image::RgbaImage, String> {
     use crate::limits::{TEXTURE_BYTES, TEXTURE_SIDE};
     let bytes = file::read(path)?;
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| e.to_string())
+    };
+    let (w, h) = reader()?.into_dimensions().map_err(|e| e.to_string())?;
+    if w > TEXTURE_SIDE || h > TEXTURE_SIDE {
+        return Err(format!(
+            "its header gives {w}x{h} texels; textures may be at most \
+             {TEXTURE_SIDE}x{TEXTURE_SIDE}"
+        ));
+    }
+    let texels = u64::from(w) * u64::from(h);
+    budget::check_host(
+        &format!("its {w}x{h} texels (from the header)"),
+        texels * 4 * TEXTURE_COPIES,
+    )?;
+    if textures == Textures::HeadersOnly {
+        return Ok(image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4])));
+    }
+    let mut reader = reader()?;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(TEXTURE_SIDE);
     limits.max_image_height = Some(TEXTURE_SIDE);
@@ -263,7 +295,32 @@ impl Scene {
     pub fn load_with(path: &Path, overrides: &Overrides) -> Result<Scene, SceneError> {
         let text = file::read_text(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
-        Self::parse(path, &text, overrides)
+        Self::parse(path, &text, overrides, Textures::Decode)
+    }
+
+    /// The triangles the scene file's objects will give, counted from the file, the models'
+    /// headers and face lines and the procedural sizes, before any mesh is built (a PLY face
+    /// counts as one triangle: a lower bound). Checked against [`MAX_SCENE_TRIANGLES`] and the
+    /// host's memory as [`Scene::load`] does first.
+    /// Also gives the file's render settings (unchecked: [`Scene::load`] checks them).
+    pub fn count_triangles(path: &Path) -> Result<(u64, RenderSettings), SceneError> {
+        let text = file::read_text(path)
+            .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
+        let src = SceneText { path, text: &text };
+        let file = src.deserialize()?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let triangles = predict_triangles(&src, dir, &file.object)?;
+        let settings = file.render.map(|r| *r.get_ref()).unwrap_or_default();
+        Ok((triangles, settings))
+    }
+
+    /// The scene for its counts (`info`): every file read and checked as [`Scene::load`] does,
+    /// but each texture only from its header (its size checked, nothing decoded), so
+    /// `textures` holds 1×1 white placeholders. Not for rendering.
+    pub fn load_counts(path: &Path) -> Result<Scene, SceneError> {
+        let text = file::read_text(path)
+            .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
+        Self::parse(path, &text, &Overrides::default(), Textures::HeadersOnly)
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -346,7 +403,12 @@ impl Scene {
         )
     }
 
-    fn parse(path: &Path, text: &str, overrides: &Overrides) -> Result<Scene, SceneError> {
+    fn parse(
+        path: &Path,
+        text: &str,
+        overrides: &Overrides,
+        textures: Textures,
+    ) -> Result<Scene, SceneError> {
         let src = SceneText { path, text };
         let mut file = src.deserialize()?;
         overrides.apply(path, &mut file.object)?;
@@ -389,16 +451,19 @@ impl Scene {
             ));
         }
         let dir = path.parent().unwrap_or(Path::new("."));
+        predict_triangles(&src, dir, &file.object)?;
         for (k, def) in file.object.into_iter().enumerate() {
             let type_line = def.kind.span().start;
             if let Some(key) = def.unknown.keys().next() {
                 return Err(src.unknown_object_key(type_line, key));
             }
-            let object = scene.build_object(dir, k, def).map_err(|e| match e {
-                // errors about the object itself point at its `type` line
-                ObjectError::Here(m) => src.error_at(type_line, m),
-                ObjectError::File(e) => e,
-            })?;
+            let object = scene
+                .build_object(dir, k, def, textures)
+                .map_err(|e| match e {
+                    // errors about the object itself point at its `type` line
+                    ObjectError::Here(m) => src.error_at(type_line, m),
+                    ObjectError::File(e) => e,
+                })?;
             validate::object(&object, scene.materials.len())
                 .map_err(|m| src.error_at(type_line, m))?;
             scene.objects.push(object);
@@ -408,11 +473,11 @@ impl Scene {
         Ok(scene)
     }
 
-    fn load_texture(&mut self, path: &Path) -> Result<u32, ObjectError> {
+    fn load_texture(&mut self, path: &Path, textures: Textures) -> Result<u32, ObjectError> {
         if let Some(i) = self.textures.iter().position(|(p, _)| p == path) {
             return Ok(i as u32);
         }
-        let img = decode_texture(path).map_err(|e| {
+        let img = decode_texture(path, textures).map_err(|e| {
             ObjectError::Here(format!("cannot load texture {}: {e}", path.display()))
         })?;
         self.textures.push((path.to_path_buf(), img));
@@ -432,15 +497,17 @@ impl Scene {
         dir: &Path,
         index: usize,
         def: ObjectDef,
+        textures: Textures,
     ) -> Result<Object, ObjectError> {
         let base = def.base_material()?;
         def.check_type_keys()?;
         def.check_numbers()?;
         let texture = match &def.texture {
-            Some(t) => Some(self.load_texture(&dir.join(t.get_ref()))?),
+            Some(t) => Some(self.load_texture(&dir.join(t.get_ref()), textures)?),
             None => None,
         };
-        let mut mesh = self.object_mesh(dir, &def, Material { texture, ..base })?;
+        let material = Material { texture, ..base };
+        let mut mesh = self.object_mesh(dir, &def, material, textures)?;
         if let Some(size) = def.fit {
             fit(&mut mesh, size)?;
         }
@@ -460,9 +527,13 @@ impl Scene {
         dir: &Path,
         def: &ObjectDef,
         material: Material,
+        textures: Textures,
     ) -> Result<Mesh, ObjectError> {
         let mut mesh = match def.kind.get_ref().as_str() {
-            "obj" => return self.obj_mesh(&def.model_path(dir, "model.obj")?, material, def),
+            "obj" => {
+                let path = def.model_path(dir, "model.obj")?;
+                return self.obj_mesh(&path, material, def, textures);
+            }
             "ply" => def.ply_mesh(dir)?,
             "teapot" => def.teapot_mesh(dir)?,
             "floor" => def.floor_mesh()?,
@@ -488,13 +559,14 @@ impl Scene {
         path: &Path,
         material: Material,
         def: &ObjectDef,
+        textures: Textures,
     ) -> Result<Mesh, ObjectError> {
         let obj = obj::load_obj(path).map_err(ObjectError::File)?;
         let mut ids = Vec::new();
         for m in &obj.materials {
             let texture = match (material.texture, &m.texture) {
                 (Some(t), _) => Some(t),
-                (None, Some(p)) => Some(self.load_texture(p)?),
+                (None, Some(p)) => Some(self.load_texture(p, textures)?),
                 (None, None) => None,
             };
             ids.push(self.add_material(Material {
@@ -512,6 +584,42 @@ impl Scene {
         }
         Ok(mesh)
     }
+}
+
+/// The most triangles a scene may have: Müller 2015's kernels carry a triangle id in a float
+/// channel of the ray state, exact up to 2^24, and the other designs are measured far below.
+pub const MAX_SCENE_TRIANGLES: u64 = 1 << 24;
+
+/// The scene's triangles counted before anything is built ([`Scene::count_triangles`]): an
+/// object whose own size is wrong is named at its `type` line, a total over
+/// [`MAX_SCENE_TRIANGLES`] or the host's memory names the object that passes it. A model file
+/// named by several objects is read once.
+fn predict_triangles(src: &SceneText, dir: &Path, defs: &[ObjectDef]) -> Result<u64, SceneError> {
+    let mut models: std::collections::HashMap<PathBuf, u64> = Default::default();
+    let mut total = 0u64;
+    for (k, def) in defs.iter().enumerate() {
+        let at = |e: ObjectError| match e {
+            ObjectError::Here(m) => src.error_at(def.kind.span().start, m),
+            ObjectError::File(e) => e,
+        };
+        let n = def.predicted_triangles(dir, &mut models).map_err(at)?;
+        total = total.saturating_add(n);
+        let upto = format!(
+            "the scene's objects up to #{} ({})",
+            k + 1,
+            def.kind.get_ref()
+        );
+        if total > MAX_SCENE_TRIANGLES {
+            let m = format!(
+                "{upto} give {total} triangles, more than the {MAX_SCENE_TRIANGLES} a scene may \
+                 have"
+            );
+            return Err(src.error_at(def.kind.span().start, m));
+        }
+        budget::check_triangles(&upto, total)
+            .map_err(|m| src.error_at(def.kind.span().start, m))?;
+    }
+    Ok(total)
 }
 
 /// Centre the mesh (its bottom at y = 0) and scale its largest extent to `size`; an error for
@@ -559,6 +667,46 @@ impl ObjectDef {
                 "an object of type \"{}\" needs path = \"{example}\"",
                 self.kind.get_ref()
             ))
+        })
+    }
+
+    /// The triangles this object will give ([`predict_triangles`]); `models` caches a model
+    /// file's count by path. Sizes out of range are the errors building it gives.
+    fn predicted_triangles(
+        &self,
+        dir: &Path,
+        models: &mut std::collections::HashMap<PathBuf, u64>,
+    ) -> Result<u64, ObjectError> {
+        let mut model = |example: &str, count: fn(&Path) -> Result<u64, SceneError>| {
+            let path = self.model_path(dir, example)?;
+            if let Some(&n) = models.get(&path) {
+                return Ok(n);
+            }
+            let n = count(&path).map_err(ObjectError::File)?;
+            models.insert(path, n);
+            Ok(n)
+        };
+        let s = &self.shape;
+        Ok(match self.kind.get_ref().as_str() {
+            "obj" => model("model.obj", obj::count_triangles)?,
+            "ply" => model("model.ply.gz", ply::count_faces)?,
+            "teapot" => {
+                let n = procedural_size("tessellation", s.tessellation, 10, 1, |n| 2 * n * n)?;
+                let patches = model("models/teapot.bpt", bpt::patch_count)?;
+                patches.saturating_mul(2 * u64::from(n).pow(2))
+            }
+            "floor" => {
+                2 * u64::from(procedural_size("quads", s.quads, 64, 1, |q| 2 * q * q)?).pow(2)
+            }
+            "sphere" => {
+                let stacks = procedural_size("stacks", s.stacks, 16, 2, |_| 0)?;
+                let slices = procedural_size("slices", s.slices, 24, 3, |_| 0)?;
+                shapes::sphere_triangles(stacks.into(), slices.into())
+            }
+            "square" => shapes::square_triangles(
+                procedural_size("level", s.level, 1, 1, shapes::square_triangles)?.into(),
+            ),
+            _ => 0, // an unknown type: its error comes when it is built
         })
     }
 

@@ -33,6 +33,18 @@ pub struct LoadedObj {
 
 /// Load an OBJ file (triangulated) with its MTL materials. Material index
 /// `materials.len()` in `triangle_material` means "no material".
+/// The triangles the OBJ file's faces give (a face of n corners: n − 2), counted from its `f`
+/// lines without parsing the rest: a scene's total is checked before any model is built.
+pub fn count_triangles(path: &Path) -> Result<u64, SceneError> {
+    let text = read_model_text(path, "OBJ file")?;
+    let corners = |l: &str| l.split_whitespace().count().saturating_sub(1) as u64;
+    Ok(text
+        .lines()
+        .filter(|l| l.starts_with("f ") || l.starts_with("f\t"))
+        .map(|l| corners(l).saturating_sub(2))
+        .sum())
+}
+
 pub fn load_obj(path: &Path) -> Result<LoadedObj, SceneError> {
     let text = read_model_text(path, "OBJ file")?;
     let faces_only = check_elements(path, &text)?;

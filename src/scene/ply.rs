@@ -45,6 +45,15 @@ pub fn load_ply(path: &Path) -> Result<Mesh, SceneError> {
     Ok(mesh)
 }
 
+/// The faces the PLY header claims (each at least one triangle), read from the header only: a
+/// scene's total is checked before any model is built.
+pub fn count_faces(path: &Path) -> Result<u64, SceneError> {
+    let bytes = read_ply_bytes(path)?;
+    let faces = header_elements(&bytes)
+        .and_then(|(_, elements, _)| elements.into_iter().find(|e| e.name == "face"));
+    Ok(faces.map_or(0, |e| e.count))
+}
+
 fn read_ply(path: &Path) -> Result<Ply<DefaultElement>, SceneError> {
     let bytes = read_ply_bytes(path)?;
     check_header(&bytes).map_err(|m| SceneError::at(path, None, m))?;

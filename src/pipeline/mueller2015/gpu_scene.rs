@@ -360,6 +360,30 @@ fn ssbo_sizes(scene: &Scene) -> [(u32, &'static str, usize); 8] {
 /// The most triangles Müller 2015's pipeline renders: their ids travel in float channels.
 pub const MAX_TRIANGLES: usize = 1 << 24;
 
+/// The scene file `path`, whose objects will give `triangles` ([`Scene::count_triangles`]),
+/// within this pipeline's limits, checked before the scene is loaded: the ids' 2^24 and the
+/// per-vertex buffers (16 bytes a vertex) within `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`.
+pub fn check_counts(info: &GlInfo, path: &std::path::Path, triangles: u64) -> Result<()> {
+    if triangles > MAX_TRIANGLES as u64 {
+        bail!(
+            "{}: {triangles} triangles, more than the {MAX_TRIANGLES} whose ids the ray-state \
+             images carry exactly (a float channel: 2^24)",
+            path.display()
+        );
+    }
+    let bytes = 16 * 3 * triangles;
+    if bytes > info.max_ssbo_block_size.max(0) as u64 {
+        bail!(
+            "{}: {triangles} triangles need {} in the scene buffer `positions` (16 bytes a \
+             vertex), more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {} of this GL implementation",
+            path.display(),
+            budget::human(bytes),
+            budget::human(info.max_ssbo_block_size.max(0) as u64),
+        );
+    }
+    Ok(())
+}
+
 /// Every buffer the upload will make, estimated before any is made: each SSBO within
 /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, the vertex arrays (host copy and VBOs) within the host's
 /// memory.
@@ -367,13 +391,7 @@ pub fn check_sizes(info: &GlInfo, scene: &Scene) -> Result<()> {
     let triangles = scene.triangle_count();
     // the kernels carry a triangle id in a float channel of the ray state (rayDir.w, the
     // colour buffer's carried hit): exact up to 2^24
-    if triangles > MAX_TRIANGLES {
-        bail!(
-            "{}: {triangles} triangles, more than the {MAX_TRIANGLES} whose ids the ray-state \
-             images carry exactly (a float channel: 2^24)",
-            scene.path.display()
-        );
-    }
+    check_counts(info, &scene.path, triangles as u64)?;
     for (_, name, bytes) in ssbo_sizes(scene) {
         if bytes as i64 > info.max_ssbo_block_size {
             bail!(
