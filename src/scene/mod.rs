@@ -1191,11 +1191,23 @@ mod tests {
     fn errors_name_file_and_line() {
         let text =
             "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[object]]\ntype = \"cube\"\n";
-        let e = Scene::parse(Path::new("x.toml"), text, &Overrides::default()).unwrap_err();
+        let e = Scene::parse(
+            Path::new("x.toml"),
+            text,
+            &Overrides::default(),
+            Textures::Decode,
+        )
+        .unwrap_err();
         assert_eq!(e.line, Some(6), "{e}");
         assert!(e.to_string().contains("unknown object type"), "{e}");
         let text = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfov = 3\n";
-        let e = Scene::parse(Path::new("x.toml"), text, &Overrides::default()).unwrap_err();
+        let e = Scene::parse(
+            Path::new("x.toml"),
+            text,
+            &Overrides::default(),
+            Textures::Decode,
+        )
+        .unwrap_err();
         assert_eq!(e.line, Some(4), "{e}");
     }
 }
