@@ -223,6 +223,7 @@ fn walk(root: &std::path::Path) -> Vec<String> {
 /// and peak resident memory in MB (from wait4, the child's own).
 fn run_measured(dir: &std::path::Path, args: &[&str], env: &[(&str, &str)]) -> (i32, String, u64) {
     let err_path = dir.join("stderr.txt");
+    #[allow(clippy::zombie_processes)] // reaped by wait4 below, which also gives its rusage
     let child = std::process::Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
         .args(args)
         .envs(env.iter().copied())
@@ -299,7 +300,8 @@ fn limits_are_checked_before_the_memory_is_taken() {
     };
     let limited = [("GPGPU_RT_MEMORY_LIMIT", "300M")];
     let bunny_bytes = 200 * 69_451 * 48;
-    let cases: Vec<(Vec<String>, &[(&str, &str)], &str)> = vec![
+    type Case<'a> = (Vec<String>, &'a [(&'a str, &'a str)], &'a str);
+    let cases: Vec<Case> = vec![
         (
             render("teapots.toml").into(),
             &[],

@@ -366,7 +366,22 @@ impl DesignArgs {
         aovs: bool,
         matches: Option<&ArgMatches>,
     ) -> Result<Design> {
-        let soft = self.soft.clone().with_scene_defaults(&scene.settings);
+        let mut settings = scene.settings;
+        let tracer_given =
+            matches.is_some_and(|m| m.value_source("tracer") == Some(ValueSource::CommandLine));
+        if let (Some(mode), true, None) = (settings.shadows, tracer_given, self.soft.shadows) {
+            // an explicit --tracer asks for the point-light tracer: it wins over the scene's
+            // default soft shadows, said aloud
+            gpgpu_rt::errln!(
+                "note: --tracer {} renders the point lights; the soft shadows {} sets \
+                 (render.shadows = \"{}\") are not drawn",
+                value_name(self.tracer),
+                scene.path.display(),
+                mode.name()
+            )?;
+            settings.shadows = None;
+        }
+        let soft = self.soft.clone().with_scene_defaults(&settings);
         let row = match soft.shadows {
             Some(_) => design::row("linespace")?,
             None => self.tracer_row(),

@@ -229,14 +229,29 @@ impl GlContext {
         let what = match driver {
             super::driver::Driver::Auto => "an OpenGL 4.5 core context".to_string(),
             d => format!(
-                "an OpenGL 4.5 core context of {} ({}={}; for zink install \
-                 mesa-vulkan-drivers)",
+                "an OpenGL 4.5 core context of {} (--driver {} or {}={}{})",
+                d.name(),
                 d.name(),
                 super::driver::DRIVER_ENV,
-                d.name()
+                d.name(),
+                match d {
+                    super::driver::Driver::Zink => "; zink needs mesa-vulkan-drivers",
+                    _ => "",
+                }
             ),
         };
-        bail!("no EGL device gives {what}:\n  {}", failures.join("\n  "))
+        let inherited = super::driver::conflicting_variables(driver);
+        let cause = match inherited.is_empty() {
+            true => String::new(),
+            false => format!(
+                "\nthe environment sets {}, which loads another driver: unset it",
+                inherited.join(" and ")
+            ),
+        };
+        bail!(
+            "no EGL device gives {what}:\n  {}{cause}",
+            failures.join("\n  ")
+        )
     }
 
     fn open(device: &Device, index: usize, choice: ProfileChoice) -> Result<GlContext> {

@@ -92,6 +92,30 @@ fn set_mesa_variables(driver: Driver) -> Result<()> {
     Ok(())
 }
 
+/// Mesa's variables from the environment that keep `driver` from being loaded (set before this
+/// program ran: [`set_mesa_variables`] leaves a user's value as it is), as `NAME=value`.
+pub fn conflicting_variables(driver: Driver) -> Vec<String> {
+    let wanted: &[(&str, &str)] = match driver {
+        Driver::Auto => &[],
+        Driver::Llvmpipe => &[
+            ("GALLIUM_DRIVER", "llvmpipe"),
+            ("MESA_LOADER_DRIVER_OVERRIDE", ""),
+        ],
+        Driver::Zink => &[
+            ("GALLIUM_DRIVER", "zink"),
+            ("MESA_LOADER_DRIVER_OVERRIDE", "zink"),
+        ],
+    };
+    let value = |k: &str| std::env::var(k).ok().filter(|v| !v.is_empty());
+    wanted
+        .iter()
+        .filter_map(|(k, want)| {
+            let v = value(k)?;
+            (v != *want).then(|| format!("{k}={v}"))
+        })
+        .collect()
+}
+
 /// A folder of our own, mode 700, for `XDG_RUNTIME_DIR` (Vulkan's loader and zink look there).
 fn runtime_dir() -> Result<std::path::PathBuf> {
     use std::os::unix::fs::{DirBuilderExt, PermissionsExt};

@@ -242,6 +242,23 @@ pub struct RayTracer {
 }
 
 /// Refuse options the pipeline cannot honour, before anything is allocated.
+/// What shortens the loop that passed the implementation's limit, for the tracer `options`
+/// choose (the refusal says it).
+fn loop_limit_advice(options: &RenderOptions) -> &'static str {
+    match options.tracer {
+        TracerKind::Bvh if options.bvh_instances => {
+            "The two-level BVH (--bvh-instances) walks every object whose box a ray enters, and \
+             these overlap: render without --bvh-instances (one tree over all triangles)"
+        }
+        TracerKind::Bvh => "A ray visits too many BVH nodes: a GPU driver runs the loop whole",
+        TracerKind::Grid => {
+            "A ray walks too many voxels or tests too many triangles in one: change \
+             --grid, or use --tracer bvh"
+        }
+        TracerKind::Base => "The base tracer tests every triangle in one loop: use --tracer bvh",
+    }
+}
+
 fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Result<PixelGrid> {
     if scene.lights.len() > options.shadow_flags.max_lights() {
         bail!("{}", too_many_lights(scene, options.shadow_flags));
@@ -704,9 +721,10 @@ impl Renderer for RayTracer {
         if stats.truncated_rays > 0 {
             bail!(
                 "{} shader loops stopped early: this GL implementation ({}) ends long shader loops \
-                 (Mesa llvmpipe: 65535 iterations per invocation); the frame would be wrong",
+                 (Mesa llvmpipe: 65535 iterations per invocation); the frame would be wrong. {}",
                 stats.truncated_rays,
-                self.renderer
+                self.renderer,
+                loop_limit_advice(&self.options)
             );
         }
         super::end_of_frame(&gl, &mut stats, start)?;
