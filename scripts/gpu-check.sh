@@ -31,7 +31,12 @@ any_commit=""
 bin=""
 tests_dir=""
 bundle=target/gpu-check
+usage() { echo "gpu-check: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
+    case "$1" in
+        --out|--reference|--budget|--bin|--tests)
+            [ $# -ge 2 ] && [ -n "$2" ] || usage "$1 needs a value (see --help)" ;;
+    esac
     case "$1" in
         --dry-run) dry_run=1 ;;
         --out) out="$2"; shift ;;
@@ -41,11 +46,26 @@ while [ $# -gt 0 ]; do
         --bin) bin="$2"; shift ;;
         --tests) tests_dir="$2"; shift ;;
         -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
-        *) echo "gpu-check: unknown option $1 (see --help)" >&2; exit 2 ;;
+        *) usage "unknown option $1 (see --help)" ;;
     esac
     shift
 done
-case "$budget" in ''|*[!0-9]*) echo "gpu-check: --budget $budget is not a number of seconds" >&2; exit 2 ;; esac
+# every argument checked before anything runs
+case "$budget" in ''|*[!0-9]*) usage "--budget $budget is not a number of seconds" ;; esac
+[ "$budget" -ge 20 ] || usage "--budget $budget: at least 20 seconds (the steps need some)"
+if [ -n "$reference" ]; then
+    case "$reference" in
+        *.tar.gz) [ -f "$reference" ] || usage "--reference $reference: no such file" ;;
+        *) [ -d "$reference" ] || usage "--reference $reference: no such folder (a parity record, or its .tar.gz)" ;;
+    esac
+fi
+[ -z "$bin" ] || [ -x "$bin" ] || usage "--bin $bin: not an executable file"
+[ -z "$tests_dir" ] || [ -d "$tests_dir" ] || usage "--tests $tests_dir: no such folder"
+if [ -n "$out" ]; then
+    [ ! -e "$out" ] || [ -d "$out" ] || usage "--out $out exists and is not a folder"
+    probe="$out"; while [ ! -e "$probe" ]; do probe=$(dirname "$probe"); done
+    [ -w "$probe" ] || usage "--out $out: $probe is not writable"
+fi
 
 start=$(date +%s)
 left() { echo $(( budget - ($(date +%s) - start) )); }
@@ -171,7 +191,9 @@ if [ -n "$reference" ]; then
     [ "$dry_run" = 1 ] && tolerance=0
     step "parity against llvmpipe" 240 "$bin" parity --size "$size" --tolerance "$tolerance" \
         --out "$out/parity" --against "$reference" $any_commit \
-        > /dev/null 2>>"$out/gpu-check.log" || say "parity: see $out/parity/report.md"
+        > /dev/null 2>>"$out/gpu-check.log" \
+        || { [ -f "$out/parity/report.md" ] && say "parity: see $out/parity/report.md" \
+             || say "parity: no report (see $out/gpu-check.log)"; }
     # the bundle's record unpacked here is the bundle's to keep; one recorded here stays
     [ "$unpacked" = 1 ] && rm -rf "$out/parity-llvmpipe"
     # the barrier bits (gl::sync): every bit before every access against the bits each access
@@ -180,7 +202,9 @@ if [ -n "$reference" ]; then
         say "parity: every barrier bit against the minimal ones"
         GPGPU_RT_BARRIERS=all step "parity, every barrier bit against the minimal ones" 240 \
             "$bin" parity --size "$size" --out "$out/parity-all-barriers" --against "$out/parity" \
-            > /dev/null 2>>"$out/gpu-check.log" || say "barriers: see $out/parity-all-barriers/report.md"
+            > /dev/null 2>>"$out/gpu-check.log" \
+            || { [ -f "$out/parity-all-barriers/report.md" ] && say "barriers: see $out/parity-all-barriers/report.md" \
+                 || say "barriers: no report (see $out/gpu-check.log)"; }
     fi
 fi
 

@@ -42,13 +42,30 @@ fn gpu_check_stops_when_its_budget_is_spent_and_names_what_it_skipped() {
     assert!(info.contains("profile: "), "{info}");
 }
 
+/// Every argument is checked before anything runs (before: `--reference /nonexistent` ran the
+/// whole dry run and then pointed at a report that did not exist).
 #[test]
-fn gpu_check_refuses_a_budget_that_is_no_number() {
-    let o = Command::new("bash")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["scripts/gpu-check.sh", "--dry-run", "--budget", "soon"])
-        .output()
-        .expect("bash runs the script");
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--budget soon"));
+fn gpu_check_refuses_bad_arguments_before_it_runs() {
+    let cases: [(&[&str], &str); 7] = [
+        (&["--budget", "soon"], "--budget soon"),
+        (&["--budget", "3"], "at least 20 seconds"),
+        (&["--reference", "/nonexistent"], "--reference /nonexistent: no such folder"),
+        (&["--reference", "/nonexistent.tar.gz"], "no such file"),
+        (&["--out", "/dev/null"], "is not a folder"),
+        (&["--bin", "/nonexistent"], "not an executable"),
+        (&["--out"], "--out needs a value"),
+    ];
+    for (args, says) in cases {
+        let t0 = Instant::now();
+        let o = Command::new("bash")
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["scripts/gpu-check.sh", "--dry-run"])
+            .args(args)
+            .output()
+            .expect("bash runs the script");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(t0.elapsed().as_secs_f64() < 5.0, "{args:?}: ran before refusing");
+    }
 }
