@@ -49,7 +49,10 @@ fn gpu_check_refuses_bad_arguments_before_it_runs() {
     let cases: [(&[&str], &str); 7] = [
         (&["--budget", "soon"], "--budget soon"),
         (&["--budget", "3"], "at least 20 seconds"),
-        (&["--reference", "/nonexistent"], "--reference /nonexistent: no such folder"),
+        (
+            &["--reference", "/nonexistent"],
+            "--reference /nonexistent: no such folder",
+        ),
         (&["--reference", "/nonexistent.tar.gz"], "no such file"),
         (&["--out", "/dev/null"], "is not a folder"),
         (&["--bin", "/nonexistent"], "not an executable"),
@@ -66,6 +69,9 @@ fn gpu_check_refuses_bad_arguments_before_it_runs() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
-        assert!(t0.elapsed().as_secs_f64() < 5.0, "{args:?}: ran before refusing");
+        assert!(
+            t0.elapsed().as_secs_f64() < 5.0,
+            "{args:?}: ran before refusing"
+        );
     }
 }

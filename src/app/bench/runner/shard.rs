@@ -14,6 +14,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context as _, Result};
+use clap::Parser as _;
 use serde::{Deserialize, Serialize};
 
 use super::machine::Machine;
@@ -204,14 +205,30 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<(Manifest, PathBuf)>> {
     Ok(shards)
 }
 
-/// One run (the same command line and N everywhere), every shard 1..=N exactly once.
+/// What a shard's command line `argv` measures, parsed: the protocols as a set, and neither
+/// where it wrote nor whether it was quiet — two shards of one run may spell their options
+/// differently (`--width 8`, `--width=8`, another order) and still measure the same units.
+fn settings(argv: &[String]) -> Result<String> {
+    let mut args = super::args::Standalone::try_parse_from(argv)
+        .map_err(|e| anyhow::anyhow!("the shard's command line `{}`: {e}", argv.join(" ")))?
+        .args;
+    args.protocols.sort();
+    args.protocols.dedup();
+    args.out = PathBuf::new();
+    args.quiet = false;
+    args.split.shard = None;
+    Ok(format!("{args:?}"))
+}
+
+/// One run (the same settings and N everywhere), every shard 1..=N exactly once.
 fn check_complete(shards: &[(Manifest, PathBuf)]) -> Result<()> {
     let Some((first, first_dir)) = shards.first() else {
         bail!("bench merge needs the output folders of the shards");
     };
     let mut seen: BTreeMap<u32, &Path> = BTreeMap::new();
     for (m, dir) in shards {
-        if m.argv != first.argv || m.shard.n != first.shard.n || m.units != first.units {
+        let same_run = settings(&m.argv)? == settings(&first.argv)?;
+        if !same_run || m.shard.n != first.shard.n || m.units != first.units {
             bail!(
                 "{} and {} are shards of different runs: `{}` ({} shards, {} units) vs `{}` ({} shards, {} units)",
                 first_dir.display(),
