@@ -600,3 +600,55 @@ pub(crate) fn find_scenes_dir(given: Option<&Path>) -> Result<PathBuf> {
         built.display()
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The turntable the bench protocols and `render --rotate` share, against the turn written
+    /// out independently: a world point p of an object lands at R(θ)·(p − c) + c (c the centre
+    /// of the scene's box, R about +y), and the orbiting camera's eye at R(−θ)·(e − c) + c.
+    /// `tests/turning_pose.rs` checks the rendered frames the same way.
+    #[test]
+    fn the_turntable_turns_about_the_scene_centre() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let scene = Scene::load(&root.join("scenes/teapot3.toml")).unwrap();
+        let world = scene.world_triangles();
+        let (lo, hi) = world.iter().flatten().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let c = (0.5 * (lo + hi)).as_dvec3();
+        let turned = |p: glam::DVec3, degrees: f64| {
+            let (s, k) = degrees.to_radians().sin_cos();
+            let (x, z) = (p.x - c.x, p.z - c.z);
+            glam::DVec3::new(c.x + k * x + s * z, p.y, c.z - s * x + k * z)
+        };
+        for degrees in [0.0, 45.0, 200.0, 720.0 + 10.0] {
+            let table = Turntable::new(&scene, Rotation::Objects);
+            let mut models = vec![Mat4::IDENTITY; scene.objects.len()];
+            let camera = table.turn(&mut |k, m| Ok(models[k] = m), degrees).unwrap();
+            assert_eq!(camera.position, scene.camera.position);
+            let mut first = 0;
+            for (o, m) in scene.objects.iter().zip(&models) {
+                let m = if degrees == 0.0 { o.model } else { *m };
+                for (k, t) in o.mesh.positions.chunks(3).enumerate() {
+                    for (v, p) in t.iter().enumerate() {
+                        let got = m.transform_point3(*p).as_dvec3();
+                        let want = turned(world[first + k][v].as_dvec3(), degrees);
+                        assert!((got - want).length() < 1e-4, "{degrees}°: {got} vs {want}");
+                    }
+                }
+                first += o.mesh.positions.len() / 3;
+            }
+            let table = Turntable::new(&scene, Rotation::Camera);
+            let camera = table.turn(&mut |_, _| unreachable!(), degrees).unwrap();
+            let eye = Vec3::from(camera.position).as_dvec3();
+            let want = turned(Vec3::from(scene.camera.position).as_dvec3(), -degrees);
+            assert!(
+                (eye - want).length() < 1e-4,
+                "{degrees}°: eye {eye} vs {want}"
+            );
+        }
+    }
+}
