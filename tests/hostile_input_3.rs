@@ -367,3 +367,113 @@ fn png_header_only(w: u32, h: u32) -> Vec<u8> {
     png.extend(chunk(b"IEND", &[]));
     png
 }
+
+// ---- inputs against every output ----
+
+/// Every output option given an input of the command as its target — the scene file, a model,
+/// its material library, a texture — is refused, and the input is left byte for byte as it
+/// was: `-o`, `--stats`, each file `--aov-dir` writes (the input inside the folder under that
+/// file's name), `export-triangles -o`, `bench --out` and `parity --out`.
+#[test]
+fn no_output_option_writes_over_an_input() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let png = {
+        let img = image::RgbaImage::from_pixel(2, 2, image::Rgba([200, 100, 50, 255]));
+        let mut c = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut c, image::ImageFormat::Png).unwrap();
+        c.into_inner()
+    };
+    // each input kind under a name: in the folder itself, and inside an --aov-dir under the
+    // name of a file it writes
+    let aovs = dir.join("aovs");
+    std::fs::create_dir(&aovs).unwrap();
+    let inputs = |model: &str, mtl: &str, texture: &str| {
+        let obj = format!(
+            "mtllib {mtl}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n"
+        );
+        let scene = format!("{HEAD}[[object]]\ntype = \"obj\"\npath = \"{model}\"\n");
+        (
+            scene,
+            obj,
+            format!("newmtl m\nKd 1 1 1\nmap_Kd {texture}\n"),
+        )
+    };
+    let (scene, obj, mtl) = inputs("m.obj", "m.mtl", "t.png");
+    let files: Vec<(std::path::PathBuf, Vec<u8>)> = vec![
+        (dir.join("s.toml"), scene.into_bytes()),
+        (dir.join("m.obj"), obj.into_bytes()),
+        (dir.join("m.mtl"), mtl.into_bytes()),
+        (dir.join("t.png"), png.clone()),
+    ];
+    let (scene, obj, mtl) = inputs("normal.npy", "ray_origin.npy", "hit_t.npy");
+    let in_aovs: Vec<(std::path::PathBuf, Vec<u8>)> = vec![
+        (aovs.join("triangle_id.npy"), scene.into_bytes()),
+        (aovs.join("normal.npy"), obj.into_bytes()),
+        (aovs.join("ray_origin.npy"), mtl.into_bytes()),
+        (aovs.join("hit_t.npy"), png),
+    ];
+    for (p, bytes) in files.iter().chain(&in_aovs) {
+        std::fs::write(p, bytes).unwrap();
+    }
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let small = ["--width", "8", "--height", "8"].map(String::from);
+    let mut commands: Vec<(String, Vec<String>)> = Vec::new();
+    for (input, _) in &files {
+        let scene = s(&files[0].0);
+        let render = |extra: &[String]| {
+            let mut a = vec!["render".to_string(), scene.clone()];
+            a.extend(small.iter().cloned());
+            a.extend(extra.iter().cloned());
+            a
+        };
+        let name = input.file_name().unwrap().to_string_lossy().into_owned();
+        let png_out = s(&dir.join("out.png"));
+        commands.push((format!("-o {name}"), render(&["-o".into(), s(input)])));
+        let stats = ["-o".into(), png_out, "--stats".into(), s(input)];
+        commands.push((format!("--stats {name}"), render(&stats)));
+        let export = vec![
+            "export-triangles".into(),
+            scene.clone(),
+            "-o".into(),
+            s(input),
+        ];
+        commands.push((format!("export-triangles -o {name}"), export));
+        let bench = ["bench", "thesis-5.1", "--angles", "1", "--warmup", "0", "--out"];
+        let mut bench: Vec<String> = bench.map(String::from).to_vec();
+        bench.splice(2..2, small.iter().cloned());
+        bench.push(s(input));
+        commands.push((format!("bench --out {name}"), bench));
+        let parity = vec![
+            "parity".into(),
+            "--only".into(),
+            "base.teapot1".into(),
+            "--out".into(),
+            s(input),
+        ];
+        commands.push((format!("parity --out {name}"), parity));
+    }
+    let aov_scene = s(&in_aovs[0].0);
+    let mut aov = vec!["render".to_string(), aov_scene];
+    aov.extend(small.iter().cloned());
+    aov.extend([
+        "-o".into(),
+        s(&dir.join("out2.png")),
+        "--aov-dir".into(),
+        s(&aovs),
+    ]);
+    commands.push(("--aov-dir over its inputs".into(), aov));
+    for (what, args) in &commands {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = run(&args);
+        assert!(!o.status.success(), "{what}: accepted");
+        for (p, bytes) in files.iter().chain(&in_aovs) {
+            assert_eq!(
+                &std::fs::read(p).unwrap(),
+                bytes,
+                "{what}: {} changed",
+                p.display()
+            );
+        }
+    }
+}

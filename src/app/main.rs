@@ -51,12 +51,12 @@ enum Command {
     /// Replicate a published evaluation (thesis-5.x: Müller 2015, ch. 5; klee-*: Klee 2016,
     /// ch. 5): CSVs, plots and report.md with our numbers beside the published ones.
     Bench(bench::BenchArgs),
-    /// Print the GL implementation's vendor, renderer, version and limits, and a scene's counts
-    /// (with its point lights' positions and shadow offset).
     /// Render every design and accelerator on a few scenes and write their first hits, shadows
     /// and exact counts to --out; with --against, compare them with another driver's
     /// (docs/drivers.md, "Parity").
     Parity(parity::ParityArgs),
+    /// Print the GL implementation's vendor, renderer, version, limits and profile, and a
+    /// scene's counts (with its point lights' positions and shadow offset).
     Info {
         scene: Option<PathBuf>,
         /// Print JSON.
