@@ -439,7 +439,15 @@ fn no_output_option_writes_over_an_input() {
             s(input),
         ];
         commands.push((format!("export-triangles -o {name}"), export));
-        let bench = ["bench", "thesis-5.1", "--angles", "1", "--warmup", "0", "--out"];
+        let bench = [
+            "bench",
+            "thesis-5.1",
+            "--angles",
+            "1",
+            "--warmup",
+            "0",
+            "--out",
+        ];
         let mut bench: Vec<String> = bench.map(String::from).to_vec();
         bench.splice(2..2, small.iter().cloned());
         bench.push(s(input));

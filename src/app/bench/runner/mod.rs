@@ -627,7 +627,11 @@ mod tests {
         for degrees in [0.0, 45.0, 200.0, 720.0 + 10.0] {
             let table = Turntable::new(&scene, Rotation::Objects);
             let mut models = vec![Mat4::IDENTITY; scene.objects.len()];
-            let camera = table.turn(&mut |k, m| Ok(models[k] = m), degrees).unwrap();
+            let mut keep = |k: usize, m: Mat4| {
+                models[k] = m;
+                Ok(())
+            };
+            let camera = table.turn(&mut keep, degrees).unwrap();
             assert_eq!(camera.position, scene.camera.position);
             let mut first = 0;
             for (o, m) in scene.objects.iter().zip(&models) {
