@@ -13,7 +13,7 @@ use crate::bench::runner::Turntable;
 use gpgpu_rt::design::Design;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::output::{Format, Staging, Target};
+use gpgpu_rt::output::{AovFormat, Format, Staging, Target};
 use gpgpu_rt::pipeline::mueller2015::gpu_scene;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Camera;
@@ -24,7 +24,8 @@ use gpgpu_rt::{limits, output};
 pub struct RenderArgs {
     /// Scene file (TOML), e.g. scenes/teapot1.toml.
     scene: PathBuf,
-    /// Output image: PNG, or JPEG for a name ending in .jpg or .jpeg.
+    /// Output image: PNG; JPEG for a name ending in .jpg or .jpeg; OpenEXR (linear float RGB,
+    /// not clamped) for .exr.
     #[arg(short, long, default_value = "out.png")]
     output: PathBuf,
     /// Image width, 1 to 16384 (default: the scene's render.width).
@@ -33,9 +34,14 @@ pub struct RenderArgs {
     /// Image height, 1 to 16384 (default: the scene's render.height).
     #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
     height: Option<u32>,
-    /// Write NumPy AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal, shadow) here.
+    /// Write the AOVs (ray_origin, ray_direction, hit_t, triangle_id, normal, shadow) here.
     #[arg(long, value_name = "DIR")]
     aov_dir: Option<PathBuf>,
+    /// How --aov-dir writes them: `npy`, a NumPy file each; `exr`, one OpenEXR file
+    /// `aovs.exr` whose channels are named as the npy files (normal.X, …; triangle_id a UINT
+    /// channel with the npy's bits, a miss 4294967295).
+    #[arg(long, value_enum, default_value_t = AovFormat::Npy, requires = "aov_dir")]
+    aov_format: AovFormat,
     /// Write the statistics of the frame as JSON.
     #[arg(long, value_name = "FILE.json")]
     stats: Option<PathBuf>,
@@ -103,14 +109,13 @@ pub fn stats_doc(ctx: &GlContext, scene: &Scene, r: &dyn Renderer, f: &Frame) ->
 
 /// The output files of a render: the image, the AOVs (`--aov-dir`), the statistics (`--stats`).
 fn targets(args: &RenderArgs) -> Vec<Target> {
-    let mut t = vec![Target::file("-o", &args.output, Format::Image)];
+    let mut t = vec![Target::file("-o", &args.output, Format::ColorImage)];
     if let Some(dir) = &args.aov_dir {
-        t.extend(Target::in_folder(
-            "--aov-dir",
-            dir,
-            &output::AOV_FILES,
-            Format::Npy,
-        ));
+        let (files, format) = match args.aov_format {
+            AovFormat::Npy => (&output::AOV_FILES[..], Format::Npy),
+            AovFormat::Exr => (&[output::AOV_EXR][..], Format::Exr),
+        };
+        t.extend(Target::in_folder("--aov-dir", dir, files, format));
     }
     if let Some(path) = &args.stats {
         t.push(Target::file("--stats", path, Format::Json));
@@ -128,12 +133,12 @@ fn write_outputs(
     frame: &Frame,
 ) -> Result<()> {
     let mut s = Staging::new();
-    let img = output::frame_image(frame);
     s.file(&args.output, |w| {
-        output::encode_image(&img, &args.output, w)
+        output::encode_color(frame, &args.output, w)
     })?;
     if let (Some(dir), Some(aovs)) = (&args.aov_dir, &frame.aovs) {
-        output::stage_aovs(&mut s, dir, frame.width, frame.height, aovs)?;
+        let size = (frame.width, frame.height);
+        output::stage_aovs_as(&mut s, args.aov_format, dir, size, aovs)?;
     }
     if let Some(path) = &args.stats {
         let doc = stats_doc(ctx, scene, r, frame);

@@ -10,8 +10,12 @@ use anyhow::{bail, Result};
 /// What a file holds; its name must end in one of the format's extensions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
-    /// The colour image: PNG or JPEG, chosen by the extension (`render -o`, `view --screenshot`).
+    /// The colour image: PNG or JPEG, chosen by the extension (`view --screenshot`).
     Image,
+    /// The colour image as `render -o` writes it: PNG, JPEG or OpenEXR (linear float).
+    ColorImage,
+    /// OpenEXR (`--aov-format exr`).
+    Exr,
     /// A NumPy array (`--aov-dir`, `export-triangles -o`).
     Npy,
     /// JSON (`--stats`).
@@ -23,6 +27,8 @@ impl Format {
     pub fn extensions(self) -> &'static [&'static str] {
         match self {
             Format::Image => &["png", "jpg", "jpeg"],
+            Format::ColorImage => &["png", "jpg", "jpeg", "exr"],
+            Format::Exr => &["exr"],
             Format::Npy => &["npy"],
             Format::Json => &["json"],
         }
@@ -31,6 +37,8 @@ impl Format {
     fn describe(self) -> &'static str {
         match self {
             Format::Image => "a PNG or JPEG image",
+            Format::ColorImage => "a PNG, JPEG or OpenEXR image",
+            Format::Exr => "an OpenEXR image",
             Format::Npy => "a NumPy array",
             Format::Json => "JSON",
         }

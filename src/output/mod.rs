@@ -50,6 +50,77 @@ pub fn frame_image(frame: &Frame) -> image::RgbImage {
     })
 }
 
+/// Is `path` an OpenEXR file by its extension?
+pub fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// The frame's colour for `path`: linear float RGB in OpenEXR for `.exr` (the values as the
+/// kernels computed them, not clamped), else 8-bit PNG or JPEG ([`encode_image`]).
+pub fn encode_color(frame: &Frame, path: &Path, w: &mut dyn WriteSeek) -> Result<()> {
+    if !is_exr(path) {
+        return encode_image(&frame_image(frame), path, w);
+    }
+    let channel = |name: &str, k: usize| {
+        let v: Vec<f32> = frame.color.iter().map(|c| c[k]).collect();
+        exr::prelude::AnyChannel::new(name, exr::prelude::FlatSamples::F32(v))
+    };
+    let channels = vec![channel("R", 0), channel("G", 1), channel("B", 2)];
+    encode_exr(w, (frame.width, frame.height), "color", channels)
+}
+
+/// One OpenEXR image of one layer named `layer` with `channels` (each `width`·`height`
+/// samples, row 0 = top), ZIP-compressed (lossless), to `w`.
+fn encode_exr(
+    w: &mut dyn WriteSeek,
+    (width, height): (u32, u32),
+    layer: &str,
+    channels: Vec<exr::prelude::AnyChannel<exr::prelude::FlatSamples>>,
+) -> Result<()> {
+    use exr::prelude::*;
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::named(layer),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(w)
+        .map_err(|e| anyhow::anyhow!("OpenEXR: {e}"))
+}
+
+/// The AOVs as one OpenEXR file: a channel per npy array and component, named as the files
+/// are (`hit_t`, `triangle_id`, `normal.X`/`.Y`/`.Z`, `ray_origin.X`…, `ray_direction.X`…,
+/// `shadow` where the renderer has it), the same values: f32, and `triangle_id` as a 32-bit
+/// unsigned channel holding the npy's i32 bits (a miss, −1, is 4294967295).
+pub fn encode_aovs_exr(w: &mut dyn WriteSeek, width: u32, height: u32, a: &Aovs) -> Result<()> {
+    use exr::prelude::{AnyChannel, FlatSamples};
+    let f32s = |name: String, v: Vec<f32>| AnyChannel::new(name.as_str(), FlatSamples::F32(v));
+    let vec3 = |name: &str, v: &[[f32; 3]]| {
+        ["X", "Y", "Z"]
+            .into_iter()
+            .enumerate()
+            .map(|(k, axis)| f32s(format!("{name}.{axis}"), v.iter().map(|p| p[k]).collect()))
+            .collect::<Vec<_>>()
+    };
+    let mut channels = vec![
+        f32s("hit_t".into(), a.hit_t.clone()),
+        AnyChannel::new(
+            "triangle_id",
+            FlatSamples::U32(a.triangle_id.iter().map(|&id| id as u32).collect()),
+        ),
+    ];
+    channels.extend(vec3("normal", &a.normal));
+    channels.extend(vec3("ray_origin", &a.ray_origin));
+    channels.extend(vec3("ray_direction", &a.ray_direction));
+    if let Some(s) = &a.shadow {
+        channels.push(f32s("shadow".into(), s.clone()));
+    }
+    encode_exr(w, (width, height), "aovs", channels)
+}
+
 /// Encode `img` for `path`: JPEG for `.jpg`/`.jpeg`, else PNG.
 pub fn encode_image(img: &image::RgbImage, path: &Path, mut w: &mut dyn WriteSeek) -> Result<()> {
     let format = match image::ImageFormat::from_path(path) {
@@ -63,8 +134,7 @@ pub fn encode_image(img: &image::RgbImage, path: &Path, mut w: &mut dyn WriteSee
 /// The frame's colour to `path` (PNG or JPEG by the extension), replacing it only when
 /// complete.
 pub fn write_image(path: &Path, frame: &Frame) -> Result<()> {
-    let img = frame_image(frame);
-    write_file(path, |w| encode_image(&img, path, w))
+    write_file(path, |w| encode_color(frame, path, w))
 }
 
 /// Encode one array as `.npy` with the given shape.
@@ -95,6 +165,36 @@ pub fn write_npy<T: npyz::AutoSerialize + Copy>(
 /// Stage the text `text` as `path`.
 pub fn stage_text(s: &mut Staging, path: &Path, text: &str) -> Result<()> {
     s.file(path, |w| Ok(w.write_all(text.as_bytes())?))
+}
+
+/// The one file of `--aov-format exr`.
+pub const AOV_EXR: &str = "aovs.exr";
+
+/// How `--aov-dir` writes the AOVs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum AovFormat {
+    /// A NumPy `.npy` file per AOV.
+    #[default]
+    Npy,
+    /// One multi-channel OpenEXR file, `aovs.exr`.
+    Exr,
+}
+
+/// Stage the AOVs in `dir` (made if missing) as `format` says.
+pub fn stage_aovs_as(
+    s: &mut Staging,
+    format: AovFormat,
+    dir: &Path,
+    (width, height): (u32, u32),
+    a: &Aovs,
+) -> Result<()> {
+    match format {
+        AovFormat::Npy => stage_aovs(s, dir, width, height, a),
+        AovFormat::Exr => {
+            s.create_folder(dir)?;
+            s.file(&dir.join(AOV_EXR), |w| encode_aovs_exr(w, width, height, a))
+        }
+    }
 }
 
 /// Stage the AOVs of the GUIDE in `dir` (made if missing): ray_origin, ray_direction (f32
