@@ -807,7 +807,7 @@ fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
         }
         let report = std::fs::read_to_string(out.join("report.md")).unwrap();
         assert!(
-            report.contains(&format!("Seed 004, Table {n}:")),
+            report.contains(&format!("The streaming tracer, Table {n}:")),
             "{report}"
         );
         assert!(out.join(format!("{p}.png")).is_file());
@@ -815,7 +815,10 @@ fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     check_report_links(&out, &report);
     let title = report.lines().next().unwrap();
-    assert!(title.starts_with("# Seed 004, Tables 1–3"), "{title}");
+    assert!(
+        title.starts_with("# The streaming tracer, Tables 1–3"),
+        "{title}"
+    );
     // the paper's test machine, as its ch. 4 names it
     assert!(report.contains("GeForce 6800GT 400 MHz with 256 MB at 1100 MHz"));
     assert!(report.contains("NVIDIA driver 1.0-9746"));

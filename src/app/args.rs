@@ -69,8 +69,8 @@ impl std::str::FromStr for GridResolution {
 #[derive(Debug, Clone, clap::Args)]
 pub struct GridArgs {
     /// Grid resolution N (N³ voxels, N from 1 to 1024), or `auto`: N = cbrt(triangles / 5),
-    /// within 4..=64 (--tracer stream: ∛triangles per axis, as seed 004). --tracer stream
-    /// also takes GXxGYxGZ cells, e.g. 14x16x14.
+    /// within 4..=64 (--tracer stream: ∛triangles per axis, as the streaming tracer's paper).
+    /// --tracer stream also takes GXxGYxGZ cells, e.g. 14x16x14.
     #[arg(long, default_value = "auto", value_name = "N|GXxGYxGZ|auto")]
     pub grid: GridResolution,
     /// --tracer stream and --tracer grid --grid-variant exact: skip empty cells by their
@@ -88,20 +88,20 @@ pub struct GridArgs {
     pub stream_max_calls: u32,
     /// --tracer stream: trace shadow rays naively — the closest hit anywhere along the ray,
     /// a blocker when it lies before the light — instead of the paper's any hit closer than
-    /// the light (seed 004, ch. 3): the same shadows, for measuring what the optimisation
-    /// saves.
+    /// the light (the streaming tracer, ch. 3): the same shadows, for measuring what the
+    /// optimisation saves.
     #[arg(long)]
     pub stream_naive_shadows: bool,
-    /// --tracer stream: switch off the masking of rays that need no work (seed 004, ch. 3:
-    /// "rays missed the scene AABB, shadow rays for rays not intersecting any objects") —
-    /// the traverse kernel's first call finds them instead, and the shadow rays of surfaces
-    /// facing away from the light are traced (their verdict unused): the same image, for
-    /// measuring what the masking saves.
+    /// --tracer stream: switch off the masking of rays that need no work (the streaming
+    /// tracer, ch. 3: "rays missed the scene AABB, shadow rays for rays not intersecting any
+    /// objects") — the traverse kernel's first call finds them instead, and the shadow rays of
+    /// surfaces facing away from the light are traced (their verdict unused): the same image,
+    /// for measuring what the masking saves.
     #[arg(long)]
     pub stream_no_mask: bool,
     /// --tracer stream: the paper's single-sided Möller–Trumbore test ("the fastest known
-    /// single sided algorithm", seed 004 ch. 3): a triangle seen from its back is no hit.
-    /// Default: two-sided, as every tracer here.
+    /// single sided algorithm", the streaming tracer, ch. 3): a triangle seen from its back is
+    /// no hit. Default: two-sided, as every tracer here.
     #[arg(long)]
     pub stream_single_sided: bool,
     /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
@@ -131,7 +131,7 @@ impl GridArgs {
         }
     }
 
-    /// Seed 004's streaming tracer with these options for a `width`×`height` image.
+    /// The streaming tracer with these options for a `width`×`height` image.
     pub fn stream(&self, width: u32, height: u32, refl_depth: u32, aovs: bool) -> StreamOptions {
         StreamOptions {
             dims: match self.grid {
@@ -225,7 +225,7 @@ impl SoftShadowArgs {
     }
 }
 
-/// `--tracer`: an accelerator of Müller 2015's pipeline, or seed 004's streaming tracer.
+/// `--tracer`: an accelerator of Müller 2015's pipeline, or the streaming tracer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TracerArg {
     /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
@@ -234,8 +234,9 @@ pub enum TracerArg {
     Grid,
     /// A BVH: ours (SAH, in Müller 2015's pipeline) or Wagner 2018's; see `--bvh-variant`.
     Bvh,
-    /// The streaming ray tracer of seed 004: fragment-program kernels over a viewport-sized
-    /// quad, a static grid built once on the CPU, an occlusion query as the halting condition.
+    /// The streaming tracer (a paper's streaming grid tracer with proximity clouds):
+    /// fragment-program kernels over a viewport-sized quad, a static grid built once on the
+    /// CPU, an occlusion query as the halting condition.
     Stream,
 }
 
@@ -276,7 +277,7 @@ pub struct DesignArgs {
     /// The accelerator of Müller 2015's pipeline: `bvh` (ours: an SAH BVH, the fastest; or
     /// Wagner 2018's with --bvh-variant wagner), `base` (the thesis' base tracer, every ray
     /// against every triangle) or `grid` (the thesis' uniform grid, see --grid-variant); or
-    /// `stream`, seed 004's streaming tracer (fragment-program kernels, a static grid,
+    /// `stream`, the streaming tracer (fragment-program kernels, a static grid,
     /// occlusion-query halting).
     #[arg(long, value_enum, default_value = "bvh")]
     pub tracer: TracerArg,

@@ -49,7 +49,8 @@ enum Command {
     /// --glsl-dir); --screenshot FILE.png --frames N saves the N-th frame and exits.
     View(view::ViewArgs),
     /// Replicate a published evaluation (thesis-5.x: Müller 2015, ch. 5; klee-*: Klee 2016,
-    /// ch. 5): CSVs, plots and report.md with our numbers beside the published ones.
+    /// ch. 5; wagner-*: Wagner 2018, appendix A; proximity-clouds-*: the streaming tracer,
+    /// Tables 1–3): CSVs, plots and report.md with our numbers beside the published ones.
     Bench(bench::BenchArgs),
     /// Render every design and accelerator on a few scenes and write their first hits, shadows
     /// and exact counts to --out; with --against, compare them with another driver's

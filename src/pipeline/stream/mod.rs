@@ -648,8 +648,8 @@ impl Renderer for StreamRenderer {
 
     fn set_model(&mut self, _object: usize, _model: Mat4) -> Result<()> {
         bail!(
-            "the streaming tracer's grid is static (seed 004: built once on the CPU, static \
-             scenes only): objects cannot move"
+            "the streaming tracer's grid is static (as in its paper: built once on the CPU, \
+             static scenes only): objects cannot move"
         )
     }
 

@@ -37,7 +37,7 @@ use gpgpu_rt::pipeline::stream::grid::auto_dims;
 
 pub const ACCEL_COMPARE: Protocol = Protocol {
     name: "accel-compare",
-    title: "every acceleration structure on the same pipeline, scenes and rays (issue 15)",
+    title: "every acceleration structure on the same pipeline, scenes and rays (ours)",
     run,
     units: Units::Configs,
 };
@@ -96,7 +96,7 @@ impl Accelerator {
         match self.row.pipeline {
             Pipeline::Mueller2015 => "Müller 2015 (4 kernels)",
             Pipeline::Wagner2018 => "own: Wagner 2018 megakernel",
-            Pipeline::Stream => "own: seed 004 fragment passes",
+            Pipeline::Stream => "own: streaming tracer fragment passes",
             Pipeline::Klee2016 => "own: Klee 2016 soft shadows",
         }
     }

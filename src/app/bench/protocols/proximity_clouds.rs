@@ -29,22 +29,22 @@ pub const QUICK: Sizing = Sizing::quick(5, 1);
 pub const FULL: Sizing = Sizing::full(10, 2);
 pub const QUICK_SIDES: &[u32] = &[64, 128, 192];
 pub const FULL_SIDES: &[u32] = &pp::SIZES;
-/// Stream vs compute grid on the Stanford bunny at 512² with the 128³ grid (issue 12 §5), in
+/// Stream vs compute grid on the Stanford bunny at 512² with the 128³ grid (ours), in
 /// Table 1 at every scale.
 pub const BUNNY_SIDE: u32 = 512;
 
 pub const PROXIMITY_CLOUDS_TABLE1: Protocol = Protocol {
     name: "proximity-clouds-table1",
-    title: "Ray casting, eye rays only: streaming grid g and pc vs compute grid (seed 004, \
-            Table 1)",
+    title: "Ray casting, eye rays only: streaming grid g and pc vs compute grid (the streaming \
+            tracer, Table 1)",
     run: |p, bench| run(p, bench, 1),
     units: Units::Configs,
 };
 
 pub const PROXIMITY_CLOUDS_TABLE2: Protocol = Protocol {
     name: "proximity-clouds-table2",
-    title: "Shadow casting, eye and shadow rays: streaming grid g and pc vs compute grid (seed \
-            004, Table 2)",
+    title: "Shadow casting, eye and shadow rays: streaming grid g and pc vs compute grid (the \
+            streaming tracer, Table 2)",
     run: |p, bench| run(p, bench, 2),
     units: Units::Configs,
 };
@@ -52,7 +52,7 @@ pub const PROXIMITY_CLOUDS_TABLE2: Protocol = Protocol {
 pub const PROXIMITY_CLOUDS_TABLE3: Protocol = Protocol {
     name: "proximity-clouds-table3",
     title: "Ray tracing, eye, shadow and reflection rays (two levels of recursion): streaming \
-            grid g and pc vs compute grid (seed 004, Table 3)",
+            grid g and pc vs compute grid (the streaming tracer, Table 3)",
     run: |p, bench| run(p, bench, 3),
     units: Units::Configs,
 };

@@ -117,7 +117,7 @@ pub fn table_text(outcomes: &[Outcome]) -> String {
         "instance table ms, CPU (mean per frame)",
         "BVH builds (frames)",
     ];
-    "### The SAH BVH beside them (ours, issue 34)\n\n`--tracer bvh` on the same scenes and frames, \
+    "### The SAH BVH beside them (ours)\n\n`--tracer bvh` on the same scenes and frames, \
      one tree and a tree per object under instances (`--bvh-instances`). With `--rotate objects` \
      every frame moves the objects: the one tree is refitted on the GPU (`bvh_refit_ms`) and \
      rebuilt on the CPU only where a refit grew its SAH cost past `REBUILD_GROWTH`; the \

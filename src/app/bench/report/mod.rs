@@ -28,14 +28,39 @@ use crate::bench::runner::shard::Shard;
 use crate::bench::runner::Bench;
 use format::table;
 
-const MULLER: &str = "Müller 2015 (B.Sc. thesis, *GPGPU ray tracing with OpenGL 4.5 compute \
-                      shaders and a per-frame uniform grid*), ch. 5";
-const KLEE: &str = "Klee 2016 (B.Sc. thesis, *Darstellung von Halbschatten durch Verwendung des \
-                    \"Cascaded Linespace\"-Verfahrens*), ch. 5";
-const SEED004: &str = "Seed 004 (paper, *a GPU ray tracer using regular grid space subdivision, \
-                       improved with proximity cloud information*), Tables 1–3";
-const WAGNER: &str = "Wagner 2018 (B.Sc. thesis, *Potenzialanalyse der GPU-Beschleunigung beim \
-                      Raytracing*), ch. 5 and appendix A";
+/// A published work a report sets our numbers beside: the short name every page uses
+/// (docs/references.md), what the work is, and the part of it the protocols replicate.
+struct Source {
+    name: &'static str,
+    citation: &'static str,
+    part: &'static str,
+}
+
+const MULLER: Source = Source {
+    name: "Müller 2015",
+    citation: "B.Sc. thesis, *Entwicklung eines GPGPU-basierten Ray Tracers*, Universität \
+               Koblenz-Landau, 2015",
+    part: "ch. 5",
+};
+const KLEE: Source = Source {
+    name: "Klee 2016",
+    citation: "B.Sc. thesis, *Darstellung von Halbschatten durch Verwendung des \"Cascaded \
+               Linespace\"-Verfahrens*, Koblenz, 2016",
+    part: "ch. 5",
+};
+const STREAMING: Source = Source {
+    name: "the streaming tracer",
+    citation: "a paper on a streaming GPU ray tracer with a uniform grid and proximity clouds; \
+               its title, authors and venue are not in the available text, see \
+               docs/references.md",
+    part: "Tables 1–3",
+};
+const WAGNER: Source = Source {
+    name: "Wagner 2018",
+    citation: "B.Sc. thesis, *Potenzialanalyse der GPU-Beschleunigung beim Raytracing*, \
+               Hochschule für Angewandte Wissenschaften Hamburg, 2018",
+    part: "ch. 5 and appendix A",
+};
 
 /// Write `<out>/report.md`.
 /// `pending`: the protocols of the command line not run yet (a report written as each protocol
@@ -53,9 +78,9 @@ pub fn write(
         (muller, MULLER),
         (klee, KLEE),
         (wagner, WAGNER),
-        (ran("proximity-clouds-"), SEED004),
+        (ran("proximity-clouds-"), STREAMING),
     ];
-    let cited: Vec<&str> = sources.iter().filter(|s| s.0).map(|s| s.1).collect();
+    let cited: Vec<&Source> = sources.iter().filter(|s| s.0).map(|s| &s.1).collect();
     let command = bench.command.clone();
     let command = command.unwrap_or_else(|| std::env::args().collect::<Vec<_>>().join(" "));
     let mut s = heading(&cited, &command, &bench.machine, wall_s);
@@ -82,15 +107,15 @@ pub fn write(
 
 /// The title, what the report compares (the works `cited`), the command, the date and the wall
 /// time.
-fn heading(cited: &[&str], command: &str, m: &Machine, wall_s: f64) -> String {
-    // "Müller 2015, ch. 5": the citation up to its title
+fn heading(cited: &[&Source], command: &str, m: &Machine, wall_s: f64) -> String {
+    // "Müller 2015, ch. 5": the short name and the part replicated
     let sources: Vec<String> = cited
         .iter()
-        .map(|c| {
-            let (author, rest) = c.split_once(" (").unwrap_or((c, ""));
-            let chapter = rest.rsplit_once("*), ").map_or("", |r| r.1);
-            format!("{author}, {chapter}")
-        })
+        .map(|c| format!("{}, {}", c.name, c.part))
+        .collect();
+    let full: Vec<String> = cited
+        .iter()
+        .map(|c| format!("{} ({}), {}", c.name, c.citation, c.part))
         .collect();
     let mut s = String::new();
     if cited.is_empty() {
@@ -102,7 +127,13 @@ fn heading(cited: &[&str], command: &str, m: &Machine, wall_s: f64) -> String {
              on the hardware.\n"
         );
     } else {
-        let _ = writeln!(s, "# {}, replicated with gpgpu-rt\n", sources.join("; "));
+        let title = sources.join("; ");
+        // a short name starting in lower case ("the streaming tracer") opens the title capitalised
+        let mut first = title.chars();
+        let title: String = first
+            .next()
+            .map_or(String::new(), |c| c.to_uppercase().chain(first).collect());
+        let _ = writeln!(s, "# {title}, replicated with gpgpu-rt\n");
         let _ = writeln!(
             s,
             "Our numbers beside the published ones of {}. The hardware differs, so absolute times \
@@ -110,7 +141,7 @@ fn heading(cited: &[&str], command: &str, m: &Machine, wall_s: f64) -> String {
              to another scene or method). Triangle-test counts do not depend on the hardware, but \
              on the image size, the camera and the scene files, which the sources do not fully \
              state.\n",
-            cited.join(" and ")
+            full.join(" and ")
         );
     }
     let _ = writeln!(

@@ -193,7 +193,7 @@ fn intro(plan: &Plan) -> String {
     };
     let sides: Vec<String> = plan.sides.iter().map(|s| format!("{s}²")).collect();
     format!(
-        "Seed 004, Table {}: {rays}. Ours: `--tracer stream` at the paper's grids (g; pc = \
+        "The streaming tracer, Table {}: {rays}. Ours: `--tracer stream` at the paper's grids (g; pc = \
          `--proximity-clouds`) and the compute exact grid (`--tracer grid`, cubic: the paper's \
          largest axis, so 16³ for Knight's 14×16×14) on the same frames; sides {}, the best GPU \
          milliseconds (sum of the kernels' GL timer queries) of {} frames after {} warm-up, as \
@@ -505,7 +505,7 @@ pub fn figures(protocol: &str, plan: &Plan, outcomes: &[Outcome]) -> Vec<Figure>
     let scenes = [pp::KNIGHT, pp::TORUS_KNOT, pp::BUNNY, SPARSE];
     let charts: Vec<Chart> = scenes.iter().map(|s| chart(plan, outcomes, s)).collect();
     let caption = format!(
-        "Seed 004, Table {}: milliseconds relative to stream g at the smallest side, by side \
+        "The streaming tracer, Table {}: milliseconds relative to stream g at the smallest side, by side \
          relative to the smallest (ours: lines; the paper's: crosses)",
         plan.table
     );

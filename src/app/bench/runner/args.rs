@@ -43,16 +43,17 @@ pub enum ProtocolId {
     /// Wagner 2018, Table A.2 / Table 5.1 / Fig. 5.4: sphere and cow × 5 resolutions.
     #[value(name = "wagner-a2")]
     WagnerA2,
-    /// Seed 004, Table 1: ray casting (eye rays), streaming grid g and pc vs the compute grid.
+    /// The streaming tracer, Table 1: ray casting (eye rays), grid g and pc vs the compute grid.
     #[value(name = "proximity-clouds-table1", alias = "purcell-table1")]
     ProximityCloudsTable1,
-    /// Seed 004, Table 2: shadow casting (eye and shadow rays), g and pc vs the compute grid.
+    /// The streaming tracer, Table 2: shadow casting (eye, shadow rays), g and pc vs compute grid.
     #[value(name = "proximity-clouds-table2", alias = "purcell-table2")]
     ProximityCloudsTable2,
-    /// Seed 004, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs compute grid.
+    /// The streaming tracer, Table 3: ray tracing (eye, shadow, reflection rays), g and pc vs
+    /// the compute grid.
     #[value(name = "proximity-clouds-table3", alias = "purcell-table3")]
     ProximityCloudsTable3,
-    /// Issue 15: every accelerator on every scene and kind of ray (and the stadium).
+    /// Ours: every accelerator on every scene and kind of ray (and the stadium).
     #[value(name = "accel-compare")]
     AccelCompare,
 }
@@ -214,8 +215,8 @@ pub struct WagnerArgs {
     /// triangles (default: the protocol's for the scale; level 1 is always measured).
     #[arg(long, value_delimiter = ',', value_name = "L,...")]
     pub levels: Option<Vec<u32>>,
-    /// BVH variants of the Wagner 2018 protocols, comma-separated (default: those this build
-    /// has, `sah`).
+    /// BVH variants of the Wagner 2018 protocols, comma-separated: `sah` (ours, in Müller 2015's
+    /// pipeline), `wagner` (Wagner 2018's megakernel). Default: both.
     #[arg(long, value_enum, value_delimiter = ',', value_name = "VARIANT,...")]
     pub bvh_variants: Option<Vec<BvhVariant>>,
 }
