@@ -14,7 +14,7 @@
 // light in an RGBA32UI texture (SHADOW_BITS, the bitwise flags of ch. 5). Flags are only ever
 // set here, so the host clears the shadow texture before every pass (ch. 3.1.3 clears the
 // textures once a frame, which would let a reflection pass inherit the flags of the pass
-// before it); see RayTracer::pass in src/pipeline/raytrace/mod.rs.
+// before it); see RayTracer::pass in src/pipeline/mueller2015/mod.rs.
 
 #include "light_target.glsl"
 #include "feeler.glsl"

@@ -164,7 +164,11 @@ fn summary(
             o.samples_v
         ),
         Design::Wagner2018(_) => "1 light, Wagner 2018's bvh tracer".to_string(),
-        d => format!("{} lights, {} tracer", scene.lights.len(), d.row().name),
+        d => {
+            let n = scene.lights.len();
+            let plural = if n == 1 { "" } else { "s" };
+            format!("{n} light{plural}, {} tracer", d.row().name)
+        }
     };
     let mut line = format!(
         "{}: {}x{}, {} triangles, {what} on {}: {:.1} GPU ms, {} triangle tests",
