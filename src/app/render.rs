@@ -16,6 +16,7 @@ use gpgpu_rt::gl::{GlContext, ShaderSource};
 use gpgpu_rt::output::{AovFormat, Format, Staging, Target};
 use gpgpu_rt::pipeline::mueller2015::gpu_scene;
 use gpgpu_rt::pipeline::Renderer;
+use gpgpu_rt::progress;
 use gpgpu_rt::scene::Camera;
 use gpgpu_rt::scene::Scene;
 use gpgpu_rt::{limits, output};
@@ -64,6 +65,9 @@ pub struct RenderArgs {
         value_parser = crate::args::finite_f32
     )]
     turn: f32,
+    /// No progress line (one appears on a terminal when a render takes more than 2 s).
+    #[arg(long)]
+    quiet: bool,
     #[command(flatten)]
     design: DesignArgs,
     #[command(flatten)]
@@ -191,6 +195,8 @@ fn summary(
 pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let targets = targets(&args);
     output::check(&targets)?;
+    let ticker = progress::Ticker::start(args.quiet);
+    progress::stage("loading the scene");
     // the GL limits from the scene file's counts, before its meshes take the memory
     let (triangles, settings) = Scene::count_triangles(&args.scene)?;
     let ctx = GlContext::headless(args.gpu.device)?;
@@ -207,16 +213,22 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
     let design = args
         .design
         .design(&scene, size, args.aov_dir.is_some(), matches)?;
+    progress::stage(format!("building the {}", design.row().name));
     let mut r = design.renderer(ctx.gl.clone(), &ctx.info, &scene, &shaders)?;
     // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported
     let table = args.rotate.map(|how| Turntable::new(&scene, how));
-    for i in 1..args.frames {
+    let n = args.frames;
+    for i in 1..n {
+        progress::stage(format!("frame {i} of {n}"));
         let camera = turn(&args, &scene, &table, r.as_mut(), i)?;
         r.draw(&camera)?;
     }
-    let camera = turn(&args, &scene, &table, r.as_mut(), args.frames)?;
+    progress::stage(format!("frame {n} of {n}"));
+    let camera = turn(&args, &scene, &table, r.as_mut(), n)?;
     let frame = r.render(&camera)?;
+    progress::stage("writing the outputs");
     write_outputs(&args, &ctx, &scene, r.as_ref(), &frame)?;
+    drop(ticker);
     gpgpu_rt::errln!("{}", summary(&ctx, &scene, &design, &args, &frame))?;
     Ok(())
 }

@@ -236,7 +236,9 @@ impl Kernel {
         // one pair of timer queries around all the tiles: a query pair per tile would add its
         // own cost to every tile on a GPU, where a tile takes microseconds
         timers.time(gl, self.timer, || {
-            for (tx, ty, tw, th) in grid.tiles() {
+            let tiles = grid.tiles();
+            for (i, &(tx, ty, tw, th)) in tiles.iter().enumerate() {
+                crate::progress::kernel(self.timer, i + 1, tiles.len());
                 self.set_ivec2("tileOffset", [tx as i32, ty as i32]);
                 let rows = th.div_ceil(group);
                 let stride = PixelGrid::row_stride(rows, grid.threads);

@@ -64,6 +64,10 @@ const WATCH_INTERVAL: Duration = Duration::from_millis(200);
 pub struct ViewArgs {
     /// Scene file (TOML), e.g. scenes/teapot1.toml.
     pub scene: PathBuf,
+    /// No progress line while the scene loads and the first tracer is built (one appears on a
+    /// terminal when that takes more than 2 s).
+    #[arg(long)]
+    pub quiet: bool,
     /// Render width in pixels, 1 to 16384 (default: the scene's render.width); the window
     /// opens at this size.
     #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
@@ -109,7 +113,10 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
         .map(|p| Target::file("--screenshot", p, Format::Image))
         .collect();
     output::check(&targets)?;
+    let ticker = gpgpu_rt::progress::Ticker::start(args.quiet);
+    gpgpu_rt::progress::stage("loading the scene");
     let scene = Scene::load(&args.scene)?;
+    drop(ticker);
     output::refuse_inputs(&targets, &output::scene_inputs(&scene))?;
     // as `render`: the scene file's render.shadows and render.light_samples by default
     args.design.soft = (args.design.soft.clone()).with_scene_defaults(&scene.settings);
@@ -279,6 +286,9 @@ impl App {
     }
 
     fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        // the acceleration structure's build and the kernels' compilation (held to the end)
+        let _ticker = gpgpu_rt::progress::Ticker::start(self.args.quiet);
+        gpgpu_rt::progress::stage(format!("building the {}", self.design.name()));
         let title = format!("gpgpu-rt view · {}", self.scene_name());
         let (width, height) = self.design.size();
         let window = GlWindow::new(event_loop, &title, width, height)?;

@@ -712,6 +712,7 @@ impl Renderer for RayTracer {
             a.keep_rays(&gl, &self.images);
         }
         for pass in 0..=self.options.refl_depth {
+            crate::progress::pass(pass, self.options.refl_depth + 1);
             self.pass(&cam, pass);
             if let (0, Some(a)) = (pass, &self.aov_images) {
                 a.keep_first_hits(&gl, &self.images);
