@@ -400,14 +400,17 @@ fn options_of_the_other_pipeline_are_refused() {
         a.extend_from_slice(extra);
         run(&a)
     };
-    assert_fails(
-        &with(&["--tracer", "grid"]),
-        &[
-            "--tracer does not apply",
-            "render.shadows in",
-            "bunny_area.toml",
-        ],
-    );
+    // an explicit --tracer wins over the scene's render.shadows, and says so
+    let o = with(&["--tracer", "grid"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for needle in [
+        "note: --tracer grid renders the point lights",
+        "bunny_area.toml",
+    ] {
+        assert!(stderr(&o).contains(needle), "{needle}: {}", stderr(&o));
+    }
+    assert!(stderr(&o).contains("grid-exact tracer"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no [[light]]"), "{}", stderr(&o));
     assert_fails(
         &with(&["--shadows", "exact", "--grid", "8", "--refl-depth", "1"]),
         &["--grid, --refl-depth do not apply", "from --shadows"],

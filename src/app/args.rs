@@ -373,9 +373,13 @@ impl DesignArgs {
         if let (Some(mode), true, None) = (settings.shadows, tracer_given, self.soft.shadows) {
             // an explicit --tracer asks for the point-light tracer: it wins over the scene's
             // default soft shadows, said aloud
+            let unlit = match scene.lights.is_empty() {
+                true => "; the scene has no [[light]], so only its ambient light shows",
+                false => "",
+            };
             gpgpu_rt::errln!(
                 "note: --tracer {} renders the point lights; the soft shadows {} sets \
-                 (render.shadows = \"{}\") are not drawn",
+                 (render.shadows = \"{}\") are not drawn{unlit}",
                 value_name(self.tracer),
                 scene.path.display(),
                 mode.name()
