@@ -34,7 +34,7 @@ pub enum Pipeline {
     /// One kernel per pixel over Wagner's BVH in three textures, Wagner 2018.
     Wagner2018,
     /// Fragment programs over a viewport-sized quad, looped until an occlusion query counts
-    /// no fragment, seed 004.
+    /// no fragment, the streaming tracer.
     Stream,
     /// G-buffer, shadow pass over the Cascaded Line Space, screen-filling quad, Klee 2016.
     Klee2016,
@@ -46,7 +46,7 @@ impl Pipeline {
         match self {
             Pipeline::Mueller2015 => "Müller 2015",
             Pipeline::Wagner2018 => "Wagner 2018",
-            Pipeline::Stream => "seed 004",
+            Pipeline::Stream => "the streaming tracer",
             Pipeline::Klee2016 => "Klee 2016",
         }
     }
@@ -158,8 +158,8 @@ mod host_bytes {
     /// and integers 2·48, ids 4, vertices, normals, colours 3·48) staged, owned and copied by
     /// the driver.
     pub const WAGNER: u64 = 44 + 2 * 48 + 3 * (2 * 48 + 4 + 3 * 48);
-    /// Seed 004's textures: two of four RGB32F slices per triangle, staged and in the driver
-    /// (padded to four channels), and the copy of the scene the renderer keeps.
+    /// The streaming tracer's textures: two of four RGB32F slices per triangle, staged and in the
+    /// driver (padded to four channels), and the copy of the scene the renderer keeps.
     pub const STREAM: u64 = 2 * 4 * (12 + 16) + 136;
     /// Klee 2016's N-tree is checked as it is built (`budget::Tracker`), not per triangle.
     pub const KLEE: u64 = 0;
@@ -223,7 +223,7 @@ pub const REGISTRY: &[Row] = &[
     Row {
         name: "stream",
         pipeline: Pipeline::Stream,
-        title: "seed 004's streaming tracer (fragment programs, a static grid)",
+        title: "the streaming tracer (fragment programs, a static grid)",
         select: &[("tracer", "stream")],
         accel: None,
         options: &[&[

@@ -50,8 +50,8 @@ pub struct FrameStats {
     /// frame, the gaps between dispatches that `gpu_ms` leaves out included.
     pub wall_ms: f64,
     /// The work of each kind of rays apart ("primary", "shadow_first_light",
-    /// "shadow_other_lights", "reflection"): Müller 2015's and seed 004's pipelines (see
-    /// `pipeline::ray_kinds`); empty for the others.
+    /// "shadow_other_lights", "reflection"): Müller 2015's and the streaming tracer's pipelines
+    /// (see `pipeline::ray_kinds`); empty for the others.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub ray_kinds: BTreeMap<String, RayKindStats>,
 }

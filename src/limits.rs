@@ -19,7 +19,7 @@ pub const WARMUP: RangeInclusive<u32> = 0..=1000;
 /// Voxels per axis of a uniform grid (N of N³; Müller 2015 measures 8 to 64).
 pub const GRID_RES: RangeInclusive<u32> = 1..=1024;
 /// Steps (triangle tests or cell moves) per call of the streaming tracer's traverse kernel
-/// (seed 004's bounded work per call; llvmpipe ends a loop after 65535 iterations).
+/// (the streaming tracer's bounded work per call; llvmpipe ends a loop after 65535 iterations).
 pub const STREAM_STEPS: RangeInclusive<u32> = 1..=4096;
 /// Calls of the streaming tracer's traverse kernel per traversal, at most.
 pub const STREAM_CALLS: RangeInclusive<u32> = 1..=1_000_000;

@@ -647,10 +647,10 @@ fn paper_ms(rows: &[HashMap<String, String>], scene: &str, column: &str) -> Stri
     row.unwrap_or_else(|| panic!("no row {scene} {column}"))["paper_ms"].clone()
 }
 
-/// Seed 004's Tables 1–3 at 16×16 (one frame each): every scene with the paper's grid in the
-/// stream tracer's g and pc columns (the Stanford bunny g only) and the compute grid; eye rays
-/// only in Table 1 (no lights, no shadow tests), shadows in 2 and 3, two reflection bounces in 3;
-/// the published milliseconds beside ours; the best GPU time the frames' sum.
+/// The streaming tracer's Tables 1–3 at 16×16 (one frame each): every scene with the paper's grid
+/// in the stream tracer's g and pc columns (the Stanford bunny g only) and the compute grid; eye
+/// rays only in Table 1 (no lights, no shadow tests), shadows in 2 and 3, two reflection bounces in
+/// 3; the published milliseconds beside ours; the best GPU time the frames' sum.
 #[test]
 fn proximity_clouds_tables_tiny_rows_grids_and_published_milliseconds() {
     let dir = tempfile::tempdir().unwrap();

@@ -245,7 +245,7 @@ fn scene_models(dir: &Path) {
     std::fs::write(m.join("stanford-bunny.obj"), &cow).unwrap();
     std::fs::write(m.join("teapot.bpt"), read("scenes/models/teapot.bpt")).unwrap();
     std::fs::write(m.join("dragon_vrip_res2.ply.gz"), gz(CUBE_PLY.as_bytes())).unwrap();
-    // seed 004's models are small: themselves
+    // the streaming tracer's models are small: themselves
     for name in [
         "knight_standin.obj",
         "torus_knot.obj",

@@ -77,7 +77,7 @@ fn every_kernel_compiles_without_warnings() {
     };
     one_frame(&ctx, &scene, Design::Wagner2018(opts));
 
-    // the streaming tracer of seed 004: its six fragment programs, with a reflection bounce
+    // the streaming tracer: its six fragment programs, with a reflection bounce
     let opts = StreamOptions {
         width: 8,
         height: 8,

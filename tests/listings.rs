@@ -296,7 +296,7 @@ fn the_map_covers_every_listing_the_issue_names() {
     );
     wanted.extend((1..=5).map(|n| format!("Listing 4.{n}")));
     wanted.extend(["Eq. 4.1", "Fig. 4.3", "Fig. 4.4", "ch. 3.3.2"].map(String::from));
-    // seed 004: the figures of the streaming tracer
+    // the streaming tracer: the figures of the streaming tracer
     wanted.extend(["Fig. 1", "Fig. 2", "Fig. 3"].map(String::from));
     let missing: Vec<&String> = wanted.iter().filter(|w| !items(w)).collect();
     assert!(

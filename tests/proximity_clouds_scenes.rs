@@ -1,8 +1,8 @@
-//! The scenes of seed 004 (Fig. 4–7) and the sparse room: exact triangle counts as the paper's
-//! Tables 1–3; the torus knot's box closed, consistently wound, facing inwards, with the light
-//! and the camera inside and the knot clear of it; the knight stand-in's two closed solids; the
-//! simplified bunny a sane mesh of the original's vertices with the original's bounds; and every
-//! scene's first hits the same with `--tracer stream` (g and pc) and `--tracer grid` as with
+//! The scenes of the streaming tracer (Fig. 4–7) and the sparse room: exact triangle counts as the
+//! paper's Tables 1–3; the torus knot's box closed, consistently wound, facing inwards, with the
+//! light and the camera inside and the knot clear of it; the knight stand-in's two closed solids;
+//! the simplified bunny a sane mesh of the original's vertices with the original's bounds; and
+//! every scene's first hits the same with `--tracer stream` (g and pc) and `--tracer grid` as with
 //! the base tracer.
 
 mod common;

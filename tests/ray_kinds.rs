@@ -1,6 +1,6 @@
-//! The work of each kind of rays apart (issue 15's `accel-compare`): Müller 2015's pipeline (and
-//! seed 004's stream) counts primary rays, the feelers towards the first light and towards the
-//! others, and the reflection rays into banks of its counter buffer, and times them apart. Checked for every
+//! The work of each kind of rays apart (`accel-compare`): Müller 2015's pipeline (and the streaming
+//! tracer) counts primary rays, the feelers towards the first light and towards the others, and the
+//! reflection rays into banks of its counter buffer, and times them apart. Checked for every
 //! accelerator of the pipeline on the stadium (4 lights, a reflective teapot): the rays of each
 //! kind equal those of the CPU reference with the accelerator's twin, the kinds add up to the
 //! frame's totals, each kind counts only its own kernel's tests, and each has GPU time.

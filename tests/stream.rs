@@ -1,4 +1,4 @@
-//! The streaming tracer of seed 004 (`--tracer stream`) against its CPU twin
+//! The streaming tracer (`--tracer stream`) against its CPU twin
 //! (`reference::stream_grid`) and brute force: first hits, distances and counts, proximity
 //! clouds on and off, the distance field, the occlusion-query halting with bounded work per
 //! call, non-cubic grids.
@@ -597,8 +597,8 @@ fn a_jump_never_passes_the_nearest_non_empty_cell() {
 }
 
 /// The paper's single-sided test (`--stream-single-sided`) drops back faces and nothing else:
-/// on seed 004's scenes (no eye ray meets a back face first) the first hits and the eye rays'
-/// triangle tests are those of the two-sided test; on the teapot (patches not consistently
+/// on the streaming tracer's scenes (no eye ray meets a back face first) the first hits and the eye
+/// rays' triangle tests are those of the two-sided test; on the teapot (patches not consistently
 /// wound) the pixels that change are exactly those whose two-sided first hit is a back face,
 /// and where the single-sided test hits, it hits a front face.
 #[test]

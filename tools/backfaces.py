@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Which eye rays' first hits land on a triangle's back face — those a single-sided
-Möller–Trumbore test (seed 004's "fastest known single sided algorithm") would miss — and what
-the single-sided test (`--stream-single-sided`) changes.
+Möller–Trumbore test (the streaming tracer's "fastest known single sided algorithm") would
+miss — and what the single-sided test (`--stream-single-sided`) changes.
 
 For each scene: `gpgpu-rt render SCENE --tracer stream --grid G --aov-dir D --stats S`, once
 with the two-sided test the stream tracer uses by default and once with
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-# seed 004's scenes at the paper's grids, and two of the other scenes at --grid auto
+# the streaming tracer's scenes at the paper's grids, and two of the other scenes at --grid auto
 SCENES = [("knight", "14x16x14"), ("torus_knot", "16"), ("bunny_low", "20"), ("bunny", "128"),
           ("sparse_room", "32"), ("cow", "auto"), ("teapot1", "auto")]
 

@@ -4,7 +4,7 @@
 // triangle gives det = 0, 1/det = inf and comparisons that fail, i.e. no hit.
 // Returns true for a hit with t > 0 and the barycentric (u, v).
 // intersectEdges is the algorithm after its first two lines (edge1 = v1 − v0, edge2 = v2 − v0),
-// for the accelerators that store the edges (the SAH BVH's leaves, seed 004's triangle
+// for the accelerators that store the edges (the SAH BVH's leaves, the streaming tracer's triangle
 // textures): the same operations on the same values, so every tracer finds the same distances.
 bool intersectEdges(vec3 r0, vec3 rd, vec3 v0, vec3 edge1, vec3 edge2,
                     out float t, out float u, out float v)

@@ -2,10 +2,10 @@
 // Tracing", 1987; the per-ray grid walk of Purcell et al., "Ray Tracing on Programmable Graphics
 // Hardware", 2002, and of the streaming GPU ray tracer with a uniform grid and proximity clouds
 // that builds on it) — ours, replacing the thesis' traversal kernel and per-ray voxel lists: the
-// intersection kernels walk the grid themselves, voxel by voxel in ray order.
-// With proximityClouds set, stepWalk leaves an empty voxel whose proximity-cloud distance
-// (Cohen & Sheffer 1994, seed 004 ch. 3; exact_grid/proximity.comp) is d >= 2 by a jump out of
-// the empty cube of Chebyshev radius d - 1 around it (jumpWalk), as seed 004's traversal does.
+// intersection kernels walk the grid themselves, voxel by voxel in ray order. With proximityClouds
+// set, stepWalk leaves an empty voxel whose proximity-cloud distance (Cohen & Sheffer 1994, the
+// streaming tracer ch. 3; exact_grid/proximity.comp) is d >= 2 by a jump out of the empty cube of
+// Chebyshev radius d - 1 around it (jumpWalk), as the streaming tracer's traversal does.
 
 layout(std430, binding = SSBO_VOXEL_COUNT) readonly buffer VoxelCount { uint voxelCount[]; };
 layout(std430, binding = SSBO_VOXEL_START) readonly buffer VoxelStart { uint voxelStart[]; };
@@ -60,10 +60,10 @@ vec3 planesOf(Walk w, ivec3 v)
     return vec3(planeT(w, 0, v.x), planeT(w, 1, v.y), planeT(w, 2, v.z));
 }
 
-// jumpWalk — seed 004 ch. 3 (proximity clouds, after Cohen & Sheffer 1994), in grid space: the
-// current voxel is empty at distance dist >= 2, so the cube of Chebyshev radius dist - 1 around
-// it holds no non-empty voxel; land in the voxel where the ray leaves that cube. The exit axis'
-// voxel is the first beyond the cube's face, the others the exit point's (within the cube) as
+// jumpWalk — the streaming tracer ch. 3 (proximity clouds, after Cohen & Sheffer 1994), in grid
+// space: the current voxel is empty at distance dist >= 2, so the cube of Chebyshev radius dist - 1
+// around it holds no non-empty voxel; land in the voxel where the ray leaves that cube. The exit
+// axis' voxel is the first beyond the cube's face, the others the exit point's (within the cube) as
 // the plane parameters place it; tMax is recomputed for the landing voxel, so the DDA goes on
 // from there. False when the cube is left beyond the walk's end or the grid. CPU twin:
 // reference::grid::Walk::jump (the same algorithm as stream/traverse_intersect.frag's jump).

@@ -1,12 +1,12 @@
-// Exact grid, pass 5 (with --proximity-clouds): proximity clouds — seed 004 ch. 3 after Cohen &
-// Sheffer, "Proximity clouds — an acceleration technique for 3D grid traversal", 1994: for
+// Exact grid, pass 5 (with --proximity-clouds): proximity clouds — the streaming tracer ch. 3 after
+// Cohen & Sheffer, "Proximity clouds — an acceleration technique for 3D grid traversal", 1994: for
 // every voxel the distance, in voxels, to the nearest non-empty voxel (0 for a non-empty one),
-// rebuilt every frame after the lists. The metric is Chebyshev (L∞), as seed 004's grid
+// rebuilt every frame after the lists. The metric is Chebyshev (L∞), as the streaming tracer's grid
 // (stream/grid.glsl, reference::proximity): a voxel at distance d >= 2 is the centre of a cube
 // of Chebyshev radius d - 1 that holds no non-empty voxel, so the DDA may jump to where the ray
 // leaves that cube (exact_grid/dda.glsl, jumpWalk) without passing a non-empty voxel.
-// Ours: seed 004 computes the clouds once on the CPU (a chamfer transform); the exact grid is
-// rebuilt per frame on the GPU, so the L∞ transform runs here in its separable form, three
+// Ours: the streaming tracer computes the clouds once on the CPU (a chamfer transform); the exact
+// grid is rebuilt per frame on the GPU, so the L∞ transform runs here in its separable form, three
 // 1D passes along x, y and z, each d'(i) = min_j max(|i - j|, d(j)) over the voxel's line
 // (exact for L∞: the max of the per-axis distances is minimised axis by axis). Distances are
 // capped at cloudCap (reference::proximity::EXACT_GRID_CLOUD_CAP, at most voxel_amount): a

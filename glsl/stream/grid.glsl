@@ -1,5 +1,5 @@
-// The static grid and the triangles in texture memory — seed 004, ch. 3, Fig. 3 ("grid data
-// layout with two levels of indirection"), and the 3D-DDA of Amanatides and Woo that walks it.
+// The static grid and the triangles in texture memory — the streaming tracer, ch. 3, Fig. 3 ("grid
+// data layout with two levels of indirection"), and the 3D-DDA of Amanatides and Woo that walks it.
 // The grid is built in src/pipeline/stream/grid.rs; the CPU twin of every function here is in
 // src/reference/stream_grid.rs (same f32 arithmetic, same order), the tests' oracle.
 //
@@ -62,8 +62,8 @@ vec3 triangleNormal(int id, int slice)
 // teapot1's first hits are back faces) render whole. SINGLE_SIDED (--stream-single-sided) is
 // the paper's single-sided test: Möller and Trumbore's culling branch, a triangle seen from its
 // back (det = edge1 · (rd × edge2) <= 0) is no hit and nothing after det is computed for it;
-// a front face gets the same arithmetic, so the same distance. On seed 004's own scenes no eye
-// ray's first hit is a back face, so both find the same first hits; a few shadows near
+// a front face gets the same arithmetic, so the same distance. On the streaming tracer's own scenes
+// no eye ray's first hit is a back face, so both find the same first hits; a few shadows near
 // silhouettes differ (docs/results/backfaces.md).
 bool intersectStored(vec3 r0, vec3 rd, int id, out float t, out float u, out float v)
 {

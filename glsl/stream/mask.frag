@@ -1,4 +1,4 @@
-// The masking kernel — seed 004, ch. 3, the optimisations: "During the execution of an
+// The masking kernel — the streaming tracer, ch. 3, the optimisations: "During the execution of an
 // additional kernel (right after the ray generator, but suppressed in figure 1) rays that are
 // known not needing further processing (eg. rays missed the scene AABB, shadow rays for rays not
 // intersecting any objects) are masked out as soon as possible, and excluded from further

@@ -1,6 +1,6 @@
-// The ray generator — seed 004, ch. 3, Fig. 1, first kernel: "The first kernel is responsible
-// for generating either primary, shadow or reflection rays. Rays are characterized by their
-// origin and direction, this output stream of data is written into two textures."
+// The ray generator — the streaming tracer, ch. 3, Fig. 1, first kernel: "The first kernel is
+// responsible for generating either primary, shadow or reflection rays. Rays are characterized by
+// their origin and direction, this output stream of data is written into two textures."
 // generate = 0: primary rays through the pixel centres (the camera of Müller 2015, Listing 11,
 //               so all tracers cast the same rays: the direction from camImgOffset, the image
 //               plane relative to the camera, as mueller2015/eye_ray_generation.comp); weight 1

@@ -1,6 +1,6 @@
-// The ray textures of seed 004, Fig. 1 ("rays are characterized by their origin and direction,
-// this output stream of data is written into two textures") and the eye or reflection ray's
-// hit record, with the surface at a hit as the shading and the ray generator see it.
+// The ray textures of the streaming tracer, Fig. 1 ("rays are characterized by their origin and
+// direction, this output stream of data is written into two textures") and the eye or reflection
+// ray's hit record, with the surface at a hit as the shading and the ray generator see it.
 // rayOrigin.w: the triangle the ray starts on (skipped by the traversal), -1 for none.
 // rayDirection.w: an eye or reflection ray's weight in the pixel's colour (0: no ray), or a
 // shadow ray's t limit, the distance to its light (0: no ray).

@@ -1,5 +1,5 @@
-// The shading kernel — seed 004, ch. 3, Fig. 1, last kernel: "a simple per-pixel diffuse
-// lighting with shadows and reflections". Its output is added into the colour texture by
+// The shading kernel — the streaming tracer, ch. 3, Fig. 1, last kernel: "a simple per-pixel
+// diffuse lighting with shadows and reflections". Its output is added into the colour texture by
 // blending (GL_ONE, GL_ONE), one draw per term, so no kernel reads the colour it writes:
 // term 0: the ambient light (or the background where the ray hit nothing)
 // term 1: one point light, unless its shadow ray found a blocker (the shadow traversal's

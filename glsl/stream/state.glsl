@@ -1,7 +1,7 @@
-// Both sets of the ping-ponged traversal state (seed 004, Fig. 2), read after or between calls
-// of the traverse-and-intersect kernel. A call reads one set and writes the other, and a ray
-// that finished is culled from the later calls (early_z.frag), so exactly one set holds its
-// final state: the one whose ray state says RAY_DONE. Before the first call the masking kernel
+// Both sets of the ping-ponged traversal state (the streaming tracer, Fig. 2), read after or
+// between calls of the traverse-and-intersect kernel. A call reads one set and writes the other,
+// and a ray that finished is culled from the later calls (early_z.frag), so exactly one set holds
+// its final state: the one whose ray state says RAY_DONE. Before the first call the masking kernel
 // wrote set A and the host cleared set B's ray state to 0.
 layout(binding = SAMPLER_STREAM_STATE_A) uniform sampler2D stateA;
 layout(binding = SAMPLER_STREAM_STATE_B) uniform sampler2D stateB;

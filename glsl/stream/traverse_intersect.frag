@@ -1,6 +1,6 @@
-// The traverse and intersect kernel — seed 004, ch. 3, Fig. 1 and Fig. 2: "traversing the grid
-// until a voxel with a non empty reference list is encountered and then intersecting the ray
-// with all the enlisted triangles. If no intersection was found, this process is repeated. The
+// The traverse and intersect kernel — the streaming tracer, ch. 3, Fig. 1 and Fig. 2: "traversing
+// the grid until a voxel with a non empty reference list is encountered and then intersecting the
+// ray with all the enlisted triangles. If no intersection was found, this process is repeated. The
 // actual grid traversal is accomplished with the fast 3D-DDA algorithm as described by
 // Amanatides and Woo." The hardware's instruction and loop limits made the paper's kernel short
 // and called many times, "an occlusion query providing the halting condition – we loop this

@@ -4,7 +4,7 @@
 //! the current voxel (`glsl/exact_grid/`). Its image equals the base tracer's. CPU twin:
 //! `reference::exact_grid`. With `--proximity-clouds` a fifth pass (`proximity.comp`) writes
 //! every voxel's Chebyshev distance to the nearest non-empty voxel after the lists, and the
-//! DDA jumps out of empty voxels by it (seed 004's proximity clouds, `dda.glsl`).
+//! DDA jumps out of empty voxels by it (the streaming tracer's proximity clouds, `dda.glsl`).
 
 use std::any::Any;
 use std::sync::Arc;

@@ -236,8 +236,8 @@ impl BuildContext<'_> {
     }
 }
 
-/// The accelerators of Müller 2015's four-kernel pipeline (`--tracer`; seed 004's `--tracer
-/// stream` is a pipeline of its own, `design::Design::Stream`).
+/// The accelerators of Müller 2015's four-kernel pipeline (`--tracer`; the streaming tracer's
+/// `--tracer stream` is a pipeline of its own, `design::Design::Stream`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum TracerKind {

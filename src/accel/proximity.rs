@@ -1,6 +1,6 @@
 //! Proximity clouds (Cohen and Sheffer, "Proximity clouds — an acceleration technique for 3D
-//! grid traversal", The Visual Computer 11, 1994), as seed 004 uses them: per empty cell of a
-//! uniform grid the Chebyshev (L∞) distance, in cells, to the nearest non-empty cell. The
+//! grid traversal", The Visual Computer 11, 1994), as the streaming tracer uses them: per empty
+//! cell of a uniform grid the Chebyshev (L∞) distance, in cells, to the nearest non-empty cell. The
 //! streaming tracer's static grid takes them from here when it is built
 //! (`pipeline::stream::grid`); the exact grid, rebuilt on the GPU every frame, computes them in
 //! `glsl/exact_grid/proximity.comp` and its CPU twin here (`reference::exact_grid`). The jump

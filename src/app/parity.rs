@@ -563,7 +563,7 @@ fn record(ctx: &GlContext, args: &ParityArgs, out: &Path) -> Result<()> {
         };
         let frame = match render_case(r, scene, s.turning, how.in_flight) {
             Ok(f) => f,
-            // a static design (seed 004's grid, Klee's N-tree) refuses moving objects: skipped
+            // a static design (the streaming tracer's grid, Klee's N-tree) cannot move: skipped
             Err(e) if s.turning.is_some() => {
                 let record = CaseRecord {
                     renderer: ctx.info.renderer.clone(),

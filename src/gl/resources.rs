@@ -725,7 +725,7 @@ impl Drop for GpuTimers {
 }
 
 /// A 3D texture of RGB32F texels read with `texelFetch` through a `sampler3D` (nearest
-/// filtering, one level): the cells and the triangle data of seed 004's grid (Fig. 3).
+/// filtering, one level): the cells and the triangle data of the streaming tracer's grid (Fig. 3).
 pub struct Texture3d {
     pub texture: Owned<glow::Texture>,
     pub size: [u32; 3],

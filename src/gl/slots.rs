@@ -169,7 +169,7 @@ slot_table! {
         WAGNER_VERTICES = 4,
         WAGNER_NORMALS = 5,
         WAGNER_COLORS = 6,
-        /// the streaming tracer of seed 004 (glsl/stream/): the ray textures (Fig. 1) and the
+        /// the streaming tracer (glsl/stream/): the ray textures (Fig. 1) and the
         /// eye or reflection ray's hit record
         STREAM_RAY_ORIGIN = 0,
         STREAM_RAY_DIR = 1,

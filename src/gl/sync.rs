@@ -18,7 +18,7 @@
 //! |---|---|---|
 //! | a compute dispatch (SSBO, image and texture reads and writes) | [`SHADER`]: `SHADER_STORAGE`, `SHADER_IMAGE_ACCESS`, `TEXTURE_FETCH` | `Kernel::dispatch_*`, the BVH refit's passes |
 //! | an indirect dispatch's command | `COMMAND` | `Kernel::dispatch_indirect` |
-//! | a draw whose shaders store (Müller 2015's transform pass, seed 004's passes) | [`SHADER`] (seed 004's: [`ALL`]) | `GpuScene::transform`, `stream::targets` |
+//! | a draw whose shaders store (Müller 2015's transform pass, the streaming tracer's passes) | [`SHADER`] (the streaming tracer's: [`ALL`]) | `GpuScene::transform`, `stream::targets` |
 //! | rendering into a texture a shader stored into (Klee 2016's G-buffer) | `FRAMEBUFFER` and [`SHADER`] | `GBuffer::draw` |
 //! | sampling what a shader stored (the screen-filling quads) | `TEXTURE_FETCH` | `Present::draw`, the viewer |
 //! | `glGetBufferSubData`, `glClearBufferData`, `glBufferSubData` | `BUFFER_UPDATE` | `resources::read_buffer`, `Gl::clear_buffer_u32`, texture-buffer uploads |
@@ -91,7 +91,7 @@ pub fn after_pass(gl: &Gl) {
     gl.set_all_barriers_pending();
 }
 
-/// Before a pass whose shaders access every kind (seed 004's fragment passes).
+/// Before a pass whose shaders access every kind (the streaming tracer's fragment passes).
 pub fn barrier(gl: &Gl) {
     before(gl, ALL);
 }

@@ -7,7 +7,7 @@
 //! | four compute kernels (eye rays → intersect1 → intersect2 → shading) | Müller 2015 | [`mueller2015`] | `glsl/mueller2015/` | `base`, `grid` (thesis, exact), `bvh` ([`crate::accel`]) |
 //! | G-buffer + shadow pass + screen-filling quad | Klee 2016 | [`klee2016`] | `glsl/klee2016/` | its N-tree + Cascaded Line Space |
 //! | one kernel per pixel (primary ray, BVH walk, Lambert, hard shadow) | Wagner 2018 | [`wagner2018`] | `glsl/wagner2018/` | its BVH in three textures (`--tracer bvh --bvh-variant wagner`) |
-//! | fragment programs over a viewport-sized quad, traversal looped until an occlusion query counts no fragment | seed 004 | [`stream`] | `glsl/stream/` | its static grid in textures, proximity clouds (`--tracer stream`) |
+//! | fragment programs over a viewport-sized quad, traversal looped until an occlusion query counts no fragment | the streaming tracer | [`stream`] | `glsl/stream/` | its static grid in textures, proximity clouds (`--tracer stream`) |
 
 pub mod klee2016;
 pub mod mueller2015;

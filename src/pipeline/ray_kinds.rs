@@ -1,7 +1,7 @@
-//! The kinds of rays a pipeline counts and times apart (ours; issue 15's `accel-compare`):
-//! primary rays, shadow feelers towards the first light and towards the others, and reflection
-//! rays — in Müller 2015's pipeline pass 0's intersect1, intersect2 of every pass and the later
-//! passes' intersect1; in seed 004's streaming pipeline the generation and traversal of each.
+//! The kinds of rays a pipeline counts and times apart (ours; issue 15's `accel-compare`): primary
+//! rays, shadow feelers towards the first light and towards the others, and reflection rays — in
+//! Müller 2015's pipeline pass 0's intersect1, intersect2 of every pass and the later passes'
+//! intersect1; in the streaming tracer's streaming pipeline the generation and traversal of each.
 //!
 //! The counter buffer holds one bank of the pipeline's counters per kind and one for the rest of
 //! the frame (builds, shading). Before each dispatch or draw the host binds the kind's bank to

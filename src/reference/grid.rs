@@ -108,8 +108,8 @@ impl Walk {
         (face - self.rog[a]) * self.inv[a]
     }
 
-    /// jumpWalk (`glsl/exact_grid/dda.glsl`), seed 004's proximity-cloud jump in the exact
-    /// grid: the current voxel is empty and its distance `dist` ≥ 2, so the cube of voxels
+    /// jumpWalk (`glsl/exact_grid/dda.glsl`), the streaming tracer's proximity-cloud jump in the
+    /// exact grid: the current voxel is empty and its distance `dist` ≥ 2, so the cube of voxels
     /// within Chebyshev radius dist − 1 around it is empty; leave it where the ray does. The
     /// exit axis' voxel is the first beyond the cube's face, the others the exit point's
     /// (within the cube) as the plane parameters place it; tMax is recomputed for the landing

@@ -1,5 +1,5 @@
-//! The proximity-cloud jump of the CPU twins' walks (seed 004 ch. 3; the distances they jump
-//! by: `accel::proximity`), shared by the streaming grid's (`reference::stream_grid`) and the
+//! The proximity-cloud jump of the CPU twins' walks (the streaming tracer ch. 3; the distances they
+//! jump by: `accel::proximity`), shared by the streaming grid's (`reference::stream_grid`) and the
 //! exact grid's (`reference::grid`).
 
 use glam::{IVec3, Vec3};
@@ -10,7 +10,7 @@ pub fn cells_between(a: IVec3, b: IVec3) -> u64 {
     ((b - a).abs().element_sum() as u64).saturating_sub(1)
 }
 
-/// A proximity-cloud jump (seed 004 ch. 3), shared by the streaming grid's walk
+/// A proximity-cloud jump (the streaming tracer ch. 3), shared by the streaming grid's walk
 /// (`StreamGrid::jump`, `glsl/stream/traverse_intersect.frag` jumpCloud) and the exact grid's
 /// (`grid::Walk::jump`, `glsl/exact_grid/dda.glsl` jumpWalk): `cell` is empty at distance
 /// `dist` ≥ 2, so the cube of Chebyshev radius dist − 1 around it (clipped to the `dims`

@@ -1,6 +1,6 @@
-//! The CPU twin of the streaming ray tracer's static grid (seed 004, ch. 3; the grid and its
-//! build: `pipeline::stream::grid`): walked with the 3D-DDA of Amanatides and Woo exactly as
-//! `glsl/stream/grid.glsl` walks it (the same f32 arithmetic, the same order of cells and of
+//! The CPU twin of the streaming ray tracer's static grid (the streaming tracer, ch. 3; the grid
+//! and its build: `pipeline::stream::grid`): walked with the 3D-DDA of Amanatides and Woo exactly
+//! as `glsl/stream/grid.glsl` walks it (the same f32 arithmetic, the same order of cells and of
 //! triangle tests), so the tests can hold the GPU's hits and counts against it.
 
 use glam::{IVec3, Vec3};

@@ -1,5 +1,5 @@
-//! CPU twin of the streaming tracer's shading (seed 004, Fig. 1's last kernel and the ray
-//! generator's shadow and reflection rays: `glsl/stream/shading.frag`,
+//! CPU twin of the streaming tracer's shading (the streaming tracer, Fig. 1's last kernel and the
+//! ray generator's shadow and reflection rays: `glsl/stream/shading.frag`,
 //! `glsl/stream/ray_generator.frag`): per pixel the ambient term or the background, the
 //! Lambert term of every point light whose shadow ray is unblocked, and the reflection
 //! bounces, each weighted as the kernels weigh them.

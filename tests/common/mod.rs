@@ -372,7 +372,7 @@ pub fn wagner(o: &RenderOptions) -> gpgpu_rt::design::Design {
     })
 }
 
-/// Seed 004's streaming tracer with the size, reflection depth and AOVs of `o`, the command
+/// The streaming tracer with the size, reflection depth and AOVs of `o`, the command
 /// line's defaults otherwise.
 pub fn stream(o: &RenderOptions) -> gpgpu_rt::design::Design {
     use gpgpu_rt::pipeline::stream::StreamOptions;
@@ -382,7 +382,7 @@ pub fn stream(o: &RenderOptions) -> gpgpu_rt::design::Design {
     })
 }
 
-/// Seed 004's streaming tracer at `size`² on the grid `dims`, with or without proximity clouds:
+/// The streaming tracer at `size`² on the grid `dims`, with or without proximity clouds:
 /// eye rays only, 64 steps per call, AOVs kept.
 pub fn stream_options(
     size: u32,

@@ -11,9 +11,9 @@
 //! Every protocol reads as **configure → measure → report**; the folders hold those parts:
 //!
 //! - [`protocols`]: one file per published evaluation it replicates (Müller 2015's ch. 5.1–5.3,
-//!   Klee 2016's tables and figures, Wagner 2018's Tables A.1/A.2, seed 004's Tables 1–3) and
-//!   `accel-compare`: its configurations and what it compares. [`Protocol`] is a protocol's
-//!   name (the command-line value), title and `run`, which measures and returns its
+//!   Klee 2016's tables and figures, Wagner 2018's Tables A.1/A.2, the streaming tracer's
+//!   Tables 1–3) and `accel-compare`: its configurations and what it compares. [`Protocol`] is
+//!   a protocol's name (the command-line value), title and `run`, which measures and returns its
 //!   [`Section`] of the report; [`protocol_of`] is the registry that says which protocol each
 //!   [`runner::args::ProtocolId`] runs.
 //! - [`published`]: the published numbers, typed in as data with their table or figure

@@ -1,5 +1,5 @@
-//! The static uniform grid of the streaming ray tracer (seed 004, ch. 3 and Fig. 3), built once
-//! on the CPU ("precomputed offline on the main processor"): per cell a pointer into the
+//! The static uniform grid of the streaming ray tracer (the streaming tracer, ch. 3 and Fig. 3),
+//! built once on the CPU ("precomputed offline on the main processor"): per cell a pointer into the
 //! tightly packed reference list, the count of references and the proximity-cloud distance.
 //! `glsl/stream/grid.glsl` walks it with the 3D-DDA of Amanatides and Woo; its CPU twin, the
 //! same walk in the same f32 arithmetic, is `reference::stream_grid`.

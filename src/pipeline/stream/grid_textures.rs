@@ -1,5 +1,5 @@
-//! The static grid and the triangles in texture memory, as seed 004's Fig. 3 lays them out
-//! (two levels of indirection): the cells in a 3D RGB32F texture (pointer, count, proximity
+//! The static grid and the triangles in texture memory, as the streaming tracer's Fig. 3 lays them
+//! out (two levels of indirection): the cells in a 3D RGB32F texture (pointer, count, proximity
 //! distance), the references tightly packed in an R32F texture buffer, the triangles in two 3D
 //! RGB32F textures of 4 depth slices each (v0, edge1, edge2, diffuse colour; n0, n1, n2,
 //! reflectivity) — 8 texels, the paper's 96 bytes, per triangle. Each texel's layout is a

@@ -1,4 +1,4 @@
-//! The streaming ray tracer of seed 004 (a Purcell-style GPU ray tracer with a uniform grid and
+//! The streaming tracer (a Purcell-style GPU ray tracer with a uniform grid and
 //! proximity clouds), `--tracer stream`: every kernel is a **fragment program** drawn over a
 //! viewport-sized quad into multiple render targets; rays are fragments, their state lives in
 //! textures (Fig. 1, Fig. 2).

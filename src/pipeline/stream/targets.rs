@@ -1,7 +1,7 @@
 //! The textures the streaming kernels read and render into, the framebuffer objects that bind
 //! them as multiple render targets, and the viewport-sized quad every kernel is drawn with
-//! (seed 004, ch. 3: "Redirecting the results of a fragment program to framebuffer attachable
-//! images is called using multiple render targets").
+//! (the streaming tracer, ch. 3: "Redirecting the results of a fragment program to framebuffer
+//! attachable images is called using multiple render targets").
 
 use std::sync::Arc;
 

@@ -1,5 +1,5 @@
 //! `accel-compare` (issue 15): every acceleration structure under the same conditions — the
-//! comparison seed 004 wishes for ("a full scale comparison of different ray shooting
+//! comparison the streaming tracer wishes for ("a full scale comparison of different ray shooting
 //! acceleration schemes as had been done for software implementations": Havran et al. 2000,
 //! "Statistical Comparison of Ray-Shooting Efficiency Schemes") and none of the four sources
 //! could make.
@@ -7,7 +7,7 @@
 //! - Accelerators in Müller 2015's pipeline (four compute kernels, the same eye rays, feelers
 //!   and shading): brute force (`base`), the uniform grid as the thesis builds it and exact,
 //!   the exact grid with proximity clouds, our SAH BVH. In their own pipelines, marked so:
-//!   Wagner 2018's BVH megakernel and seed 004's streaming grid (fragment passes, with and
+//!   Wagner 2018's BVH megakernel and the streaming tracer's grid (fragment passes, with and
 //!   without proximity clouds).
 //! - Scenes: every shipped scene of every source, the area scenes' geometry lit by a point
 //!   light at the area light's centre, and the teapot in a stadium (`stadium.toml`).

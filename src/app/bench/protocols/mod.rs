@@ -7,7 +7,7 @@
 //! - [`klee`]: Klee 2016, Tables 1–3 and Fig. 12–13; [`klee_measure`] times its soft shadows
 //!   on the GPU and the CPU.
 //! - [`wagner`]: Wagner 2018, Tables A.1 and A.2.
-//! - [`proximity_clouds`]: seed 004, Tables 1–3.
+//! - [`proximity_clouds`]: the streaming tracer, Tables 1–3.
 //! - [`accel_compare`]: every accelerator under the same conditions (ours; nothing published).
 
 pub mod accel_compare;

@@ -1,5 +1,5 @@
-//! Seed 004's evaluation (ch. 4, Tables 1–3): milliseconds per frame of the streaming grid
-//! tracer, with (pc) and without (g) proximity clouds, on the four scenes of Fig. 4–7 at
+//! The streaming tracer's evaluation (ch. 4, Tables 1–3): milliseconds per frame of the streaming
+//! grid tracer, with (pc) and without (g) proximity clouds, on the four scenes of Fig. 4–7 at
 //! 256², 512², 768², best of several runs.
 //!
 //! - `proximity-clouds-table1`: ray casting, eye rays only (the scenes' lights removed);

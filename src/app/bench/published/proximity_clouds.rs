@@ -1,5 +1,5 @@
-//! The published evaluation of seed 004 (a Purcell-style streaming GPU ray tracer with a
-//! uniform grid and proximity clouds), typed in as data with the table each number belongs to:
+//! The published evaluation of the streaming tracer (a Purcell-style streaming GPU ray tracer with
+//! a uniform grid and proximity clouds), typed in as data with the table each number belongs to:
 //! Table 1 (ray casting, eye rays only), Table 2 (shadow casting, eye and shadow rays) and
 //! Table 3 (ray tracing, eye, shadow and reflection rays, two levels of recursion); the four
 //! scenes of Fig. 4–7 with their triangle counts and the grid sizes of ch. 4; and the

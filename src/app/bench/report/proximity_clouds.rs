@@ -1,6 +1,6 @@
-//! The report of `proximity-clouds-table1…3` (seed 004, Tables 1–3): our best GPU milliseconds beside
-//! the published ones, the pc/g ratios, the streaming tracer beside the compute grid on the
-//! same frames, the work counts, and the paper's findings beside what we measured.
+//! The report of `proximity-clouds-table1…3` (the streaming tracer, Tables 1–3): our best GPU
+//! milliseconds beside the published ones, the pc/g ratios, the streaming tracer beside the compute
+//! grid on the same frames, the work counts, and the paper's findings beside what we measured.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -66,7 +66,7 @@ pub enum TracerSpec {
     /// The SAH BVH as a tree per object under instances (`--tracer bvh --bvh-instances`): a
     /// moving object rewrites its instance, where the one tree is refitted.
     BvhInstances,
-    /// Seed 004's streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
+    /// The streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
     /// proximity clouds: the paper's columns pc and g.
     /// With `naive_shadows`, the naive shadow rays the paper's optimisation is measured
     /// against (`--stream-naive-shadows`); with `no_mask`, without the masking kernel's
@@ -229,7 +229,7 @@ pub struct Config {
     /// Frames rendered first at the first angle and not counted.
     pub warmup: u32,
     /// Shadow rays towards the scene's lights; `false`: the lights removed, eye rays (and
-    /// reflection rays) only, lit by the ambient term (seed 004's Table 1, ray casting).
+    /// reflection rays) only, lit by the ambient term: the streaming tracer's Table 1.
     pub shadows: bool,
     /// Compare the first frame's first hits with the CPU reference's (`accel-compare`): the
     /// facts `first_hit_agreement` and `first_hit_judge` of that frame.

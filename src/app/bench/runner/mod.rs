@@ -481,8 +481,8 @@ fn area_centres_lit(scene: &Scene) -> Scene {
     }
 }
 
-/// `scene` with its lights removed: eye (and reflection) rays only, no shadow rays (seed 004's
-/// Table 1, "ray casting (eye rays only)").
+/// `scene` with its lights removed: eye (and reflection) rays only, no shadow rays (the streaming
+/// tracer's Table 1, "ray casting (eye rays only)").
 fn without_lights(scene: &Scene) -> Scene {
     Scene {
         lights: Vec::new(),
