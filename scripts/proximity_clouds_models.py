@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Seed 004's procedural test models (Fig. 4 and Fig. 5), written once as OBJ files into
-scenes/models/ (plain Python 3, no packages):
+"""The streaming tracer's procedural test models (Fig. 4 and Fig. 5), written once as OBJ files
+into scenes/models/ (plain Python 3, no packages):
 
   knight_standin.obj  634 triangles: a stand-in for the paper's Knight (not available) — a
                       lathe-turned chess-piece base (25 segments × 9 profile rings, capped:
@@ -181,7 +181,7 @@ def knight():
     tris = bt + [(a + off, b + off, c + off) for a, b, c in ht]
     assert len(tris) == 634, len(tris)
     write_obj("knight_standin.obj", [
-        "Seed 004, Fig. 4: a stand-in for the paper's Knight model (not available), written by",
+        "Streaming tracer, Fig. 4: a stand-in for the paper's Knight model (not available), written by",
         "scripts/proximity_clouds_models.py: a lathe-turned chess-piece base (25 segments x 9 rings, capped,",
         "450 triangles) and a horse-head silhouette of 47 points extruded 0.3 deep (184 triangles);",
         "scenes/knight.toml adds a 2-triangle floor: 636 triangles as the paper's Knight scene.",
@@ -220,7 +220,7 @@ def torus_knot():
     tris = orient(verts, tris)
     assert len(tris) == 1012
     write_obj("torus_knot.obj", [
-        "Seed 004, Fig. 5: a (2,3) torus knot (trefoil), written by scripts/proximity_clouds_models.py:",
+        "Streaming tracer, Fig. 5: a (2,3) torus knot (trefoil), written by scripts/proximity_clouds_models.py:",
         "the curve r = 2 + cos(3t), (r cos 2t, r sin 2t, -sin 3t), a tube of radius 0.45,",
         "46 segments along the knot x 11 around it = 1012 triangles; closed_box.obj adds 12.",
     ], verts, tris)
@@ -244,7 +244,7 @@ def closed_box():
 
     tris = [(a, c, b) if facing_out((a, b, c)) else (a, b, c) for a, b, c in tris]
     write_obj("closed_box.obj", [
-        "Seed 004, Fig. 5: the closed box around the torus knot, written by",
+        "Streaming tracer, Fig. 5: the closed box around the torus knot, written by",
         "scripts/proximity_clouds_models.py: 8 shared corners, 12 triangles wound to face inwards;",
         "the camera and the light are inside it (all shadow rays originate inside the box).",
     ], verts, tris)
