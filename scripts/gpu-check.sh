@@ -151,7 +151,7 @@ if [ "$dry_run" = 1 ] && [ -z "$reference" ]; then size=32; else size=48; fi
 # the executable of test file $1: in --tests (or the bundle), else the newest cargo built here
 test_exe() {
     if [ -n "$tests_dir" ]; then echo "$tests_dir/$1"; return; fi
-    ls -t target/release/deps/"$1"-???????????????? 2>/dev/null | grep -v '\.d$' | head -1
+    ls -t "${CARGO_TARGET_DIR:-target}"/release/deps/"$1"-???????????????? 2>/dev/null | grep -v '\.d$' | head -1
 }
 if [ -n "$tests_dir" ] || [ -n "$(test_exe bvh)" ]; then
     mkdir -p "$out/tests"

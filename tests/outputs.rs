@@ -88,7 +88,7 @@ fn an_unsupported_format_leaves_the_file_untouched() {
     let keep = dir.path().join("keep.bmp");
     std::fs::write(&keep, "precious").unwrap();
     let o = render(&teapot(), &["-o", s(&keep)]);
-    assert_fails(&o, &["-o", "keep.bmp", ".png, .jpg or .jpeg"]);
+    assert_fails(&o, &["-o", "keep.bmp", ".png, .jpg, .jpeg or .exr"]);
     assert_eq!(std::fs::read_to_string(&keep).unwrap(), "precious");
     // the same formats for the viewer's screenshot, refused before a window is opened
     let o = run(&["view", s(&teapot()), "--screenshot", s(&keep)]);

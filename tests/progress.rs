@@ -47,11 +47,15 @@ fn a_long_render_shows_its_progress_on_a_terminal_only() {
     let d = tempfile::tempdir().unwrap();
     let lines = long_render(d.path(), false);
     let shown = |needle: &str| lines.iter().any(|l| l.contains(needle));
-    assert!(shown("frame 1 of 2") && shown("frame 2 of 2"), "{lines:?}");
-    assert!(shown("pass 1 of 2: intersect1"), "{lines:?}");
+    // (which frame and kernel the line catches depends on the machine's speed)
+    let stage = |l: &String| l.contains("frame ") && l.contains(" of 2, pass ") && l.contains(": ");
+    assert!(
+        lines.iter().any(stage),
+        "a frame, its pass and a kernel: {lines:?}"
+    );
     assert!(shown("69451 triangles"), "the summary line: {lines:?}");
     let quiet = long_render(d.path(), true);
-    assert!(!quiet.iter().any(|l| l.contains("frame 1 of")), "{quiet:?}");
+    assert!(!quiet.iter().any(|l| l.contains("frame ")), "{quiet:?}");
     assert!(
         quiet.iter().any(|l| l.contains("69451 triangles")),
         "{quiet:?}"
@@ -76,7 +80,7 @@ fn a_long_render_shows_its_progress_on_a_terminal_only() {
     let e = stderr(&o);
     assert!(o.status.success(), "{e}");
     assert!(
-        !e.contains('\r') && !e.contains('\x1b') && !e.contains("frame 1 of"),
+        !e.contains('\r') && !e.contains('\x1b') && !e.contains("frame "),
         "{e:?}"
     );
 }

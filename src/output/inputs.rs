@@ -13,7 +13,13 @@ pub fn scene_inputs(scene: &Scene) -> Vec<Input> {
         role: role.to_string(),
     };
     let mut inputs = vec![input(&scene.path, "the scene file")];
+    for buffer in crate::scene::gltf::buffer_files(&scene.path) {
+        inputs.push(input(&buffer, "a buffer of the scene's glTF file"));
+    }
     for model in model_paths(&scene.path) {
+        for buffer in crate::scene::gltf::buffer_files(&model) {
+            inputs.push(input(&buffer, "a buffer of a glTF model of the scene"));
+        }
         for mtl in material_libraries(&model) {
             inputs.push(input(&mtl, "a material library of the scene"));
         }

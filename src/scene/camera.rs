@@ -31,6 +31,15 @@ fn default_near() -> f32 {
     0.05
 }
 
+/// The image plane's distance for a camera from elsewhere (a glTF file's `znear`): that
+/// distance where it is finite and positive, else the default. Rays start there, so a scene
+/// that reaches closer to the eye is cut as by a near clipping plane.
+pub fn default_near_for(znear: Option<f32>) -> f32 {
+    znear
+        .filter(|z| z.is_finite() && *z > 0.0)
+        .unwrap_or_else(default_near)
+}
+
 /// The kernel uniforms of Listing 11, in world space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraRays {

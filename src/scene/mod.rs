@@ -6,6 +6,7 @@ pub mod bpt;
 pub mod budget;
 pub mod camera;
 pub mod file;
+pub mod gltf;
 pub mod magnitudes;
 pub mod mesh;
 pub mod obj;
@@ -293,6 +294,16 @@ impl Scene {
 
     /// Load a scene file with some of its procedural sizes replaced by `overrides`.
     pub fn load_with(path: &Path, overrides: &Overrides) -> Result<Scene, SceneError> {
+        if gltf::is_gltf(path) {
+            if *overrides != Overrides::default() {
+                return Err(SceneError::at(
+                    path,
+                    None,
+                    "a glTF file has no procedural objects to size".into(),
+                ));
+            }
+            return Self::from_gltf(path, Textures::Decode);
+        }
         let text = file::read_text(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
         Self::parse(path, &text, overrides, Textures::Decode)
@@ -304,6 +315,9 @@ impl Scene {
     /// host's memory as [`Scene::load`] does first.
     /// Also gives the file's render settings (unchecked: [`Scene::load`] checks them).
     pub fn count_triangles(path: &Path) -> Result<(u64, RenderSettings), SceneError> {
+        if gltf::is_gltf(path) {
+            return Ok((gltf::count_triangles(path)?, RenderSettings::default()));
+        }
         let text = file::read_text(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
         let src = SceneText { path, text: &text };
@@ -318,6 +332,9 @@ impl Scene {
     /// but each texture only from its header (its size checked, nothing decoded), so
     /// `textures` holds 1×1 white placeholders. Not for rendering.
     pub fn load_counts(path: &Path) -> Result<Scene, SceneError> {
+        if gltf::is_gltf(path) {
+            return Self::from_gltf(path, Textures::HeadersOnly);
+        }
         let text = file::read_text(path)
             .map_err(|e| SceneError::at(path, None, format!("cannot read scene file: {e}")))?;
         Self::parse(path, &text, &Overrides::default(), Textures::HeadersOnly)
@@ -468,6 +485,13 @@ impl Scene {
                 .map_err(|m| src.error_at(type_line, m))?;
             scene.objects.push(object);
         }
+        let triangles = scene.triangle_count() as u64;
+        if triangles > MAX_SCENE_TRIANGLES {
+            let m = format!(
+                "{triangles} triangles, more than the {MAX_SCENE_TRIANGLES} a scene may have"
+            );
+            return Err(SceneError::at(path, None, m));
+        }
         validate::scene(&scene).map_err(|m| SceneError::at(path, None, m))?;
         magnitudes::check(&scene)?;
         Ok(scene)
@@ -534,6 +558,15 @@ impl Scene {
                 let path = def.model_path(dir, "model.obj")?;
                 return self.obj_mesh(&path, material, def, textures);
             }
+            "gltf" => {
+                let path = def.model_path(dir, "model.gltf")?;
+                let loaded = gltf::load(&path).map_err(ObjectError::File)?;
+                let mut mesh = self.gltf_mesh(loaded.mesh, &loaded.materials, textures)?;
+                if let Some(c) = def.color {
+                    mesh.colors.fill(Vec3::from(c));
+                }
+                return Ok(mesh);
+            }
             "ply" => def.ply_mesh(dir)?,
             "teapot" => def.teapot_mesh(dir)?,
             "floor" => def.floor_mesh()?,
@@ -549,6 +582,87 @@ impl Scene {
         let id = self.add_material(material);
         mesh.triangle_material.fill(id);
         Ok(mesh)
+    }
+
+    /// A glTF file's triangles with their materials made scene materials (textures loaded).
+    fn gltf_mesh(
+        &mut self,
+        mut mesh: Mesh,
+        materials: &[gltf::GltfMaterial],
+        textures: Textures,
+    ) -> Result<Mesh, ObjectError> {
+        let mut ids = Vec::with_capacity(materials.len());
+        for m in materials {
+            let texture = match &m.texture {
+                Some(p) => Some(self.load_texture(p, textures)?),
+                None => None,
+            };
+            ids.push(self.add_material(Material {
+                reflection: m.reflection,
+                specular: m.specular,
+                shininess: m.shininess,
+                texture,
+            }));
+        }
+        for m in mesh.triangle_material.iter_mut() {
+            *m = ids[*m as usize];
+        }
+        Ok(mesh)
+    }
+
+    /// A glTF file as the whole scene (`render model.glb`): its camera, or one that frames it;
+    /// its lights, or one above the camera; default render settings.
+    fn from_gltf(path: &Path, textures: Textures) -> Result<Scene, SceneError> {
+        let triangles = gltf::count_triangles(path)?;
+        if triangles > MAX_SCENE_TRIANGLES {
+            return Err(SceneError::at(
+                path,
+                None,
+                format!(
+                    "{triangles} triangles, more than the {MAX_SCENE_TRIANGLES} a scene may have"
+                ),
+            ));
+        }
+        let loaded = gltf::load(path)?;
+        let camera = loaded
+            .camera
+            .unwrap_or_else(|| gltf::framing_camera(&loaded.mesh));
+        let lights = match loaded.lights.is_empty() {
+            true => vec![gltf::default_light(&camera, &loaded.mesh)],
+            false => loaded.lights,
+        };
+        let mut scene = Scene {
+            path: path.to_path_buf(),
+            camera,
+            settings: RenderSettings::default(),
+            lights,
+            area_lights: Vec::new(),
+            objects: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+        };
+        let on_file = |e: ObjectError| match e {
+            ObjectError::Here(m) => SceneError::at(path, None, m),
+            ObjectError::File(e) => e,
+        };
+        let mesh = scene
+            .gltf_mesh(loaded.mesh, &loaded.materials, textures)
+            .map_err(on_file)?;
+        let name = path
+            .file_name()
+            .map_or("gltf".into(), |n| n.to_string_lossy().into_owned());
+        scene.objects.push(Object {
+            name,
+            mesh,
+            model: Mat4::IDENTITY,
+        });
+        scene
+            .camera
+            .validate()
+            .map_err(|(_, m)| SceneError::at(path, None, m))?;
+        validate::scene(&scene).map_err(|m| SceneError::at(path, None, m))?;
+        magnitudes::check(&scene)?;
+        Ok(scene)
     }
 
     /// An OBJ model with one scene material per MTL material (with the MTL texture unless
@@ -590,19 +704,25 @@ impl Scene {
 /// channel of the ray state, exact up to 2^24, and the other designs are measured far below.
 pub const MAX_SCENE_TRIANGLES: u64 = 1 << 24;
 
-/// The scene's triangles counted before anything is built ([`Scene::count_triangles`]): an
-/// object whose own size is wrong is named at its `type` line, a total over
-/// [`MAX_SCENE_TRIANGLES`] or the host's memory names the object that passes it. A model file
-/// named by several objects is read once.
+/// The scene's triangles counted before anything is built ([`Scene::count_triangles`]): a
+/// total over [`MAX_SCENE_TRIANGLES`] or the host's memory names the object that passes it. A
+/// model file named by several objects is read once.
+///
+/// An object that is wrong or too large on its own stops the count there: building it gives
+/// the error that names its file, key or header (checked, like this count, before its memory
+/// is taken), and [`Scene::parse`] checks the built total again.
 fn predict_triangles(src: &SceneText, dir: &Path, defs: &[ObjectDef]) -> Result<u64, SceneError> {
     let mut models: std::collections::HashMap<PathBuf, u64> = Default::default();
     let mut total = 0u64;
     for (k, def) in defs.iter().enumerate() {
-        let at = |e: ObjectError| match e {
-            ObjectError::Here(m) => src.error_at(def.kind.span().start, m),
-            ObjectError::File(e) => e,
+        let Ok(n) = def.predicted_triangles(dir, &mut models) else {
+            return Ok(total);
         };
-        let n = def.predicted_triangles(dir, &mut models).map_err(at)?;
+        let alone = n > MAX_SCENE_TRIANGLES.min(MAX_PROCEDURAL_TRIANGLES)
+            || budget::check_triangles("", n).is_err();
+        if alone {
+            return Ok(total);
+        }
         total = total.saturating_add(n);
         let upto = format!(
             "the scene's objects up to #{} ({})",
@@ -689,6 +809,7 @@ impl ObjectDef {
         let s = &self.shape;
         Ok(match self.kind.get_ref().as_str() {
             "obj" => model("model.obj", obj::count_triangles)?,
+            "gltf" => model("model.gltf", gltf::count_triangles)?,
             "ply" => model("model.ply.gz", ply::count_faces)?,
             "teapot" => {
                 let n = procedural_size("tessellation", s.tessellation, 10, 1, |n| 2 * n * n)?;
@@ -872,7 +993,7 @@ const OBJECT_KEYS: &[&str] = &[
 ];
 
 /// The object types of a scene file.
-const OBJECT_TYPES: &[&str] = &["obj", "ply", "teapot", "floor", "sphere", "square"];
+const OBJECT_TYPES: &[&str] = &["obj", "ply", "gltf", "teapot", "floor", "sphere", "square"];
 
 /// "\"a\", \"b\" or \"c\"".
 fn quoted(names: &[&str]) -> String {

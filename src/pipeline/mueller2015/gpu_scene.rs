@@ -374,7 +374,7 @@ pub fn check_counts(info: &GlInfo, path: &std::path::Path, triangles: u64) -> Re
     let bytes = 16 * 3 * triangles;
     if bytes > info.max_ssbo_block_size.max(0) as u64 {
         bail!(
-            "{}: {triangles} triangles need {} in the scene buffer `positions` (16 bytes a \
+            "{}: {triangles} triangles need {} in the scene buffer `vertex` (16 bytes a \
              vertex), more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE = {} of this GL implementation",
             path.display(),
             budget::human(bytes),
