@@ -423,3 +423,37 @@ fn bpt_files() {
         |p| bpt::teapot(p, 4).map(|_| ()).map_err(|e| e.to_string()),
     );
 }
+
+/// glTF: mutants of the shipped GLB (its JSON chunk and binary chunk) and of a small JSON file
+/// with a data-URI buffer, through the loader and the triangle count.
+#[test]
+fn gltf_files() {
+    let glb = read("scenes/models/cow.glb");
+    let pos: String = {
+        use base64::Engine as _;
+        let p: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        base64::engine::general_purpose::STANDARD.encode(p)
+    };
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+"nodes":[{{"mesh":0,"translation":[1,2,3],"children":[1]}},{{"camera":0,"rotation":[0,0,0,1]}}],
+"cameras":[{{"type":"perspective","perspective":{{"yfov":0.8,"znear":0.1}}}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":5121,"count":3,"type":"SCALAR"}}],
+"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":1,"byteLength":3}}],
+"buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{pos}"}},
+{{"byteLength":3,"uri":"data:application/octet-stream;base64,AAEC"}}]}}"#
+    );
+    let load = |p: &Path| {
+        gpgpu_rt::scene::gltf::count_triangles(p).map_err(|e| e.to_string())?;
+        gpgpu_rt::scene::gltf::load(p)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    };
+    fuzz("m.glb", vec![glb], |_| {}, load);
+    fuzz("m.gltf", vec![json.into_bytes()], |_| {}, load);
+}
