@@ -485,3 +485,50 @@ fn no_output_option_writes_over_an_input() {
         }
     }
 }
+
+/// A loop-limit refusal names what to change: 20,000 overlapping squares under the two-level
+/// BVH pass llvmpipe's loop limit, and the message names --bvh-instances and the one-tree
+/// alternative (before: "shader loops stopped early … 65535 iterations" and nothing more).
+#[test]
+fn a_loop_limit_refusal_names_the_option_that_avoids_it() {
+    let d = tempfile::tempdir().unwrap();
+    let each = |i: usize| {
+        format!(
+            "[[object]]\ntype = \"square\"\nsize = 2.0\nrotate = [{}.0, {}.0, 0.0]\n",
+            (i * 7) % 90,
+            (i * 13) % 360
+        )
+    };
+    let scene = d.path().join("overlap.toml");
+    let text = HEAD.to_string() + &(0..20_000).map(each).collect::<String>();
+    std::fs::write(&scene, text).unwrap();
+    let png = d.path().join("x.png");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--tracer",
+        "bvh",
+        "--bvh-instances",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let e = stderr(&o);
+    if o.status.success() {
+        // a driver that keeps no loop limit renders it: only llvmpipe (and zink over
+        // lavapipe) must refuse
+        assert!(
+            !e.contains("llvmpipe"),
+            "rendered on llvmpipe past its loop limit: {e}"
+        );
+        return;
+    }
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("loops stopped early") && e.contains("render without --bvh-instances"),
+        "{e}"
+    );
+}
