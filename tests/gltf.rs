@@ -256,16 +256,11 @@ fn bad_gltf_files_are_refused_with_what_is_wrong() {
     let good = dir.join("good.gltf");
     std::fs::write(&good, triangle_gltf(|_| {})).unwrap();
     let png = dir.join("x.png");
-    let o = run(&[
-        "render",
-        good.to_str().unwrap(),
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
+    let render16 = |scene: &Path| {
+        let (s, p) = (scene.to_str().unwrap(), png.to_str().unwrap());
+        run(&["render", s, "--width", "16", "--height", "16", "-o", p])
+    };
+    let o = render16(&good);
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::remove_file(&png).unwrap();
     type Edit = Box<dyn Fn(&mut serde_json::Value)>;
@@ -317,16 +312,7 @@ fn bad_gltf_files_are_refused_with_what_is_wrong() {
     for (name, edit, says) in cases {
         let f = dir.join(format!("{name}.gltf"));
         std::fs::write(&f, triangle_gltf(edit)).unwrap();
-        let o = run(&[
-            "render",
-            f.to_str().unwrap(),
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "-o",
-            png.to_str().unwrap(),
-        ]);
+        let o = render16(&f);
         let e = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "{name}: {e}");
         assert!(

@@ -1310,25 +1310,16 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let text =
-            "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[object]]\ntype = \"cube\"\n";
-        let e = Scene::parse(
-            Path::new("x.toml"),
-            text,
-            &Overrides::default(),
-            Textures::Decode,
-        )
-        .unwrap_err();
+        let parse = |text: &str| {
+            let none = Overrides::default();
+            Scene::parse(Path::new("x.toml"), text, &none, Textures::Decode).unwrap_err()
+        };
+        let e = parse(
+            "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\n\n[[object]]\ntype = \"cube\"\n",
+        );
         assert_eq!(e.line, Some(6), "{e}");
         assert!(e.to_string().contains("unknown object type"), "{e}");
-        let text = "[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfov = 3\n";
-        let e = Scene::parse(
-            Path::new("x.toml"),
-            text,
-            &Overrides::default(),
-            Textures::Decode,
-        )
-        .unwrap_err();
+        let e = parse("[camera]\nposition = [0, 1, 3]\nlook_at = [0, 0, 0]\nfov = 3\n");
         assert_eq!(e.line, Some(4), "{e}");
     }
 }
