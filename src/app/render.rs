@@ -23,7 +23,7 @@ use gpgpu_rt::{limits, output};
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML), e.g. scenes/teapot1.toml.
+    /// Scene file: TOML (e.g. scenes/teapot1.toml) or glTF 2.0 (.gltf, .glb).
     scene: PathBuf,
     /// Output image: PNG; JPEG for a name ending in .jpg or .jpeg; OpenEXR (linear float RGB,
     /// not clamped) for .exr.

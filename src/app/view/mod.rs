@@ -62,7 +62,7 @@ const WATCH_INTERVAL: Duration = Duration::from_millis(200);
 /// Options of `gpgpu-rt view`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Scene file (TOML), e.g. scenes/teapot1.toml.
+    /// Scene file: TOML (e.g. scenes/teapot1.toml) or glTF 2.0 (.gltf, .glb).
     pub scene: PathBuf,
     /// No progress line while the scene loads and the first tracer is built (one appears on a
     /// terminal when that takes more than 2 s).
