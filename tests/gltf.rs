@@ -262,6 +262,18 @@ fn bad_gltf_files_are_refused_with_what_is_wrong() {
     };
     let o = render16(&good);
     assert!(o.status.success(), "{}", stderr(&o));
+    // a cycle of children (the specification forbids it; nothing may loop on it): each node
+    // once, or refused as malformed
+    let cycle = dir.join("cycle.gltf");
+    std::fs::write(
+        &cycle,
+        triangle_gltf(|d| {
+            d["nodes"] = serde_json::json!([{"mesh": 0, "children": [1]}, {"children": [0]}])
+        }),
+    )
+    .unwrap();
+    let o = render16(&cycle);
+    assert!(o.status.code().is_some_and(|c| c <= 1), "{}", stderr(&o));
     std::fs::remove_file(&png).unwrap();
     type Edit = Box<dyn Fn(&mut serde_json::Value)>;
     let cases: Vec<(&str, Edit, &str)> = vec![

@@ -86,11 +86,13 @@ fn world_nodes<'a>(scene: &gltf::Scene<'a>) -> Vec<(gltf::Node<'a>, Mat4)> {
     let mut stack: Vec<(gltf::Node<'a>, Mat4)> =
         scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     stack.reverse();
-    // a node may appear under one parent only (the specification; gltf-rs does not check it):
-    // the depth bound keeps a cycle from running forever
+    // a node may appear under one parent only and the hierarchy is a forest (the
+    // specification; gltf-rs does not check it): each node is taken once, so a cycle or a
+    // shared child cannot run forever or multiply the work
+    let mut seen = std::collections::HashSet::new();
     while let Some((node, parent)) = stack.pop() {
-        if out.len() > 1 << 20 {
-            break;
+        if !seen.insert(node.index()) {
+            continue;
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         let children: Vec<_> = node.children().map(|c| (c, world)).collect();
