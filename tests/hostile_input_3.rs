@@ -532,3 +532,72 @@ fn a_loop_limit_refusal_names_the_option_that_avoids_it() {
         "{e}"
     );
 }
+
+/// A shard keeps its finished protocols too: interrupted in thesis-5.2, its folder holds
+/// thesis-5.1's rows and a `shard.json` naming thesis-5.2 as pending, and `bench merge`
+/// refuses that shard as cut short rather than report a run with a protocol missing.
+#[test]
+fn an_interrupted_shard_keeps_its_protocols_and_the_merge_refuses_it() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s1");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args([
+            "bench",
+            "thesis-5.1",
+            "thesis-5.2",
+            "--quiet",
+            "--shard",
+            "1/1",
+        ])
+        .args(["--width", "8", "--height", "8", "--angles", "1"])
+        .args(["--warmup", "0", "--out", out.to_str().unwrap()])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !out.join("shard.json").exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before 5.1 was kept"
+        );
+        assert!(start.elapsed() < Duration::from_secs(300), "5.1 never kept");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "thesis-5.2 finished before the interrupt"
+    );
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("shard.json")).unwrap()).unwrap();
+    assert_eq!(
+        manifest["pending"],
+        serde_json::json!(["thesis-5.2"]),
+        "{manifest}"
+    );
+    assert_eq!(
+        manifest["configs"].as_object().unwrap().len(),
+        9,
+        "thesis-5.1's nine"
+    );
+    assert!(out.join("thesis-5.1.csv").exists());
+    let merged = dir.path().join("m");
+    let o = run(&[
+        "bench",
+        "merge",
+        out.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("cut short before thesis-5.2"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -182,26 +182,25 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
     )?;
     let batch = Batch::begin();
     let (mut failed, mut measured) = (0, 0);
-    for p in protocols(bench) {
+    let all = protocols(bench);
+    for (n, p) in all.iter().enumerate() {
         let section = run_protocol(p, bench)?;
         failed += section.failures;
         measured += section.measured;
+        // a finished protocol is kept with a manifest that names the protocols still to come
+        // (the merge refuses it as cut short until the shard is run whole)
+        let pending: Vec<String> = all[n + 1..].iter().map(|p| p.name.to_string()).collect();
+        if !pending.is_empty() {
+            shard::write_manifest(bench, &shard_manifest(bench, shard, start, pending))?;
+            batch.commit_so_far()?;
+        }
     }
     let failed_configs = bench
         .measured
         .values()
         .filter(|m| m.error.is_some())
         .count();
-    let manifest = shard::Manifest {
-        format: shard::FORMAT,
-        shard,
-        argv: shard::recorded_argv(&std::env::args().collect::<Vec<_>>()),
-        units: bench.units(),
-        machine: bench.machine.clone(),
-        wall_s: start.elapsed().as_secs_f64(),
-        configs: std::mem::take(&mut bench.measured),
-        sections: std::mem::take(&mut bench.sections),
-    };
+    let manifest = shard_manifest(bench, shard, start, Vec::new());
     let path = shard::write_manifest(bench, &manifest)?;
     // a shard that took no unit still writes its manifest: the merge needs every shard's
     let ok_configs = manifest.configs.len() - failed_configs;
@@ -225,6 +224,26 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         );
     }
     Ok(())
+}
+
+/// The shard's record of what it measured so far; `pending`: the protocols it has yet to run.
+fn shard_manifest(
+    bench: &Bench,
+    shard: Shard,
+    start: Instant,
+    pending: Vec<String>,
+) -> shard::Manifest {
+    shard::Manifest {
+        format: shard::FORMAT,
+        shard,
+        argv: shard::recorded_argv(&std::env::args().collect::<Vec<_>>()),
+        units: bench.units(),
+        machine: bench.machine.clone(),
+        wall_s: start.elapsed().as_secs_f64(),
+        configs: bench.measured.clone(),
+        sections: bench.sections.clone(),
+        pending,
+    }
 }
 
 /// `bench merge`: check the shards, replay the run on their records, write its report.

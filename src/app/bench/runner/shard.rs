@@ -154,6 +154,10 @@ pub struct Manifest {
     pub configs: BTreeMap<String, Measured>,
     /// The whole protocols it ran, by id (the protocol's name).
     pub sections: BTreeMap<String, Section>,
+    /// The protocols it had yet to run when this was written: empty for a shard that ran
+    /// whole; else it was cut short (an interrupt, a killed job) after the others.
+    #[serde(default)]
+    pub pending: Vec<String>,
 }
 
 /// The shards' records, merged, and the folder each unit's files are in.
@@ -239,6 +243,15 @@ fn check_complete(shards: &[(Manifest, PathBuf)]) -> Result<()> {
                 m.argv.join(" "),
                 m.shard.n,
                 m.units
+            );
+        }
+        if !m.pending.is_empty() {
+            bail!(
+                "{}: shard {} was cut short before {}; run it again (`bench … --shard {}`)",
+                dir.display(),
+                m.shard,
+                m.pending.join(", "),
+                m.shard
             );
         }
         if let Some(other) = seen.insert(m.shard.k, dir) {
