@@ -7,10 +7,11 @@ This script renders the same comparison with `gpgpu-rt render --shadows MODE --l
 UxV` for `exact` and each mode (default `linespace`, `linespace-fast`, `variant2`) at 2x2, 5x5
 and 10x10 samples, reads each render's `shadow.npy` AOV (the share of a pixel's shadow rays
 that reach the light), and composes one PNG: a row per sample count; in it `exact`, then for
-each mode its image and the map of |s - exact| (black 0, white 0.25 or more) labelled with the
-mean over all pixels — the error `bench klee-table2` reports. It prints the errors (and each
-render's triangle tests and line-space lookups from `--stats`) as a Markdown table. A
-render's time is left out: one frame's includes the shaders' compilation.
+each mode its image and the map of |s - exact| (black 0, white 0.25 or more) labelled with its
+mean over the pixels with a first hit (`triangle_id` >= 0), as results/linespace-shadows.md
+gives it. It prints the errors (and each render's triangle tests and line-space lookups from
+`--stats`) as a Markdown table. A render's time is left out: one frame's includes the
+shaders' compilation.
 
     python3 tools/klee_fig11.py [--scene scenes/bunny_area.toml] [--size 128]
         [--samples 2x2,5x5,10x10] [--modes linespace,linespace-fast,variant2]
@@ -50,7 +51,8 @@ def render(binary, scene, mode, samples, size, folder):
         sys.exit(f"{' '.join(cmd)} failed:\n{done.stderr}")
     wall = time.monotonic() - start
     shadow = np.load(folder / "aov" / "shadow.npy").astype(np.float64)
-    return pngio.read_png(png), shadow, json.loads(stats.read_text()), wall
+    hit = np.load(folder / "aov" / "triangle_id.npy") >= 0
+    return pngio.read_png(png), shadow, hit, json.loads(stats.read_text()), wall
 
 
 def error_map(diff):
@@ -94,17 +96,17 @@ def main():
     for sample in samples:
         u, v = (int(x) for x in sample.lower().split("x"))
         rays = u * v
-        exact_img, exact_s, exact_stats, wall = render(binary, args.scene, "exact", sample, args.size,
+        exact_img, exact_s, hit, exact_stats, wall = render(binary, args.scene, "exact", sample, args.size,
                                                        work / sample / "exact")
         walls.append(("exact", sample, wall))
         cells = [labelled(exact_img, f"exact {rays} rays")]
         table.append((sample, rays, "exact", 0.0, 0.0, exact_stats))
         for mode in modes:
-            img, s, stats, wall = render(binary, args.scene, mode, sample, args.size, work / sample / mode)
+            img, s, _, stats, wall = render(binary, args.scene, mode, sample, args.size, work / sample / mode)
             walls.append((mode, sample, wall))
             diff = np.abs(s - exact_s)
-            mean = float(diff.mean())
-            share = float((diff > 1e-6).mean())
+            mean = float(diff[hit].mean())
+            share = float((diff[hit] > 1e-6).mean())
             table.append((sample, rays, mode, mean, share, stats))
             cells.append(labelled(img, mode))
             cells.append(labelled(error_map(diff), f"err {mean:.4f}"))
@@ -121,7 +123,7 @@ def main():
     pngio.write_png(out, np.vstack(picture))
 
     print(f"{args.scene}, {args.size}x{args.size}, renderer {table[0][5].get('renderer', '?')}\n")
-    print("| light samples (rays) | mode | mean \\|s − exact\\| | pixels that differ | triangle tests | line-space lookups |")
+    print("| light samples (rays) | mode | mean \\|s − exact\\| (hit pixels) | hit pixels that differ | triangle tests | line-space lookups |")
     print("|---|---|---|---|---|---|")
     for sample, rays, mode, mean, share, stats in table:
         print(f"| {sample} ({rays}) | `{mode}` | {mean:.4f} | {100 * share:.1f} % | "

@@ -13,8 +13,8 @@ sparse room (not in the paper) beside them.
 fixed-size voxel lists (`--voxel-array-length`, Listing 17: 512) are too short for the
 triangles a voxel holds; the ids that do not fit are dropped. The bunny at 24³, the exact
 grid beside the thesis grid with lists of 512, 64 and 16 ids. Each panel's label gives the
-share of pixels whose first hit (the `triangle_id` AOV) differs from the exact grid's; the
-table printed gives `dropped_triangle_refs` from `--stats` as well.
+share of pixels whose first hit (the `triangle_id` AOV) differs from the exact grid's
+("wrong"); the table printed gives `dropped_triangle_refs` from `--stats` as well.
 
 Each prints a Markdown table of what it rendered. Needs Python 3 with numpy; the PNGs are
 read and written by tools/pngio.py (no imaging library).
@@ -119,7 +119,7 @@ def grid_holes(args, binary, work):
             exact_ids = ids
         wrong = float((ids != exact_ids).mean())
         walls.append(wall)
-        text = label if i == 0 else f"{label} {100 * wrong:.1f}%"
+        text = label if i == 0 else f"{label} {100 * wrong:.1f}% wrong"
         cells.append((img, text))
         print(f"| {label} | `{shown(cmd)}` | {stats.get('dropped_triangle_refs', 0):,} | "
               f"{100 * wrong:.1f} % of pixels |")
@@ -148,7 +148,8 @@ def main():
     out = Path(out) if Path(out).is_absolute() else ROOT / out
     out.parent.mkdir(parents=True, exist_ok=True)
     pngio.write_png(out, picture)
-    print(f"\n{out}: {len(walls)} renders at {args.size}x{args.size}, {sum(walls):.1f} s of render wall time")
+    shown_out = out.relative_to(ROOT) if out.is_relative_to(ROOT) else out
+    print(f"\n{shown_out}: {len(walls)} renders at {args.size}x{args.size}, {sum(walls):.1f} s of render wall time")
 
 
 if __name__ == "__main__":
