@@ -11,6 +11,7 @@ use anyhow::{bail, Result};
 use glow::HasContext;
 
 use super::resources::GpuTimers;
+use super::resources::Owned;
 use super::{compile_program, Defines, Gl, ShaderSource};
 use super::{crash, sync};
 
@@ -20,7 +21,7 @@ pub const PIXEL_GROUP: u32 = 8;
 /// One GLSL program: a compute kernel, or a vertex + fragment program of a raster pass.
 pub struct Kernel {
     gl: Arc<Gl>,
-    program: glow::Program,
+    program: Owned<glow::Program>,
     /// The name its dispatches are timed under (the key of `gpu_ms`).
     timer: &'static str,
     uniforms: HashMap<String, glow::UniformLocation>,
@@ -123,7 +124,7 @@ impl Kernel {
         defines: &Defines,
         timer: &'static str,
     ) -> Result<Kernel> {
-        let program = compile_program(gl, shaders, stages, defines)?;
+        let program = Owned::new(gl, compile_program(gl, shaders, stages, defines)?);
         let files: Vec<String> = stages
             .iter()
             .map(|(_, f)| shaders.display_name(f))
@@ -133,6 +134,7 @@ impl Kernel {
         let crash_note = crash::keep(&crash::message(timer, &files, &renderer));
         // SAFETY: queries of the program we just linked.
         let uniforms = unsafe {
+            let program = program.raw();
             (0..gl.get_active_uniforms(program))
                 .filter_map(|i| gl.get_active_uniform(program, i))
                 .filter_map(|u| {
@@ -158,7 +160,7 @@ impl Kernel {
     pub fn use_program(&self) {
         crash::note_program(self.crash_note);
         // SAFETY: binding our own program.
-        unsafe { self.gl.use_program(Some(self.program)) };
+        unsafe { self.gl.use_program(Some(self.program.raw())) };
     }
 
     /// The location of `name`; `None` where the program has no such active uniform (the
@@ -278,13 +280,6 @@ impl Kernel {
             });
         }
         sync::after_pass(gl);
-    }
-}
-
-impl Drop for Kernel {
-    fn drop(&mut self) {
-        // SAFETY: deleting our own program.
-        unsafe { self.gl.delete_program(self.program) };
     }
 }
 

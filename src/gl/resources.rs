@@ -39,6 +39,7 @@ gl_object! {
     glow::NativeVertexArray => delete_vertex_array,
     glow::NativeQuery => delete_query,
     glow::NativeProgram => delete_program,
+    glow::NativeFence => delete_sync,
 }
 
 /// A GL object name owned: deleted when this drops. It holds the [`Gl`] it was made with; the

@@ -24,6 +24,7 @@ use super::{
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
+use crate::gl::resources::Owned;
 use crate::gl::resources::{GpuTimers, Ssbo, TexelData, TextureBuffers};
 use crate::gl::slots::{image, ssbo};
 use crate::gl::{Gl, GlInfo, Kernel};
@@ -311,7 +312,7 @@ struct Moving {
     cost: Cell<f64>,
     /// the fence after the last refit, while its cost is not read: the host reads it once the
     /// GPU has passed the fence, without waiting ([`Bvh::read_cost`])
-    pending: Cell<Option<glow::Fence>>,
+    pending: Cell<Option<Owned<glow::Fence>>>,
     /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
     max_block: i64,
     /// the compute image units of the profile, for the refit's image-buffer views
@@ -556,9 +557,9 @@ impl Bvh {
         };
         let timeout = if wait { i32::MAX } else { 0 };
         loop {
-            // SAFETY: a fence of ours, not deleted (it is deleted once, here or in drop_pending).
+            // SAFETY: a fence of ours, alive while `fence` is (deleted as it drops).
             let flush = glow::SYNC_FLUSH_COMMANDS_BIT;
-            let state = unsafe { self.gl.client_wait_sync(fence, flush, timeout) };
+            let state = unsafe { self.gl.client_wait_sync(fence.raw(), flush, timeout) };
             match state {
                 glow::TIMEOUT_EXPIRED if wait => continue,
                 glow::TIMEOUT_EXPIRED => {
@@ -568,8 +569,7 @@ impl Bvh {
                 _ => break,
             }
         }
-        // SAFETY: as above.
-        unsafe { self.gl.delete_sync(fence) };
+        drop(fence);
         let refit = self
             .moving
             .refit
@@ -581,10 +581,7 @@ impl Bvh {
 
     /// Forget the last refit's cost unread (a rebuild replaces it).
     fn drop_pending(&self) {
-        if let Some(fence) = self.moving.pending.take() {
-            // SAFETY: a fence of ours, not deleted yet.
-            unsafe { self.gl.delete_sync(fence) };
-        }
+        drop(self.moving.pending.take());
     }
 
     /// Refit the tree on the GPU to this frame's world-space vertices (the scene's `vertex` SSBO,
@@ -599,11 +596,10 @@ impl Bvh {
         }
         refit.run(f.gl, f.timers, &self.moving.kernels, storage);
         self.drop_pending();
-        // SAFETY: a fence on a current context; deleted in read_cost or drop_pending.
+        // SAFETY: a fence on a current context, owned (deleted as it drops).
         let fence = unsafe { f.gl.fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0) };
-        self.moving
-            .pending
-            .set(Some(fence.map_err(|e| anyhow!("glFenceSync: {e}"))?));
+        let fence = fence.map_err(|e| anyhow!("glFenceSync: {e}"))?;
+        self.moving.pending.set(Some(Owned::new(f.gl, fence)));
         self.built_for = Some(f.models.to_vec());
         self.moving.refits += 1;
         Ok(())
@@ -628,12 +624,6 @@ impl Bvh {
         if let Some(b) = &self.buffers {
             b.bind_images(gl, access);
         }
-    }
-}
-
-impl Drop for Bvh {
-    fn drop(&mut self) {
-        self.drop_pending();
     }
 }
 

@@ -40,6 +40,7 @@ use winit::keyboard::ModifiersState;
 use winit::window::WindowId;
 
 use crate::args::DesignArgs;
+use gpgpu_rt::gl::resources::Owned;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::limits;
 use gpgpu_rt::output::console::ConsoleError;
@@ -378,19 +379,15 @@ impl App {
         let running = self.running.as_mut().ok_or_else(|| anyhow!("no window"))?;
         let start = Instant::now();
         let gl = running.window.gl.clone();
-        let program = if quad {
-            Some(compile_quad_program(&gl, &self.shaders)?)
-        } else {
-            None
+        // owned: a failed reload below deletes it as it drops
+        let program = match quad {
+            true => Some(Owned::new(&gl, compile_quad_program(&gl, &self.shaders)?)),
+            false => None,
         };
         let shown = self.design.shown();
-        if let Err(e) = running.renderers.reload(&self.scene, &self.shaders, shown) {
-            if let Some(p) = program {
-                // SAFETY: deleting the program we just made.
-                unsafe { gl.delete_program(p) };
-            }
-            return Err(e);
-        }
+        running
+            .renderers
+            .reload(&self.scene, &self.shaders, shown)?;
         if let Some(p) = program {
             running.quad.set_program(p);
         }

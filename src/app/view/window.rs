@@ -318,8 +318,8 @@ impl ScreenQuad {
     }
 
     /// Replace the program (after a live reload); the old one is deleted.
-    pub fn set_program(&mut self, program: glow::Program) {
-        self.program = Owned::new(&self.gl, program);
+    pub fn set_program(&mut self, program: Owned<glow::Program>) {
+        self.program = program;
     }
 
     /// Clear the bound draw framebuffer (`size`: its size) to the letterbox colour and draw
@@ -361,10 +361,11 @@ impl ScreenQuad {
         height: u32,
     ) -> Result<Vec<u8>> {
         let gl = &self.gl;
-        // SAFETY: a framebuffer of our own, deleted before returning.
+        // SAFETY: a framebuffer of our own, deleted as it drops (at the return).
         unsafe {
-            let fbo = gl.create_framebuffer().map_err(|e| anyhow!(e))?;
-            let rb = gl.create_renderbuffer().map_err(|e| anyhow!(e))?;
+            let fbo = Owned::new(gl, gl.create_framebuffer().map_err(|e| anyhow!(e))?);
+            let rb = Owned::new(gl, gl.create_renderbuffer().map_err(|e| anyhow!(e))?);
+            let (fbo, rb) = (fbo.raw(), rb.raw());
             gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
             gl.renderbuffer_storage(glow::RENDERBUFFER, glow::RGBA8, width as i32, height as i32);
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(fbo));
@@ -389,8 +390,6 @@ impl ScreenQuad {
                 Err(anyhow!("offscreen framebuffer incomplete (0x{status:x})"))
             };
             gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-            gl.delete_framebuffer(fbo);
-            gl.delete_renderbuffer(rb);
             result
         }
     }
