@@ -151,22 +151,24 @@ fn code_spans(text: &str) -> Vec<&str> {
     text.split('`').skip(1).step_by(2).collect()
 }
 
-#[test]
-fn every_test_file_is_described_in_testing_md() {
-    let testing = std::fs::read_to_string(root().join("docs/testing.md")).unwrap();
-    let named = code_spans(&testing);
-    let mut missing = Vec::new();
-    let mut files: Vec<_> = std::fs::read_dir(root().join("tests"))
+/// The files of the folder `dir` ending in `ext` whose name (after `prefix`) is no code span
+/// of the page `page`, sorted.
+fn not_named(dir: &str, ext: &str, page: &str, prefix: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(root().join(page)).unwrap();
+    let named = code_spans(&text);
+    let mut missing: Vec<String> = std::fs::read_dir(root().join(dir))
         .unwrap()
         .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(ext) && !named.contains(&format!("{prefix}{n}").as_str()))
         .collect();
-    files.sort_by_key(|e| e.path());
-    for e in files {
-        let name = e.file_name().to_string_lossy().to_string();
-        if name.ends_with(".rs") && !named.contains(&format!("tests/{name}").as_str()) {
-            missing.push(name);
-        }
-    }
+    missing.sort();
+    missing
+}
+
+#[test]
+fn every_test_file_is_described_in_testing_md() {
+    let missing = not_named("tests", ".rs", "docs/testing.md", "tests/");
     assert!(
         missing.is_empty(),
         "test files without a row in docs/testing.md: {missing:?}"
@@ -175,20 +177,7 @@ fn every_test_file_is_described_in_testing_md() {
 
 #[test]
 fn every_scene_is_described_in_scenes_md() {
-    let scenes = std::fs::read_to_string(root().join("docs/scenes.md")).unwrap();
-    let named = code_spans(&scenes);
-    let mut missing = Vec::new();
-    let mut files: Vec<_> = std::fs::read_dir(root().join("scenes"))
-        .unwrap()
-        .flatten()
-        .collect();
-    files.sort_by_key(|e| e.path());
-    for e in files {
-        let name = e.file_name().to_string_lossy().to_string();
-        if name.ends_with(".toml") && !named.contains(&name.as_str()) {
-            missing.push(name);
-        }
-    }
+    let missing = not_named("scenes", ".toml", "docs/scenes.md", "");
     assert!(
         missing.is_empty(),
         "scenes not in docs/scenes.md: {missing:?}"

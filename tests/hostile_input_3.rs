@@ -145,34 +145,9 @@ fn a_closed_pipe_or_a_full_disk_is_no_panic() {
 /// staged file is left. (Before: "14 unfinished output(s) removed" and an empty folder.)
 #[test]
 fn an_interrupted_bench_keeps_the_protocols_it_finished() {
-    use std::process::{Command, Stdio};
-    use std::time::{Duration, Instant};
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("b");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
-        .args(["bench", "thesis-5.1", "thesis-5.2", "--quiet"])
-        .args(["--width", "8", "--height", "8", "--angles", "1"])
-        .args(["--warmup", "0", "--out", out.to_str().unwrap()])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !out.join("thesis-5.1_summary.csv").exists() {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "ended before 5.1 was kept"
-        );
-        assert!(start.elapsed() < Duration::from_secs(300), "5.1 never kept");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "thesis-5.2 finished before the interrupt: the test needs a slower protocol"
-    );
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    interrupt_bench_in_5_2(&[], &out, "thesis-5.1_summary.csv");
     let mut names: Vec<String> = walk(&out);
     names.sort();
     assert!(
@@ -199,6 +174,43 @@ fn an_interrupted_bench_keeps_the_protocols_it_finished() {
         10,
         "nine configurations and the header: {csv}"
     );
+}
+
+/// `bench thesis-5.1 thesis-5.2` (8×8, one angle) with `extra` into `out`, sent SIGINT once
+/// `kept` exists there (thesis-5.1 kept) while thesis-5.2 still runs: it exits with 130.
+fn interrupt_bench_in_5_2(
+    extra: &[&str],
+    out: &std::path::Path,
+    kept: &str,
+) -> std::process::Output {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
+        .args(["bench", "thesis-5.1", "thesis-5.2", "--quiet"])
+        .args(extra)
+        .args(["--width", "8", "--height", "8", "--angles", "1"])
+        .args(["--warmup", "0", "--out", out.to_str().unwrap()])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !out.join(kept).exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "ended before 5.1 was kept"
+        );
+        assert!(start.elapsed() < Duration::from_secs(300), "5.1 never kept");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "thesis-5.2 finished before the interrupt: the test needs a slower protocol"
+    );
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    o
 }
 
 /// Every file below `root`, as a path relative to it.
@@ -538,41 +550,9 @@ fn a_loop_limit_refusal_names_the_option_that_avoids_it() {
 /// refuses that shard as cut short rather than report a run with a protocol missing.
 #[test]
 fn an_interrupted_shard_keeps_its_protocols_and_the_merge_refuses_it() {
-    use std::process::{Command, Stdio};
-    use std::time::{Duration, Instant};
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s1");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_gpgpu-rt"))
-        .args([
-            "bench",
-            "thesis-5.1",
-            "thesis-5.2",
-            "--quiet",
-            "--shard",
-            "1/1",
-        ])
-        .args(["--width", "8", "--height", "8", "--angles", "1"])
-        .args(["--warmup", "0", "--out", out.to_str().unwrap()])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !out.join("shard.json").exists() {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "ended before 5.1 was kept"
-        );
-        assert!(start.elapsed() < Duration::from_secs(300), "5.1 never kept");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "thesis-5.2 finished before the interrupt"
-    );
-    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-    let o = child.wait_with_output().unwrap();
-    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    interrupt_bench_in_5_2(&["--shard", "1/1"], &out, "shard.json");
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("shard.json")).unwrap()).unwrap();
     assert_eq!(

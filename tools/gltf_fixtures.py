@@ -18,9 +18,8 @@ Exit status 2 when trimesh, pygltflib or NumPy is missing.
 """
 import base64
 import math
-import struct
+import os
 import sys
-import zlib
 
 try:
     import numpy as np
@@ -29,6 +28,9 @@ try:
 except ImportError as e:
     print(f"gltf_fixtures: {e} (pip install trimesh pygltflib numpy)", file=sys.stderr)
     sys.exit(2)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pngio import write_png  # noqa: E402  (beside this script)
 
 # the scene both files describe
 PARENT_T = [0.2, 0.0, -0.3]
@@ -39,15 +41,6 @@ LIGHT = [1.5, 3.0, 2.0]
 FLOOR = 1.5  # half the floor's side
 # 2×2 texels, row 0 at the top of the image
 TEXELS = [[(220, 40, 40), (40, 200, 60)], [(40, 60, 220), (230, 210, 40)]]
-
-
-def png(texels):
-    """A PNG of RGB texels (rows top to bottom), by hand: no imaging library needed."""
-    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in texels)
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-    ihdr = struct.pack(">IIBBBBB", len(texels[0]), len(texels), 8, 2, 0, 0, 0)
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
 
 
 def look_at_matrix(eye, target, up):
@@ -84,8 +77,7 @@ def main(out, models):
     # glTF's texture coordinates run down the image, OBJ's up: the same texel at each corner
     floor_uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float32)
     floor_idx = np.array([0, 2, 1, 0, 3, 2], dtype=np.uint32)
-    with open(f"{out}/floor.png", "wb") as f:
-        f.write(png(TEXELS))
+    write_png(f"{out}/floor.png", np.array(TEXELS, dtype=np.uint8))
     with open(f"{out}/floor.mtl", "w") as f:
         f.write("newmtl floor\nKd 1 1 1\nmap_Kd floor.png\n")
     with open(f"{out}/floor.obj", "w") as f:

@@ -148,8 +148,17 @@ impl Tracker {
 
 /// `triangles` of `what`, with the copies made for the GPU, within the host's memory.
 pub fn check_triangles(what: &str, triangles: u64) -> Result<(), String> {
+    check_triangles_against(what, triangles, host_limit())
+}
+
+/// [`check_triangles`] against a limit taken once (a scene's objects, one after another).
+pub fn check_triangles_against(
+    what: &str,
+    triangles: u64,
+    limit: Option<(u64, &str)>,
+) -> Result<(), String> {
     let bytes = triangles.saturating_mul(MESH_TRIANGLE_BYTES * TRIANGLE_COPIES);
-    check_host(&format!("{what}: {triangles} triangles"), bytes)
+    check_against(&format!("{what}: {triangles} triangles"), bytes, limit)
 }
 
 /// A model file of `len` bytes, read and parsed, within the host's memory.

@@ -152,8 +152,14 @@ fn mesh_name(mesh: &gltf::Mesh) -> String {
 pub fn count_triangles(path: &Path) -> Result<u64, SceneError> {
     let doc = parse(path)?.document;
     let scene = main_scene(path, &doc)?;
+    nodes_triangles(path, &world_nodes(&scene))
+}
+
+/// The triangles the meshes of `nodes` give (each primitive checked by
+/// [`primitive_triangles`]).
+fn nodes_triangles(path: &Path, nodes: &[(gltf::Node, Mat4)]) -> Result<u64, SceneError> {
     let mut total = 0u64;
-    for (node, _) in world_nodes(&scene) {
+    for (node, _) in nodes {
         if let Some(mesh) = node.mesh() {
             for p in mesh.primitives() {
                 total = total.saturating_add(primitive_triangles(path, &mesh, &p)?);
@@ -315,15 +321,21 @@ fn check_accessor(path: &Path, a: &gltf::Accessor, buffers: &[Vec<u8>]) -> Resul
     Ok(())
 }
 
-/// Load the glTF file's scene.
+/// Load the glTF file's scene: its triangles are counted from the JSON and checked against
+/// [`super::MAX_SCENE_TRIANGLES`] and the host's memory before any buffer is read.
 pub fn load(path: &Path) -> Result<LoadedGltf, SceneError> {
-    let triangles = count_triangles(path)?;
-    budget::check_triangles("the glTF file's scene", triangles).map_err(|m| err(path, m))?;
     let g = parse(path)?;
-    let buffers = buffers(path, &g)?;
     let doc = &g.document;
     let scene = main_scene(path, doc)?;
     let nodes = world_nodes(&scene);
+    let triangles = nodes_triangles(path, &nodes)?;
+    if triangles > super::MAX_SCENE_TRIANGLES {
+        let most = super::MAX_SCENE_TRIANGLES;
+        let m = format!("{triangles} triangles, more than the {most} a scene may have");
+        return Err(err(path, m));
+    }
+    budget::check_triangles("the glTF file's scene", triangles).map_err(|m| err(path, m))?;
+    let buffers = buffers(path, &g)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut out = LoadedGltf {
         mesh: Mesh::default(),

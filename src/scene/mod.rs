@@ -613,16 +613,6 @@ impl Scene {
     /// A glTF file as the whole scene (`render model.glb`): its camera, or one that frames it;
     /// its lights, or one above the camera; default render settings.
     fn from_gltf(path: &Path, textures: Textures) -> Result<Scene, SceneError> {
-        let triangles = gltf::count_triangles(path)?;
-        if triangles > MAX_SCENE_TRIANGLES {
-            return Err(SceneError::at(
-                path,
-                None,
-                format!(
-                    "{triangles} triangles, more than the {MAX_SCENE_TRIANGLES} a scene may have"
-                ),
-            ));
-        }
         let loaded = gltf::load(path)?;
         let camera = loaded
             .camera
@@ -714,12 +704,14 @@ pub const MAX_SCENE_TRIANGLES: u64 = 1 << 24;
 fn predict_triangles(src: &SceneText, dir: &Path, defs: &[ObjectDef]) -> Result<u64, SceneError> {
     let mut models: std::collections::HashMap<PathBuf, u64> = Default::default();
     let mut total = 0u64;
+    // (the host's memory read once for the whole scene, not twice an object)
+    let limit = budget::host_limit();
     for (k, def) in defs.iter().enumerate() {
         let Ok(n) = def.predicted_triangles(dir, &mut models) else {
             return Ok(total);
         };
         let alone = n > MAX_SCENE_TRIANGLES.min(MAX_PROCEDURAL_TRIANGLES)
-            || budget::check_triangles("", n).is_err();
+            || budget::check_triangles_against("", n, limit).is_err();
         if alone {
             return Ok(total);
         }
@@ -736,7 +728,7 @@ fn predict_triangles(src: &SceneText, dir: &Path, defs: &[ObjectDef]) -> Result<
             );
             return Err(src.error_at(def.kind.span().start, m));
         }
-        budget::check_triangles(&upto, total)
+        budget::check_triangles_against(&upto, total, limit)
             .map_err(|m| src.error_at(def.kind.span().start, m))?;
     }
     Ok(total)
