@@ -16,13 +16,14 @@ use std::sync::Arc;
 use anyhow::{bail, Result};
 use serde::Serialize;
 
-use crate::accel::{self, GridOptions};
+use crate::accel::{self, Accel};
 use crate::gl::{Gl, GlInfo, ShaderSource};
 use crate::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
-use crate::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
+use crate::pipeline::mueller2015::{RayTracer, RenderOptions};
 use crate::pipeline::stream::{StreamOptions, StreamRenderer};
 use crate::pipeline::wagner2018::{WagnerOptions, WagnerRenderer};
 use crate::pipeline::Renderer;
+use crate::reference::{self, CpuAccelerator, MakeTwin};
 use crate::scene::{Scene, ShadowMode};
 
 /// The four pipelines — how rays flow through the GPU — named as their modules and their
@@ -69,16 +70,7 @@ pub const COMMON_OPTIONS: &[&str] = &[
 
 /// The defaults of the design options where the command line gives none, which
 /// [`Design::plain`] takes too.
-pub mod defaults {
-    /// `--tile`: dispatches of at most 256×256 pixels.
-    pub const TILE: u32 = 256;
-    /// `--light-samples`: U×V samples of the area light.
-    pub const LIGHT_SAMPLES: (u32, u32) = (4, 4);
-    /// `--ntree-n`: cells per axis of every N-tree node (the thesis' 10).
-    pub const NTREE_N: u32 = 10;
-    /// `--ntree-depth`: levels of the N-tree counting the root (reading A).
-    pub const NTREE_DEPTH: u32 = 3;
-}
+pub use crate::limits::defaults;
 
 /// The options of Müller 2015's pipeline, whatever its accelerator (`light-samples`: the
 /// feelers towards each area light, ours after Klee 2016).
@@ -100,8 +92,10 @@ pub struct Row {
     /// The command-line values that select it (`--shadows` with any value selects Klee 2016's,
     /// whatever `--tracer` says, which is then refused).
     pub select: &'static [(&'static str, &'static str)],
-    /// The accelerator of Müller 2015's pipeline (its GPU side and CPU twin).
+    /// The accelerator of Müller 2015's pipeline (its GPU side and default options).
     pub accel: Option<&'static accel::Entry>,
+    /// The accelerator's CPU twin, which the tests hold its GPU side against.
+    pub twin: Option<MakeTwin>,
     /// The options, beyond [`COMMON_OPTIONS`], that belong to it (long names without `--`),
     /// in groups (those of its pipeline, of its accelerator).
     pub options: &'static [&'static [&'static str]],
@@ -176,6 +170,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the base tracer (every ray against every triangle)",
         select: &[("tracer", "base")],
         accel: Some(&accel::brute_force::ENTRY),
+        twin: Some(reference::base_twin),
         options: &[MUELLER],
         glsl: &["mueller2015", "brute_force"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -186,6 +181,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the thesis' uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "thesis")],
         accel: Some(&accel::thesis_grid::ENTRY),
+        twin: Some(reference::thesis_grid_twin),
         options: &[MUELLER, GRID, &["voxel-array-length", "ray-array-length"]],
         glsl: &["mueller2015", "thesis_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -196,6 +192,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the exact uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "exact")],
         accel: Some(&accel::exact_grid::ENTRY),
+        twin: Some(reference::exact_grid_twin),
         options: &[MUELLER, GRID, &["proximity-clouds"]],
         glsl: &["mueller2015", "exact_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -206,7 +203,16 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with our SAH BVH",
         select: &[("tracer", "bvh"), ("bvh-variant", "sah")],
         accel: Some(&accel::bvh::ENTRY),
-        options: &[MUELLER, &["bvh-variant", "fused-passes", "bvh-instances"]],
+        twin: Some(reference::bvh_twin),
+        options: &[
+            MUELLER,
+            &[
+                "bvh-variant",
+                "four-kernels",
+                "fused-passes",
+                "bvh-instances",
+            ],
+        ],
         glsl: &["mueller2015", "bvh"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD + host_bytes::SAH_BVH,
     },
@@ -216,6 +222,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Wagner 2018's kernel (one light, hard shadows, no reflection) over his BVH",
         select: &[("tracer", "bvh"), ("bvh-variant", "wagner")],
         accel: None,
+        twin: None,
         options: &[&["tracer", "bvh-variant", "tile"]],
         glsl: &["wagner2018"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::WAGNER,
@@ -226,6 +233,7 @@ pub const REGISTRY: &[Row] = &[
         title: "the streaming tracer (fragment programs, a static grid)",
         select: &[("tracer", "stream")],
         accel: None,
+        twin: None,
         options: &[&[
             "tracer",
             "refl-depth",
@@ -246,6 +254,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Klee 2016's soft shadows (N-tree, Cascaded Line Space)",
         select: &[],
         accel: None,
+        twin: None,
         options: &[&[
             "shadows",
             "light-samples",
@@ -262,6 +271,15 @@ pub const REGISTRY: &[Row] = &[
 /// The accelerators of Müller 2015's pipeline, in the registry's order.
 pub fn accelerators() -> impl Iterator<Item = &'static accel::Entry> {
     REGISTRY.iter().filter_map(|r| r.accel)
+}
+
+/// The CPU twin of `accel` over `scene`, from its row of the registry.
+pub fn twin(scene: &Scene, accel: &Accel) -> Result<Box<dyn CpuAccelerator>> {
+    let row = row(accel.entry().label)?;
+    let make = row
+        .twin
+        .ok_or_else(|| anyhow::anyhow!("{row:?} names no CPU twin"))?;
+    make(scene, accel)
 }
 
 /// The row named `name`.
@@ -331,23 +349,9 @@ impl Design {
     /// triangle count, bitwise shadow flags, the line space; no AOVs.
     pub fn plain(row: &Row, width: u32, height: u32, refl_depth: u32) -> Design {
         match (row.pipeline, row.accel) {
-            (Pipeline::Mueller2015, Some(entry)) => Design::Mueller2015(RenderOptions {
-                tracer: entry.tracer,
-                width,
-                height,
-                refl_depth,
-                tile: defaults::TILE,
-                shadow_flags: ShadowFlags::Bits,
-                aovs: false,
-                grid: GridOptions {
-                    variant: entry.grid_variant.unwrap_or_default(),
-                    ..GridOptions::default()
-                },
-                triangles_per_dispatch: None,
-                light_samples: defaults::LIGHT_SAMPLES,
-                fused_passes: false,
-                bvh_instances: false,
-            }),
+            (Pipeline::Mueller2015, Some(entry)) => {
+                Design::Mueller2015(RenderOptions::new(entry.plain, width, height, refl_depth))
+            }
             (Pipeline::Wagner2018, _) => Design::Wagner2018(WagnerOptions {
                 width,
                 height,
@@ -376,7 +380,7 @@ impl Design {
     /// Its row of the registry.
     pub fn row(&self) -> &'static Row {
         let name = match self {
-            Design::Mueller2015(o) => accel::entry(o.tracer, &o.grid).label,
+            Design::Mueller2015(o) => o.accel.entry().label,
             Design::Wagner2018(_) => "bvh-wagner",
             Design::Stream(_) => "stream",
             Design::Klee2016(_) => "linespace",
@@ -438,7 +442,7 @@ impl Design {
         check("the image width", w, &IMAGE_SIDE).map_err(anyhow::Error::msg)?;
         check("the image height", h, &IMAGE_SIDE).map_err(anyhow::Error::msg)?;
         let (refl_depth, grid) = match self {
-            Design::Mueller2015(o) => (o.refl_depth, o.grid.resolution.map(|n| [n; 3])),
+            Design::Mueller2015(o) => (o.refl_depth, o.accel.grid_resolution().map(|n| [n; 3])),
             Design::Stream(o) => (o.refl_depth, o.dims),
             _ => (0, None),
         };

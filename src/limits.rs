@@ -50,6 +50,19 @@ pub fn parser(range: RangeInclusive<u32>) -> clap::builder::RangedI64ValueParser
     clap::value_parser!(u32).range(*range.start() as i64..=*range.end() as i64)
 }
 
+/// The defaults of the design options where the command line gives none, which
+/// `design::Design::plain` and the pipelines' option constructors take too.
+pub mod defaults {
+    /// `--tile`: dispatches of at most 256×256 pixels.
+    pub const TILE: u32 = 256;
+    /// `--light-samples`: U×V samples of the area light.
+    pub const LIGHT_SAMPLES: (u32, u32) = (4, 4);
+    /// `--ntree-n`: cells per axis of every N-tree node (the thesis' 10).
+    pub const NTREE_N: u32 = 10;
+    /// `--ntree-depth`: levels of the N-tree counting the root (reading A).
+    pub const NTREE_DEPTH: u32 = 3;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

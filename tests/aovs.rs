@@ -9,17 +9,13 @@ mod common;
 
 use common::*;
 use glam::{DVec3, Vec3};
-use gpgpu_rt::accel::{self, GridOptions, TracerKind};
 use gpgpu_rt::design::Design;
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Light;
 
 fn bvh_options(w: u32, h: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Bvh,
-        ..options(w, h, 1)
-    }
+    options_with(BVH_FOUR_KERNELS, w, h, 1)
 }
 
 /// Barycentric (u, v) of the projection of `p` onto the triangle's plane, and the distance of
@@ -117,8 +113,7 @@ fn shadow_aov_is_the_share_of_unblocked_lights() {
         color: Vec3::splat(0.3),
     });
     let (w, h) = (48, 40);
-    let twin = gpgpu_rt::reference::twin(accel::TracerKind::Bvh, &scene, &GridOptions::default())
-        .expect("CPU twin");
+    let twin = gpgpu_rt::design::twin(&scene, &BVH_FOUR_KERNELS).expect("CPU twin");
     let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, w, h, 1);
     let want = cpu
         .aovs

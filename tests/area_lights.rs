@@ -27,7 +27,7 @@ fn accelerators() -> Vec<(&'static str, RenderOptions)> {
 }
 
 fn reference(scene: &Scene, o: &RenderOptions, samples: (u32, u32)) -> ReferenceFrame {
-    let twin = gpgpu_rt::reference::twin(o.tracer, scene, &o.grid).expect("CPU twin");
+    let twin = gpgpu_rt::design::twin(scene, &o.accel).expect("CPU twin");
     Reference::with_accelerator(scene, twin)
         .with_light_samples(samples)
         .render(&scene.camera, o.width, o.height, o.refl_depth)
@@ -88,7 +88,7 @@ fn every_accelerator_casts_the_area_lights_feelers_as_the_reference() {
 #[test]
 fn the_samples_change_the_primary_and_the_reflected_hits() {
     let scene = load("cow_area.toml");
-    let opts = &accelerators()[5].1;
+    let opts = &pipeline_accelerator("bvh four-kernels", &accelerators());
     let spread = reference(&scene, opts, SAMPLES);
     let centre = reference(&scene, opts, (1, 1));
     let share = |f: &ReferenceFrame| f.aovs.shadow.clone().unwrap();
@@ -114,7 +114,7 @@ fn tracer(scene: &Scene, opts: RenderOptions) -> anyhow::Result<RayTracer> {
 #[test]
 fn layouts_that_cannot_hold_the_samples_are_refused() {
     let mut scene = load("cow_area.toml");
-    let mut opts = accelerators()[5].1.clone();
+    let mut opts = pipeline_accelerator("bvh four-kernels", &accelerators());
     opts.shadow_flags = ShadowFlags::Rgba;
     let err = tracer(&scene, opts.clone())
         .err()

@@ -15,7 +15,7 @@ fn a_pass_leaves_every_bit_pending_and_an_access_takes_only_its_own() {
     let ctx = context();
     let scene = load("cow.toml");
     let mut opts = options(16, 16, 0);
-    opts.tracer = gpgpu_rt::accel::TracerKind::Bvh;
+    opts.accel = BVH_FOUR_KERNELS;
     let mut t = ray_tracer(&ctx, &scene, opts);
     // a frame ends with its counters and images read back: those bits were issued for them
     t.render(&scene.camera).expect("frame");

@@ -6,8 +6,6 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use gpgpu_rt::accel::TracerKind;
-
 mod common;
 use common::stderr;
 
@@ -33,7 +31,7 @@ const TINY: [&str; 8] = [
 ];
 
 fn has_grid() -> bool {
-    <TracerKind as clap::ValueEnum>::from_str("grid", true).is_ok()
+    gpgpu_rt::design::row("grid-exact").is_ok()
 }
 
 /// A CSV as rows of column → value.

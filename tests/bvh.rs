@@ -12,17 +12,13 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::Bvh;
-use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::gl::{ProfileChoice, ProfileName};
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use serde_json::json;
 
 fn bvh_options(w: u32, h: u32, refl: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Bvh,
-        ..options(w, h, refl)
-    }
+    options_with(BVH_FOUR_KERNELS, w, h, refl)
 }
 
 fn builds(t: &RayTracer) -> u64 {

@@ -8,19 +8,17 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::Bvh;
-use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::accel::{BvhLevels, BvhPasses};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
 use serde_json::json;
 
+/// The two-level BVH in Müller 2015's four kernels.
 fn instances(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Bvh,
-        bvh_instances: true,
-        ..options(w, h, refl_depth)
-    }
+    let accel = common::bvh(BvhPasses::FourKernels, BvhLevels::Two);
+    options_with(accel, w, h, refl_depth)
 }
 
 fn bvh(t: &RayTracer) -> &Bvh {
@@ -131,11 +129,8 @@ fn the_fused_pass_walks_the_instances() {
     let scene = load("teapot3.toml");
     let models = moved(&scene, 40.0, 0.0);
     let mut frames = Vec::new();
-    for fused_passes in [false, true] {
-        let opts = RenderOptions {
-            fused_passes,
-            ..instances(40, 40, 1)
-        };
+    for passes in [BvhPasses::FourKernels, BvhPasses::Fused] {
+        let opts = options_with(common::bvh(passes, BvhLevels::Two), 40, 40, 1);
         let mut t = ray_tracer(&ctx, &scene, opts);
         t.render(&scene.camera).unwrap();
         for (k, m) in models.iter().enumerate() {
@@ -152,19 +147,13 @@ fn the_fused_pass_walks_the_instances() {
     assert_eq!(four.stats.events, fused.stats.events);
 }
 
-/// Only the SAH BVH has instances: beside another accelerator the option is refused by name.
+/// Only the SAH BVH has instances (no other accelerator's options can hold them): beside
+/// another design the option is refused by name, with the design that takes it.
 #[test]
 fn instances_are_refused_beside_other_accelerators() {
-    let scene = load("cow.toml");
-    let ctx = context();
-    let opts = RenderOptions {
-        tracer: TracerKind::Grid,
-        bvh_instances: true,
-        ..options(16, 16, 0)
-    };
-    let err = try_ray_tracer(&ctx, &scene, opts).err().expect("refused");
-    assert!(
-        format!("{err:#}").contains("--bvh-instances needs --tracer bvh"),
-        "{err:#}"
-    );
+    let row = gpgpu_rt::design::row("grid-exact").unwrap();
+    let given = ["bvh-instances".to_string()];
+    let err = gpgpu_rt::design::refuse_foreign(row, &given, "from --tracer grid").unwrap_err();
+    let err = format!("{err:#}");
+    assert!(err.contains("--bvh-instances applies to bvh ("), "{err}");
 }

@@ -10,17 +10,13 @@ mod common;
 use common::*;
 use glam::{Mat4, Vec3};
 use gpgpu_rt::accel::bvh::{Bvh, BvhTree, Grid, NodeRecord, NODE_WORDS, OCTANTS, REBUILD_GROWTH};
-use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::{transform_triangles, Scene};
 use serde_json::json;
 
 fn bvh_options(w: u32, h: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Bvh,
-        ..options(w, h, 1)
-    }
+    options_with(BVH_FOUR_KERNELS, w, h, 1)
 }
 
 fn bvh(t: &RayTracer) -> &Bvh {

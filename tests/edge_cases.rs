@@ -27,7 +27,7 @@ fn every_tracer(grid_resolution: u32) -> Vec<(&'static Row, Design)> {
         let mut d = Design::plain(row, 64, 64, 0);
         d.keep_aovs();
         match &mut d {
-            Design::Mueller2015(o) => o.grid.resolution = Some(grid_resolution),
+            Design::Mueller2015(o) => o.accel = o.accel.with_grid_resolution(grid_resolution),
             Design::Stream(o) => o.dims = Some([grid_resolution; 3]),
             _ => {}
         }
@@ -150,8 +150,8 @@ fn equal_distances_go_to_the_lower_triangle_id_on_every_tracer() {
         // the CPU side: the accelerator's twin, Wagner's BVH on the CPU; the stream's twin is
         // held against its GPU side in tests/stream.rs, here only the GPU's ids are checked
         let cpu_ids: Vec<i32> = match (&design, row.accel) {
-            (Design::Mueller2015(o), Some(e)) => {
-                let twin = gpgpu_rt::reference::twin(e.tracer, &scene, &o.grid).unwrap();
+            (Design::Mueller2015(o), Some(_)) => {
+                let twin = gpgpu_rt::design::twin(&scene, &o.accel).unwrap();
                 let cpu = Reference::with_accelerator(&scene, twin).render(
                     &scene.camera,
                     o.width,

@@ -6,31 +6,25 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlInfo;
 use gpgpu_rt::pipeline::mueller2015::{RenderOptions, ShadowFlags};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
 
+/// The SAH BVH in Müller 2015's four kernels, the frame the fused pass is held against.
 fn bvh(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Bvh,
-        ..options(w, h, refl_depth)
-    }
+    options_with(BVH_FOUR_KERNELS, w, h, refl_depth)
 }
 
 /// The frame of the four kernels and of the fused pass with otherwise the same options.
 fn both(scene: &Scene, opts: &RenderOptions) -> (Frame, Frame) {
     let ctx = context();
     let four = render_gpu(&ctx, scene, opts.clone());
-    let fused = RenderOptions {
-        fused_passes: true,
-        ..opts.clone()
-    };
-    let mut tracer = ray_tracer(&ctx, scene, fused);
-    assert!(
-        tracer.settings().contains_key("fused_passes"),
+    let mut tracer = ray_tracer(&ctx, scene, fused_if(opts, true));
+    assert_eq!(
+        tracer.settings()["bvh_passes"],
+        "fused",
         "the fused pass was not selected"
     );
     let fused = tracer.render(&scene.camera).expect("frame");
@@ -41,7 +35,11 @@ fn both(scene: &Scene, opts: &RenderOptions) -> (Frame, Frame) {
         ms.contains_key("fused_pass") && !ms.contains_key("shading"),
         "{ms:?}"
     );
-    assert_eq!(ms.contains_key("fused_miss"), !opts.bvh_instances, "{ms:?}");
+    assert_eq!(
+        ms.contains_key("fused_miss"),
+        !opts.accel.instances(),
+        "{ms:?}"
+    );
     (four, fused)
 }
 
@@ -149,16 +147,12 @@ fn no_lights_and_a_single_light() {
 
 #[test]
 fn the_fused_pass_is_refused_beside_other_accelerators() {
-    let scene = load("cow.toml");
-    let ctx = context();
-    let opts = RenderOptions {
-        tracer: TracerKind::Grid,
-        fused_passes: true,
-        ..options(16, 16, 0)
-    };
-    let err = try_ray_tracer(&ctx, &scene, opts).err().expect("refused");
+    // no other accelerator's options can hold it; on the command line it is refused by name
+    let row = gpgpu_rt::design::row("grid-exact").unwrap();
+    let given = ["four-kernels".to_string()];
+    let err = gpgpu_rt::design::refuse_foreign(row, &given, "from --tracer grid").unwrap_err();
     assert!(
-        format!("{err:#}").contains("--fused-passes needs --tracer bvh"),
+        format!("{err:#}").contains("--four-kernels applies to bvh ("),
         "{err:#}"
     );
     let o = run(&[
@@ -166,14 +160,18 @@ fn the_fused_pass_is_refused_beside_other_accelerators() {
         scene_path("cow.toml").to_str().unwrap(),
         "--bvh-variant",
         "wagner",
-        "--fused-passes",
+        "--four-kernels",
         "--width",
         "16",
         "--height",
         "16",
     ]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("fused-passes"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--four-kernels applies to bvh"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
@@ -224,10 +222,7 @@ fn the_storage_buffer_reads_where_the_gl_has_only_8_image_units() {
     let mut scene = load("teapot1.toml");
     ring_of_lights(&mut scene, 2);
     for fused_passes in [false, true] {
-        let opts = RenderOptions {
-            fused_passes,
-            ..bvh(48, 40, 1)
-        };
+        let opts = fused_if(&bvh(48, 40, 1), fused_passes);
         let (a, b) = (
             two_frames(&scene, &opts, |gl| gl.max_image_units = 192),
             two_frames(&scene, &opts, |gl| gl.max_image_units = 8),
@@ -254,10 +249,7 @@ fn the_work_lists_take_rows_where_the_gl_allows_few_work_groups() {
         .into_iter()
         .flat_map(|f| [(f, 2), (f, 3), (f, 5)])
     {
-        let opts = RenderOptions {
-            fused_passes,
-            ..bvh(48, 40, 1)
-        };
+        let opts = fused_if(&bvh(48, 40, 1), fused_passes);
         let (a, b) = (
             two_frames(&scene, &opts, |_| {}),
             two_frames(&scene, &opts, |gl| gl.max_compute_work_group_count[0] = row),
@@ -311,10 +303,7 @@ fn the_first_pass_leaves_its_miss_blocks_to_clears() {
             light_samples: (2, 2),
             ..bvh(w, h, refl_depth)
         };
-        let fused_opts = RenderOptions {
-            fused_passes: true,
-            ..opts.clone()
-        };
+        let fused_opts = fused_if(&opts, true);
         let mut four = ray_tracer(&ctx, &scene, opts);
         let mut fused = ray_tracer(&ctx, &scene, fused_opts);
         for frame in 0..2 {

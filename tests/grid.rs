@@ -10,7 +10,7 @@ use glam::{IVec3, Mat4, Vec3};
 use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::thesis_grid::ThesisGrid;
 use gpgpu_rt::accel::tribox::tri_box_overlap;
-use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
+use gpgpu_rt::accel::{Accel, GridVariant, ThesisGridOptions};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
@@ -182,16 +182,16 @@ fn triangle_box_overlap_matches_dense_sampling() {
     }
 }
 
-fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Grid,
-        grid: GridOptions {
-            variant,
-            resolution: Some(n),
-            ..GridOptions::default()
-        },
-        ..options(w, h, 1)
+/// The grid `variant` of `n`³ voxels (the thesis grid with Listing 17's list lengths).
+fn grid_accel(variant: GridVariant, n: u32) -> Accel {
+    match variant {
+        GridVariant::Thesis => thesis_grid(n),
+        GridVariant::Exact => exact_grid(n, false),
     }
+}
+
+fn grid_options(w: u32, h: u32, variant: GridVariant, n: u32) -> RenderOptions {
+    options_with(grid_accel(variant, n), w, h, 1)
 }
 
 /// The grid's voxel lists of the last frame and its scene-to-grid mapping (centre, scale).
@@ -216,12 +216,9 @@ type ListDiff = Vec<(usize, Vec<i32>, Vec<i32>)>;
 fn list_differences(
     ctx: &gpgpu_rt::gl::GlContext,
     scene: &Scene,
-    grid: GridOptions,
+    grid: Accel,
 ) -> (ListDiff, usize) {
-    let opts = RenderOptions {
-        grid,
-        ..grid_options(16, 16, grid.variant, 0)
-    };
+    let opts = options_with(grid, 16, 16, 1);
     let mut t = ray_tracer(ctx, scene, opts);
     let f = t.render(&scene.camera).unwrap();
     for lost in ["dropped_triangle_refs", "truncated_rays"] {
@@ -237,14 +234,14 @@ fn list_differences(
             "voxels count and fill disagree on"
         );
     }
-    let n = grid.resolution.unwrap();
+    let n = grid.grid_resolution().unwrap();
     let g = GridSpace { n };
     let mut expected = vec![Vec::new(); (n * n * n) as usize];
     for (id, tri) in scene.world_triangles().iter().enumerate() {
         let tg = tri.map(|p| (p - center) * scale);
-        let voxels = match grid.variant {
-            GridVariant::Thesis => g.thesis_voxels(tg),
-            GridVariant::Exact => g.exact_voxels(tg),
+        let voxels = match grid {
+            Accel::ThesisGrid(_) => g.thesis_voxels(tg),
+            _ => g.exact_voxels(tg),
         };
         for v in voxels {
             expected[v].push(id as i32);
@@ -265,11 +262,12 @@ fn list_differences(
 /// The GPU's voxel lists equal the CPU reference's exactly (same f32 operations in the same
 /// order on both sides: grid.glsl, voxelwalk.glsl and tribox.glsl against reference/grid.rs).
 fn check_lists(ctx: &gpgpu_rt::gl::GlContext, scene: &Scene, variant: GridVariant, n: u32) {
-    let grid = GridOptions {
-        variant,
-        resolution: Some(n),
-        voxel_array_length: 4096,
-        ..GridOptions::default()
+    let grid = match grid_accel(variant, n) {
+        Accel::ThesisGrid(o) => Accel::ThesisGrid(ThesisGridOptions {
+            voxel_array_length: 4096,
+            ..o
+        }),
+        other => other,
     };
     let (differing, refs) = list_differences(ctx, scene, grid);
     assert!(
@@ -559,17 +557,12 @@ fn thesis_grid_loses_big_triangle_interiors_the_exact_grid_does_not() {
 fn thesis_grid_counts_what_its_fixed_lists_drop() {
     let ctx = context();
     let scene = load("bunny.toml");
-    let opts = RenderOptions {
-        tracer: TracerKind::Grid,
-        grid: GridOptions {
-            variant: GridVariant::Thesis,
-            resolution: Some(8),
-            voxel_array_length: 16,
-            ray_array_length: Some(2),
-            ..GridOptions::default()
-        },
-        ..options(24, 24, 0)
-    };
+    let accel = Accel::ThesisGrid(ThesisGridOptions {
+        resolution: Some(8),
+        voxel_array_length: 16,
+        ray_array_length: Some(2),
+    });
+    let opts = options_with(accel, 24, 24, 0);
     let mut t = ray_tracer(&ctx, &scene, opts);
     let f = t.render(&scene.camera).unwrap();
     let dropped = f.stats.events["dropped_triangle_refs"];
@@ -594,7 +587,7 @@ fn moving_object_is_rebuilt_every_frame() {
         &scene,
         &ShaderSource::default(),
         RenderOptions {
-            tracer: TracerKind::Base,
+            accel: Accel::Base,
             ..opts
         },
     )

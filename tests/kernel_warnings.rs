@@ -7,7 +7,7 @@
 
 mod common;
 
-use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
+use gpgpu_rt::accel::{BvhLevels, BvhPasses};
 use gpgpu_rt::design::{accelerators, Design};
 use gpgpu_rt::gl::program::compiler_messages;
 use gpgpu_rt::gl::{compile_program, Defines, GlContext, ShaderSource};
@@ -26,46 +26,38 @@ fn every_kernel_compiles_without_warnings() {
     let ctx = common::context();
     let shaders = ShaderSource::default();
 
-    // the ray tracer with every accelerator of the registry, both shadow-flag layouts
+    // the ray tracer with every accelerator of the registry and each of its variants (the exact
+    // grid's distance pass, proximity.comp; the SAH BVH's four kernels beside its fused pass),
+    // each accelerator's first in both shadow-flag layouts
     let scene = common::load("teapot1.toml");
     for entry in accelerators() {
-        for shadow_flags in [ShadowFlags::Bits, ShadowFlags::Rgba] {
-            let opts = RenderOptions {
-                tracer: entry.tracer,
-                grid: GridOptions {
-                    variant: entry.grid_variant.unwrap_or_default(),
-                    resolution: Some(8),
-                    // the exact grid's distance pass (proximity.comp) in one of the two runs
-                    proximity_clouds: entry.grid_variant == Some(GridVariant::Exact)
-                        && shadow_flags == ShadowFlags::Rgba,
-                    ..GridOptions::default()
-                },
-                shadow_flags,
-                // the SAH BVH's fused pass (bvh/fused_pass.comp) in one of the two runs
-                fused_passes: entry.tracer == TracerKind::Bvh && shadow_flags == ShadowFlags::Rgba,
-                // and its two levels (BVH_INSTANCES) in the other
-                bvh_instances: entry.tracer == TracerKind::Bvh && shadow_flags == ShadowFlags::Bits,
-                ..common::options(8, 8, 1)
+        for (i, (_, accel)) in entry.variants.iter().enumerate() {
+            let layouts: &[ShadowFlags] = match i {
+                0 => &[ShadowFlags::Bits, ShadowFlags::Rgba],
+                _ => &[ShadowFlags::Bits],
             };
-            let mut t =
-                RayTracer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts).expect("tracer");
-            t.render(&scene.camera).expect("frame");
+            for &shadow_flags in layouts {
+                let opts = RenderOptions {
+                    shadow_flags,
+                    ..common::options_with(accel.with_grid_resolution(8), 8, 8, 1)
+                };
+                let mut t = RayTracer::new(ctx.gl.clone(), &ctx.info, &scene, &shaders, opts)
+                    .expect("tracer");
+                t.render(&scene.camera).expect("frame");
+            }
         }
     }
 
-    // the SAH BVH's instances with one object (its walk without the instance loop), in the
-    // fused pass and the four kernels
+    // the SAH BVH's two levels (BVH_INSTANCES), in the fused pass and the four kernels: with
+    // several objects, and with one (its walk without the instance loop)
     let cow = common::load("cow.toml");
-    for fused_passes in [false, true] {
-        let opts = RenderOptions {
-            tracer: TracerKind::Bvh,
-            bvh_instances: true,
-            fused_passes,
-            ..common::options(8, 8, 1)
-        };
-        let mut t =
-            RayTracer::new(ctx.gl.clone(), &ctx.info, &cow, &shaders, opts).expect("tracer");
-        t.render(&cow.camera).expect("frame");
+    for passes in [BvhPasses::FourKernels, BvhPasses::Fused] {
+        for scene in [&scene, &cow] {
+            let opts = common::options_with(common::bvh(passes, BvhLevels::Two), 8, 8, 1);
+            let mut t =
+                RayTracer::new(ctx.gl.clone(), &ctx.info, scene, &shaders, opts).expect("tracer");
+            t.render(&scene.camera).expect("frame");
+        }
     }
 
     // Wagner 2018's kernel

@@ -6,7 +6,6 @@ mod common;
 
 use std::path::PathBuf;
 
-use gpgpu_rt::accel::TracerKind;
 use gpgpu_rt::scene::Scene;
 
 /// `sphere.toml` with the camera, the light and the sphere scaled by `k` (the camera's near
@@ -42,7 +41,7 @@ fn refusal(name: &str, text: &str) -> String {
 fn a_scene_scaled_by_a_million_shows_the_same_triangles() {
     let ctx = common::context();
     let mut opts = common::options(48, 48, 0);
-    opts.tracer = TracerKind::Bvh;
+    opts.accel = common::BVH_FOUR_KERNELS;
     let ids = |k: f64| {
         let scene = Scene::load(&write(&format!("sphere{k}.toml"), &sphere_scaled(k))).unwrap();
         let frame = common::render_gpu(&ctx, &scene, opts.clone());

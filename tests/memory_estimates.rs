@@ -168,16 +168,12 @@ fn random_builds_allocate_within_their_estimates() {
 /// host's part of it within the frame's estimate.
 #[test]
 fn a_frame_and_its_aovs_allocate_within_their_estimate() {
-    use gpgpu_rt::accel::TracerKind;
     use gpgpu_rt::pipeline::Renderer;
     let _s = serial();
     let ctx = common::context();
     let scene = common::load("teapot1.toml");
     let (w, h) = (256, 192);
-    let opts = gpgpu_rt::pipeline::mueller2015::RenderOptions {
-        tracer: TracerKind::Bvh,
-        ..common::options(w, h, 1)
-    };
+    let opts = common::options_with(common::BVH_FOUR_KERNELS, w, h, 1);
     let mut r = common::ray_tracer(&ctx, &scene, opts);
     r.render(&scene.camera).unwrap(); // the first frame builds the BVH
     let dir = tempfile::tempdir().unwrap();

@@ -12,7 +12,6 @@ use gpgpu_rt::accel::exact_grid::ExactGrid;
 use gpgpu_rt::accel::exact_grid::EXACT_GRID_CLOUD_CAP;
 use gpgpu_rt::accel::grid_frame::GridMapping;
 use gpgpu_rt::accel::proximity::chebyshev_distances;
-use gpgpu_rt::accel::{GridOptions, GridVariant, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::GlContext;
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
@@ -22,16 +21,7 @@ use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
 fn grid_options(w: u32, h: u32, n: u32, clouds: bool) -> RenderOptions {
-    RenderOptions {
-        tracer: TracerKind::Grid,
-        grid: GridOptions {
-            variant: GridVariant::Exact,
-            resolution: Some(n),
-            proximity_clouds: clouds,
-            ..GridOptions::default()
-        },
-        ..options(w, h, 1)
-    }
+    options_with(exact_grid(n, clouds), w, h, 1)
 }
 
 /// A scene of one OBJ's text, seen from `eye`, lit from above.

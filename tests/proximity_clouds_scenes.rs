@@ -11,7 +11,6 @@ use std::collections::{HashMap, HashSet};
 
 use common::{context, load, options, render_gpu, scene_path};
 use glam::Vec3;
-use gpgpu_rt::accel::{GridOptions, TracerKind};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::scene::Scene;
@@ -226,18 +225,11 @@ fn stream_and_grid_first_hits_agree_with_the_base_tracer() {
         let base = render_gpu(&ctx, &scene, options(SIZE, SIZE, 0));
         let hits = ids(&base).iter().filter(|&&i| i >= 0).count();
         assert!(hits > (SIZE * SIZE / 20) as usize, "{name}: {hits} hits");
-        let grid = GridOptions {
-            resolution: Some(dims.into_iter().max().unwrap()),
-            ..Default::default()
-        };
+        let n = dims.into_iter().max().unwrap();
         let g = render_gpu(
             &ctx,
             &scene,
-            gpgpu_rt::pipeline::mueller2015::RenderOptions {
-                tracer: TracerKind::Grid,
-                grid,
-                ..options(SIZE, SIZE, 0)
-            },
+            common::options_with(common::exact_grid(n, false), SIZE, SIZE, 0),
         );
         let s = stream(&ctx, &scene, dims, false);
         let pc = stream(&ctx, &scene, dims, true);

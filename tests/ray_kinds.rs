@@ -8,7 +8,6 @@
 mod common;
 
 use common::*;
-use gpgpu_rt::accel::{self, TracerKind};
 use gpgpu_rt::frame::{Frame, RAY_KINDS};
 use gpgpu_rt::pipeline::mueller2015::RenderOptions;
 use gpgpu_rt::reference::Reference;
@@ -42,9 +41,7 @@ fn every_kind_of_ray_is_counted_and_timed_apart() {
         base.rays
     );
     for (label, opts) in accelerators() {
-        let entry = accel::entry(opts.tracer, &opts.grid);
-        let twin =
-            gpgpu_rt::reference::twin(entry.tracer, &scene, &opts.grid).expect("its CPU twin");
+        let twin = gpgpu_rt::design::twin(&scene, &opts.accel).expect("its CPU twin");
         let cpu = Reference::with_accelerator(&scene, twin).render(&scene.camera, SIZE, SIZE, 1);
         let f = render_gpu(&ctx, &scene, opts);
         let s = &f.stats;
@@ -109,7 +106,7 @@ fn one_light_and_no_reflection_leave_their_kinds_out() {
     let scene = load("bunny_low.toml");
     assert_eq!(scene.lights.len(), 1);
     let mut opts = options(SIZE, SIZE, 0);
-    opts.tracer = TracerKind::Bvh;
+    opts.accel = BVH_FOUR_KERNELS;
     let f = render_gpu(&ctx, &scene, opts);
     let kinds: Vec<&str> = f.stats.ray_kinds.keys().map(|k| k.as_str()).collect();
     assert_eq!(kinds, ["primary", "shadow_first_light"]);
@@ -139,7 +136,7 @@ fn the_own_pipelines_count_the_rays_they_trace() {
     assert_eq!(scene.lights.len(), 1);
     // the stream traces the same rays as Müller's pipeline: eye, feelers, reflection
     let mut opts = options(SIZE, SIZE, 1);
-    opts.tracer = TracerKind::Bvh;
+    opts.accel = BVH_FOUR_KERNELS;
     let mueller = render_gpu(&ctx, &scene, opts.clone());
     let reflection = count(&mueller, "reflection", "rays");
     assert!(reflection > 0, "the teapot reflects");

@@ -9,7 +9,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use gpgpu_rt::accel::{self, GridOptions};
+use gpgpu_rt::accel::Accel;
 use gpgpu_rt::design::{self, Design, Pipeline, Row, COMMON_OPTIONS, REGISTRY};
 
 /// The value `row` selects for a selecting option, else the command line's default.
@@ -53,23 +53,27 @@ fn each_accelerator_is_the_one_its_tracer_picks() {
         };
         assert_eq!(row.pipeline, Pipeline::Mueller2015, "{row:?}");
         assert_eq!(entry.label, row.name);
-        assert_eq!(selected(row, "tracer"), entry.tracer.name(), "{row:?}");
-        let grid = GridOptions {
-            variant: entry.grid_variant.unwrap_or_default(),
-            ..GridOptions::default()
-        };
-        assert!(
-            std::ptr::eq(accel::entry(entry.tracer, &grid), entry),
-            "{row:?}"
-        );
-        if let Some(v) = entry.grid_variant {
-            let name = format!("{v:?}").to_lowercase();
-            assert_eq!(selected(row, "grid-variant"), name, "{row:?}");
+        assert_eq!(selected(row, "tracer"), entry.plain.tracer(), "{row:?}");
+        // its options, and each variant's, name it as theirs
+        for accel in std::iter::once(&entry.plain).chain(entry.variants.iter().map(|v| &v.1)) {
+            assert!(std::ptr::eq(accel.entry(), entry), "{row:?}: {accel:?}");
         }
-        // its twin is made over a scene (the oracle the tests compare its GPU side with)
+        let variant = match entry.plain {
+            Accel::ThesisGrid(_) => Some("thesis"),
+            Accel::ExactGrid(_) => Some("exact"),
+            _ => None,
+        };
+        if let Some(v) = variant {
+            assert_eq!(selected(row, "grid-variant"), v, "{row:?}");
+        }
+        // its twin is made over a scene for each variant (the oracle the tests compare its GPU
+        // side with)
         let scene = load("cow.toml");
-        gpgpu_rt::reference::twin(entry.tracer, &scene, &grid)
-            .unwrap_or_else(|e| panic!("{row:?}: twin: {e:#}"));
+        assert!(row.twin.is_some(), "{row:?} names no CPU twin");
+        for (label, accel) in entry.variants {
+            gpgpu_rt::design::twin(&scene, accel)
+                .unwrap_or_else(|e| panic!("{row:?}, {label}: twin: {e:#}"));
+        }
     }
 }
 

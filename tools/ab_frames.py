@@ -15,9 +15,9 @@ import tempfile
 
 CASES = [
     # (label, render arguments, kernels to report beside the total)
-    ("bunny 512², bvh", ["scenes/bunny.toml", "--tracer", "bvh"], ["intersect1", "evaluate_hit", "intersect2"]),
-    ("bunny 512², bvh --fused-passes", ["scenes/bunny.toml", "--tracer", "bvh", "--fused-passes"], ["fused_pass"]),
-    ("dragon 512², bvh", ["scenes/dragon.toml", "--tracer", "bvh"], ["intersect1", "evaluate_hit", "intersect2"]),
+    ("bunny 512², bvh --four-kernels", ["scenes/bunny.toml", "--tracer", "bvh", "--four-kernels"], ["intersect1", "evaluate_hit", "intersect2"]),
+    ("bunny 512², bvh (fused pass)", ["scenes/bunny.toml", "--tracer", "bvh"], ["fused_pass"]),
+    ("dragon 512², bvh --four-kernels", ["scenes/dragon.toml", "--tracer", "bvh", "--four-kernels"], ["intersect1", "evaluate_hit", "intersect2"]),
     ("teapot1 256², grid exact", ["scenes/teapot1.toml", "--tracer", "grid", "--width", "256", "--height", "256"], ["grid_count", "grid_fill", "intersect1"]),
     ("bunny_area 256², linespace 5×5", ["scenes/bunny_area.toml", "--shadows", "linespace", "--light-samples", "5x5", "--width", "256", "--height", "256"], ["shadow_linespace"]),
 ]

@@ -17,7 +17,8 @@ triangle-id order) and `gpgpu-rt info --json` (light positions, shadow offset). 
   clears, transform, eye rays, searches, hit evaluation, counts, shading) against Embree's
   time for the primary rays
   plus the feelers, with each kernel's share of ours; for `--tracer bvh --bvh-variant sah`
-  also the frame with `--fused-passes` (each pass in one kernel), rendered in the same rounds.
+  also the frame with the fused pass (the default; each pass in one kernel), rendered in the
+  same rounds.
 
 Threads: embreex's `run` loops over single rays (rtcIntersect1/rtcOccluded1, Embree's
 single-ray path; it binds no packet calls) on the calling thread with the GIL released, so
@@ -326,9 +327,10 @@ def measure(scene, a, work):
         queries["feelers"], traced = feeler_query(aov, info, first_light_only=wagner)
     # the megakernel times primary rays and feelers together: agreement only
     timed = ray_tracer and a.bvh_variant == "sah"
-    # the SAH BVH's frame also as one kernel per pass (--fused-passes), rendered beside the
-    # four kernels in every round
-    fused_args = [*pipeline_args, "--fused-passes"] if timed and a.tracer == "bvh" else None
+    # the SAH BVH's frame also as one kernel per pass (the fused pass, the default of
+    # --tracer bvh), rendered beside the four kernels in every round
+    fused = [w for w in pipeline_args if w != "--four-kernels"]
+    fused_args = fused if timed and a.tracer == "bvh" else None
     fused_runs = [rerun(a, scene, fused_args, d, "0f")] if fused_args else []
 
     def rerender(k):
@@ -403,7 +405,9 @@ def tracer_args(a):
     """The render options of the tracer measured: --tracer bvh (either variant), or another
     accelerator of Müller 2015's pipeline (base, the grids at --grid auto) on the same rays."""
     if a.tracer == "bvh":
-        return ["--tracer", "bvh", "--bvh-variant", a.bvh_variant]
+        # ours in Müller 2015's four kernels; the fused pass, the default, is rendered beside
+        four = ["--four-kernels"] if a.bvh_variant == "sah" else []
+        return ["--tracer", "bvh", "--bvh-variant", a.bvh_variant, *four]
     if a.tracer == "base":
         return ["--tracer", "base"]
     variant, _, pc = a.tracer.partition("+")
@@ -523,7 +527,7 @@ def frame_lines(results, threads):
              "| scene | ours ms | Embree ms (primary + feelers) | ours / Embree: median (range) "
              "| kernels: ms (share) |", "|---|---:|---:|---:|---|"]
     for r in rows:
-        for key, how in (("frame", ""), ("frame_fused", " (`--fused-passes`)")):
+        for key, how in (("frame", ""), ("frame_fused", " (fused pass)")):
             if key not in r:
                 continue
             f = r[key]
@@ -533,7 +537,8 @@ def frame_lines(results, threads):
             lines.append(f"| `{r['scene']}`{how} | {f['ours_ms']:.1f} | {f['embree_ms']:.1f} | "
                          f"{q['median']:.2f} ({q['min']:.2f}–{q['max']:.2f}) | {shares} |")
     if any("frame_fused" in r for r in rows):
-        lines += ["", "`--fused-passes`: the same frame with each pass in one kernel "
+        lines += ["", "fused pass (the default of `--tracer bvh`; the other rows: `--four-kernels`): "
+                  "the same frame with each pass in one kernel "
                   "(`glsl/bvh/fused_pass.comp`: closest hit, Listings 13–14, the feelers and "
                   "Listing 16), rendered beside the four kernels in every round; its "
                   "`intersect1` is the blocks' entry pass alone, and the Mrays/s above are the "

@@ -6,7 +6,7 @@ more than 1.3x a still frame. This runs `tools/kernel_samples.py` (CPU samples p
 which the machine's other load disturbs far less than the GPU timers) on each scene for:
 the still frame with one tree; the turning frame with one tree (refitted on the GPU every
 frame); the turning and the still frame with a tree per object under instances
-(`--bvh-instances`) — each with the four kernels and with `--fused-passes`. A frame's cost is
+(`--bvh-instances`) — each with the four kernels (`--four-kernels`) and with the fused pass. A frame's cost is
 the sum of its kernels' samples; each run renders FRAMES frames and keeps the median of its last
 three; the configurations alternate within a round, and the ratios are taken within a round.
 The frames are told apart by their count of kernel runs: a turning frame of one tree that
@@ -36,7 +36,7 @@ CONFIGS = [
     ("turning, instances", TURN + ["--bvh-instances"], 0),
     ("still, instances", ["--bvh-instances"], 0),
 ]
-PASSES = [("four kernels", [], 8), ("fused", ["--fused-passes"], 3)]
+PASSES = [("four kernels", ["--four-kernels"], 8), ("fused", [], 3)]
 
 
 def frame_samples(scene, options, runs_per_frame):

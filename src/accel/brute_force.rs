@@ -12,15 +12,15 @@ use std::any::Any;
 
 use anyhow::{bail, Result};
 
-use super::{Accelerator, BuildContext, Entry, FrameContext, GridOptions, LightTarget, TracerKind};
+use super::{Accel, Accelerator, BuildContext, Entry, FrameContext, LightTarget};
 use crate::frame::FrameStats;
 use crate::gl::{GlInfo, Kernel};
 use crate::scene::Scene;
 
 pub const ENTRY: Entry = Entry {
-    tracer: TracerKind::Base,
-    grid_variant: None,
     label: "base",
+    plain: Accel::Base,
+    variants: &[("base", Accel::Base)],
     gpu: BruteForce::create,
 };
 
@@ -79,7 +79,7 @@ pub struct BruteForce {
 }
 
 impl BruteForce {
-    fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+    fn create(b: &BuildContext, scene: &Scene, _: &Accel) -> Result<Box<dyn Accelerator>> {
         let per = b
             .triangles_per_dispatch
             .unwrap_or_else(|| triangles_per_dispatch(b.info));

@@ -14,10 +14,7 @@ use serde_json::json;
 
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
-use super::TracerKind;
-use super::{
-    Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant, LightTarget,
-};
+use super::{Accel, Accelerator, BuildContext, Entry, ExactGridOptions, FrameContext, LightTarget};
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;
@@ -37,10 +34,25 @@ pub const MAX_RESOLUTION: u32 = 128;
 /// on the CPU, are not capped.
 pub const EXACT_GRID_CLOUD_CAP: u32 = 8;
 
+/// The exact grid with `--grid auto`, without proximity clouds.
+const PLAIN: Accel = Accel::ExactGrid(ExactGridOptions {
+    resolution: None,
+    proximity_clouds: false,
+});
+
 pub const ENTRY: Entry = Entry {
-    tracer: TracerKind::Grid,
-    grid_variant: Some(GridVariant::Exact),
     label: "grid-exact",
+    plain: PLAIN,
+    variants: &[
+        ("grid exact", PLAIN),
+        (
+            "grid exact pc",
+            Accel::ExactGrid(ExactGridOptions {
+                resolution: None,
+                proximity_clouds: true,
+            }),
+        ),
+    ],
     gpu: ExactGrid::create,
 };
 
@@ -106,8 +118,12 @@ pub struct ExactGrid {
 const SIZED_BY: &str = "--grid (N³ voxels) with the scene (its references)";
 
 impl ExactGrid {
-    fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        let frame = GridFrame::new(scene, resolution(scene, o, MAX_RESOLUTION)?);
+    fn create(b: &BuildContext, scene: &Scene, o: &Accel) -> Result<Box<dyn Accelerator>> {
+        let Accel::ExactGrid(o) = o else {
+            unreachable!("made from its own options")
+        };
+        let n = resolution(scene, o.resolution, "exact", MAX_RESOLUTION)?;
+        let frame = GridFrame::new(scene, n);
         let n3 = frame.voxels();
         let defs = [frame.define()];
         let max_ssbo = b.info.max_ssbo_block_size;

@@ -47,17 +47,17 @@ impl GridFrame {
     }
 }
 
-/// The resolution `--grid` asks for (`auto`: [`super::auto_resolution`]), checked against the
-/// variant's largest.
-pub fn resolution(scene: &Scene, options: &super::GridOptions, max: u32) -> anyhow::Result<u32> {
-    let n = options
-        .resolution
-        .unwrap_or_else(|| super::auto_resolution(scene.triangle_count()));
+/// The resolution `--grid` asks for (`requested`; `None`: [`super::auto_resolution`]),
+/// checked against the largest of the grid `variant` ("thesis", "exact").
+pub fn resolution(
+    scene: &Scene,
+    requested: Option<u32>,
+    variant: &str,
+    max: u32,
+) -> anyhow::Result<u32> {
+    let n = requested.unwrap_or_else(|| super::auto_resolution(scene.triangle_count()));
     if n == 0 || n > max {
-        anyhow::bail!(
-            "--grid {n}: the {:?} grid supports 1..={max} voxels per axis",
-            options.variant
-        );
+        anyhow::bail!("--grid {n}: the {variant} grid supports 1..={max} voxels per axis");
     }
     Ok(n)
 }

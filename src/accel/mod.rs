@@ -183,9 +183,6 @@ pub struct BuildContext<'a> {
     /// The scene's vertex attributes and lights are bound as image buffers too
     /// (`SCENE_IMAGES`, `GpuScene::vertex_images`).
     pub scene_images: bool,
-    /// `--bvh-instances`: the SAH BVH as a tree per object under instances
-    /// (`bvh::instances`), which moving objects update without a refit.
-    pub bvh_instances: bool,
 }
 
 /// What a fused pass kernel (`glsl/bvh/fused_pass.comp`) needs to know at compile time.
@@ -236,31 +233,6 @@ impl BuildContext<'_> {
     }
 }
 
-/// The accelerators of Müller 2015's four-kernel pipeline (`--tracer`; the streaming tracer's
-/// `--tracer stream` is a pipeline of its own, `design::Design::Stream`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum TracerKind {
-    /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
-    Base,
-    /// The uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2); see `--grid-variant`.
-    Grid,
-    /// A BVH built on the CPU with the SAH, rebuilt when an object moved (ours, after Wagner
-    /// 2018 ch. 3.2, 4.2).
-    Bvh,
-}
-
-impl TracerKind {
-    /// The `--tracer` value.
-    pub fn name(self) -> &'static str {
-        match self {
-            TracerKind::Base => "base",
-            TracerKind::Grid => "grid",
-            TracerKind::Bvh => "bvh",
-        }
-    }
-}
-
 /// The two uniform-grid designs (Müller 2015, ch. 3.2, 4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -300,29 +272,163 @@ impl BvhVariant {
     }
 }
 
-/// Options of the grid accelerators.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct GridOptions {
-    pub variant: GridVariant,
-    /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
-    pub resolution: Option<u32>,
-    /// The thesis variant's fixed list lengths: voxel_array_length (triangle ids per voxel,
-    /// Listing 17: 512) and ray_array_length (voxel ids per ray; `None`: 3·N as Listing 17).
-    pub voxel_array_length: u32,
-    pub ray_array_length: Option<u32>,
-    /// The exact grid: skip empty cells by their proximity-cloud distances
-    /// (`--proximity-clouds`).
-    pub proximity_clouds: bool,
+/// An accelerator of Müller 2015's pipeline with its own options: the one value `--tracer` and
+/// the options of its group make (`design::Design::Mueller2015`), which cannot hold another
+/// accelerator's option. Its variant names the accelerator; [`Accel::entry`] its registry
+/// entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "accelerator", rename_all = "kebab-case")]
+pub enum Accel {
+    /// The thesis' base tracer: every ray against every triangle (Müller 2015, ch. 3.1, 4.1).
+    Base,
+    /// The thesis' uniform grid rebuilt every frame (Müller 2015, ch. 3.2, 4.2, Listings 17–22).
+    ThesisGrid(ThesisGridOptions),
+    /// The exact uniform grid rebuilt every frame (ours: overlap test, compact lists, 3D-DDA).
+    ExactGrid(ExactGridOptions),
+    /// Our SAH BVH, refitted or rebuilt when an object moved (after Wagner 2018 ch. 3.2, 4.2).
+    Bvh(BvhOptions),
 }
 
-impl Default for GridOptions {
+/// `--grid-variant thesis`: the thesis' fixed-size lists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct ThesisGridOptions {
+    /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
+    pub resolution: Option<u32>,
+    /// Triangle ids per voxel list (Listing 17: 512).
+    pub voxel_array_length: u32,
+    /// Voxel ids per ray list; `None`: 3·N as Listing 17.
+    pub ray_array_length: Option<u32>,
+}
+
+impl Default for ThesisGridOptions {
     fn default() -> Self {
-        GridOptions {
-            variant: GridVariant::Exact,
+        ThesisGridOptions {
             resolution: None,
             voxel_array_length: 512,
             ray_array_length: None,
-            proximity_clouds: false,
+        }
+    }
+}
+
+/// `--grid-variant exact`: compact lists, walked by a 3D-DDA.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+pub struct ExactGridOptions {
+    /// N of the N³ voxels; `None`: chosen from the triangle count (`--grid auto`).
+    pub resolution: Option<u32>,
+    /// Skip empty cells by their proximity-cloud distances (`--proximity-clouds`).
+    pub proximity_clouds: bool,
+}
+
+/// Our SAH BVH's two variants, each with kernels of its own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+pub struct BvhOptions {
+    pub passes: BvhPasses,
+    pub levels: BvhLevels,
+}
+
+/// How a pass of Fig. 8 runs over the SAH BVH.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum BvhPasses {
+    /// Ours, the default: the closest hit (Listings 13–14), the shadow feelers (Listing 15) and
+    /// the shading (Listing 16) of a pass in one kernel (`glsl/bvh/fused_pass.comp`): the same
+    /// image and counts as the four kernels, without storing and reloading the ray state.
+    #[default]
+    Fused,
+    /// Müller 2015's four kernels (`--four-kernels`): eye rays, intersect1, intersect2 per
+    /// light, shading, communicating through the ray-state textures.
+    FourKernels,
+}
+
+/// How the SAH BVH holds the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum BvhLevels {
+    /// One tree over the world-space scene, refitted or rebuilt when an object moves.
+    #[default]
+    One,
+    /// Ours (`--bvh-instances`): a tree per object, built once in object space, under the
+    /// objects' instances (`bvh::instances`) — a moving object costs its instance's update.
+    Two,
+}
+
+impl Accel {
+    /// Its entry of the accelerators (and its row's name in `design::REGISTRY`).
+    pub fn entry(&self) -> &'static Entry {
+        match self {
+            Accel::Base => &brute_force::ENTRY,
+            Accel::ThesisGrid(_) => &thesis_grid::ENTRY,
+            Accel::ExactGrid(_) => &exact_grid::ENTRY,
+            Accel::Bvh(_) => &bvh::ENTRY,
+        }
+    }
+
+    /// The `--tracer` value that selects it.
+    pub fn tracer(&self) -> &'static str {
+        match self {
+            Accel::Base => "base",
+            Accel::ThesisGrid(_) | Accel::ExactGrid(_) => "grid",
+            Accel::Bvh(_) => "bvh",
+        }
+    }
+
+    /// The grid's N where `--grid` fixes it (`None`: auto, or not a grid).
+    pub fn grid_resolution(&self) -> Option<u32> {
+        match self {
+            Accel::ThesisGrid(o) => o.resolution,
+            Accel::ExactGrid(o) => o.resolution,
+            _ => None,
+        }
+    }
+
+    /// Whether the grid skips empty cells by proximity clouds.
+    pub fn proximity_clouds(&self) -> bool {
+        matches!(self, Accel::ExactGrid(o) if o.proximity_clouds)
+    }
+
+    /// Whether a pass runs in the SAH BVH's fused kernel.
+    pub fn fused(&self) -> bool {
+        matches!(self, Accel::Bvh(o) if o.passes == BvhPasses::Fused)
+    }
+
+    /// It with the grid's N fixed at `n` (the grids; the others have no resolution).
+    pub fn with_grid_resolution(self, n: u32) -> Accel {
+        match self {
+            Accel::ThesisGrid(o) => Accel::ThesisGrid(ThesisGridOptions {
+                resolution: Some(n),
+                ..o
+            }),
+            Accel::ExactGrid(o) => Accel::ExactGrid(ExactGridOptions {
+                resolution: Some(n),
+                ..o
+            }),
+            other => other,
+        }
+    }
+
+    /// Whether the SAH BVH keeps the objects in their own space under instances.
+    pub fn instances(&self) -> bool {
+        matches!(self, Accel::Bvh(o) if o.levels == BvhLevels::Two)
+    }
+
+    /// The settings that name the configuration, for the statistics ("bvh_passes": "fused").
+    pub fn settings(&self) -> Vec<(&'static str, serde_json::Value)> {
+        use serde_json::json;
+        match self {
+            Accel::Base => vec![],
+            Accel::ThesisGrid(_) => vec![("grid_variant", json!(GridVariant::Thesis))],
+            Accel::ExactGrid(o) => [("grid_variant", json!(GridVariant::Exact))]
+                .into_iter()
+                .chain(
+                    o.proximity_clouds
+                        .then_some(("proximity_clouds", json!(true))),
+                )
+                .collect(),
+            Accel::Bvh(o) => vec![
+                ("bvh_variant", json!(BvhVariant::Sah)),
+                ("bvh_passes", json!(o.passes)),
+                ("bvh_levels", json!(o.levels)),
+            ],
         }
     }
 }
@@ -334,28 +440,19 @@ pub fn auto_resolution(triangles: usize) -> u32 {
     ((triangles as f64 / 5.0).cbrt().round() as u32).clamp(4, 64)
 }
 
-/// Makes the GPU side of an accelerator.
-pub type MakeGpu = fn(&BuildContext, &Scene, &GridOptions) -> Result<Box<dyn Accelerator>>;
+/// Makes the GPU side of an accelerator from its options (always its own variant of [`Accel`]).
+pub type MakeGpu = fn(&BuildContext, &Scene, &Accel) -> Result<Box<dyn Accelerator>>;
 
-/// One accelerator of Müller 2015's pipeline: how the command line names it, and how its GPU
-/// side and CPU twin are made (its row in `design::REGISTRY` says what else belongs to it).
+/// One accelerator of Müller 2015's pipeline: its name, its options where the command line
+/// gives none, and how its GPU side is made (its row in `design::REGISTRY` says what else
+/// belongs to it, its CPU twin included).
 pub struct Entry {
-    /// The `--tracer` value.
-    pub tracer: TracerKind,
-    /// The `--grid-variant` it answers to (`None`: any; the option is then ignored).
-    pub grid_variant: Option<GridVariant>,
     /// Its row's name in `design::REGISTRY`: "base", "grid-thesis", "grid-exact", "bvh".
     pub label: &'static str,
+    /// It with the command line's defaults.
+    pub plain: Accel,
+    /// Its variants whose frames equal its CPU twin's, hits and counts (the tests walk them):
+    /// a label ("grid exact pc") and the options.
+    pub variants: &'static [(&'static str, Accel)],
     pub gpu: MakeGpu,
-}
-
-/// The accelerator `--tracer tracer` with `options` selects; `design::REGISTRY` lists each in
-/// its row.
-pub fn entry(tracer: TracerKind, options: &GridOptions) -> &'static Entry {
-    match (tracer, options.variant) {
-        (TracerKind::Base, _) => &brute_force::ENTRY,
-        (TracerKind::Grid, GridVariant::Thesis) => &thesis_grid::ENTRY,
-        (TracerKind::Grid, GridVariant::Exact) => &exact_grid::ENTRY,
-        (TracerKind::Bvh, _) => &bvh::ENTRY,
-    }
 }

@@ -16,9 +16,8 @@ use serde_json::json;
 
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
-use super::TracerKind;
 use super::{
-    Accelerator, BuildContext, Entry, FrameContext, GridOptions, GridVariant, LightTarget,
+    Accel, Accelerator, BuildContext, Entry, FrameContext, LightTarget, ThesisGridOptions,
 };
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
@@ -31,11 +30,18 @@ use crate::scene::Scene;
 pub const MAX_RESOLUTION: u32 = 64;
 
 pub const ENTRY: Entry = Entry {
-    tracer: TracerKind::Grid,
-    grid_variant: Some(GridVariant::Thesis),
     label: "grid-thesis",
+    plain: PLAIN,
+    variants: &[("grid thesis", PLAIN)],
     gpu: ThesisGrid::create,
 };
+
+/// The thesis grid with Listing 17's list lengths and `--grid auto`.
+const PLAIN: Accel = Accel::ThesisGrid(ThesisGridOptions {
+    resolution: None,
+    voxel_array_length: 512,
+    ray_array_length: None,
+});
 
 pub struct ThesisGrid {
     frame: GridFrame,
@@ -57,8 +63,12 @@ pub struct ThesisGrid {
 }
 
 impl ThesisGrid {
-    fn create(b: &BuildContext, scene: &Scene, o: &GridOptions) -> Result<Box<dyn Accelerator>> {
-        let frame = GridFrame::new(scene, resolution(scene, o, MAX_RESOLUTION)?);
+    fn create(b: &BuildContext, scene: &Scene, o: &Accel) -> Result<Box<dyn Accelerator>> {
+        let Accel::ThesisGrid(o) = o else {
+            unreachable!("made from its own options")
+        };
+        let n = resolution(scene, o.resolution, "thesis", MAX_RESOLUTION)?;
+        let frame = GridFrame::new(scene, n);
         let (n, n3) = (frame.n, frame.voxels());
         let l = o.voxel_array_length;
         let r = o.ray_array_length.unwrap_or(3 * n);

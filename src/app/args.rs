@@ -8,7 +8,10 @@ use anyhow::Result;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Parser as _, ValueEnum};
 
-use gpgpu_rt::accel::{BvhVariant, GridOptions, GridVariant};
+use gpgpu_rt::accel::{
+    Accel, BvhLevels, BvhOptions, BvhPasses, BvhVariant, ExactGridOptions, GridVariant,
+    ThesisGridOptions,
+};
 use gpgpu_rt::design::{self, defaults, Design, Pipeline, Row};
 use gpgpu_rt::limits;
 use gpgpu_rt::pipeline::klee2016::{KleeShading, LinespaceBuild, SoftShadowOptions};
@@ -78,6 +81,49 @@ pub struct GridArgs {
     /// the exact grid computes it on the GPU after every per-frame build).
     #[arg(long)]
     pub proximity_clouds: bool,
+    /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
+    /// compact lists, 3D-DDA.
+    #[arg(long, value_enum, default_value = "exact")]
+    pub grid_variant: GridVariant,
+    /// Thesis variant: triangle ids per voxel list, 1 to 65536 (Listing 17: 512).
+    #[arg(long, default_value_t = 512, value_name = "L", value_parser = limits::parser(limits::VOXEL_ARRAY_LENGTH))]
+    pub voxel_array_length: u32,
+    /// Thesis variant: voxel ids per ray list, 1 to 65536 (default 3·N, as Listing 17).
+    #[arg(long, value_name = "R", value_parser = limits::parser(limits::RAY_ARRAY_LENGTH))]
+    pub ray_array_length: Option<u32>,
+}
+
+impl GridArgs {
+    /// N of the uniform grids' N³ voxels (`None`: auto; the streaming tracer's axes are its own).
+    fn cubic(&self) -> Option<u32> {
+        match self.grid {
+            GridResolution::N(n) => Some(n),
+            _ => None,
+        }
+    }
+
+    /// The thesis grid's options.
+    pub fn thesis(&self) -> ThesisGridOptions {
+        ThesisGridOptions {
+            resolution: self.cubic(),
+            voxel_array_length: self.voxel_array_length,
+            ray_array_length: self.ray_array_length,
+        }
+    }
+
+    /// The exact grid's options.
+    pub fn exact(&self) -> ExactGridOptions {
+        ExactGridOptions {
+            resolution: self.cubic(),
+            proximity_clouds: self.proximity_clouds,
+        }
+    }
+}
+
+/// The streaming tracer's own options (its grid: [`GridArgs`]'s `--grid` and
+/// `--proximity-clouds`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct StreamArgs {
     /// --tracer stream: steps (one triangle test or one move to the next cell) per call of
     /// the traverse kernel, 1 to 4096.
     #[arg(long, default_value_t = StreamOptions::STEPS_PER_CALL, value_name = "N", value_parser = limits::parser(limits::STREAM_STEPS))]
@@ -104,42 +150,24 @@ pub struct GridArgs {
     /// no hit. Default: two-sided, as every tracer here.
     #[arg(long)]
     pub stream_single_sided: bool,
-    /// `thesis`: edge-registered fixed-size lists as Müller 2015; `exact`: overlap test,
-    /// compact lists, 3D-DDA.
-    #[arg(long, value_enum, default_value = "exact")]
-    pub grid_variant: GridVariant,
-    /// Thesis variant: triangle ids per voxel list, 1 to 65536 (Listing 17: 512).
-    #[arg(long, default_value_t = 512, value_name = "L", value_parser = limits::parser(limits::VOXEL_ARRAY_LENGTH))]
-    pub voxel_array_length: u32,
-    /// Thesis variant: voxel ids per ray list, 1 to 65536 (default 3·N, as Listing 17).
-    #[arg(long, value_name = "R", value_parser = limits::parser(limits::RAY_ARRAY_LENGTH))]
-    pub ray_array_length: Option<u32>,
 }
 
-impl GridArgs {
-    /// The grid accelerators' options.
-    pub fn options(&self) -> GridOptions {
-        GridOptions {
-            variant: self.grid_variant,
-            resolution: match self.grid {
-                GridResolution::N(n) => Some(n),
-                _ => None,
-            },
-            voxel_array_length: self.voxel_array_length,
-            ray_array_length: self.ray_array_length,
-            proximity_clouds: self.proximity_clouds,
-        }
-    }
-
-    /// The streaming tracer with these options for a `width`×`height` image.
-    pub fn stream(&self, width: u32, height: u32, refl_depth: u32, aovs: bool) -> StreamOptions {
+impl StreamArgs {
+    /// The streaming tracer with these options and `grid`'s for a `width`×`height` image.
+    pub fn options(
+        &self,
+        grid: &GridArgs,
+        (width, height): (u32, u32),
+        refl_depth: u32,
+        aovs: bool,
+    ) -> StreamOptions {
         StreamOptions {
-            dims: match self.grid {
+            dims: match grid.grid {
                 GridResolution::Auto => None,
                 GridResolution::N(n) => Some([n; 3]),
                 GridResolution::Axes(a) => Some(a),
             },
-            proximity_clouds: self.proximity_clouds,
+            proximity_clouds: grid.proximity_clouds,
             steps_per_call: self.stream_steps,
             max_calls: self.stream_max_calls,
             naive_shadows: self.stream_naive_shadows,
@@ -147,6 +175,42 @@ impl GridArgs {
             single_sided: self.stream_single_sided,
             aovs,
             ..StreamOptions::new(width, height, refl_depth)
+        }
+    }
+}
+
+/// Our SAH BVH's options (`--tracer bvh`, `--bvh-variant sah`): its variants.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BvhArgs {
+    /// With --tracer bvh (sah): Müller 2015's four kernels (eye rays, intersect1, intersect2 per
+    /// light, shading, through the ray-state textures) instead of the default fused pass, which
+    /// runs each pass of Fig. 8 in one kernel (ours, `glsl/bvh/fused_pass.comp`: the same image
+    /// and counts, faster).
+    #[arg(long, conflicts_with = "fused_passes")]
+    pub four_kernels: bool,
+    /// With --tracer bvh (sah): the fused pass, which is the default (the option stays for
+    /// command lines that name it).
+    #[arg(long)]
+    pub fused_passes: bool,
+    /// With --tracer bvh (sah): a tree per object, built once in object space, under the
+    /// objects' instances (ours: two levels) instead of one tree over the world-space scene —
+    /// an object that moves updates its instance, no refit or rebuild.
+    #[arg(long)]
+    pub bvh_instances: bool,
+}
+
+impl BvhArgs {
+    /// The SAH BVH's options.
+    pub fn options(&self) -> BvhOptions {
+        BvhOptions {
+            passes: match self.four_kernels {
+                true => BvhPasses::FourKernels,
+                false => BvhPasses::Fused,
+            },
+            levels: match self.bvh_instances {
+                true => BvhLevels::Two,
+                false => BvhLevels::One,
+            },
         }
     }
 }
@@ -286,17 +350,8 @@ pub struct DesignArgs {
     /// shadows, no reflection).
     #[arg(long, value_enum, default_value = "sah")]
     pub bvh_variant: BvhVariant,
-    /// With --tracer bvh (sah): each pass of Müller 2015's Fig. 8 in one kernel (ours: the
-    /// closest hit, Listings 13–14, the shadow feelers of Listing 15 and the shading of Listing
-    /// 16 in `glsl/bvh/fused_pass.comp`) instead of the four kernels — the same image and
-    /// counts, without storing and reloading the ray state between them.
-    #[arg(long)]
-    pub fused_passes: bool,
-    /// With --tracer bvh (sah): a tree per object, built once in object space, under the
-    /// objects' instances (ours: two levels) instead of one tree over the world-space scene —
-    /// an object that moves updates its instance, no refit or rebuild.
-    #[arg(long)]
-    pub bvh_instances: bool,
+    #[command(flatten)]
+    pub bvh: BvhArgs,
     /// Reflection passes after the primary pass, REFL_DEPTH of Fig. 8, 0 to 16 (default: the
     /// scene's).
     #[arg(long, value_parser = limits::parser(limits::REFL_DEPTH))]
@@ -310,6 +365,8 @@ pub struct DesignArgs {
     pub tile: u32,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub stream: StreamArgs,
     #[command(flatten)]
     pub soft: SoftShadowArgs,
 }
@@ -426,26 +483,34 @@ impl DesignArgs {
                 tile: self.tile,
                 aovs,
             }),
-            Pipeline::Stream => Design::Stream(self.grid.stream(width, height, refl_depth, aovs)),
+            Pipeline::Stream => {
+                Design::Stream(
+                    self.stream
+                        .options(&self.grid, (width, height), refl_depth, aovs),
+                )
+            }
             _ => Design::Mueller2015(RenderOptions {
-                tracer: row
-                    .accel
-                    .expect("Müller 2015's rows name their accelerator")
-                    .tracer,
-                width,
-                height,
-                refl_depth,
                 tile: self.tile,
                 shadow_flags: self.shadow_flags,
                 aovs,
-                grid: self.grid.options(),
-                triangles_per_dispatch: None,
                 light_samples: self.soft.samples(),
-                // only for the row it belongs to: the viewer's keys and `parity` switch rows
-                // with the command line's options (which refuse it beside any other row)
-                fused_passes: self.fused_passes && row.options().any(|o| o == "fused-passes"),
-                bvh_instances: self.bvh_instances && row.options().any(|o| o == "bvh-instances"),
+                ..RenderOptions::new(self.accel(row), width, height, refl_depth)
             }),
+        }
+    }
+
+    /// The accelerator of Müller 2015's row `row` with its group's options: each takes only
+    /// its own (the viewer's keys and `parity` switch rows with the command line's options,
+    /// which refuse an option beside any other row).
+    fn accel(&self, row: &Row) -> Accel {
+        let entry = row
+            .accel
+            .expect("Müller 2015's rows name their accelerator");
+        match entry.plain {
+            Accel::Base => Accel::Base,
+            Accel::ThesisGrid(_) => Accel::ThesisGrid(self.grid.thesis()),
+            Accel::ExactGrid(_) => Accel::ExactGrid(self.grid.exact()),
+            Accel::Bvh(_) => Accel::Bvh(self.bvh.options()),
         }
     }
 }
@@ -467,20 +532,27 @@ fn given(matches: Option<&ArgMatches>) -> Vec<String> {
 mod tests {
     use super::*;
 
-    /// `--fused-passes` reaches the SAH BVH's design only: the viewer switching to another
-    /// tracer with it set gets that tracer's four kernels, not a refusal.
+    /// The SAH BVH runs the fused pass unless `--four-kernels` asks for the thesis' kernels;
+    /// the BVH's options reach its design only: the viewer switching to another tracer with
+    /// them set gets that tracer, not a refusal.
     #[test]
-    fn fused_passes_only_for_the_sah_bvh() {
-        let fused = |name: &str| {
+    fn the_bvh_options_reach_the_sah_bvh_only() {
+        let accel = |name: &str, extra: &[&str]| {
             let row = design::row(name).unwrap();
-            let args = DesignArgs::of_row(row, &["--fused-passes"]).unwrap();
+            let args = DesignArgs::of_row(row, extra).unwrap();
             match args.tracer_design(row, (8, 8), 0, false) {
-                Design::Mueller2015(o) => o.fused_passes,
+                Design::Mueller2015(o) => o.accel,
                 _ => panic!("{name}: not Müller 2015's pipeline"),
             }
         };
-        assert!(fused("bvh"));
-        assert!(!fused("grid-exact"));
-        assert!(!fused("base"));
+        assert!(accel("bvh", &[]).fused());
+        assert!(accel("bvh", &["--fused-passes"]).fused());
+        assert!(!accel("bvh", &["--four-kernels"]).fused());
+        assert!(accel("bvh", &["--bvh-instances"]).instances());
+        assert_eq!(
+            accel("grid-exact", &["--four-kernels"]),
+            design::row("grid-exact").unwrap().accel.unwrap().plain
+        );
+        assert_eq!(accel("base", &["--bvh-instances"]), Accel::Base);
     }
 }

@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::accel::grid_frame::{resolution, GridMapping};
-use crate::accel::{self, bvh::BvhTree, GridOptions, GridVariant, TracerKind};
+use crate::accel::{self, bvh::BvhTree, Accel};
 use crate::frame::Aovs;
 use crate::scene::{AreaLight, Camera, Scene, WorldAttributes};
 
@@ -42,37 +42,61 @@ pub trait CpuAccelerator: Send + Sync {
     fn occluded(&self, feeler: &Feeler) -> (bool, u64);
 }
 
-/// The CPU twin of the accelerator `--tracer tracer` with `options` (the grid's variant, its
-/// resolution, its lists) over the scene as loaded: the oracle its GPU side is held against.
-pub fn twin(
-    tracer: TracerKind,
-    scene: &Scene,
-    options: &GridOptions,
-) -> anyhow::Result<Box<dyn CpuAccelerator>> {
-    let triangles = scene.world_triangles();
-    Ok(match (tracer, options.variant) {
-        (TracerKind::Base, _) => Box::new(brute_force::BruteForce::new(triangles)),
-        (TracerKind::Grid, GridVariant::Thesis) => {
-            let n = resolution(scene, options, accel::thesis_grid::MAX_RESOLUTION)?;
-            Box::new(thesis_grid::ThesisGrid::new(
-                triangles,
-                n,
-                GridMapping::of_scene(scene),
-                options.voxel_array_length as usize,
-                options.ray_array_length.unwrap_or(3 * n) as usize,
-            ))
-        }
-        (TracerKind::Grid, GridVariant::Exact) => {
-            let n = resolution(scene, options, accel::exact_grid::MAX_RESOLUTION)?;
-            let g = exact_grid::ExactGrid::new(triangles, n, GridMapping::of_scene(scene));
-            Box::new(if options.proximity_clouds {
-                g.with_proximity()
-            } else {
-                g
-            })
-        }
-        (TracerKind::Bvh, _) => Box::new(BvhTree::new(triangles)),
-    })
+/// Makes the CPU twin of an accelerator (`accel::Accel`, its own variant) over the scene as
+/// loaded: the oracle its GPU side is held against. Each accelerator's row of
+/// `design::REGISTRY` names its twin.
+pub type MakeTwin = fn(&Scene, &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>>;
+
+/// The base tracer's twin.
+pub fn base_twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    Ok(Box::new(brute_force::BruteForce::new(
+        scene.world_triangles(),
+    )))
+}
+
+/// The thesis grid's twin, with its resolution and list lengths.
+pub fn thesis_grid_twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    let Accel::ThesisGrid(o) = o else {
+        anyhow::bail!("the thesis grid's twin made from {o:?}")
+    };
+    let n = resolution(
+        scene,
+        o.resolution,
+        "thesis",
+        accel::thesis_grid::MAX_RESOLUTION,
+    )?;
+    Ok(Box::new(thesis_grid::ThesisGrid::new(
+        scene.world_triangles(),
+        n,
+        GridMapping::of_scene(scene),
+        o.voxel_array_length as usize,
+        o.ray_array_length.unwrap_or(3 * n) as usize,
+    )))
+}
+
+/// The exact grid's twin, with its resolution and proximity clouds.
+pub fn exact_grid_twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    let Accel::ExactGrid(o) = o else {
+        anyhow::bail!("the exact grid's twin made from {o:?}")
+    };
+    let n = resolution(
+        scene,
+        o.resolution,
+        "exact",
+        accel::exact_grid::MAX_RESOLUTION,
+    )?;
+    let g = exact_grid::ExactGrid::new(scene.world_triangles(), n, GridMapping::of_scene(scene));
+    Ok(Box::new(match o.proximity_clouds {
+        true => g.with_proximity(),
+        false => g,
+    }))
+}
+
+/// The SAH BVH's twin: one tree over the world-space scene, whatever its variant (the fused
+/// pass counts as the four kernels; the two levels find the same hits, their counts are the
+/// instances' own: `tests/bvh_instances.rs`).
+pub fn bvh_twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    Ok(Box::new(BvhTree::new(scene.world_triangles())))
 }
 
 /// A shadow feeler: blocked by a triangle other than `last` hit at `offset` < t <
@@ -237,7 +261,7 @@ impl Reference {
             ambient: Vec3::from(scene.settings.ambient),
             shadow_offset: scene.settings.shadow_offset,
         }
-        .with_light_samples(crate::design::defaults::LIGHT_SAMPLES)
+        .with_light_samples(crate::limits::defaults::LIGHT_SAMPLES)
     }
 
     /// The reference with `su`×`sv` feelers towards every area light (`--light-samples`).

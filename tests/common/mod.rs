@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use gpgpu_rt::accel::TracerKind;
+use gpgpu_rt::accel::{Accel, BvhLevels, BvhOptions, BvhPasses, ExactGridOptions};
 use gpgpu_rt::frame::Frame;
 use gpgpu_rt::gl::{GlContext, ShaderSource};
-use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions, ShadowFlags};
+use gpgpu_rt::pipeline::mueller2015::{RayTracer, RenderOptions};
 use gpgpu_rt::pipeline::Renderer;
 use gpgpu_rt::reference::{Reference, ReferenceFrame};
 use gpgpu_rt::scene::{Light, Scene};
@@ -71,21 +71,68 @@ impl Drop for TestContext {
     }
 }
 
+/// The base tracer at `w`×`h` with `refl_depth` reflection passes, keeping its AOVs.
 pub fn options(w: u32, h: u32, refl_depth: u32) -> RenderOptions {
     RenderOptions {
-        tracer: TracerKind::Base,
-        width: w,
-        height: h,
-        refl_depth,
-        tile: 256,
-        shadow_flags: ShadowFlags::Bits,
         aovs: true,
-        grid: Default::default(),
-        triangles_per_dispatch: None,
-        light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
-        fused_passes: false,
-        bvh_instances: false,
+        ..RenderOptions::new(Accel::Base, w, h, refl_depth)
     }
+}
+
+/// [`options`] with the accelerator `accel`.
+pub fn options_with(accel: Accel, w: u32, h: u32, refl_depth: u32) -> RenderOptions {
+    RenderOptions {
+        accel,
+        ..options(w, h, refl_depth)
+    }
+}
+
+/// The SAH BVH with `passes` over `levels`.
+pub fn bvh(passes: BvhPasses, levels: BvhLevels) -> Accel {
+    Accel::Bvh(BvhOptions { passes, levels })
+}
+
+/// The SAH BVH in Müller 2015's four kernels, one tree.
+pub const BVH_FOUR_KERNELS: Accel = Accel::Bvh(BvhOptions {
+    passes: BvhPasses::FourKernels,
+    levels: BvhLevels::One,
+});
+
+/// The SAH BVH's fused pass over one tree (the default).
+pub const BVH_FUSED: Accel = Accel::Bvh(BvhOptions {
+    passes: BvhPasses::Fused,
+    levels: BvhLevels::One,
+});
+
+/// `opts` (the SAH BVH) with the fused pass where `fused`, else the four kernels; its levels
+/// kept.
+pub fn fused_if(opts: &RenderOptions, fused: bool) -> RenderOptions {
+    let Accel::Bvh(b) = opts.accel else {
+        panic!("not the SAH BVH: {:?}", opts.accel)
+    };
+    let passes = match fused {
+        true => BvhPasses::Fused,
+        false => BvhPasses::FourKernels,
+    };
+    RenderOptions {
+        accel: Accel::Bvh(BvhOptions { passes, ..b }),
+        ..opts.clone()
+    }
+}
+
+/// The exact grid of `n`³ voxels.
+pub fn exact_grid(n: u32, proximity_clouds: bool) -> Accel {
+    Accel::ExactGrid(ExactGridOptions {
+        resolution: Some(n),
+        proximity_clouds,
+    })
+}
+
+/// The thesis grid of `n`³ voxels with Listing 17's list lengths.
+pub fn thesis_grid(n: u32) -> Accel {
+    gpgpu_rt::accel::thesis_grid::ENTRY
+        .plain
+        .with_grid_resolution(n)
 }
 
 /// The ray tracer with the accelerator `opts.tracer` for `scene`, kernels built in.
@@ -108,43 +155,42 @@ pub fn try_ray_tracer(
     )
 }
 
-/// Every accelerator of Müller 2015's pipeline at `w`×`h` with `refl_depth` reflection passes
-/// and grids of `n`³, the base tracer also with its triangles split over dispatches of 2000
-/// (a ray counted once, a found occluder carried in the flag): (label, options).
+/// Every accelerator of Müller 2015's pipeline and each of its variants that the registry
+/// holds equal to its twin (`accel::Entry::variants`) at `w`×`h` with `refl_depth` reflection
+/// passes and grids of `n`³, the base tracer also with its triangles split over dispatches of
+/// 2000 (a ray counted once, a found occluder carried in the flag): (label, options).
 pub fn pipeline_accelerators(
     w: u32,
     h: u32,
     refl_depth: u32,
     n: u32,
 ) -> Vec<(&'static str, RenderOptions)> {
-    use gpgpu_rt::accel::GridVariant;
-    let with = |tracer, variant, clouds: bool| {
-        let mut o = options(w, h, refl_depth);
-        o.tracer = tracer;
-        o.grid.variant = variant;
-        o.grid.resolution = Some(n);
-        o.grid.proximity_clouds = clouds;
-        o
-    };
-    let mut split = with(TracerKind::Base, GridVariant::Exact, false);
-    split.triangles_per_dispatch = Some(2000);
-    vec![
-        ("base", with(TracerKind::Base, GridVariant::Exact, false)),
-        ("base split", split),
-        (
-            "grid thesis",
-            with(TracerKind::Grid, GridVariant::Thesis, false),
-        ),
-        (
-            "grid exact",
-            with(TracerKind::Grid, GridVariant::Exact, false),
-        ),
-        (
-            "grid exact pc",
-            with(TracerKind::Grid, GridVariant::Exact, true),
-        ),
-        ("bvh sah", with(TracerKind::Bvh, GridVariant::Exact, false)),
-    ]
+    let mut all = Vec::new();
+    for entry in gpgpu_rt::design::accelerators() {
+        for &(label, accel) in entry.variants {
+            all.push((
+                label,
+                options_with(accel.with_grid_resolution(n), w, h, refl_depth),
+            ));
+            if accel == Accel::Base {
+                let split = RenderOptions {
+                    triangles_per_dispatch: Some(2000),
+                    ..options(w, h, refl_depth)
+                };
+                all.push(("base split", split));
+            }
+        }
+    }
+    all
+}
+
+/// The options of `label` among [`pipeline_accelerators`].
+pub fn pipeline_accelerator(label: &str, all: &[(&'static str, RenderOptions)]) -> RenderOptions {
+    let found = all.iter().find(|(l, _)| *l == label);
+    found
+        .unwrap_or_else(|| panic!("no accelerator `{label}`"))
+        .1
+        .clone()
 }
 
 pub fn render_gpu(ctx: &GlContext, scene: &Scene, opts: RenderOptions) -> Frame {

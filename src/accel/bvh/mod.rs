@@ -19,8 +19,8 @@ use glow::HasContext;
 use serde_json::json;
 
 use super::{
-    max_pixel_events, set_camera, Accelerator, BuildContext, Entry, FrameContext, FusedPasses,
-    GridOptions, LightTarget, TracerKind, PIXELS_PER_INVOCATION,
+    max_pixel_events, set_camera, Accel, Accelerator, BuildContext, BvhLevels, BvhOptions,
+    BvhPasses, Entry, FrameContext, FusedPasses, LightTarget, PIXELS_PER_INVOCATION,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
@@ -44,10 +44,27 @@ pub use layout::{
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 pub use refit::{Refit, RefitKernels, REBUILD_GROWTH, REFIT_GROUP, REFIT_TIMER};
 
+/// The fastest configuration (`docs/design/bvh.md`, "The default"): the fused pass over one
+/// tree.
+const PLAIN: Accel = Accel::Bvh(BvhOptions {
+    passes: BvhPasses::Fused,
+    levels: BvhLevels::One,
+});
+
 pub const ENTRY: Entry = Entry {
-    tracer: TracerKind::Bvh,
-    grid_variant: None,
     label: "bvh",
+    plain: PLAIN,
+    // the two levels find the twin's hits with counts of their own (`tests/bvh_instances.rs`)
+    variants: &[
+        ("bvh", PLAIN),
+        (
+            "bvh four-kernels",
+            Accel::Bvh(BvhOptions {
+                passes: BvhPasses::FourKernels,
+                levels: BvhLevels::One,
+            }),
+        ),
+    ],
     gpu: Bvh::create,
 };
 
@@ -355,12 +372,12 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    fn create(b: &BuildContext, scene: &Scene, _: &GridOptions) -> Result<Box<dyn Accelerator>> {
+    fn create(b: &BuildContext, scene: &Scene, o: &Accel) -> Result<Box<dyn Accelerator>> {
         image_units_suffice(b.info.profile.image_units)?;
         let blocks = image_blocks(b.width, b.height);
         // the fused pass over block lists: with one tree (an instance's empty entry leaves the
         // block's other instances to walk)
-        let lists = b.fused.is_some() && !b.bvh_instances;
+        let lists = b.fused.is_some() && !o.instances();
         let defs = kernel_defines(b.info, blocks);
         let entry_defs = [
             ("BVH_ENTRY_GROUP", ENTRY_GROUP.to_string()),
@@ -420,7 +437,7 @@ impl Bvh {
                 .iter()
                 .map(|o| o.mesh.positions.clone())
                 .collect(),
-            levels: match b.bvh_instances {
+            levels: match o.instances() {
                 true => Levels::Two(None),
                 false => Levels::One,
             },

@@ -107,11 +107,21 @@ impl Design {
         self.options.row(self.kind).pipeline == Pipeline::Wagner2018
     }
 
-    /// "base", "bvh sah", "bvh wagner", "grid exact 16³", "grid thesis auto=12³".
+    /// "base", "bvh sah fused", "bvh wagner", "grid exact 16³", "grid thesis auto=12³".
     fn tracer_title(&self) -> String {
         let mut t = value_name(self.kind);
         if self.kind == TracerArg::Bvh {
             t += &format!(" {}", value_name(self.options.args.bvh_variant));
+            if !self.wagner() {
+                // the configuration that runs: the fused pass unless the thesis' four kernels
+                let bvh = &self.options.args.bvh;
+                t += if bvh.four_kernels {
+                    " four kernels"
+                } else {
+                    " fused"
+                };
+                t += if bvh.bvh_instances { " two levels" } else { "" };
+            }
         }
         if self.kind == TracerArg::Grid {
             let res = self

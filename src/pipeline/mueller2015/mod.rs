@@ -22,8 +22,7 @@ use self::records::{Record, Records, FUSED_RECORDS};
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
-    self, Accelerator, BuildContext, BvhVariant, Entry, FrameContext, FusedPasses, GridOptions,
-    LightTarget, PassRays, TracerKind,
+    self, Accel, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, LightTarget, PassRays,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
@@ -61,8 +60,8 @@ impl ShadowFlags {
 /// Options of Müller 2015's pipeline with one of its accelerators (`design::Design::Mueller2015`).
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
-    /// The accelerator (`--tracer`, with `grid.variant` for the grid).
-    pub tracer: TracerKind,
+    /// The accelerator with its own options (`--tracer` and its group).
+    pub accel: Accel,
     pub width: u32,
     pub height: u32,
     /// REFL_DEPTH: reflection passes after the primary pass (Fig. 8).
@@ -72,23 +71,36 @@ pub struct RenderOptions {
     pub shadow_flags: ShadowFlags,
     /// Keep the primary rays and first hits for the AOVs.
     pub aovs: bool,
-    /// The grid's options (`tracer` grid; the other accelerators have none).
-    pub grid: GridOptions,
     /// The base tracer's triangles per dispatch (`accel::BuildContext`); `None`: as the GL
     /// implementation needs.
     pub triangles_per_dispatch: Option<u32>,
     /// `--light-samples` U×V: the feelers towards each area light per hit point (ours, after
     /// Klee 2016; the scene's point lights get one each, as Listing 15).
     pub light_samples: (u32, u32),
-    /// `--fused-passes` (ours, the SAH BVH only): each pass of Fig. 8 in one kernel
-    /// (`glsl/bvh/fused_pass.comp`) instead of intersect1, the hit evaluation, intersect2 per
-    /// light and shading — the same image and counts, without the ray-state traffic between
-    /// them.
-    pub fused_passes: bool,
-    /// `--bvh-instances` (ours, the SAH BVH only): a tree per object, built once in object
-    /// space, under the objects' instances (`accel::bvh::instances`) — a moving object costs
-    /// its instance's update, no refit.
-    pub bvh_instances: bool,
+}
+
+impl RenderOptions {
+    /// Müller 2015's pipeline with `accel` at `width`×`height`, `refl_depth` reflection passes,
+    /// and the command line's defaults otherwise: tiles of [`crate::limits::defaults::TILE`],
+    /// bitwise shadow flags, 4×4 area-light samples, no AOVs.
+    pub fn new(accel: Accel, width: u32, height: u32, refl_depth: u32) -> RenderOptions {
+        RenderOptions {
+            accel,
+            width,
+            height,
+            refl_depth,
+            tile: crate::limits::defaults::TILE,
+            shadow_flags: ShadowFlags::Bits,
+            aovs: false,
+            triangles_per_dispatch: None,
+            light_samples: crate::limits::defaults::LIGHT_SAMPLES,
+        }
+    }
+
+    /// Whether a pass runs in the accelerator's fused kernel (the SAH BVH's default).
+    pub fn fused(&self) -> bool {
+        self.accel.fused()
+    }
 }
 
 /// Global counter slots, shared with the kernels through `#define COUNTER_*`.
@@ -143,7 +155,7 @@ pub fn kernel_defines(scene: &Scene, options: &RenderOptions) -> Defines {
         // and the point lights (shading.comp, the fused pass): a constant, so that llvmpipe
         // unrolls the light loops (docs/design/frame.md)
         .set("POINT_LIGHTS", scene.lights.len())
-        .set("BVH_INSTANCES", options.bvh_instances as i32)
+        .set("BVH_INSTANCES", options.accel.instances() as i32)
         // and how many instances it has: one per object with triangles (accel::bvh::instances)
         .set(
             "BVH_INSTANCE_COUNT",
@@ -245,17 +257,17 @@ pub struct RayTracer {
 /// What shortens the loop that passed the implementation's limit, for the tracer `options`
 /// choose (the refusal says it).
 fn loop_limit_advice(options: &RenderOptions) -> &'static str {
-    match options.tracer {
-        TracerKind::Bvh if options.bvh_instances => {
+    match options.accel {
+        Accel::Bvh(_) if options.accel.instances() => {
             "The two-level BVH (--bvh-instances) walks every object whose box a ray enters, and \
              these overlap: render without --bvh-instances (one tree over all triangles)"
         }
-        TracerKind::Bvh => "A ray visits too many BVH nodes: a GPU driver runs the loop whole",
-        TracerKind::Grid => {
+        Accel::Bvh(_) => "A ray visits too many BVH nodes: a GPU driver runs the loop whole",
+        Accel::ThesisGrid(_) | Accel::ExactGrid(_) => {
             "A ray walks too many voxels or tests too many triangles in one: change \
              --grid, or use --tracer bvh"
         }
-        TracerKind::Base => "The base tracer tests every triangle in one loop: use --tracer bvh",
+        Accel::Base => "The base tracer tests every triangle in one loop: use --tracer bvh",
     }
 }
 
@@ -264,20 +276,6 @@ fn check_options(info: &GlInfo, scene: &Scene, options: &RenderOptions) -> Resul
         bail!("{}", too_many_lights(scene, options.shadow_flags));
     }
     check_area_lights(scene, options)?;
-    if options.bvh_instances && options.tracer != TracerKind::Bvh {
-        bail!(
-            "--bvh-instances needs --tracer bvh (the SAH BVH's trees per object); --tracer {} \
-             has no instances",
-            options.tracer.name()
-        );
-    }
-    if options.fused_passes && options.tracer != TracerKind::Bvh {
-        bail!(
-            "--fused-passes needs --tracer bvh (the SAH BVH's fused pass kernel); --tracer {} \
-             runs Müller 2015's four kernels",
-            options.tracer.name()
-        );
-    }
     let max_tex = info.max_texture_size as u32;
     let (w, h) = (options.width, options.height);
     if w == 0 || h == 0 || w > max_tex || h > max_tex {
@@ -344,7 +342,7 @@ impl RayTracer {
         options: RenderOptions,
     ) -> Result<RayTracer> {
         let pixels = check_options(info, scene, &options)?;
-        let entry = accel::entry(options.tracer, &options.grid);
+        let entry = options.accel.entry();
         let gpu_scene = GpuScene::new(&gl, info, scene, shaders)?;
         let defines = kernel_defines(scene, &options);
         let compute = |file, timer| Kernel::compute(&gl, shaders, file, &defines, timer);
@@ -367,7 +365,7 @@ impl RayTracer {
             width: w,
             height: h,
             triangles_per_dispatch: options.triangles_per_dispatch,
-            fused: options.fused_passes.then(|| FusedPasses {
+            fused: options.fused().then(|| FusedPasses {
                 feelers: shadow_slots(scene, options.light_samples) as u32,
                 lights: (scene.lights.len() + scene.area_lights.len()) as u32,
                 first_light_point: !scene.lights.is_empty(),
@@ -378,14 +376,9 @@ impl RayTracer {
                 },
             }),
             scene_images: gpu_scene.vertex_images(),
-            bvh_instances: options.bvh_instances,
         };
-        let accel = (entry.gpu)(&build, scene, &options.grid)?;
-        let per_pixel = if options.fused_passes {
-            FUSED_RECORDS
-        } else {
-            1
-        };
+        let accel = (entry.gpu)(&build, scene, &options.accel)?;
+        let per_pixel = if options.fused() { FUSED_RECORDS } else { 1 };
         let records = accel
             .records()
             .then(|| {
@@ -451,7 +444,7 @@ impl RayTracer {
     /// `y · width + x`, GL rows, in the order `evaluate_hit` appended them); `None` for an
     /// accelerator without one. For tests and inspection, after a frame.
     pub fn hit_list(&self) -> Option<Vec<u32>> {
-        match (&self.records, self.options.fused_passes) {
+        match (&self.records, self.options.fused()) {
             (Some(r), false) => Some(r.hit_list_entries(&self.gl)),
             _ => None,
         }
@@ -468,7 +461,7 @@ impl RayTracer {
     /// One pass of Fig. 8's loop: intersect1, intersect2 per light, shading — or with
     /// `--fused-passes` the accelerator's fused pass kernel.
     fn pass(&mut self, cam: &CameraRays, pass: u32) {
-        if self.options.fused_passes {
+        if self.options.fused() {
             return self.fused_pass(cam, pass);
         }
         let mut f = FrameContext {
@@ -531,7 +524,7 @@ impl RayTracer {
     /// Whether pass `pass` computes its eye rays in place (the fused pass' first, where no
     /// AOVs keep the rays: `glsl/common/pass_ray.glsl`), so no eye-ray kernel runs.
     fn eye_in_place(&self, pass: u32) -> bool {
-        self.options.fused_passes && pass == 0 && self.aov_images.is_none()
+        self.options.fused() && pass == 0 && self.aov_images.is_none()
     }
 
     /// One pass in the accelerator's fused kernel (`glsl/bvh/fused_pass.comp`, ours): the
@@ -635,13 +628,13 @@ impl RayTracer {
                 stats.events.insert(name.to_string(), v);
             }
         }
-        if !self.options.grid.proximity_clouds {
+        if !self.options.accel.proximity_clouds() {
             for k in ["cloud_jumps", "empty_cells_skipped"] {
                 stats.events.remove(k);
             }
         }
         self.accel.stats(&mut stats);
-        if let (Some(r), false) = (&self.records, self.options.fused_passes) {
+        if let (Some(r), false) = (&self.records, self.options.fused()) {
             let pixels = r.hit_list_pixels(&self.gl);
             stats.facts.insert("hit_list_pixels".into(), json!(pixels));
         }
@@ -669,7 +662,7 @@ fn feeler_records(fused: FusedPasses) -> Vec<(Bank, Record)> {
 
 impl Renderer for RayTracer {
     fn name(&self) -> &'static str {
-        self.options.tracer.name()
+        self.options.accel.tracer()
     }
 
     fn size(&self) -> (u32, u32) {
@@ -684,7 +677,7 @@ impl Renderer for RayTracer {
         // --bvh-instances the SSBOs keep object space (the instances place the objects, the
         // hit evaluation turns the normals), so nothing is transformed after the first frame
         let identity;
-        let scene_models = if self.options.bvh_instances {
+        let scene_models = if self.options.accel.instances() {
             identity = vec![Mat4::IDENTITY; self.models.len()];
             &identity
         } else {
@@ -770,9 +763,7 @@ impl Renderer for RayTracer {
             ("tile", json!(o.tile)),
         ]
         .into_iter()
-        .chain((o.tracer == TracerKind::Bvh).then(|| ("bvh_variant", json!(BvhVariant::Sah))))
-        .chain(o.fused_passes.then_some(("fused_passes", json!(true))))
-        .chain(o.bvh_instances.then_some(("bvh_instances", json!(true))))
+        .chain(o.accel.settings())
         .chain(self.area_settings())
         .map(|(k, v)| (k.to_string(), v))
         .collect()

@@ -13,7 +13,9 @@ use glam::Mat4;
 
 use super::args::BenchArgs;
 use super::config::{BvhVariant, Config, Sizing, TracerSpec};
-use gpgpu_rt::accel::{GridOptions, TracerKind};
+use gpgpu_rt::accel::{
+    Accel, BvhLevels, BvhOptions, BvhPasses, ExactGridOptions, GridVariant, ThesisGridOptions,
+};
 use gpgpu_rt::design::Design;
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
@@ -50,7 +52,7 @@ impl Gpu {
 /// The thesis grid's default list lengths: triangle ids per voxel, voxel ids per ray (`None`:
 /// 3·N).
 pub fn grid_list_defaults() -> (u32, Option<u32>) {
-    let d = GridOptions::default();
+    let d = ThesisGridOptions::default();
     (d.voxel_array_length, d.ray_array_length)
 }
 
@@ -61,53 +63,51 @@ pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
 /// The design of configuration `c`, with the command line's `--tile` and list lengths; the
 /// first hits kept where the configuration is judged against the CPU reference.
 fn design(c: &Config, args: &BenchArgs) -> Design {
-    let d = GridOptions::default();
     let (width, height, aovs) = (c.width, c.height, c.judge);
-    let mueller = |tracer, grid, bvh_instances| {
+    let mueller = |accel| {
         Design::Mueller2015(RenderOptions {
-            tracer,
-            width,
-            height,
-            refl_depth: c.refl_depth,
             tile: args.tile,
             shadow_flags: ShadowFlags::Rgba,
             aovs,
-            grid,
-            triangles_per_dispatch: None,
-            light_samples: gpgpu_rt::design::defaults::LIGHT_SAMPLES,
-            fused_passes: false,
-            bvh_instances,
+            ..RenderOptions::new(accel, width, height, c.refl_depth)
+        })
+    };
+    // the protocols measure the SAH BVH in Müller 2015's four kernels, the thesis' pipeline
+    // that every accelerator of theirs runs in: pinned here, whatever the default of `render`
+    let bvh = |levels| {
+        Accel::Bvh(BvhOptions {
+            passes: BvhPasses::FourKernels,
+            levels,
         })
     };
     match c.tracer {
-        TracerSpec::Base => mueller(TracerKind::Base, d, false),
+        TracerSpec::Base => mueller(Accel::Base),
         TracerSpec::Grid {
-            variant,
+            variant: GridVariant::Thesis,
             resolution,
-        } => mueller(
-            TracerKind::Grid,
-            GridOptions {
-                variant,
+        } => {
+            let d = ThesisGridOptions::default();
+            mueller(Accel::ThesisGrid(ThesisGridOptions {
                 resolution: Some(resolution),
                 voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
                 ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
-                ..d
-            },
-            false,
-        ),
-        TracerSpec::GridPc { resolution } => mueller(
-            TracerKind::Grid,
-            GridOptions {
-                resolution: Some(resolution),
-                proximity_clouds: true,
-                ..d
-            },
-            false,
-        ),
+            }))
+        }
+        TracerSpec::Grid {
+            variant: GridVariant::Exact,
+            resolution,
+        } => mueller(Accel::ExactGrid(ExactGridOptions {
+            resolution: Some(resolution),
+            proximity_clouds: false,
+        })),
+        TracerSpec::GridPc { resolution } => mueller(Accel::ExactGrid(ExactGridOptions {
+            resolution: Some(resolution),
+            proximity_clouds: true,
+        })),
         TracerSpec::Bvh {
             variant: BvhVariant::Sah,
-        } => mueller(TracerKind::Bvh, d, false),
-        TracerSpec::BvhInstances => mueller(TracerKind::Bvh, d, true),
+        } => mueller(bvh(BvhLevels::One)),
+        TracerSpec::BvhInstances => mueller(bvh(BvhLevels::Two)),
         TracerSpec::Bvh {
             variant: BvhVariant::Wagner,
         } => Design::Wagner2018(WagnerOptions {

@@ -7,7 +7,7 @@
 use anyhow::Result;
 
 use super::adapter::Frame;
-use gpgpu_rt::accel::{self, GridOptions};
+use gpgpu_rt::accel;
 use gpgpu_rt::reference::Reference;
 use gpgpu_rt::scene::Scene;
 
@@ -39,8 +39,7 @@ impl Judge {
         let (name, reference) = if work <= BRUTE_FORCE_MAX_TESTS {
             ("CPU brute force", Reference::new(&unlit))
         } else {
-            let grid = GridOptions::default();
-            let twin = gpgpu_rt::reference::twin(accel::TracerKind::Bvh, &unlit, &grid)?;
+            let twin = gpgpu_rt::design::twin(&unlit, &accel::bvh::ENTRY.plain)?;
             ("CPU SAH BVH", Reference::with_accelerator(&unlit, twin))
         };
         let f = reference.render(&scene.camera, width, height, 0);
