@@ -12,6 +12,8 @@
 // the first of the dispatches counts the ray (raysTraced, common/intersect_head.glsl)
 #define COUNTS_RAY (firstTriangle == 0)
 #include "../common/intersect_head.glsl"
+#include "../common/count_work.glsl"
+#include "../common/vertex_attributes.glsl"
 #include "../common/intersect1_hit.glsl"
 
 // this dispatch's triangles (ours): firstTriangle <= i < endTriangle; one dispatch: 0 and

@@ -9,6 +9,7 @@
 // the first of the dispatches counts the feeler (raysTraced, common/intersect_head.glsl)
 #define COUNTS_RAY (firstTriangle == 0)
 #include "../common/intersect_head.glsl"
+#include "../common/count_work.glsl"
 
 // this dispatch's triangles (ours): firstTriangle <= i < endTriangle; one dispatch: 0 and
 // triangleCount()

@@ -35,7 +35,7 @@
 layout(local_size_x = BVH_ENTRY_GROUP) in;
 
 #include "entries.glsl"
-#include "../common/pass_ray.glsl"
+#include "pass_ray.glsl"
 
 // the block's rays: per axis the smallest and largest 1/direction and origin (in the space of
 // the tree descended), and the divisors of safeInverse in world space

@@ -19,6 +19,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/images.glsl"
 #include "../common/intersect.glsl"
 #include "records.glsl"
+#include "vertex_attributes.glsl"
 #include "../common/intersect1_hit.glsl"
 // a hit record: a leaf-triangle address
 #include "hit_record.glsl"

@@ -7,7 +7,7 @@
 // same t, u and v. With two levels (BVH_INSTANCES) the leaf triangle is in its object's space
 // and its zero1 word (t1.w) is its instance + 1 (src/accel/bvh/instances.rs): the ray is taken
 // there as the walk took it (instanceRay), and the instance's normal matrix set for the hit
-// evaluation (hitNormalMatrix, common/intersect1_hit.glsl, included before this file); with
+// evaluation (hitNormalMatrix, bvh/vertex_attributes.glsl, included before this file); with
 // one level that word is 0.
 #include "words.glsl"
 

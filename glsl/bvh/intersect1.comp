@@ -5,13 +5,11 @@
 // equal distances go to the lower triangle id, as in the base tracer's loop, so the image
 // equals the base tracer's. Listings 13, 14 of Müller 2015: bvh/evaluate_hit.comp
 // (bvh/intersect1_main.glsl).
-#if RECORD_STORE_64
-#extension GL_ARB_gpu_shader_int64 : require
-#endif
-// the work counts stored per pixel (storePixelRecord), not added to the counters
-#define PIXEL_RECORDS
+#include "int64.glsl"
 #include "../common/intersect_head.glsl"
 #include "records.glsl"
+// the work counts stored per pixel (storePixelRecord), not added to the counters
+#include "record_work.glsl"
 #include "traverse.glsl"
 
 // the entry point of each 8×8 block of rays (bvh/entry.comp, run before this kernel)
@@ -49,6 +47,14 @@ void closestHit(ivec2 storePos, vec3 ro, vec3 rd, int lastTriID,
     traverseScene(ro, rd, 0.0, limit, bvhRecord(entryTexel(storePos >> 3)));
     t_min = bestT; triID = bestID;
     closestHitRecord = bestAt;
+}
+
+// an invocation per pixel, its work in the pixel's record
+bool workItem(out ivec2 storePos, out int record)
+{
+    storePos = pixelPosition();
+    record = pixelIndex(storePos);
+    return insideImage(storePos);
 }
 
 #include "intersect1_main.glsl"

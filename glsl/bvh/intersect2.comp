@@ -5,17 +5,25 @@
 // Deviations: see traverse.glsl; any number of lights.
 // Feeler set-up, N·L early out and flags: common/intersect2_main.glsl (Müller 2015, Listing 15).
 // Ours: an invocation per pixel of the pass' hit list (bvh/hit_list.glsl), not per pixel.
-#if RECORD_STORE_64
-#extension GL_ARB_gpu_shader_int64 : require
-#endif
-// the work counts stored per pixel (storePixelRecord), not added to the counters
-#define PIXEL_RECORDS
-// the feelers of the pixels in the pass' hit list, not of every pixel (bvh/hit_list.glsl)
-#define HIT_LIST
+#include "int64.glsl"
 #include "hit_list.glsl"
 #include "../common/intersect_head.glsl"
 #include "records.glsl"
+// the work counts stored per pixel (storePixelRecord), not added to the counters
+#include "record_work.glsl"
 #include "traverse.glsl"
+
+// the feelers of the pixels in the pass' hit list, not of every pixel (bvh/hit_list.glsl): an
+// invocation per entry, its work in the record of its list position
+bool workItem(out ivec2 storePos, out int record)
+{
+    uint k = listGroup() * HIT_LIST_GROUP + gl_LocalInvocationIndex;
+    record = int(k);
+    storePos = ivec2(0);
+    bool listed = k < hitCount();
+    if (listed) storePos = hitPixel(k);
+    return listed;
+}
 
 // the feeler's last triangle and the light's distance, for triangleHit (the feeler itself:
 // rayO, rayD of bvh/traverse.glsl)

@@ -1,5 +1,5 @@
 // Per-pixel records of the SAH BVH: work counts and hit records (ours; not in the thesis). Its
-// intersection kernels (which define PIXEL_RECORDS: common/intersect_head.glsl) store each
+// intersection kernels (bvh/record_work.glsl, and the fused pass: bvh/fused.glsl) store each
 // invocation's work — ray–triangle tests, BVH nodes visited, a loop cut short, the ray traced —
 // in its pixel's record, which bvh/pixel_counts.comp adds to the 64-bit counters after the
 // dispatch. Its intersect1 keeps the closest-hit search apart from the evaluation of the hit:
@@ -13,7 +13,7 @@
 // (bvh/hit_record.glsl), −1 for none.
 int closestHitRecord = -1;
 
-// One record per pixel (three with the fused pass: bvh/fused_pass.comp), a PixelRecord (src/pipeline/mueller2015/records.rs): xy its counts
+// One record per pixel (three with the fused pass: bvh/fused.glsl), a PixelRecord (src/pipeline/mueller2015/records.rs): xy its counts
 // (packCounts: tests_truncated, nodes_traced), z its hit record (hit; intersect1 only), w
 // unused. One store per invocation: on llvmpipe every store costs a loop over the 8 lanes per
 // component and about as much again for the store itself (docs/design/frame.md).
@@ -21,8 +21,8 @@ layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordBuffer { uvec4 pi
 #if RECORD_STORE_64
 // The same records as two 64-bit words (GL_ARB_gpu_shader_int64, which the including kernel
 // enables): the counts' two words and the hit record's (its high half 0), for the stores of
-// storePixelRecord (intersect1: both, one store of two components; intersect2: the
-// counts) — on llvmpipe a store costs a loop over the 8 lanes per component, so two
+// storeRecordPairs and storePixelRecord (intersect1 and the fused pass: one store of two
+// components; intersect2: the counts) — on llvmpipe a store costs a loop over the 8 lanes per component, so two
 // components cost less than three (docs/design/frame.md; docs/design/bvh.md, step 22).
 layout(std430, binding = SSBO_PIXEL_RECORDS) buffer PixelRecordWords {
     u64vec2 pixelRecordWords[];
@@ -46,26 +46,14 @@ uvec4 unpackCounts(uvec2 c)
 // IMAGE_WIDTH × IMAGE_HEIGHT: the image size (#defines of the pipeline); one record per pixel
 int pixelIndex(ivec2 storePos) { return storePos.y * IMAGE_WIDTH + storePos.x; }
 
-#ifdef PIXEL_RECORDS
-// The intersection kernels' store of their work in record `at` (the hook of
-// common/intersect_head.glsl's traceAndCount): the counts, and in intersect1 the hit record too.
-void storePixelRecord(int at, int testsSlot)
+// Record `at` as two pairs of words in one store: two 64-bit words where the profile has them
+// (RECORD_STORE_64), else four 32-bit ones — intersect1's counts and hit record
+// (bvh/record_work.glsl), the fused pass' closest-hit and first-light counts (bvh/fused.glsl).
+void storeRecordPairs(int at, uvec2 low, uvec2 high)
 {
-    uvec2 counts = packCounts(tests, nodesVisited, truncated, raysTraced);
-    // (a constant condition: one of the two stores is compiled)
-    if (testsSlot == COUNTER_INTERSECT1) {
 #if RECORD_STORE_64
-        uint64_t record = uint64_t(uint(closestHitRecord));
-        pixelRecordWords[at] = u64vec2(packUint2x32(counts), record);
+    pixelRecordWords[at] = u64vec2(packUint2x32(low), packUint2x32(high));
 #else
-        pixelRecord[at].xyz = uvec3(counts, uint(closestHitRecord));
+    pixelRecord[at] = uvec4(low, high);
 #endif
-    } else {
-#if RECORD_STORE_64
-        pixelRecordWords[at].x = packUint2x32(counts);
-#else
-        pixelRecord[at].xy = counts;
-#endif
-    }
 }
-#endif

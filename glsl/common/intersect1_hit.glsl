@@ -14,31 +14,13 @@ uniform vec4 backgroundColor;
 uniform int storePrimaryHit;
 layout(binding = SAMPLER_TEXTURES) uniform sampler2DArray textures;
 
-// The vertex normals and colours of the scene (common/scene.glsl). Ours: with SCENE_IMAGES
-// (the SAH BVH's evaluate_hit, where the GL has the image units: GpuScene::vertex_images) the
-// same buffers are read as image buffers — llvmpipe loads a storage-buffer vector lane by lane
-// and component by component, an image texel for all lanes at once (docs/design/frame.md).
-#if SCENE_IMAGES
-layout(rgba32f, binding = IMAGE_SCENE_NORMAL) readonly uniform imageBuffer normalImage;
-layout(rgba32f, binding = IMAGE_SCENE_COLOR) readonly uniform imageBuffer colorImage;
-vec3 vertexNormal(int k) { return imageLoad(normalImage, k).xyz; }
-vec3 vertexColor(int k) { return imageLoad(colorImage, k).rgb; }
-#else
-vec3 vertexNormal(int k) { return normals[k].xyz; }
-vec3 vertexColor(int k) { return colors[k].rgb; }
-#endif
-
-#if BVH_INSTANCES
-// The SAH BVH's two levels (ours; src/accel/bvh/instances.rs): the scene's vertex normals stay
-// in object space, and the hit's instance turns each into world space and normalises it, as the
-// transform pass does with its normalMatrix (the transpose of the inverse of the model matrix'
-// 3×3 part), before Listing 13 interpolates them — the same normal under any scale;
-// bvh/hit_record.glsl sets it for the hit's instance.
-mat3 hitNormalMatrix = mat3(1.0);
-vec3 hitVertexNormal(int k) { return normalize(hitNormalMatrix * vertexNormal(k)); }
-#else
-vec3 hitVertexNormal(int k) { return vertexNormal(k); }
-#endif
+// The hit triangle's vertex attributes, which the including kernel defines before including
+// this file (a hook, as closestHit is): common/vertex_attributes.glsl reads the scene's buffers
+// as the transform pass stored them (the base tracer, the grids); the SAH BVH reads them its
+// own way (bvh/vertex_attributes.glsl, ours: as image buffers, and with two levels turned into
+// world space by the hit's instance).
+//     vec3 hitVertexNormal(int k)   the world-space normal of vertex k, for Listing 13 to interpolate
+//     vec3 hitVertexColor(int k)    the colour of vertex k
 
 // inactive ray: an empty colour buffer, nothing for shading to add. Ours: weight -1 marks it;
 // the thesis' shading skips an empty colour buffer (ch. 4.1.3, "sofern dieser nicht leer
@@ -76,8 +58,8 @@ void hitTexels(vec3 ro, vec3 rd, float rayState, float t_min, int triID, float h
         if (dot(interpolated_normal, direction) > 0.0) interpolated_normal = -interpolated_normal;
 
         mat = material[triMaterial[triID]];
-        vec3 color = w * vertexColor(3 * triID) + hit_u * vertexColor(3 * triID + 1)
-                   + hit_v * vertexColor(3 * triID + 2);
+        vec3 color = w * hitVertexColor(3 * triID) + hit_u * hitVertexColor(3 * triID + 1)
+                   + hit_v * hitVertexColor(3 * triID + 2);
 #if SCENE_TEXTURES
         if (mat.w >= 0.0) {
             // textured triangle: interpolated texture coordinates, sampled through the sampler

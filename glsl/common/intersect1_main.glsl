@@ -8,6 +8,7 @@
 // (Listings 13 and 14) is in common/intersect1_hit.glsl; the base tracer's kernel
 // (brute_force/intersect1.comp, Listing 12) calls it directly. (The SAH BVH's intersect1 only
 // stores its closest hit: bvh/intersect1_main.glsl.)
+#include "vertex_attributes.glsl"
 #include "intersect1_hit.glsl"
 
 void trace(ivec2 storePos)

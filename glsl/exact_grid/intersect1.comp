@@ -6,6 +6,7 @@
 // tracer's loop, so the image equals the base tracer's. Listings 13, 14:
 // common/intersect1_main.glsl.
 #include "../common/intersect_head.glsl"
+#include "../common/count_work.glsl"
 #include "../common/grid.glsl"
 #include "dda.glsl"
 

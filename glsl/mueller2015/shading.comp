@@ -14,46 +14,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/scene.glsl"
 #include "../common/images.glsl"
 
-uniform vec4 camPosition;
-uniform vec4 ambientColor;
-// the point lights (POINT_LIGHTS: a #define of the pipeline; ours: Listing 16 loops over a
-// uniform count, which llvmpipe kept as a loop with its lane masks — as a constant it unrolls,
-// docs/design/frame.md)
-const int lightCount = POINT_LIGHTS;
-#if AREA_LIGHTS > 0 && !SHADOW_BITS
-#error "area lights need the bitwise shadow flags (a bit per light sample)"
-#endif
-#if AREA_LIGHTS > 0
-// per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
-uniform vec4 areaLight[4 * AREA_LIGHTS];
-#endif
-
-// The point lights (common/scene.glsl). Ours: with SCENE_IMAGES the same buffers read as image
-// buffers — llvmpipe loads a storage-buffer vector lane by lane and component by component, an
-// image texel for all lanes at once (docs/design/frame.md; common/intersect1_hit.glsl).
-#if SCENE_IMAGES
-layout(rgba32f, binding = IMAGE_SCENE_LIGHT_POS) readonly uniform imageBuffer lightPosImage;
-layout(rgba32f, binding = IMAGE_SCENE_LIGHT_COLOR) readonly uniform imageBuffer lightColorImage;
-vec3 pointLightPos(int l) { return imageLoad(lightPosImage, l).xyz; }
-vec3 pointLightColor(int l) { return imageLoad(lightColorImage, l).rgb; }
-#else
-vec3 pointLightPos(int l) { return lightPos[l].xyz; }
-vec3 pointLightColor(int l) { return lightColor[l].rgb; }
-#endif
-
+// the lights, their shadow slots and Listing 16's lighting (shared with the SAH BVH's fused pass)
 #include "shade.glsl"
-
-// The pixel's shadow flags as one bit per slot (shade.glsl): the bitwise flags as they are,
-// the thesis' RGBA flags (channel l > 0.5: light l blocked) as bits 0–3.
-uvec4 blockedSlots(ivec2 storePos)
-{
-#if SHADOW_BITS
-    return imageLoad(shadowTexture, storePos);
-#else
-    bvec4 set = greaterThan(imageLoad(shadowTexture, storePos), vec4(0.5));
-    return uvec4(uint(set.x) | uint(set.y) << 1 | uint(set.z) << 2 | uint(set.w) << 3, 0u, 0u, 0u);
-#endif
-}
 
 void main()
 {

@@ -5,6 +5,7 @@
 // lies beyond the voxel (where a closer triangle in a later voxel could hide it); the exact
 // variant (exact_grid/intersect1.comp) does not. Listings 13, 14: common/intersect1_main.glsl.
 #include "../common/intersect_head.glsl"
+#include "../common/count_work.glsl"
 #include "../common/grid.glsl"
 
 // The thesis' block names (Listing 19), though VerticesInVoxel holds triangle ids (N³ lists of

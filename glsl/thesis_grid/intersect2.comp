@@ -3,6 +3,7 @@
 // triangles of the listed voxels tested until the first occluder (any hit). Feeler set-up,
 // N·L early out and flags: common/intersect2_main.glsl (Listing 15).
 #include "../common/intersect_head.glsl"
+#include "../common/count_work.glsl"
 #include "../common/grid.glsl"
 
 // The thesis' block names (Listing 19), though VerticesInVoxel holds triangle ids (N³ lists of

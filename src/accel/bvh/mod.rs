@@ -166,13 +166,15 @@ fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<Re
     })
 }
 
-/// The fused pass (`glsl/bvh/fused_pass.comp`): each pixel's counts in record 0 (the first
+/// The fused pass (`glsl/bvh/fused.glsl`): each pixel's counts in record 0 (the first
 /// light's beside the closest hit's where it is a point light), else the first light's at
 /// record 1; the other lights' at record 2 where the scene has more than one light
 /// (`pipeline::mueller2015::records`). With block lists (`lists`: one tree) two kernels, a
-/// work group per block: the blocks whose rays may hit (`fused_pass`) and those
-/// whose rays all miss (`FUSED_MISS`, timed as `fused_miss`; `glsl/bvh/block_lists.glsl`).
-/// `eye`: the variant that computes the eye rays in place (`PASS_EYE_RAYS`).
+/// work group per block: the blocks whose rays may hit (`glsl/bvh/fused_pass.comp`) and those
+/// whose rays all miss (`glsl/bvh/fused_miss.comp`, timed as `fused_miss`;
+/// `glsl/bvh/block_lists.glsl`); without (two levels, [`Bvh::create`]) one, a pixel an
+/// invocation (`glsl/bvh/fused_instances.comp`). `eye`: the variant that computes the eye rays
+/// in place (`PASS_EYE_RAYS`).
 fn fused_kernels(
     b: &BuildContext,
     defs: &[(&'static str, String)],
@@ -181,27 +183,23 @@ fn fused_kernels(
     eye: bool,
 ) -> Result<Vec<Kernel>> {
     let variant = [
-        ("BVH_BLOCK_LISTS", (lists as i32).to_string()),
         ("PASS_EYE_RAYS", (eye as i32).to_string()),
         (
             "EYE_PASS_STORES_RAYS",
             (f.rays.eye_pass_stores_rays as i32).to_string(),
         ),
     ];
-    let kernel = |miss: bool, timer| {
-        let miss = [("FUSED_MISS", (miss as i32).to_string())];
-        fused_kernel(b, &[defs, &variant[..], &miss[..]].concat(), f, timer)
-    };
+    let kernel = |file, timer| fused_kernel(b, &[defs, &variant[..]].concat(), f, file, timer);
     match lists {
         true => Ok(vec![
-            kernel(false, "fused_pass")?,
-            kernel(true, "fused_miss")?,
+            kernel("bvh/fused_pass.comp", "fused_pass")?,
+            kernel("bvh/fused_miss.comp", "fused_miss")?,
         ]),
-        false => Ok(vec![kernel(false, "fused_pass")?]),
+        false => Ok(vec![kernel("bvh/fused_instances.comp", "fused_pass")?]),
     }
 }
 
-/// `--fused-passes` (`glsl/bvh/fused_pass.comp`): the pass in one kernel, or with one tree in
+/// `--fused-passes` (`glsl/bvh/fused.glsl`): the pass in one kernel, or with one tree in
 /// two over the block lists (the blocks that may hit, those that cannot); no kernel without.
 struct Fused {
     /// the kernels of the passes whose rays are in the ray-state images, compiled only where
@@ -269,6 +267,7 @@ fn fused_kernel(
     b: &BuildContext,
     defs: &[(&'static str, String)],
     f: FusedPasses,
+    file: &str,
     timer: &'static str,
 ) -> Result<Kernel> {
     let extra = [
@@ -283,7 +282,7 @@ fn fused_kernel(
             (f.first_light_point as i32).to_string(),
         ),
     ];
-    b.kernel("bvh/fused_pass.comp", &[defs, &extra[..]].concat(), timer)
+    b.kernel(file, &[defs, &extra[..]].concat(), timer)
 }
 
 /// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
