@@ -131,7 +131,10 @@ uvec4 feelers(ivec2 storePos, vec3 p, vec3 n, int id, inout uvec4 first, inout u
             blocked[l >> 5] |= 1u << uint(l & 31);
         if (l == 0) first += takeCounts(); else others += takeCounts();
     }
-    // (no pass without area lights: AREA_LIGHTS is a constant)
+    // (no loop of no pass: Mesa 22.3 kept a loop over AREA_LIGHTS = 0 with its walk, and
+    // llvmpipe ran its first pass under an empty lane mask — with shade.glsl's such loop
+    // 1.11–1.16× the JIT instructions of a bunny frame, docs/design/frame.md)
+#if AREA_LIGHTS > 0
     for (int a = 0; a < AREA_LIGHTS; a++) {
         for (int r = 0; r < areaSamples; r++) {
             int s = lightCount + a * areaSamples + r;
@@ -140,6 +143,7 @@ uvec4 feelers(ivec2 storePos, vec3 p, vec3 n, int id, inout uvec4 first, inout u
             if (lightCount + a == 0) first += takeCounts(); else others += takeCounts();
         }
     }
+#endif
     return blocked;
 }
 

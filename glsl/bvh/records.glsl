@@ -48,7 +48,8 @@ int pixelIndex(ivec2 storePos) { return storePos.y * IMAGE_WIDTH + storePos.x; }
 
 // Record `at` as two pairs of words in one store: two 64-bit words where the profile has them
 // (RECORD_STORE_64), else four 32-bit ones — intersect1's counts and hit record
-// (bvh/record_work.glsl), the fused pass' closest-hit and first-light counts (bvh/fused.glsl).
+// (bvh/record_work.glsl; its w then 0, which nothing reads), the fused pass' closest-hit and
+// first-light counts (bvh/fused.glsl).
 void storeRecordPairs(int at, uvec2 low, uvec2 high)
 {
 #if RECORD_STORE_64

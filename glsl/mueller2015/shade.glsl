@@ -14,14 +14,6 @@ const int lightCount = POINT_LIGHTS;
 #if AREA_LIGHTS > 0 && !SHADOW_BITS
 #error "area lights need the bitwise shadow flags (a bit per light sample)"
 #endif
-#if AREA_LIGHTS > 0
-// per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
-uniform vec4 areaLight[4 * AREA_LIGHTS];
-#else
-// none: the loops over the area lights (litColor, the fused pass' feelers) run no pass, and
-// their reads of an array of AREA_LIGHTS entries still compile
-const vec4 areaLight[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
-#endif
 // an area light's samples (common/light_samples.glsl)
 const int areaSamples = SAMPLES_U * SAMPLES_V;
 
@@ -39,6 +31,12 @@ vec3 pointLightPos(int l) { return lightPos[l].xyz; }
 vec3 pointLightColor(int l) { return lightColor[l].rgb; }
 #endif
 
+// The area lights, where the scene has them: no loop over AREA_LIGHTS = 0 (Mesa 22.3 kept such
+// a loop, and llvmpipe ran its first pass under an empty lane mask: bvh/fused.glsl's feelers).
+#if AREA_LIGHTS > 0
+// per area light: corner, edge u, edge v (xyz) and colour (rgb), four vec4 each
+uniform vec4 areaLight[4 * AREA_LIGHTS];
+
 #include "../common/light_samples.glsl"
 // Sample r of area light a, the target of its feeler (Klee's sample positions), for the fused
 // pass, which traces a hit's feelers itself (intersect2's: common/light_target.glsl).
@@ -47,6 +45,7 @@ vec3 areaLightSample(int a, int r)
     return lightSamplePoint(areaLight[4 * a].xyz, areaLight[4 * a + 1].xyz,
                             areaLight[4 * a + 2].xyz, r, SAMPLES_U, SAMPLES_V);
 }
+#endif
 
 // The pixel's shadow flags as one bit per slot (below): the bitwise flags as they are, the
 // thesis' RGBA flags (channel l > 0.5: light l blocked) as bits 0–3.
@@ -87,6 +86,7 @@ bool slotBlocked(uvec4 blocked, int s)
     return (blocked[s >> 5] & (1u << uint(s & 31))) != 0u;
 }
 
+#if AREA_LIGHTS > 0
 // The share of area light a's feelers that no triangle blocked: its sample slots are
 // lightCount + a·U·V … + U·V − 1 (a sample behind the surface counts as blocked, as Listing 15
 // treats a point light behind it).
@@ -99,6 +99,7 @@ float unblockedShare(uvec4 blocked, int a)
         count += int(slotBlocked(blocked, s));
     return float(samples - count) / float(samples);
 }
+#endif
 
 // Listing 16's lit colour of the hit at p (normal n, material mat of its triangle, colour
 // albedo) with the shadow slots `blocked`: the ambient term and Phong per light that reaches it.
@@ -111,6 +112,7 @@ vec3 litColor(vec3 p, vec3 n, vec4 mat, vec3 albedo, uvec4 blocked)
         vec3 L = normalize(pointLightPos(l) - p);
         temp_color += pointLightColor(l) * phong(n, L, view, mat, albedo);
     }
+#if AREA_LIGHTS > 0
     for (int a = 0; a < AREA_LIGHTS; a++) {
         float share = unblockedShare(blocked, a);
         if (share <= 0.0) continue;
@@ -119,6 +121,7 @@ vec3 litColor(vec3 p, vec3 n, vec4 mat, vec3 albedo, uvec4 blocked)
         vec3 L = normalize(centre - p);
         temp_color += share * areaLight[4 * a + 3].rgb * phong(n, L, view, mat, albedo);
     }
+#endif
     return temp_color;
 }
 
