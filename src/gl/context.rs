@@ -45,7 +45,7 @@ pub struct GlInfo {
     pub timer_query_bits: i32,
     /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH's intersect1 stores
     /// a pixel's record as two 64-bit words in one store, its intersect2 the counts as one
-    /// word: `glsl/common/intersect_head.glsl`).
+    /// word: `glsl/bvh/records.glsl`).
     pub int64: bool,
     /// GL_ARB_shader_ballot with 64-bit integers: a SIMD group's votes as one mask (the SAH
     /// BVH's hit list reserves a SIMD group's entries with one atomic: `glsl/bvh/hit_list.glsl`).

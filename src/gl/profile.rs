@@ -112,7 +112,7 @@ pub struct Profile {
     /// implementation has it with 64-bit integers; else a work group's shared counter.
     pub hit_list_ballot: bool,
     /// The SAH BVH's kernels store a pixel's record as two 64-bit words in one store
-    /// (`RECORD_STORE_64`, `glsl/common/intersect_head.glsl`), where the implementation has
+    /// (`RECORD_STORE_64`, `glsl/bvh/records.glsl`), where the implementation has
     /// GL_ARB_gpu_shader_int64; else as 32-bit words.
     pub record_store_64: bool,
     /// The image units a compute kernel may bind: units `0..image_units` (the least of

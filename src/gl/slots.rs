@@ -122,13 +122,14 @@ slot_table! {
         /// its kernels bind too
         BVH = 7,
         /// the scene's vertex normals and colours (the SSBOs NORMAL, COLOR) read as image
-        /// buffers by the SAH BVH's evaluate_hit (glsl/common/intersect1_hit.glsl,
+        /// buffers by the SAH BVH's hit evaluations (glsl/bvh/vertex_attributes.glsl,
         /// SCENE_IMAGES): beyond the 8 units GL 4.5 guarantees, so only where
         /// `GL_MAX_IMAGE_UNITS` has them
         SCENE_NORMAL = 8,
         SCENE_COLOR = 9,
         /// the lights' positions and colours (the SSBOs LIGHT_POS, LIGHT_COLOR) read as
-        /// image buffers by shading's light loop (SCENE_IMAGES), the same way
+        /// image buffers by shading's light loop (SCENE_IMAGES, glsl/mueller2015/shade.glsl),
+        /// the same way
         SCENE_LIGHT_POS = 10,
         SCENE_LIGHT_COLOR = 11,
         /// the world-space vertices (the SSBO VERTEX) read the same way by the SAH BVH's

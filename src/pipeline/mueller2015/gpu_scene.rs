@@ -481,7 +481,7 @@ impl GpuScene {
     }
 
     /// Whether the vertex normals and colours and the lights are also bound as image buffers
-    /// (`SCENE_IMAGES` of `glsl/common/intersect1_hit.glsl` and `shading.comp`).
+    /// (`SCENE_IMAGES` of `glsl/bvh/vertex_attributes.glsl` and `glsl/mueller2015/shade.glsl`).
     pub fn vertex_images(&self) -> bool {
         !self.vertex_views.is_empty()
     }
