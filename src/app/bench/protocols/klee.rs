@@ -20,10 +20,12 @@
 use anyhow::Result;
 
 use super::klee_measure::{section, Row, Setup, READINGS};
-use super::{Protocol, Section, Units};
-use crate::bench::report::format::{int, num, percent, ratio, table};
+use super::protocol::Protocol;
+use crate::bench::common::format::{int, num, percent, ratio, table};
+use crate::bench::common::section::Section;
 use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
 use crate::bench::runner::config::Sizing;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 use gpgpu_rt::scene::ShadowMode;
 
