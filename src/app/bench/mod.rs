@@ -50,7 +50,7 @@
 //!    [`report::plots::Figure`]s: [`Protocol::sweep_section`]); see [`protocols::thesis_5_3`] for a
 //!    complete example. Work that is not a list of rendered frames (a CPU implementation, a
 //!    build-time measurement) goes through [`runner::adapter`] and
-//!    [`protocols::klee_measure`] or helpers like them.
+//!    [`protocols::klee::measure`] or helpers like them.
 //! 3. Say what its units are: `Units::Configs` when everything it measures goes through
 //!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
 //!    measurements depend on each other.

@@ -8,8 +8,8 @@ use std::time::Instant;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::protocol::Protocol;
 use crate::bench::common::section::Section;
+use crate::bench::protocols::protocol::Protocol;
 use crate::bench::report::plots::Figure;
 use crate::bench::runner::adapter::{ShadowFrame, SoftShadows};
 use crate::bench::runner::config::Sizing;
