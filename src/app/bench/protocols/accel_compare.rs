@@ -293,7 +293,7 @@ mod tests {
             assert_eq!(compared, want, "{row:?}");
         }
         for a in ACCELERATORS.iter() {
-            let spec = a.tracer(70_000);
+            let spec = tracer(a, 70_000);
             assert_eq!(spec.row().name, a.row.name, "{}", a.name);
             assert_eq!(accelerator_of(&spec).name, a.name);
         }
