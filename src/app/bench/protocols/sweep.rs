@@ -1,7 +1,7 @@
 //! What the grid-resolution protocols (ch. 5.2, 5.3) share: configurations over resolutions
 //! and variants, the table per resolution, and the curves per variant.
 
-use crate::bench::report::format::{int, ratio, table};
+use crate::bench::common::format::{int, ratio, table};
 use crate::bench::report::plots::{Chart, Series, Style};
 use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
 use crate::bench::runner::outcome::{Outcome, MEASURED_COLUMNS};

@@ -6,14 +6,17 @@
 
 use anyhow::Result;
 
+use super::protocol::Protocol;
 use super::sweep::{self, resolution_chart};
-use super::{thesis_bvh, Protocol, Section, Units};
+use super::thesis_bvh;
+use crate::bench::common::format::{int, num, ratio, table};
+use crate::bench::common::section::Section;
 use crate::bench::published::thesis::{self as p, Published};
-use crate::bench::report::format::{int, num, ratio, table};
 use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
 use crate::bench::runner::args::Scale;
 use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
 use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
@@ -51,7 +54,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         + &tables(&results)
         + &thesis_bvh::table_text(&outcomes);
     let figures = figures(plan.sizing, &results);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
+    p.sweep_section(&bench.out, markdown, &outcomes, &figures)
 }
 
 impl Plan {

@@ -7,7 +7,7 @@
 //! "Two levels"). The protocols' own tables and figures stay the thesis' (base and grids); this
 //! module adds one table of the BVH beside them.
 
-use crate::bench::report::format::{int, num, ratio, table};
+use crate::bench::common::format::{int, num, ratio, table};
 use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
 use crate::bench::runner::outcome::{FrameRecord, Outcome};
 
