@@ -16,8 +16,10 @@ use std::ops::ControlFlow;
 
 use glam::Vec3;
 
-use super::{closest_among, CpuAccelerator, Feeler, Hit};
 use crate::accel::bvh::{octant_planes, BvhTree, RayGrid, OCTANTS};
+use crate::accel::Accel;
+use crate::reference::search::{closest_among, CpuAccelerator, Feeler, Hit};
+use crate::scene::Scene;
 
 mod entry;
 pub use entry::{BlockEntry, RayBounds};
@@ -144,6 +146,13 @@ impl CpuAccelerator for BvhTree {
         let (blocked, tests, _) = self.feeler_walk(feeler);
         (blocked, tests)
     }
+}
+
+/// The SAH BVH's twin (`design::REGISTRY`): one tree over the world-space scene, whatever its
+/// variant (the fused pass counts as the four kernels; the two levels find the same hits,
+/// their counts are the instances' own: `tests/bvh_instances.rs`).
+pub fn twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    Ok(Box::new(BvhTree::new(scene.world_triangles())))
 }
 
 #[cfg(test)]
