@@ -29,7 +29,7 @@ use super::protocol::Protocol;
 use crate::bench::common::section::Section;
 use crate::bench::report::accel_compare::{self as report, Accelerator, Plan, Row, Work};
 use crate::bench::runner::args::Scale;
-use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
 use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
@@ -86,31 +86,16 @@ pub const QUICK_WAGNER_MAX_TRIANGLES: usize = 50_000;
 
 /// The configuration of accelerator `a` on a scene of `t` triangles: the grids at `--grid auto`'s
 /// N = ∛(T/5), the stream's at the paper's ∛T per axis.
-fn tracer(a: &Accelerator, t: usize) -> TracerSpec {
+fn tracer(a: &Accelerator, t: usize) -> Tracer {
     let resolution = auto_resolution(t);
     match (a.row.name, a.proximity_clouds) {
-        ("grid-exact", true) => TracerSpec::GridPc { resolution },
-        ("stream", proximity_clouds) => TracerSpec::Stream {
-            axes: auto_dims(t).to_array(),
-            proximity_clouds,
-            naive_shadows: false,
-            no_mask: false,
-        },
-        ("grid-thesis", _) => TracerSpec::Grid {
-            variant: GridVariant::Thesis,
-            resolution,
-        },
-        ("grid-exact", _) => TracerSpec::Grid {
-            variant: GridVariant::Exact,
-            resolution,
-        },
-        ("bvh", _) => TracerSpec::Bvh {
-            variant: BvhVariant::Sah,
-        },
-        ("bvh-wagner", _) => TracerSpec::Bvh {
-            variant: BvhVariant::Wagner,
-        },
-        ("base", _) => TracerSpec::Base,
+        ("grid-exact", true) => Tracer::grid_pc(resolution),
+        ("stream", pc) => Tracer::stream(auto_dims(t).to_array(), pc, false, false),
+        ("grid-thesis", _) => Tracer::uniform_grid(GridVariant::Thesis, resolution),
+        ("grid-exact", _) => Tracer::uniform_grid(GridVariant::Exact, resolution),
+        ("bvh", _) => Tracer::bvh(BvhVariant::Sah),
+        ("bvh-wagner", _) => Tracer::bvh(BvhVariant::Wagner),
+        ("base", _) => Tracer::base(),
         (other, _) => unreachable!("accel-compare has no configuration of `{other}`"),
     }
 }
@@ -153,7 +138,7 @@ pub static ACCELERATORS: LazyLock<Vec<Accelerator>> = LazyLock::new(|| {
 });
 
 /// The accelerator a configuration's tracer belongs to.
-pub fn accelerator_of(spec: &TracerSpec) -> &'static Accelerator {
+pub fn accelerator_of(spec: &Tracer) -> &'static Accelerator {
     let key = (spec.row().name, spec.proximity_clouds());
     ACCELERATORS
         .iter()

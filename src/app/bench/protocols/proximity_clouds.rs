@@ -18,7 +18,7 @@ use super::protocol::Protocol;
 use crate::bench::common::section::Section;
 use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
 use crate::bench::report::proximity_clouds::{self as report, Plan};
-use crate::bench::runner::config::{Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
@@ -93,24 +93,16 @@ impl Plan {
     /// The tracers of `scene`: stream g, stream pc (where the paper has pc), the compute exact
     /// grid g (cubic, the paper's largest axis), and its pc column (`--tracer grid
     /// --proximity-clouds`) where the paper has pc.
-    pub fn tracers(scene: &PaperScene) -> Vec<TracerSpec> {
-        let stream = |pc| TracerSpec::Stream {
-            axes: scene.grid,
-            proximity_clouds: pc,
-            naive_shadows: false,
-            no_mask: false,
-        };
+    pub fn tracers(scene: &PaperScene) -> Vec<Tracer> {
+        let stream = |pc| Tracer::stream(scene.grid, pc, false, false);
         let resolution = scene.grid.into_iter().max().unwrap_or(1);
         let mut v = vec![stream(false)];
         if scene.pc {
             v.push(stream(true));
         }
-        v.push(TracerSpec::Grid {
-            variant: GridVariant::Exact,
-            resolution,
-        });
+        v.push(Tracer::uniform_grid(GridVariant::Exact, resolution));
         if scene.pc {
-            v.push(TracerSpec::GridPc { resolution });
+            v.push(Tracer::grid_pc(resolution));
         }
         v
     }
@@ -119,17 +111,14 @@ impl Plan {
     /// to the naive implementation of shadow rays") on its dense scenes, each switched off
     /// beside stream g: the any-hit search (`--stream-naive-shadows`), the masking
     /// (`--stream-no-mask`), and both.
-    fn naive(&self, scene: &PaperScene) -> Vec<TracerSpec> {
+    fn naive(&self, scene: &PaperScene) -> Vec<Tracer> {
         let dense = pp::SCENES.iter().any(|s| s.file == scene.file);
         if self.table != 2 || !dense {
             return Vec::new();
         }
         [(true, false), (false, true), (true, true)]
-            .map(|(naive_shadows, no_mask)| TracerSpec::Stream {
-                axes: scene.grid,
-                proximity_clouds: false,
-                naive_shadows,
-                no_mask,
+            .map(|(naive_shadows, no_mask)| {
+                Tracer::stream(scene.grid, false, naive_shadows, no_mask)
             })
             .to_vec()
     }
@@ -142,7 +131,7 @@ impl Plan {
         for scene in scenes {
             for tracer in Plan::tracers(scene).into_iter().chain(self.naive(scene)) {
                 for &side in &self.sides {
-                    v.push(self.config(scene, tracer, side));
+                    v.push(self.config(scene, tracer.clone(), side));
                 }
             }
         }
@@ -154,7 +143,7 @@ impl Plan {
         v
     }
 
-    fn config(&self, scene: &PaperScene, tracer: TracerSpec, side: u32) -> Config {
+    fn config(&self, scene: &PaperScene, tracer: Tracer, side: u32) -> Config {
         Config {
             refl_depth: self.refl_depth(),
             shadows: self.shadows(),

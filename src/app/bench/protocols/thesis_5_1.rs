@@ -11,7 +11,7 @@ use crate::bench::common::format::{int, percent, ratio, table};
 use crate::bench::common::section::Section;
 use crate::bench::published::thesis::{self, TEAPOT_TRIANGLES};
 use crate::bench::report::plots::{self, Chart, Figure, Series, Style};
-use crate::bench::runner::config::{Config, Sizing, TracerSpec};
+use crate::bench::runner::config::{Config, Sizing, Tracer};
 use crate::bench::runner::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
 use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
@@ -36,7 +36,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         .collect();
     let mut configs: Vec<Config> = scenes
         .iter()
-        .map(|scene| Config::new(scene, TracerSpec::Base, 1, s))
+        .map(|scene| Config::new(scene, Tracer::base(), 1, s))
         .collect();
     let names: Vec<&str> = scenes.iter().map(String::as_str).collect();
     configs.extend(thesis_bvh::configs(&names, 1, s));

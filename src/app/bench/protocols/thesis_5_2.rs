@@ -12,7 +12,7 @@ use crate::bench::common::format::{int, num};
 use crate::bench::common::section::Section;
 use crate::bench::published::thesis;
 use crate::bench::report::plots::Figure;
-use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
 use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
@@ -33,7 +33,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let s = bench.sizing(sweep::QUICK, sweep::FULL);
     let resolutions = bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS);
     let variants = bench.variants();
-    let mut configs = vec![Config::new(SCENE, TracerSpec::Base, 1, s)];
+    let mut configs = vec![Config::new(SCENE, Tracer::base(), 1, s)];
     configs.extend(sweep::grid_configs(SCENE, 1, s, &variants, &resolutions));
     configs.extend(thesis_bvh::configs(&[SCENE], 1, s));
     // measure

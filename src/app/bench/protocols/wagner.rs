@@ -20,7 +20,7 @@ use crate::bench::common::section::Section;
 use crate::bench::published::wagner as pw;
 use crate::bench::report::wagner::{self as report, size, Plan, RatioRow, Ratios};
 use crate::bench::runner::args::Scale;
-use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
+use crate::bench::runner::config::{BvhVariant, Config, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
 use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
@@ -86,7 +86,7 @@ impl Plan {
         let mut v = Vec::new();
         for &variant in &self.variants {
             for &size in &self.sizes {
-                let c = Config::fixed(scene, TracerSpec::Bvh { variant }, size, self.frames);
+                let c = Config::fixed(scene, Tracer::bvh(variant), size, self.frames);
                 v.push(match level {
                     Some(l) => c.with_level(l),
                     None => c,
@@ -116,7 +116,7 @@ impl Plan {
         };
         for &variant in &self.variants {
             if self.scale == Scale::Full || variant == BvhVariant::Sah {
-                let bvh = TracerSpec::Bvh { variant };
+                let bvh = Tracer::bvh(variant);
                 v.push(Config::fixed(DRAGON, bvh, pw::REFERENCE_SIZE, one));
             }
         }
@@ -129,7 +129,7 @@ impl Plan {
 fn a1_reference(o: &Outcome, r: &Outcome) -> bool {
     let (c, d) = (&o.config, &r.config);
     d.overrides.level == Some(REFERENCE_LEVEL)
-        && (c.tracer, c.width, c.height) == (d.tracer, d.width, d.height)
+        && (c.tracer.label(), c.width, c.height) == (d.tracer.label(), d.width, d.height)
 }
 
 /// Whether `r` is the reference of `o` in Table A.2: the same object and variant at 320×240.

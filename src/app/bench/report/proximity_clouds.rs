@@ -10,7 +10,7 @@ use anyhow::Result;
 use super::plots::{Chart, Figure, Series, Style};
 use crate::bench::common::format::{int, num, ratio, table};
 use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
-use crate::bench::runner::config::{Sizing, TracerSpec};
+use crate::bench::runner::config::{Sizing, Tracer};
 use crate::bench::runner::csv_files::write_rows;
 use crate::bench::runner::outcome::Outcome;
 
@@ -58,26 +58,19 @@ impl Column {
             Column::GridPc => "grid-pc",
         }
     }
-    fn of(t: &TracerSpec) -> Option<Column> {
-        match *t {
-            TracerSpec::Stream {
-                naive_shadows,
-                no_mask,
-                ..
-            } if naive_shadows || no_mask => Some(match (naive_shadows, no_mask) {
-                (true, false) => Column::StreamNaive,
-                (false, true) => Column::StreamNoMask,
-                _ => Column::StreamNaiveNoMask,
-            }),
-            TracerSpec::Stream {
-                proximity_clouds, ..
-            } => Some(if proximity_clouds {
-                Column::StreamPc
-            } else {
-                Column::StreamG
-            }),
-            TracerSpec::Grid { .. } => Some(Column::GridG),
-            TracerSpec::GridPc { .. } => Some(Column::GridPc),
+    fn of(t: &Tracer) -> Option<Column> {
+        if let Some(o) = t.stream_options() {
+            return Some(match (o.naive_shadows, o.no_mask, o.proximity_clouds) {
+                (true, false, _) => Column::StreamNaive,
+                (false, true, _) => Column::StreamNoMask,
+                (true, true, _) => Column::StreamNaiveNoMask,
+                (false, false, true) => Column::StreamPc,
+                (false, false, false) => Column::StreamG,
+            });
+        }
+        match (t.grid(), t.proximity_clouds()) {
+            (Some(_), _) => Some(Column::GridG),
+            (None, true) => Some(Column::GridPc),
             _ => None,
         }
     }
