@@ -521,8 +521,6 @@ const KNOWN_CIRCLES: &[(&[&str], &str)] = &[
     (&["src/accel/brute_force.rs", "src/accel/bvh/mod.rs", "src/accel/exact_grid.rs",
        "src/accel/grid_frame.rs", "src/accel/mod.rs", "src/accel/thesis_grid.rs"],
      "accel/mod.rs holds the Accelerator trait and its types beside the dispatch that names every accelerator; being reworked apart"),
-    (&["src/accel/bvh/build.rs", "src/accel/bvh/layout.rs", "src/accel/bvh/planes.rs"],
-     "layout.rs still builds the wide layout it describes, from build.rs's tree and planes.rs's planes"),
     (&["src/app/view/design.rs", "src/app/view/frames.rs", "src/app/view/keys.rs",
        "src/app/view/mod.rs", "src/app/view/renderer.rs", "src/app/view/window.rs"],
      "the viewer's parts read the state that view/mod.rs holds and drives them with"),

@@ -36,14 +36,16 @@ pub mod instances;
 pub mod layout;
 mod planes;
 pub mod refit;
+pub mod tree;
 pub use instances::{instance_count, InstanceRecord, Instances, INSTANCE_TEXELS};
 pub use layout::{
-    block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
-    NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
-    NODE_WORDS, OCTANTS, PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
+    block_of, Aabb, BvhStats, EntryTexel, Header, LeafTriangle, Node, NodeRecord, BINS, BLOCK, END,
+    HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF, NODE_WORDS, OCTANTS,
+    PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
 };
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 pub use refit::{Refit, RefitKernels, REBUILD_GROWTH, REFIT_GROUP, REFIT_TIMER};
+pub use tree::{octant_planes, BvhTree};
 
 /// The fastest configuration (`docs/design/bvh.md`, "The default"): the fused pass over one
 /// tree.

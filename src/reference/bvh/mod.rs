@@ -158,7 +158,7 @@ pub fn twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::bvh::layout::tests::soup;
+    use crate::accel::bvh::tree::tests::soup;
 
     #[test]
     fn traversal_finds_the_brute_force_hits() {
