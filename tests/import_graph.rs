@@ -526,8 +526,6 @@ const KNOWN_CIRCLES: &[(&[&str], &str)] = &[
      "the viewer's parts read the state that view/mod.rs holds and drives them with"),
     (&["src/gl/context.rs", "src/gl/sync.rs"], "the context and its fences call each other"),
     (&["src/gl/program.rs", "src/gl/slots.rs"], "the slot table and the program that injects it call each other"),
-    (&["src/pipeline/klee2016/linespace_cpu.rs", "src/pipeline/klee2016/ntree.rs"],
-     "the shaft test lives in ntree.rs, which calls the line-space build that uses it"),
     (&["src/pipeline/mueller2015/images.rs", "src/pipeline/mueller2015/mod.rs",
        "src/pipeline/mueller2015/records.rs"],
      "the pipeline's images and records read the renderer's types in mod.rs"),

@@ -21,6 +21,7 @@ pub mod ntree;
 pub mod options;
 pub mod present;
 pub mod shadow_pass;
+pub mod shaft;
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
