@@ -3,13 +3,14 @@
 //! `render`, `view`, `parity`, the bench and the tests enumerate.
 //!
 //! A design is one of the four pipelines of [`crate::pipeline`] with its options; Müller 2015's
-//! pipeline takes one of the accelerators of [`crate::accel::REGISTRY`]. A [`Row`] says how the
+//! pipeline takes one of the accelerators of [`crate::accel`] ([`accelerators`]). A [`Row`] says how the
 //! command line selects a design and which options belong to it, so that the command line
 //! refuses, with one message, an option the chosen design would ignore.
 //!
-//! Adding a design or an accelerator: its CPU twin (`src/reference/`), its GPU type
-//! (`src/accel/` or `src/pipeline/`), its GLSL folder (`glsl/`), one row here.
-//! `tests/registry.rs` walks the table, so that a place forgotten fails.
+//! Adding a design or an accelerator takes the steps of `docs/architecture.md` ("Adding a
+//! design or an accelerator"): its CPU twin, its options (a variant of [`Accel`]), its GPU type,
+//! its GLSL folder, one row here, its bench configuration. `tests/registry.rs` walks the
+//! table, so that a place forgotten fails.
 
 use std::sync::Arc;
 
@@ -200,7 +201,8 @@ pub const REGISTRY: &[Row] = &[
     Row {
         name: "bvh",
         pipeline: Pipeline::Mueller2015,
-        title: "Müller 2015's four kernels with our SAH BVH",
+        title: "Müller 2015's pipeline with our SAH BVH (a pass in one kernel, or the four \
+                kernels with --four-kernels)",
         select: &[("tracer", "bvh"), ("bvh-variant", "sah")],
         accel: Some(&accel::bvh::ENTRY),
         twin: Some(reference::bvh::twin),

@@ -14,8 +14,10 @@
 //! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
 //! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). The base tracer's
 //! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
-//! `glsl/common/intersect1_hit.glsl`. Each is one row of `design::REGISTRY`; `reference::twin`
-//! makes its CPU twin. What the GPU path builds from — boxes ([`aabb`]), the scene-to-grid
+//! `glsl/common/intersect1_hit.glsl`. The SAH BVH runs a whole pass in one kernel by default
+//! through the trait's one optional hook ([`Accelerator::fused_pass`]). Each accelerator is one
+//! variant of [`Accel`] with its own options, one [`Entry`] and one row of `design::REGISTRY`,
+//! which names its CPU twin (`design::twin`). What the GPU path builds from — boxes ([`aabb`]), the scene-to-grid
 //! mapping ([`grid_frame`]), the distance transform ([`proximity`]), the triangle/box test
 //! ([`tribox`]) — lives here too, and the twins import it.
 

@@ -223,8 +223,8 @@ impl Tracer {
             Some(Accel::ThesisGrid(_)) => "thesis",
             Some(Accel::ExactGrid(o)) if o.proximity_clouds => "exact-pc",
             Some(Accel::ExactGrid(_)) => "exact",
-            Some(a) if a.instances() => "sah-instances",
-            Some(_) => "sah",
+            Some(Accel::Bvh(o)) if o.levels == BvhLevels::Two => "sah-instances",
+            Some(Accel::Bvh(_)) => "sah",
         })
     }
     /// "base", "grid thesis 24³", "bvh sah", "stream pc 14x16x14".
