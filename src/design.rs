@@ -212,6 +212,7 @@ pub const REGISTRY: &[Row] = &[
                 "bvh-variant",
                 "four-kernels",
                 "fused-passes",
+                "bvh-levels",
                 "bvh-instances",
             ],
         ],
