@@ -3,13 +3,14 @@
 //! `render`, `view`, `parity`, the bench and the tests enumerate.
 //!
 //! A design is one of the four pipelines of [`crate::pipeline`] with its options; Müller 2015's
-//! pipeline takes one of the accelerators of [`crate::accel::REGISTRY`]. A [`Row`] says how the
+//! pipeline takes one of the accelerators of [`crate::accel`] ([`accelerators`]). A [`Row`] says how the
 //! command line selects a design and which options belong to it, so that the command line
 //! refuses, with one message, an option the chosen design would ignore.
 //!
-//! Adding a design or an accelerator: its CPU twin (`src/reference/`), its GPU type
-//! (`src/accel/` or `src/pipeline/`), its GLSL folder (`glsl/`), one row here.
-//! `tests/registry.rs` walks the table, so that a place forgotten fails.
+//! Adding a design or an accelerator takes the steps of `docs/architecture.md` ("Adding a
+//! design or an accelerator"): its CPU twin, its options (a variant of [`Accel`]), its GPU type,
+//! its GLSL folder, one row here, its bench configuration. `tests/registry.rs` walks the
+//! table, so that a place forgotten fails.
 
 use std::sync::Arc;
 
@@ -170,7 +171,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the base tracer (every ray against every triangle)",
         select: &[("tracer", "base")],
         accel: Some(&accel::brute_force::ENTRY),
-        twin: Some(reference::base_twin),
+        twin: Some(reference::brute_force::twin),
         options: &[MUELLER],
         glsl: &["mueller2015", "brute_force"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -181,7 +182,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the thesis' uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "thesis")],
         accel: Some(&accel::thesis_grid::ENTRY),
-        twin: Some(reference::thesis_grid_twin),
+        twin: Some(reference::thesis_grid::twin),
         options: &[MUELLER, GRID, &["voxel-array-length", "ray-array-length"]],
         glsl: &["mueller2015", "thesis_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -192,7 +193,7 @@ pub const REGISTRY: &[Row] = &[
         title: "Müller 2015's four kernels with the exact uniform grid",
         select: &[("tracer", "grid"), ("grid-variant", "exact")],
         accel: Some(&accel::exact_grid::ENTRY),
-        twin: Some(reference::exact_grid_twin),
+        twin: Some(reference::exact_grid::twin),
         options: &[MUELLER, GRID, &["proximity-clouds"]],
         glsl: &["mueller2015", "exact_grid"],
         host_bytes_per_triangle: host_bytes::WORLD + host_bytes::UPLOAD,
@@ -200,16 +201,18 @@ pub const REGISTRY: &[Row] = &[
     Row {
         name: "bvh",
         pipeline: Pipeline::Mueller2015,
-        title: "Müller 2015's four kernels with our SAH BVH",
+        title: "Müller 2015's pipeline with our SAH BVH (a pass in one kernel, or the four \
+                kernels with --four-kernels)",
         select: &[("tracer", "bvh"), ("bvh-variant", "sah")],
         accel: Some(&accel::bvh::ENTRY),
-        twin: Some(reference::bvh_twin),
+        twin: Some(reference::bvh::twin),
         options: &[
             MUELLER,
             &[
                 "bvh-variant",
                 "four-kernels",
                 "fused-passes",
+                "bvh-levels",
                 "bvh-instances",
             ],
         ],

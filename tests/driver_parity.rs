@@ -75,7 +75,7 @@ fn llvmpipe_and_zink_render_every_design_alike() {
     );
     // the cases that look where a GPU could go wrong: every one compared, the colour too
     for case in [
-        "| bvh-fused.teapot1 | 1024 | 0 | 0 | 0 | 0 | 0 |",
+        "| bvh-four-kernels.teapot1 | 1024 | 0 | 0 | 0 | 0 | 0 |",
         "| bvh-instances.teapot3-turning-in-flight | 1024 | 0 |",
         "| bvh.teapot1-tile64 | 13600 | 0 |",
         "| bvh-wagner.teapot1-61x47 | 2867 | 0 |",
@@ -89,7 +89,7 @@ fn llvmpipe_and_zink_render_every_design_alike() {
 }
 
 /// `parity --list`: every case, one a line, with the options it is rendered with — the GPU's
-/// cases among them (fused passes, instances, tiles, an odd size, 5×5 soft shadows, frames in
+/// cases among them (the four kernels, instances, tiles, an odd size, 5×5 soft shadows, frames in
 /// flight, the colour image, the repeated 512² case).
 #[test]
 fn parity_lists_its_cases_with_their_options() {
@@ -100,7 +100,10 @@ fn parity_lists_its_cases_with_their_options() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let list = String::from_utf8_lossy(&o.stdout);
     for (case, options) in [
-        ("bvh-fused.teapot1 ", "--fused-passes (colour compared)"),
+        (
+            "bvh-four-kernels.teapot1 ",
+            "--four-kernels (colour compared)",
+        ),
         (
             "bvh-instances.teapot3-turning-in-flight ",
             "--bvh-instances (frames in flight)",
@@ -204,7 +207,7 @@ fn parity_refuses_to_overwrite_or_to_compare_with_an_incomplete_record() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("bvh.teapot1:") && err.contains("bvh-fused.teapot1:"),
+        err.contains("bvh.teapot1:") && err.contains("bvh-four-kernels.teapot1:"),
         "{err}"
     );
     assert!(

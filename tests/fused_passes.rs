@@ -252,7 +252,9 @@ fn the_work_lists_take_rows_where_the_gl_allows_few_work_groups() {
         let opts = fused_if(&bvh(48, 40, 1), fused_passes);
         let (a, b) = (
             two_frames(&scene, &opts, |_| {}),
-            two_frames(&scene, &opts, |gl| gl.max_compute_work_group_count[0] = row),
+            two_frames(&scene, &opts, |gl| {
+                gl.compute.max_compute_work_group_count[0] = row
+            }),
         );
         for (x, y, frame) in [(&a.0, &b.0, "still"), (&a.1, &b.1, "turned")] {
             let what = format!("fused {fused_passes}, {frame}, {row} work groups a row");

@@ -393,6 +393,8 @@ fn kernel_edit_reloads_live() {
         &xvfb,
         &[
             "scenes/teapot1.toml",
+            // the four kernels: the edited kernel is their shading (the fused pass has its own)
+            "--four-kernels",
             "--width",
             "64",
             "--height",

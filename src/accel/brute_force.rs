@@ -20,6 +20,7 @@ use crate::scene::Scene;
 pub const ENTRY: Entry = Entry {
     label: "base",
     plain: Accel::Base,
+    records: false,
     variants: &[("base", Accel::Base)],
     gpu: BruteForce::create,
 };

@@ -43,6 +43,7 @@ const PLAIN: Accel = Accel::ExactGrid(ExactGridOptions {
 pub const ENTRY: Entry = Entry {
     label: "grid-exact",
     plain: PLAIN,
+    records: false,
     variants: &[
         ("grid exact", PLAIN),
         (

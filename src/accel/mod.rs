@@ -14,8 +14,10 @@
 //! `closestHit` and its intersect2 kernel `occluded`; the rest of both kernels is the
 //! pipeline's (`glsl/common/intersect1_main.glsl`, `intersect2_main.glsl`). The base tracer's
 //! intersect1 is written out whole around Listing 12 and calls Listings 13 and 14 in
-//! `glsl/common/intersect1_hit.glsl`. Each is one row of `design::REGISTRY`; `reference::twin`
-//! makes its CPU twin. What the GPU path builds from — boxes ([`aabb`]), the scene-to-grid
+//! `glsl/common/intersect1_hit.glsl`. The SAH BVH runs a whole pass in one kernel by default
+//! through the trait's one optional hook ([`Accelerator::fused_pass`]). Each accelerator is one
+//! variant of [`Accel`] with its own options, one [`Entry`] and one row of `design::REGISTRY`,
+//! which names its CPU twin (`design::twin`). What the GPU path builds from — boxes ([`aabb`]), the scene-to-grid
 //! mapping ([`grid_frame`]), the distance transform ([`proximity`]), the triangle/box test
 //! ([`tribox`]) — lives here too, and the twins import it.
 
@@ -69,38 +71,47 @@ pub trait Accelerator {
     fn occluded(&mut self, f: &mut FrameContext, target: &LightTarget) -> &Kernel;
     /// Add the design's facts (sizes, build time, settings) and events to the statistics.
     fn stats(&self, stats: &mut FrameStats);
-    /// Whether the design's intersect1 stores hit records and its intersection kernels store
-    /// per-pixel counts (`glsl/bvh/records.glsl`), for the
-    /// pipeline to evaluate the hits and add the counts after them
-    /// (`pipeline::mueller2015::records`). The thesis' designs evaluate and count in the kernel.
-    fn records(&self) -> bool {
-        false
-    }
-    /// With `--fused-passes` ([`BuildContext::fused`]): prepare the design's fused pass
-    /// kernels as [`Accelerator::closest_hit`] prepares intersect1 (run what must come first,
-    /// bind) and return them — one, or the SAH BVH's two over its block lists — for the
-    /// pipeline to set the pass' uniforms on each; `None` for a design without one. `eye`: the
-    /// camera where the pass computes its eye rays in place (the kernels' `PASS_EYE_RAYS`
-    /// variant, `glsl/common/pass_ray.glsl`) instead of loading the eye-ray kernel's texels.
+    /// The one optional hook, ours: pass `pass` of Fig. 8 — the closest hit, the shadow
+    /// feelers, the shading — in the accelerator's own kernels (the SAH BVH's fused pass),
+    /// with the pipeline's part done through `host`; how it ran, for the pipeline to add its
+    /// counts. `eye`: the camera where the pass computes its eye rays in place instead of
+    /// loading the eye-ray kernel's texels. `None`: the accelerator has none (or was made
+    /// without it), and the pipeline runs its four kernels.
     fn fused_pass(
         &mut self,
         _f: &mut FrameContext,
         _pass: u32,
         _eye: Option<&CameraRays>,
-    ) -> Option<&[Kernel]> {
+        _host: &dyn PassHost,
+    ) -> Option<FusedRun> {
         None
     }
-    /// Whether the fused pass runs the blocks whose rays all miss in a kernel of their own
-    /// (the SAH BVH's block lists), which [`Accelerator::dispatch_fused`] can leave out.
-    fn fused_misses_apart(&self) -> bool {
-        false
-    }
-    /// Dispatch the kernels [`Accelerator::fused_pass`] returned, their uniforms set; without
-    /// `misses` not the one for the blocks whose rays all miss (where
-    /// [`Accelerator::fused_misses_apart`]: the pipeline filled their pixels by clears).
-    fn dispatch_fused(&mut self, _f: &mut FrameContext, _misses: bool) {}
     /// For tests and inspection: the concrete type.
     fn as_any(&self) -> &dyn Any;
+}
+
+/// What the pipeline does in a fused pass ([`Accelerator::fused_pass`]) at the accelerator's
+/// call: the part of the four kernels the pass stands for that is the pipeline's.
+pub trait PassHost {
+    /// Set the pipeline's uniforms of the pass (background, stores, camera position, ambient
+    /// light, area lights) on `kernel`, in use.
+    fn set_uniforms(&self, kernel: &Kernel);
+    /// From here on the work is the frame's, not one ray kind's (a fused kernel traces every
+    /// kind of the pass): its counters and time go to the frame.
+    fn frame_work(&self, gl: &Gl, timers: &mut GpuTimers);
+    /// Fill the pixels whose blocks' rays all miss as the miss kernel would, by a clear: the
+    /// output colour the background at full weight (Listing 16's addToFinal on a miss).
+    fn fill_misses(&self, gl: &Gl, timers: &mut GpuTimers);
+}
+
+/// How a fused pass ran ([`Accelerator::fused_pass`]), which decides where its counts lie.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FusedRun {
+    /// over the block lists: the per-pixel records are summed a block at a time
+    pub lists: bool,
+    /// the blocks whose rays all miss were left to [`PassHost::fill_misses`]: their records
+    /// were not written, each of their pixels counts one ray traced that visited nothing
+    pub clears: bool,
 }
 
 /// The camera uniforms of Listing 11 (`glsl/common/eye_ray.glsl`) on `k`, the program in use.
@@ -178,7 +189,8 @@ pub struct BuildContext<'a> {
     /// (the rest in further dispatches); `None`: [`brute_force::triangles_per_dispatch`] —
     /// split only where the GL implementation ends long loops.
     pub triangles_per_dispatch: Option<u32>,
-    /// `--fused-passes`: the pass in one kernel ([`Accelerator::fused_pass`]).
+    /// The SAH BVH's fused pass (its default): the pass in one kernel
+    /// ([`Accelerator::fused_pass`]).
     pub fused: Option<FusedPasses>,
     /// The scene's vertex attributes and lights are bound as image buffers too
     /// (`SCENE_IMAGES`, `GpuScene::vertex_images`).
@@ -451,6 +463,11 @@ pub struct Entry {
     pub label: &'static str,
     /// It with the command line's defaults.
     pub plain: Accel,
+    /// Whether its intersect1 stores hit records and its intersection kernels store per-pixel
+    /// counts (`glsl/bvh/records.glsl`), for the pipeline to evaluate the hits and add the
+    /// counts after them (`pipeline::mueller2015::records`); the thesis' accelerators evaluate
+    /// and count in the kernel.
+    pub records: bool,
     /// Its variants whose frames equal its CPU twin's, hits and counts (the tests walk them):
     /// a label ("grid exact pc") and the options.
     pub variants: &'static [(&'static str, Accel)],

@@ -32,6 +32,7 @@ pub const MAX_RESOLUTION: u32 = 64;
 pub const ENTRY: Entry = Entry {
     label: "grid-thesis",
     plain: PLAIN,
+    records: false,
     variants: &[("grid thesis", PLAIN)],
     gpu: ThesisGrid::create,
 };

@@ -192,25 +192,54 @@ pub struct BvhArgs {
     /// command lines that name it).
     #[arg(long)]
     pub fused_passes: bool,
-    /// With --tracer bvh (sah): a tree per object, built once in object space, under the
-    /// objects' instances (ours: two levels) instead of one tree over the world-space scene —
-    /// an object that moves updates its instance, no refit or rebuild.
+    /// With --tracer bvh (sah): `one` tree over the world-space scene, refitted when objects
+    /// move; `two` levels, a tree per object built once in object space under the objects'
+    /// instances (ours), which a moving object updates without a refit; `auto`: two where the
+    /// objects move from frame to frame (`render --rotate objects`), where they are faster,
+    /// else one.
+    #[arg(long, value_enum, default_value_t = BvhLevelsArg::Auto, conflicts_with = "bvh_instances")]
+    pub bvh_levels: BvhLevelsArg,
+    /// With --tracer bvh (sah): the same as --bvh-levels two.
     #[arg(long)]
     pub bvh_instances: bool,
 }
 
+/// `--bvh-levels`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BvhLevelsArg {
+    Auto,
+    One,
+    Two,
+}
+
 impl BvhArgs {
-    /// The SAH BVH's options.
+    /// The SAH BVH's options (`--bvh-levels auto`: one tree; [`BvhArgs::objects_move`] says
+    /// where two).
     pub fn options(&self) -> BvhOptions {
         BvhOptions {
             passes: match self.four_kernels {
                 true => BvhPasses::FourKernels,
                 false => BvhPasses::Fused,
             },
-            levels: match self.bvh_instances {
-                true => BvhLevels::Two,
-                false => BvhLevels::One,
+            levels: match (self.bvh_levels, self.bvh_instances) {
+                (BvhLevelsArg::Two, _) | (_, true) => BvhLevels::Two,
+                _ => BvhLevels::One,
             },
+        }
+    }
+
+    /// These options where the objects move from frame to frame: `--bvh-levels auto` takes
+    /// the two levels, which update a moving object's instance where one tree is refitted
+    /// every frame (a turning dragon's frame 0.77× the refitted tree's on llvmpipe, 0.75× on
+    /// zink: docs/design/bvh.md, "The default").
+    pub fn objects_move(self) -> BvhArgs {
+        let levels = match self.bvh_levels {
+            BvhLevelsArg::Auto => BvhLevelsArg::Two,
+            given => given,
+        };
+        BvhArgs {
+            bvh_levels: levels,
+            ..self
         }
     }
 }
@@ -554,5 +583,25 @@ mod tests {
             design::row("grid-exact").unwrap().accel.unwrap().plain
         );
         assert_eq!(accel("base", &["--bvh-instances"]), Accel::Base);
+    }
+
+    /// `--bvh-levels auto` is one tree, or two levels where the objects move; a level the
+    /// command line names stays.
+    #[test]
+    fn moving_objects_take_two_levels_unless_told() {
+        let levels = |extra: &[&str], moving: bool| {
+            let row = design::row("bvh").unwrap();
+            let args = DesignArgs::of_row(row, extra).unwrap();
+            let bvh = match moving {
+                true => args.bvh.objects_move(),
+                false => args.bvh,
+            };
+            bvh.options().levels
+        };
+        assert_eq!(levels(&[], false), BvhLevels::One);
+        assert_eq!(levels(&[], true), BvhLevels::Two);
+        assert_eq!(levels(&["--bvh-levels", "one"], true), BvhLevels::One);
+        assert_eq!(levels(&["--bvh-levels", "two"], false), BvhLevels::Two);
+        assert_eq!(levels(&["--bvh-instances"], false), BvhLevels::Two);
     }
 }

@@ -182,7 +182,7 @@ struct Render {
     height: u32,
     /// `--tile` (0: the whole image in one dispatch)
     tile: u32,
-    /// options beyond the row's (`--fused-passes`, `--bvh-instances`)
+    /// options beyond the row's (`--four-kernels`, `--bvh-instances`)
     options: &'static [&'static str],
     /// the soft shadows' light samples, n×n
     samples: u32,
@@ -407,25 +407,26 @@ fn point_case(name: String, row_name: &str, scene: &str, how: Render) -> Spec {
     }
 }
 
-/// The cases that look where a GPU could go wrong and the plain matrix does not: the fused
-/// pass' block lists and GPU-written dispatches, the instances' two levels, tiles, an odd size
+/// The cases that look where a GPU could go wrong and the plain matrix does not: the SAH BVH's
+/// four kernels beside its default fused pass (the matrix's `bvh` cases, whose block lists and
+/// dispatches the GPU writes) with their hit list, the instances' two levels, tiles, an odd size
 /// (partial work groups, reads past the image's edge), 5×5 soft shadows, a turning scene's
 /// frames in flight, the colour image after reflections, and one 512² case run
 /// [`REPEATS`] times.
 fn gpu_cases(size: u32) -> Vec<Spec> {
     let square = Render::square(size);
     let mut v = Vec::new();
-    let fused = Render {
-        options: &["--fused-passes"],
+    let four = Render {
+        options: &["--four-kernels"],
         colour: true,
         ..square
     };
     for scene in ["teapot1", "bunny"] {
         v.push(point_case(
-            format!("bvh-fused.{scene}"),
+            format!("bvh-four-kernels.{scene}"),
             "bvh",
             scene,
-            fused,
+            four,
         ));
     }
     let in_flight = Render {

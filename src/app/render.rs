@@ -210,9 +210,15 @@ pub fn run(args: RenderArgs, matches: Option<&ArgMatches>) -> Result<()> {
         args.width.unwrap_or(scene.settings.width),
         args.height.unwrap_or(scene.settings.height),
     );
-    let design = args
-        .design
-        .design(&scene, size, args.aov_dir.is_some(), matches)?;
+    let design_args = match args.rotate {
+        // the objects move every frame: the SAH BVH's two levels where it may choose
+        Some(Rotation::Objects) => DesignArgs {
+            bvh: args.design.bvh.clone().objects_move(),
+            ..args.design.clone()
+        },
+        _ => args.design.clone(),
+    };
+    let design = design_args.design(&scene, size, args.aov_dir.is_some(), matches)?;
     progress::stage(format!("building the {}", design.row().name));
     let mut r = design.renderer(ctx.gl.clone(), &ctx.info, &scene, &shaders)?;
     // `--frames N`: N − 1 warm-up frames (shader compilation on first use), the last reported

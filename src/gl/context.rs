@@ -33,14 +33,11 @@ pub struct GlInfo {
     pub ssbo_offset_alignment: i32,
     pub max_texture_size: i32,
     pub max_3d_texture_size: i32,
-    pub max_compute_work_group_count: [i32; 3],
-    pub max_compute_work_group_invocations: i32,
-    pub max_compute_shared_memory_size: i32,
+    /// The compute stage's own limits (their keys stay at the top level of `info --json`).
+    #[serde(flatten)]
+    pub compute: ComputeLimits,
     pub max_vertex_shader_storage_blocks: i32,
-    pub max_compute_shader_storage_blocks: i32,
     pub max_image_units: i32,
-    /// GL_MAX_COMPUTE_IMAGE_UNIFORMS: the image uniforms one compute kernel may declare.
-    pub max_compute_image_uniforms: i32,
     pub max_array_texture_layers: i32,
     pub timer_query_bits: i32,
     /// GL_ARB_gpu_shader_int64: 64-bit integers in the kernels (the SAH BVH's intersect1 stores
@@ -53,6 +50,17 @@ pub struct GlInfo {
     /// Every choice adapted to this implementation ([`Profile`]), made once from the facts
     /// above (and `GPGPU_RT_PROFILE`).
     pub profile: Profile,
+}
+
+/// The limits of the compute stage (GL 4.5, table 23.63).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ComputeLimits {
+    pub max_compute_work_group_count: [i32; 3],
+    pub max_compute_work_group_invocations: i32,
+    pub max_compute_shared_memory_size: i32,
+    pub max_compute_shader_storage_blocks: i32,
+    /// GL_MAX_COMPUTE_IMAGE_UNIFORMS: the image uniforms one compute kernel may declare.
+    pub max_compute_image_uniforms: i32,
 }
 
 impl GlInfo {
@@ -103,7 +111,9 @@ impl GlInfo {
             ProfileChoice::Auto => (ProfileName::Gpu, false),
             ProfileChoice::Forced(n) => (n, true),
         };
-        let units = self.max_image_units.min(self.max_compute_image_uniforms);
+        let units = self
+            .max_image_units
+            .min(self.compute.max_compute_image_uniforms);
         match name {
             ProfileName::Llvmpipe => Profile {
                 name,
@@ -140,7 +150,7 @@ impl GlInfo {
     /// of x, at least 65535 by GL 4.6 §19): the GPU-written commands of work lists keep within
     /// it (`MAX_GROUPS_X` in `glsl/common/work_lists.glsl`).
     pub fn max_groups_x(&self) -> u32 {
-        self.max_compute_work_group_count[0].max(1) as u32
+        self.compute.max_compute_work_group_count[0].max(1) as u32
     }
 }
 
@@ -364,17 +374,19 @@ pub fn query_info(gl: &Gl, device: usize, device_name: &str, choice: ProfileChoi
             ssbo_offset_alignment: int(glow::SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT),
             max_texture_size: int(glow::MAX_TEXTURE_SIZE),
             max_3d_texture_size: int(glow::MAX_3D_TEXTURE_SIZE),
-            max_compute_work_group_count: [
-                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 0),
-                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 1),
-                indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 2),
-            ],
-            max_compute_work_group_invocations: int(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS),
-            max_compute_shared_memory_size: int(glow::MAX_COMPUTE_SHARED_MEMORY_SIZE),
+            compute: ComputeLimits {
+                max_compute_work_group_count: [
+                    indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 0),
+                    indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 1),
+                    indexed(glow::MAX_COMPUTE_WORK_GROUP_COUNT, 2),
+                ],
+                max_compute_work_group_invocations: int(glow::MAX_COMPUTE_WORK_GROUP_INVOCATIONS),
+                max_compute_shared_memory_size: int(glow::MAX_COMPUTE_SHARED_MEMORY_SIZE),
+                max_compute_shader_storage_blocks: int(glow::MAX_COMPUTE_SHADER_STORAGE_BLOCKS),
+                max_compute_image_uniforms: int(glow::MAX_COMPUTE_IMAGE_UNIFORMS),
+            },
             max_vertex_shader_storage_blocks: int(glow::MAX_VERTEX_SHADER_STORAGE_BLOCKS),
-            max_compute_shader_storage_blocks: int(glow::MAX_COMPUTE_SHADER_STORAGE_BLOCKS),
             max_image_units: int(glow::MAX_IMAGE_UNITS),
-            max_compute_image_uniforms: int(glow::MAX_COMPUTE_IMAGE_UNIFORMS),
             max_array_texture_layers: int(glow::MAX_ARRAY_TEXTURE_LAYERS),
             timer_query_bits: timer_bits,
             int64: extensions.contains("GL_ARB_gpu_shader_int64"),

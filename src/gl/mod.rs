@@ -10,7 +10,9 @@ pub mod resources;
 pub mod slots;
 pub mod sync;
 
-pub use context::{alloc_error, check_alloc, check_error, gl_error_name, Gl, GlContext, GlInfo};
+pub use context::{
+    alloc_error, check_alloc, check_error, gl_error_name, ComputeLimits, Gl, GlContext, GlInfo,
+};
 pub use kernel::{Kernel, PixelGrid};
 pub use profile::{Profile, ProfileChoice, ProfileName, PROFILE_ENV};
 pub use program::{compile_program, Defines, ShaderSource, GLSL_DIR_ENV};

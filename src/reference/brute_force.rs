@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use super::{closest_among, CpuAccelerator, Feeler, Hit};
+use super::search::{closest_among, CpuAccelerator, Feeler, Hit};
+use crate::accel::Accel;
+use crate::scene::Scene;
 
 pub struct BruteForce {
     triangles: Vec<[Vec3; 3]>,
@@ -28,4 +30,9 @@ impl CpuAccelerator for BruteForce {
         let blocked = feeler.blocked_among(&self.triangles, 0..self.triangles.len(), &mut tests);
         (blocked, tests)
     }
+}
+
+/// The base tracer's twin (`design::REGISTRY`).
+pub fn twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    Ok(Box::new(BruteForce::new(scene.world_triangles())))
 }

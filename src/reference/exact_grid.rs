@@ -12,10 +12,14 @@ use glam::Vec3;
 
 use super::grid::{GridSpace, Walk};
 use super::proximity::cells_between;
-use super::{closest_among, CpuAccelerator, Feeler, Hit};
+use super::search::{closest_among, CpuAccelerator, Feeler, Hit};
 use crate::accel::exact_grid::EXACT_GRID_CLOUD_CAP;
+use crate::accel::exact_grid::MAX_RESOLUTION;
+use crate::accel::grid_frame::resolution;
 use crate::accel::grid_frame::GridMapping;
 use crate::accel::proximity::chebyshev_distances;
+use crate::accel::Accel;
+use crate::scene::Scene;
 
 /// The walks' counts, summed over every ray traced (shared with whoever reads them, as the
 /// GPU's counters are): voxels entered (`voxels_visited`), proximity-cloud jumps
@@ -139,4 +143,17 @@ impl CpuAccelerator for ExactGrid {
         });
         (blocked, tests)
     }
+}
+
+/// The exact grid's twin (`design::REGISTRY`), with its resolution and proximity clouds.
+pub fn twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    let Accel::ExactGrid(o) = o else {
+        anyhow::bail!("the exact grid's twin made from {o:?}")
+    };
+    let n = resolution(scene, o.resolution, "exact", MAX_RESOLUTION)?;
+    let g = ExactGrid::new(scene.world_triangles(), n, GridMapping::of_scene(scene));
+    Ok(Box::new(match o.proximity_clouds {
+        true => g.with_proximity(),
+        false => g,
+    }))
 }

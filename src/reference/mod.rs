@@ -9,161 +9,19 @@ pub mod exact_grid;
 pub mod grid;
 pub mod linespace;
 pub mod proximity;
+pub mod search;
 pub mod stream_grid;
 pub mod stream_shading;
 pub mod thesis_grid;
 pub mod wagner2018;
 
+pub use search::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit, MakeTwin};
+
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::accel::grid_frame::{resolution, GridMapping};
-use crate::accel::{self, bvh::BvhTree, Accel};
 use crate::frame::Aovs;
 use crate::scene::{AreaLight, Camera, Scene, WorldAttributes};
-
-/// A closest hit: ray parameter, triangle id and barycentric (u, v).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Hit {
-    pub t: f32,
-    pub id: usize,
-    pub u: f32,
-    pub v: f32,
-}
-
-/// The CPU twin of an accelerator (`crate::accel`): the same searches as its intersect1 and
-/// intersect2 kernels, in f32 with the same arithmetic, so the tests can hold every GPU
-/// accelerator against its twin. Each returns the number of ray–triangle tests it made.
-pub trait CpuAccelerator: Send + Sync {
-    /// The closest hit of ro + t·rd (t > 0) other than triangle `last`; equal distances go to
-    /// the lower triangle id.
-    fn closest_hit(&self, ro: Vec3, rd: Vec3, last: i32) -> (Option<Hit>, u64);
-    /// Whether the shadow feeler is blocked (Listing 15).
-    fn occluded(&self, feeler: &Feeler) -> (bool, u64);
-}
-
-/// Makes the CPU twin of an accelerator (`accel::Accel`, its own variant) over the scene as
-/// loaded: the oracle its GPU side is held against. Each accelerator's row of
-/// `design::REGISTRY` names its twin.
-pub type MakeTwin = fn(&Scene, &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>>;
-
-/// The base tracer's twin.
-pub fn base_twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
-    Ok(Box::new(brute_force::BruteForce::new(
-        scene.world_triangles(),
-    )))
-}
-
-/// The thesis grid's twin, with its resolution and list lengths.
-pub fn thesis_grid_twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
-    let Accel::ThesisGrid(o) = o else {
-        anyhow::bail!("the thesis grid's twin made from {o:?}")
-    };
-    let n = resolution(
-        scene,
-        o.resolution,
-        "thesis",
-        accel::thesis_grid::MAX_RESOLUTION,
-    )?;
-    Ok(Box::new(thesis_grid::ThesisGrid::new(
-        scene.world_triangles(),
-        n,
-        GridMapping::of_scene(scene),
-        o.voxel_array_length as usize,
-        o.ray_array_length.unwrap_or(3 * n) as usize,
-    )))
-}
-
-/// The exact grid's twin, with its resolution and proximity clouds.
-pub fn exact_grid_twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
-    let Accel::ExactGrid(o) = o else {
-        anyhow::bail!("the exact grid's twin made from {o:?}")
-    };
-    let n = resolution(
-        scene,
-        o.resolution,
-        "exact",
-        accel::exact_grid::MAX_RESOLUTION,
-    )?;
-    let g = exact_grid::ExactGrid::new(scene.world_triangles(), n, GridMapping::of_scene(scene));
-    Ok(Box::new(match o.proximity_clouds {
-        true => g.with_proximity(),
-        false => g,
-    }))
-}
-
-/// The SAH BVH's twin: one tree over the world-space scene, whatever its variant (the fused
-/// pass counts as the four kernels; the two levels find the same hits, their counts are the
-/// instances' own: `tests/bvh_instances.rs`).
-pub fn bvh_twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
-    Ok(Box::new(BvhTree::new(scene.world_triangles())))
-}
-
-/// A shadow feeler: blocked by a triangle other than `last` hit at `offset` < t <
-/// `light_distance` along ro + t·rd.
-#[derive(Debug, Clone, Copy)]
-pub struct Feeler {
-    pub ro: Vec3,
-    pub rd: Vec3,
-    pub light_distance: f32,
-    pub offset: f32,
-    pub last: i32,
-}
-
-impl Feeler {
-    /// The feeler of Listing 15 from the hit point `p` (normal `n`, triangle `last`) towards a
-    /// point light, as `common/intersect2_main.glsl` sets it up; `None` where the light is in
-    /// the back half-space of the hit point (shadow without a test).
-    pub fn towards(p: Vec3, n: Vec3, last: i32, light: Vec3, offset: f32) -> Option<Feeler> {
-        let to_light = light - p;
-        let dist = to_light.length();
-        let rd = to_light / dist;
-        (n.dot(rd) > 0.0).then_some(Feeler {
-            ro: p,
-            rd,
-            light_distance: dist,
-            offset,
-            last,
-        })
-    }
-
-    /// Whether one of the triangles `ids` (in order, `last` skipped) blocks the feeler,
-    /// stopping at the first that does; every test made is added to `tests`.
-    pub fn blocked_among(
-        &self,
-        triangles: &[[Vec3; 3]],
-        ids: impl IntoIterator<Item = usize>,
-        tests: &mut u64,
-    ) -> bool {
-        ids.into_iter().filter(|&i| i as i32 != self.last).any(|i| {
-            *tests += 1;
-            let v = &triangles[i];
-            intersect_triangle(self.ro, self.rd, v[0], v[1], v[2])
-                .is_some_and(|(t, _, _)| t > self.offset && t < self.light_distance)
-        })
-    }
-}
-
-/// The closest hit among the triangles `ids` (`last` skipped) of ro + t·rd, kept in `best`
-/// (equal distances: the lower id, as intersect1's loops); every test made is added to
-/// `tests`.
-pub fn closest_among(
-    best: &mut Option<Hit>,
-    triangles: &[[Vec3; 3]],
-    ids: impl IntoIterator<Item = usize>,
-    (ro, rd, last): (Vec3, Vec3, i32),
-    tests: &mut u64,
-) {
-    for id in ids.into_iter().filter(|&i| i as i32 != last) {
-        *tests += 1;
-        let v = &triangles[id];
-        if let Some((t, u, v)) = intersect_triangle(ro, rd, v[0], v[1], v[2]) {
-            if best.is_none_or(|b| t < b.t || (t == b.t && id < b.id)) {
-                *best = Some(Hit { t, id, u, v });
-            }
-        }
-    }
-}
 
 /// The scene prepared for tracing on the CPU.
 pub struct Reference {
@@ -194,32 +52,6 @@ pub struct ReferenceFrame {
     /// towards the first light and the others (those with N·L > 0: the kernel traces no other),
     /// reflection rays.
     pub rays: [u64; 4],
-}
-
-/// Algorithm 1 (Möller–Trumbore without a determinant epsilon), as `glsl/common/intersect.glsl`.
-#[inline]
-pub fn intersect_triangle(
-    r0: Vec3,
-    rd: Vec3,
-    v0: Vec3,
-    v1: Vec3,
-    v2: Vec3,
-) -> Option<(f32, f32, f32)> {
-    let edge1 = v1 - v0;
-    let edge2 = v2 - v0;
-    let pvec = rd.cross(edge2);
-    let det = edge1.dot(pvec);
-    let inv_det = 1.0 / det;
-    let tvec = r0 - v0;
-    let u = inv_det * tvec.dot(pvec);
-    let qvec = tvec.cross(edge1);
-    let v = inv_det * rd.dot(qvec);
-    let t = inv_det * edge2.dot(qvec);
-    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 {
-        Some((t, u, v))
-    } else {
-        None
-    }
 }
 
 /// GLSL's reflect(I, N).

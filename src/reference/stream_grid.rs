@@ -6,7 +6,7 @@
 use glam::{IVec3, Vec3};
 
 use super::proximity::{cells_between, cloud_jump};
-use super::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
+use super::search::{closest_among, intersect_triangle, CpuAccelerator, Feeler, Hit};
 use crate::pipeline::stream::grid::StreamGrid;
 
 /// What a walk counted: triangle tests, cells entered, proximity-cloud jumps, and the empty

@@ -9,8 +9,12 @@
 use glam::Vec3;
 
 use super::grid::{clip_to_grid, GridSpace};
-use super::{closest_among, CpuAccelerator, Feeler, Hit};
+use super::search::{closest_among, CpuAccelerator, Feeler, Hit};
+use crate::accel::grid_frame::resolution;
 use crate::accel::grid_frame::GridMapping;
+use crate::accel::thesis_grid::MAX_RESOLUTION;
+use crate::accel::Accel;
+use crate::scene::Scene;
 
 pub struct ThesisGrid {
     triangles: Vec<[Vec3; 3]>,
@@ -99,4 +103,19 @@ impl CpuAccelerator for ThesisGrid {
             });
         (blocked, tests)
     }
+}
+
+/// The thesis grid's twin (`design::REGISTRY`), with its resolution and list lengths.
+pub fn twin(scene: &Scene, o: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    let Accel::ThesisGrid(o) = o else {
+        anyhow::bail!("the thesis grid's twin made from {o:?}")
+    };
+    let n = resolution(scene, o.resolution, "thesis", MAX_RESOLUTION)?;
+    Ok(Box::new(ThesisGrid::new(
+        scene.world_triangles(),
+        n,
+        GridMapping::of_scene(scene),
+        o.voxel_array_length as usize,
+        o.ray_array_length.unwrap_or(3 * n) as usize,
+    )))
 }

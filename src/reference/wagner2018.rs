@@ -20,7 +20,7 @@
 
 use glam::Vec3;
 
-use super::Hit;
+use super::search::Hit;
 use crate::pipeline::wagner2018::bvh::{NodeKind, WagnerBvh};
 use crate::pipeline::wagner2018::uniforms::{
     Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK,

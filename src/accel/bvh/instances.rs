@@ -19,7 +19,8 @@ use anyhow::{bail, Result};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use super::layout::{Aabb, BvhStats, BvhTree, NodeRecord, HEADER_WORDS, OCTANTS, TRIANGLE_WORDS};
+use super::layout::{Aabb, BvhStats, NodeRecord, HEADER_WORDS, OCTANTS, TRIANGLE_WORDS};
+use super::tree::BvhTree;
 
 /// One instance in the word buffer: five texels, 80 bytes (`glsl/bvh/words.glsl`'s
 /// `instanceRay`, `glsl/bvh/traverse.glsl`'s `traverseScene`).

@@ -20,7 +20,8 @@ use serde_json::json;
 
 use super::{
     max_pixel_events, set_camera, Accel, Accelerator, BuildContext, BvhLevels, BvhOptions,
-    BvhPasses, Entry, FrameContext, FusedPasses, LightTarget, PIXELS_PER_INVOCATION,
+    BvhPasses, Entry, FrameContext, FusedPasses, FusedRun, LightTarget, PassHost,
+    PIXELS_PER_INVOCATION,
 };
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
@@ -35,14 +36,16 @@ pub mod instances;
 pub mod layout;
 mod planes;
 pub mod refit;
+pub mod tree;
 pub use instances::{instance_count, InstanceRecord, Instances, INSTANCE_TEXELS};
 pub use layout::{
-    block_of, octant_planes, Aabb, BvhStats, BvhTree, EntryTexel, Header, LeafTriangle, Node,
-    NodeRecord, BINS, BLOCK, END, HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF,
-    NODE_WORDS, OCTANTS, PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
+    block_of, Aabb, BvhStats, EntryTexel, Header, LeafTriangle, Node, NodeRecord, BINS, BLOCK, END,
+    HEADER_WORDS, LEAF_COUNT_BITS, LEAF_SIZE, MAX_DEPTH, MAX_LEAF, NODE_WORDS, OCTANTS,
+    PARALLEL_BUILD, SAH_DEPTH, TRIANGLE_WORDS,
 };
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 pub use refit::{Refit, RefitKernels, REBUILD_GROWTH, REFIT_GROUP, REFIT_TIMER};
+pub use tree::{octant_planes, BvhTree};
 
 /// The fastest configuration (`docs/design/bvh.md`, "The default"): the fused pass over one
 /// tree.
@@ -55,6 +58,7 @@ pub const ENTRY: Entry = Entry {
     label: "bvh",
     plain: PLAIN,
     // the two levels find the twin's hits with counts of their own (`tests/bvh_instances.rs`)
+    records: true,
     variants: &[
         ("bvh", PLAIN),
         (
@@ -636,6 +640,49 @@ impl Bvh {
 
     /// Bind the word buffer with `access`: the entry kernel writes its last texels
     /// (`glow::READ_WRITE`), the others only read it (`glow::READ_ONLY`).
+    /// The fused pass' entry pass (and its block lists around it) for the pass' rays: the eye
+    /// rays of `eye` in place, or the loaded ray state.
+    fn fused_entry(&mut self, f: &mut FrameContext, eye: Option<&CameraRays>) {
+        self.fused.in_place = eye.is_some();
+        if let Some(lists) = &self.fused.lists {
+            lists.step(f.gl, f.timers, false);
+        }
+        let entry = match eye {
+            Some(_) => self.fused.eye_entry.as_ref(),
+            None => Some(&self.entry),
+        };
+        let entry = entry.expect("the entry pass of the rays the frame's passes take");
+        self.dispatch_entry(f, entry, eye);
+        if let Some(lists) = &self.fused.lists {
+            // the lists' dispatch commands from what the entry pass counted
+            lists.step(f.gl, f.timers, true);
+        }
+    }
+
+    /// Dispatch the fused kernels of the pass, their uniforms set; without `misses` not the
+    /// one for the blocks whose rays all miss (their pixels were filled by clears).
+    fn dispatch_fused(&self, f: &mut FrameContext, misses: bool) {
+        let kernels = self.fused.pass_kernels();
+        match &self.fused.lists {
+            Some(lists) => {
+                // the blocks that may hit, then the others: each list in one dispatch, whatever
+                // the tiles (glsl/bvh/block_lists.glsl)
+                let dispatched = if misses { 2 } else { 1 };
+                for (list, k) in kernels.iter().enumerate().take(dispatched) {
+                    k.use_program();
+                    k.set_i32("listThreads", f.pixels.threads as i32);
+                    let command = 16 * list as i32;
+                    k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
+                }
+            }
+            None => {
+                let k = &kernels[0];
+                k.use_program();
+                k.dispatch_pixels(f.timers, f.pixels);
+            }
+        }
+    }
+
     fn bind(&self, gl: &Gl, access: u32) {
         if let Some(b) = &self.buffers {
             b.bind_images(gl, access);
@@ -697,67 +744,39 @@ impl Accelerator for Bvh {
         f.insert("bvh_refit_ms".into(), json!(refit_ms));
     }
 
-    fn records(&self) -> bool {
-        true
-    }
-
     fn fused_pass(
         &mut self,
         f: &mut FrameContext,
         _pass: u32,
         eye: Option<&CameraRays>,
-    ) -> Option<&[Kernel]> {
+        host: &dyn PassHost,
+    ) -> Option<FusedRun> {
         if self.fused.loaded.is_empty() && self.fused.eye.is_empty() {
             return None;
         }
-        self.fused.in_place = eye.is_some();
-        if let Some(lists) = &self.fused.lists {
-            lists.step(f.gl, f.timers, false);
-        }
-        let entry = match eye {
-            Some(_) => self.fused.eye_entry.as_ref(),
-            None => Some(&self.entry),
-        };
-        let entry = entry.expect("the entry pass of the rays the frame's passes take");
-        self.dispatch_entry(f, entry, eye);
-        if let Some(lists) = &self.fused.lists {
-            // the lists' dispatch commands from what the entry pass counted
-            lists.step(f.gl, f.timers, true);
-        }
-        let kernels = self.fused.pass_kernels();
-        for k in kernels {
+        self.fused_entry(f, eye);
+        for k in self.fused.pass_kernels() {
             k.use_program();
             if let Some(cam) = eye {
                 set_camera(k, cam);
             }
+            host.set_uniforms(k);
         }
-        Some(kernels)
-    }
-
-    fn fused_misses_apart(&self) -> bool {
-        self.fused.lists.is_some()
-    }
-
-    fn dispatch_fused(&mut self, f: &mut FrameContext, misses: bool) {
-        let kernels = self.fused.pass_kernels();
-        match &self.fused.lists {
-            Some(lists) => {
-                // the blocks that may hit, then the others: each list in one dispatch, whatever
-                // the tiles (glsl/bvh/block_lists.glsl)
-                let dispatched = if misses { 2 } else { 1 };
-                for (list, k) in kernels.iter().enumerate().take(dispatched) {
-                    k.use_program();
-                    k.set_i32("listThreads", f.pixels.threads as i32);
-                    let command = 16 * list as i32;
-                    k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
-                }
-            }
-            None => {
-                let k = &kernels[0];
-                k.use_program();
-                k.dispatch_pixels(f.timers, f.pixels);
-            }
+        host.frame_work(f.gl, f.timers);
+        // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
+        // miss the tree (the miss list) ends as a clear leaves it, its counts one ray traced
+        // that visited nothing a pixel — where no AOVs keep the first hits (eye rays in place)
+        // and no texel of the ray state needs storing: the frame's clear left them inactive
+        // (docs/design/frame.md, "The fused pass")
+        let run = FusedRun {
+            lists: self.fused.lists.is_some(),
+            clears: eye.is_some() && self.fused.lists.is_some(),
+        };
+        if run.clears {
+            host.fill_misses(f.gl, f.timers);
         }
+        self.dispatch_fused(f, !run.clears);
+        Some(run)
     }
 
     fn as_any(&self) -> &dyn Any {

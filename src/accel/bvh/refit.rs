@@ -27,8 +27,9 @@ use glam::Vec3;
 use glow::HasContext;
 use rayon::prelude::*;
 
-use super::layout::{Aabb, BvhTree, Node, LEAF_COUNT_BITS, OCTANTS};
+use super::layout::{Aabb, Node, LEAF_COUNT_BITS, OCTANTS};
 use super::planes::Grid;
+use super::tree::BvhTree;
 use crate::gl::resources::{bind_image_unit, GpuTimers, Owned, Ssbo};
 use crate::gl::slots::{image, ssbo};
 use crate::gl::{sync, Gl, Kernel};
@@ -317,7 +318,7 @@ impl Refit {
 
 #[cfg(test)]
 mod tests {
-    use super::super::layout::tests::soup;
+    use super::super::tree::tests::soup;
     use super::*;
     use glam::Mat4;
 

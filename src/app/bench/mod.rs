@@ -47,16 +47,17 @@
 //!    configures (the [`runner::config::Config`]s for the scale), measures
 //!    (`bench.measure(p.name, &configs)`: the CSV files come for free) and reports (a
 //!    [`Section`] whose markdown sets the published values beside ours, with its
-//!    [`report::plots::Figure`]s: [`Section::of_sweep`]); see [`protocols::thesis_5_3`] for a
+//!    [`report::plots::Figure`]s: [`Protocol::sweep_section`]); see [`protocols::thesis_5_3`] for a
 //!    complete example. Work that is not a list of rendered frames (a CPU implementation, a
 //!    build-time measurement) goes through [`runner::adapter`] and
-//!    [`protocols::klee_measure`] or helpers like them.
+//!    [`protocols::klee::measure`] or helpers like them.
 //! 3. Say what its units are: `Units::Configs` when everything it measures goes through
 //!    `bench.measure` (then `--shard` and `bench merge` work unchanged), `Units::Whole` when its
 //!    measurements depend on each other.
 //! 4. Add a variant with `#[value(name = "...")]` to [`runner::args::ProtocolId`] and its line in
 //!    [`protocol_of`]; mention it in `docs/bench.md`.
 
+pub mod common;
 pub mod protocols;
 pub mod published;
 pub mod report;
@@ -70,9 +71,11 @@ use clap::Parser as _;
 use gpgpu_rt::errln;
 use gpgpu_rt::output::Batch;
 
-pub use protocols::{protocol_of, Protocol, Section, Units};
+pub use common::section::Section;
+pub use protocols::{protocol_of, Protocol};
 pub use runner::args::{BenchArgs, BenchCommand, MergeArgs};
-use runner::shard::{self, Mode, Shard};
+use runner::shard::{self, Mode};
+use runner::units::{Shard, Units};
 pub use runner::{Bench, NotMeasuredHere};
 
 /// Run the protocols of `args` and write the report (or list their units, or measure one
@@ -191,7 +194,7 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         // (the merge refuses it as cut short until the shard is run whole)
         let pending: Vec<String> = all[n + 1..].iter().map(|p| p.name.to_string()).collect();
         if !pending.is_empty() {
-            shard::write_manifest(bench, &shard_manifest(bench, shard, start, pending))?;
+            shard::write_manifest(&bench.out, &shard_manifest(bench, shard, start, pending))?;
             batch.commit_so_far()?;
         }
     }
@@ -201,7 +204,7 @@ fn measure_shard(bench: &mut Bench, shard: Shard, start: Instant) -> Result<()> 
         .filter(|m| m.error.is_some())
         .count();
     let manifest = shard_manifest(bench, shard, start, Vec::new());
-    let path = shard::write_manifest(bench, &manifest)?;
+    let path = shard::write_manifest(&bench.out, &manifest)?;
     // a shard that took no unit still writes its manifest: the merge needs every shard's
     let ok_configs = manifest.configs.len() - failed_configs;
     let (measured, all_failed) = (measured + ok_configs, failed + failed_configs);
@@ -290,9 +293,7 @@ fn run_protocol(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     if p.units == Units::Whole {
         let (i, id) = bench.next_unit(p.name.to_string());
         match &bench.mode {
-            Mode::Measure(Some(s)) if !s.takes(i) => {
-                return Ok(Section::new(p, String::new(), vec![]))
-            }
+            Mode::Measure(Some(s)) if !s.takes(i) => return Ok(p.section(String::new(), vec![])),
             Mode::Replay(r) => return Ok(replayed_section(p, r, &id, &bench.out)),
             _ => {}
         }
@@ -300,11 +301,11 @@ fn run_protocol(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     errln!("{}: {}", p.name, p.title)?;
     let section = match (p.run)(p, bench) {
         Ok(s) => s,
-        Err(e) if e.is::<NotMeasuredHere>() => Section::new(p, String::new(), vec![]),
+        Err(e) if e.is::<NotMeasuredHere>() => p.section(String::new(), vec![]),
         Err(e) if is_console(&e) => return Err(e),
         Err(e) => {
             errln!("{}: failed: {e:#}", p.name)?;
-            Section::failed(p, &e)
+            p.failed(&e)
         }
     };
     if p.units == Units::Whole && matches!(bench.mode, Mode::Measure(Some(_))) {
@@ -330,5 +331,5 @@ fn replayed_section(p: &Protocol, r: &shard::Recorded, id: &str, out: &std::path
         }
         Ok(section.clone())
     };
-    copy().unwrap_or_else(|e| Section::failed(p, &e))
+    copy().unwrap_or_else(|e| p.failed(&e))
 }

@@ -12,7 +12,7 @@
 //! [`shaft_hits_cell`] — the test of the hierarchical build and of the GPU kernel, so the bits are
 //! the same (`tests/linespace_cpu_build.rs` compares them with [`super::ntree::build_linespace`]).
 
-use super::ntree::{entry_index, face_axes, linespace_words, shaft_hits_cell, FACES};
+use super::shaft::{entry_index, face_axes, linespace_words, shaft_hits_cell, FACES};
 use rayon::prelude::*;
 
 /// Widening of the t bounds and of the candidate ranges: the bounds are computed in f64 and only

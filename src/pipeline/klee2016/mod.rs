@@ -18,8 +18,10 @@ pub mod gbuffer;
 pub mod linespace_build;
 pub mod linespace_cpu;
 pub mod ntree;
+pub mod options;
 pub mod present;
 pub mod shadow_pass;
+pub mod shaft;
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -42,27 +44,8 @@ pub use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, Camera, Scene, ShadowMode};
 
 pub use self::linespace_build::LinespaceBuild;
+pub use self::options::SoftShadowOptions;
 pub use crate::scene::shadows::parse_samples;
-
-/// Options of the soft-shadow renderer.
-#[derive(Debug, Clone)]
-pub struct SoftShadowOptions {
-    pub mode: ShadowMode,
-    pub samples_u: u32,
-    pub samples_v: u32,
-    /// N: cells per axis of every N-tree node (10 in the thesis).
-    pub ntree_n: u32,
-    /// Levels of the N-tree including the root (3 in the thesis).
-    pub ntree_depth: u32,
-    pub width: u32,
-    pub height: u32,
-    /// Dispatch the shadow pass in tiles of at most tile×tile pixels (0: one dispatch).
-    pub tile: u32,
-    /// How the shadow value lights a pixel (ours, or Fig. 7's product).
-    pub shading: KleeShading,
-    /// Where the line spaces are computed (GPU or CPU).
-    pub linespace_build: LinespaceBuild,
-}
 
 /// The scene's single area light (the thesis lights with one).
 pub fn scene_light(scene: &Scene) -> Result<AreaLight> {

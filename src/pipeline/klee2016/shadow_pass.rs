@@ -12,11 +12,12 @@ use glow::HasContext;
 
 use super::linespace_build::{r32ui_texture_3d, read_texture_3d};
 use super::ntree::{NTree, PackedLinespaces};
-use super::{KleeShading, SoftShadowOptions};
+use super::options::SoftShadowOptions;
 use crate::gl::context::LoopLimit;
 use crate::gl::resources::{read_tex_image, GpuTimers, Image2d, Owned, Ssbo, TextureBuffer};
 use crate::gl::slots::{image, sampler, ssbo};
 use crate::gl::{Defines, Gl, GlInfo, Kernel, PixelGrid, ShaderSource};
+use crate::scene::shadows::KleeShading;
 use crate::scene::{AreaLight, ShadowMode};
 
 /// Counter slots of the shadow kernel, shared with it through `#define COUNTER_*`. After the

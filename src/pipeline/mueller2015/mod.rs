@@ -22,7 +22,8 @@ use self::records::{Record, Records, FUSED_RECORDS};
 use super::ray_kinds::{self, Bank, CounterBanks};
 use super::Renderer;
 use crate::accel::{
-    self, Accel, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, LightTarget, PassRays,
+    Accel, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, LightTarget, PassHost,
+    PassRays,
 };
 use crate::frame::{flip_rows, Frame, FrameStats};
 use crate::gl::resources::GpuTimers;
@@ -379,12 +380,11 @@ impl RayTracer {
         };
         let accel = (entry.gpu)(&build, scene, &options.accel)?;
         let per_pixel = if options.fused() { FUSED_RECORDS } else { 1 };
-        let records = accel
-            .records()
-            .then(|| {
-                let lists = accel.fused_misses_apart();
-                Records::new(&gl, info, shaders, &images, (w, h), per_pixel, lists)
-            })
+        // the counts over block lists where the fused pass may run over them (FusedRun::lists)
+        let lists = options.fused();
+        let records = entry
+            .records
+            .then(|| Records::new(&gl, info, shaders, &images, (w, h), per_pixel, lists))
             .transpose()?;
         let counters = CounterBanks::new(&gl, info, COUNTERS.len())?;
         let t = RayTracer {
@@ -454,7 +454,7 @@ impl RayTracer {
     fn eye_rays(&mut self, cam: &CameraRays) {
         let k = &self.kernels.eye_ray_generation;
         k.use_program();
-        accel::set_camera(k, cam);
+        crate::accel::set_camera(k, cam);
         k.dispatch_pixels(&mut self.timers, self.pixels);
     }
 
@@ -527,9 +527,9 @@ impl RayTracer {
         self.options.fused() && pass == 0 && self.aov_images.is_none()
     }
 
-    /// One pass in the accelerator's fused kernel (`glsl/bvh/fused_pass.comp`, ours): the
-    /// uniforms of the four kernels it stands for, then the counts of its three records, each
-    /// under the bank intersect1 and intersect2 count under.
+    /// One pass in the accelerator's fused kernel (ours, the SAH BVH's default:
+    /// `glsl/bvh/fused_pass.comp`), the pipeline's part through [`FusedHost`]; then the
+    /// counts of its three records, each under the bank intersect1 and intersect2 count under.
     fn fused_pass(&mut self, cam: &CameraRays, pass: u32) {
         let eye = self.eye_in_place(pass);
         let mut f = FrameContext {
@@ -538,57 +538,33 @@ impl RayTracer {
             pixels: self.pixels,
             models: &self.models,
         };
+        // the entry pass is the closest-hit search's set-up
         self.counters.bind(f.gl, f.timers, Bank::closest_hit(pass));
-        let l = &self.lighting;
-        let kernels = self
+        let host = FusedHost {
+            counters: &self.counters,
+            lighting: &self.lighting,
+            final_color: &self.images.final_color,
+            cam,
+            pass,
+            refl_depth: self.options.refl_depth,
+        };
+        let run = self
             .accel
-            .fused_pass(&mut f, pass, eye.then_some(cam))
-            .expect("--fused-passes is refused for an accelerator without a fused pass");
-        for k in kernels {
-            k.use_program();
-            k.set_vec4("backgroundColor", l.background, 1.0);
-            k.set_i32("storePrimaryHit", (pass == 0) as i32);
-            k.set_i32("storeRayState", (pass < self.options.refl_depth) as i32);
-            k.set_i32("firstPass", (pass == 0) as i32);
-            k.set_vec4("camPosition", cam.cam_position.into(), 1.0);
-            k.set_vec4("ambientColor", l.ambient, 1.0);
-            k.set_vec4_slice("areaLight", &l.area_uniform());
-        }
+            .fused_pass(&mut f, pass, eye.then_some(cam), &host)
+            .expect("the fused pass runs with an accelerator made with it");
         let r = self
             .records
             .as_ref()
             .expect("the fused pass stores records");
-        let feelers = feeler_records(
-            self.fused
-                .expect("fused_pass runs with --fused-passes only"),
-        );
-        // timed as the frame's, not one ray kind's: the kernel traces every kind of the pass
-        // (and the colour's clear stands for the miss kernel)
-        self.counters.bind(f.gl, f.timers, Bank::Frame);
-        // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
-        // miss the tree (the accelerator's miss list) ends as a clear leaves it: the output
-        // colour the background at full weight (Listing 16's addToFinal on a miss: every such
-        // pixel's), its counts one ray traced that visited nothing a pixel, which pixel_counts
-        // adds without a record; where no AOVs keep the first hits (eye rays in place) and no
-        // texel of the ray state needs storing — the frame's clear left them inactive
-        // (docs/design/frame.md, "The fused pass")
-        let lists = self.accel.fused_misses_apart();
-        let clears = eye && lists;
-        if clears {
-            let (final_color, bg) = (&self.images.final_color, l.background);
-            f.timers.time(f.gl, "fused_miss", || {
-                final_color.fill_f32(f.gl, [bg[0], bg[1], bg[2], 1.0])
-            });
-        }
-        self.accel.dispatch_fused(&mut f, !clears);
+        let feelers = feeler_records(self.fused.expect("made with the fused pass"));
         let kinds = [(Bank::closest_hit(pass), "intersect1", Record::Packed(0))].into_iter();
         let feelers = feelers.into_iter().map(|(b, r)| (b, "intersect2", r));
         for (bank, tests, record) in kinds.chain(feelers) {
             self.counters.bind(&self.gl, &mut self.timers, bank);
-            match lists {
+            match run.lists {
                 // the records over the block lists: only the hit blocks' where the clears
                 // stood for the miss kernel
-                true => r.add_block_counts(&mut self.timers, tests, record, clears),
+                true => r.add_block_counts(&mut self.timers, tests, record, run.clears),
                 false => r.add_record_counts(&mut self.timers, tests, record),
             }
         }
@@ -639,6 +615,44 @@ impl RayTracer {
             stats.facts.insert("hit_list_pixels".into(), json!(pixels));
         }
         stats
+    }
+}
+
+/// The pipeline's part of a fused pass ([`PassHost`]): the uniforms of the four kernels it
+/// stands for, the frame's counters, the miss blocks' clear.
+struct FusedHost<'a> {
+    counters: &'a CounterBanks,
+    lighting: &'a Lighting,
+    final_color: &'a crate::gl::resources::Image2d,
+    cam: &'a CameraRays,
+    pass: u32,
+    refl_depth: u32,
+}
+
+impl PassHost for FusedHost<'_> {
+    fn set_uniforms(&self, k: &Kernel) {
+        let (l, pass) = (self.lighting, self.pass);
+        k.set_vec4("backgroundColor", l.background, 1.0);
+        k.set_i32("storePrimaryHit", (pass == 0) as i32);
+        k.set_i32("storeRayState", (pass < self.refl_depth) as i32);
+        k.set_i32("firstPass", (pass == 0) as i32);
+        k.set_vec4("camPosition", self.cam.cam_position.into(), 1.0);
+        k.set_vec4("ambientColor", l.ambient, 1.0);
+        k.set_vec4_slice("areaLight", &l.area_uniform());
+    }
+
+    /// Timed as the frame's, not one ray kind's: the kernel traces every kind of the pass (and
+    /// the colour's clear stands for the miss kernel).
+    fn frame_work(&self, gl: &Gl, timers: &mut GpuTimers) {
+        self.counters.bind(gl, timers, Bank::Frame);
+    }
+
+    fn fill_misses(&self, gl: &Gl, timers: &mut GpuTimers) {
+        let bg = self.lighting.background;
+        let c = self.final_color;
+        timers.time(gl, "fused_miss", || {
+            c.fill_f32(gl, [bg[0], bg[1], bg[2], 1.0])
+        });
     }
 }
 

@@ -62,8 +62,8 @@ pub struct Records {
     records: Ssbo,
     evaluate_hit: Kernel,
     pixel_counts: Kernel,
-    /// its variant over the fused pass' block lists (`BLOCK_LISTED`), where the accelerator
-    /// has them (`Accelerator::fused_misses_apart`)
+    /// its variant over the fused pass' block lists (`BLOCK_LISTED`), where a fused pass may
+    /// run over them (`accel::FusedRun::lists`)
     block_counts: Option<Kernel>,
     hit_list: HitList,
     /// the records as an RGBA32UI image buffer for `pixel_counts` (`RECORD_IMAGE`), where the

@@ -233,7 +233,7 @@ mod tests {
 
     #[test]
     fn block_entries_keep_every_hit_and_skip_nodes() {
-        let bvh = BvhTree::new(crate::accel::bvh::layout::tests::soup());
+        let bvh = BvhTree::new(crate::accel::bvh::tree::tests::soup());
         // the soup fills [0, 10.3]³: a camera in front of it, its image's edges beside it, and
         // the rays' x and y turning sign at the image's middle (blocks of two octants there)
         let size = (52, 36);

@@ -16,8 +16,10 @@ use std::ops::ControlFlow;
 
 use glam::Vec3;
 
-use super::{closest_among, CpuAccelerator, Feeler, Hit};
 use crate::accel::bvh::{octant_planes, BvhTree, RayGrid, OCTANTS};
+use crate::accel::Accel;
+use crate::reference::search::{closest_among, CpuAccelerator, Feeler, Hit};
+use crate::scene::Scene;
 
 mod entry;
 pub use entry::{BlockEntry, RayBounds};
@@ -146,10 +148,17 @@ impl CpuAccelerator for BvhTree {
     }
 }
 
+/// The SAH BVH's twin (`design::REGISTRY`): one tree over the world-space scene, whatever its
+/// variant (the fused pass counts as the four kernels; the two levels find the same hits,
+/// their counts are the instances' own: `tests/bvh_instances.rs`).
+pub fn twin(scene: &Scene, _: &Accel) -> anyhow::Result<Box<dyn CpuAccelerator>> {
+    Ok(Box::new(BvhTree::new(scene.world_triangles())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::bvh::layout::tests::soup;
+    use crate::accel::bvh::tree::tests::soup;
 
     #[test]
     fn traversal_finds_the_brute_force_hits() {

@@ -18,17 +18,20 @@
 //!   time, the one figure every pipeline has); agreement of the first hits with the CPU
 //!   reference ([`crate::bench::runner::judge`]).
 //!
-//! The tables, figures and analysis are in [`crate::bench::report::accel_compare`].
+//! The tables, figures and analysis are in [`crate::bench::report::accel_compare`], which reads
+//! the rows and the [`Plan`] of the comparison.
 
 use std::sync::LazyLock;
 
 use anyhow::Result;
 
-use super::{Protocol, Section, Units};
-use crate::bench::report::accel_compare as report;
+use super::protocol::Protocol;
+use crate::bench::common::section::Section;
+use crate::bench::report::accel_compare::{self as report, Accelerator, Plan, Row, Work};
 use crate::bench::runner::args::Scale;
-use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{BvhVariant, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 use gpgpu_rt::accel::auto_resolution;
 use gpgpu_rt::design::{self, Pipeline};
@@ -81,55 +84,19 @@ pub const QUICK_BASE_MAX_TRIANGLES: usize = 30_000;
 /// triangles (above it takes minutes, as the thesis says of 100k).
 pub const QUICK_WAGNER_MAX_TRIANGLES: usize = 50_000;
 
-/// An accelerator of the comparison: a point-light design of `design::REGISTRY`, with or
-/// without proximity clouds where it takes them, and its name in the tables and figures.
-#[derive(Debug, Clone, Copy)]
-pub struct Accelerator {
-    pub name: &'static str,
-    pub row: &'static design::Row,
-    pub proximity_clouds: bool,
-}
-
-impl Accelerator {
-    /// The pipeline it runs in, as the tables name it.
-    pub fn pipeline(&self) -> &'static str {
-        match self.row.pipeline {
-            Pipeline::Mueller2015 => "Müller 2015 (4 kernels)",
-            Pipeline::Wagner2018 => "own: Wagner 2018 megakernel",
-            Pipeline::Stream => "own: streaming tracer fragment passes",
-            Pipeline::Klee2016 => "own: Klee 2016 soft shadows",
-        }
-    }
-
-    /// Its configuration on a scene of `t` triangles: the grids at `--grid auto`'s
-    /// N = ∛(T/5), the stream's at the paper's ∛T per axis.
-    fn tracer(&self, t: usize) -> TracerSpec {
-        let resolution = auto_resolution(t);
-        match (self.row.name, self.proximity_clouds) {
-            ("grid-exact", true) => TracerSpec::GridPc { resolution },
-            ("stream", proximity_clouds) => TracerSpec::Stream {
-                axes: auto_dims(t).to_array(),
-                proximity_clouds,
-                naive_shadows: false,
-                no_mask: false,
-            },
-            ("grid-thesis", _) => TracerSpec::Grid {
-                variant: GridVariant::Thesis,
-                resolution,
-            },
-            ("grid-exact", _) => TracerSpec::Grid {
-                variant: GridVariant::Exact,
-                resolution,
-            },
-            ("bvh", _) => TracerSpec::Bvh {
-                variant: BvhVariant::Sah,
-            },
-            ("bvh-wagner", _) => TracerSpec::Bvh {
-                variant: BvhVariant::Wagner,
-            },
-            ("base", _) => TracerSpec::Base,
-            (other, _) => unreachable!("accel-compare has no configuration of `{other}`"),
-        }
+/// The configuration of accelerator `a` on a scene of `t` triangles: the grids at `--grid auto`'s
+/// N = ∛(T/5), the stream's at the paper's ∛T per axis.
+fn tracer(a: &Accelerator, t: usize) -> Tracer {
+    let resolution = auto_resolution(t);
+    match (a.row.name, a.proximity_clouds) {
+        ("grid-exact", true) => Tracer::grid_pc(resolution),
+        ("stream", pc) => Tracer::stream(auto_dims(t).to_array(), pc, false, false),
+        ("grid-thesis", _) => Tracer::uniform_grid(GridVariant::Thesis, resolution),
+        ("grid-exact", _) => Tracer::uniform_grid(GridVariant::Exact, resolution),
+        ("bvh", _) => Tracer::bvh(BvhVariant::Sah),
+        ("bvh-wagner", _) => Tracer::bvh(BvhVariant::Wagner),
+        ("base", _) => Tracer::base(),
+        (other, _) => unreachable!("accel-compare has no configuration of `{other}`"),
     }
 }
 
@@ -171,7 +138,7 @@ pub static ACCELERATORS: LazyLock<Vec<Accelerator>> = LazyLock::new(|| {
 });
 
 /// The accelerator a configuration's tracer belongs to.
-pub fn accelerator_of(spec: &TracerSpec) -> &'static Accelerator {
+pub fn accelerator_of(spec: &Tracer) -> &'static Accelerator {
     let key = (spec.row().name, spec.proximity_clouds());
     ACCELERATORS
         .iter()
@@ -199,7 +166,7 @@ fn configs(bench: &mut Bench) -> Result<Vec<Config>> {
         let loaded = bench.scene(scene)?;
         let (t, refl) = (loaded.triangle_count(), loaded.settings.refl_depth);
         for a in ACCELERATORS.iter().filter(|a| runs(a, t, scale)) {
-            let mut c = Config::fixed(scene, a.tracer(t), (s.width, s.height), s);
+            let mut c = Config::fixed(scene, tracer(a, t), (s.width, s.height), s);
             c.refl_depth = refl;
             c.judge = true;
             v.push(c);
@@ -213,77 +180,19 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let outcomes = bench.measure(p.name, &configs)?;
     let rows = rows(&outcomes);
     let file = report::write_csv(&bench.out, p.name, &rows)?;
-    let markdown = report::markdown(&rows, bench.sizing(QUICK, FULL), bench.scale());
-    let figures = report::figures(&rows);
-    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    let plan = Plan {
+        accelerators: ACCELERATORS.as_slice(),
+        stadium: STADIUM,
+        quick_base_max_triangles: QUICK_BASE_MAX_TRIANGLES,
+        quick_wagner_max_triangles: QUICK_WAGNER_MAX_TRIANGLES,
+        sizing: bench.sizing(QUICK, FULL),
+        scale: bench.scale(),
+    };
+    let markdown = report::markdown(&plan, &rows);
+    let figures = report::figures(&plan, &rows);
+    let mut s = p.sweep_section(&bench.out, markdown, &outcomes, &figures)?;
     s.files.push(file);
     Ok(s)
-}
-
-/// The work of one kind of rays (or of the whole frame) per frame.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Work {
-    pub rays: f64,
-    /// Mean GPU milliseconds over the measured frames.
-    pub gpu_ms: f64,
-    pub tests: f64,
-    /// Voxels (grids) or BVH nodes visited.
-    pub visits: f64,
-}
-
-impl Work {
-    pub fn mrays_per_s(&self) -> Option<f64> {
-        (self.gpu_ms > 0.0 && self.rays > 0.0).then(|| self.rays / self.gpu_ms / 1e3)
-    }
-    pub fn tests_per_ray(&self) -> Option<f64> {
-        (self.rays > 0.0).then(|| self.tests / self.rays)
-    }
-    pub fn visits_per_ray(&self) -> Option<f64> {
-        (self.rays > 0.0 && self.visits > 0.0).then(|| self.visits / self.rays)
-    }
-    fn add(&mut self, o: &Work) {
-        self.rays += o.rays;
-        self.gpu_ms += o.gpu_ms;
-        self.tests += o.tests;
-        self.visits += o.visits;
-    }
-}
-
-/// One configuration's measurements.
-#[derive(Debug, Clone)]
-pub struct Row {
-    pub scene: String,
-    pub triangles: usize,
-    pub lights: usize,
-    pub accelerator: &'static Accelerator,
-    /// "grid exact 24³", "stream pc 58": the tracer with its resolution.
-    pub tracer: String,
-    pub build_ms: Option<f64>,
-    pub bytes: Option<f64>,
-    /// Per kind of ray, [`RAY_KINDS`] order (Müller's pipeline and the stream; zero work in
-    /// Wagner's megakernel).
-    pub kinds: [Work; 4],
-    /// Every ray of the frame over all of the frame's GPU time (builds included).
-    pub frame: Work,
-    /// Share of the pixels whose first hit agrees with the judge's, and the judge.
-    pub agreement: Option<(f64, String)>,
-    /// Triangle references and voxel ids the thesis grid's fixed lists could not hold.
-    pub lost: u64,
-    pub error: Option<String>,
-}
-
-impl Row {
-    /// Whether the pipeline counted the kinds of ray apart (all but Wagner's megakernel).
-    pub fn has_kinds(&self) -> bool {
-        self.kinds[0].rays > 0.0
-    }
-
-    /// The feelers towards every light: the first light's and the others'.
-    pub fn shadow_all(&self) -> Work {
-        let mut w = self.kinds[1];
-        w.add(&self.kinds[2]);
-        w
-    }
 }
 
 /// The rows of the outcomes.
@@ -369,7 +278,7 @@ mod tests {
             assert_eq!(compared, want, "{row:?}");
         }
         for a in ACCELERATORS.iter() {
-            let spec = a.tracer(70_000);
+            let spec = tracer(a, 70_000);
             assert_eq!(spec.row().name, a.row.name, "{}", a.name);
             assert_eq!(accelerator_of(&spec).name, a.name);
         }

@@ -9,14 +9,17 @@
 //! Every scene is measured with `--tracer stream` at the paper's grid (g, and pc where the
 //! paper has it) and with the compute exact grid (`--tracer grid`, cubic: the paper's largest
 //! axis) on the same frames; a sparse scene (`sparse_room.toml`) is added, where skipping empty
-//! cells should pay. The report is in [`crate::bench::report::proximity_clouds`].
+//! cells should pay. The report is in [`crate::bench::report::proximity_clouds`], and reads the
+//! run's [`Plan`].
 
 use anyhow::Result;
 
-use super::{Protocol, Section, Units};
+use super::protocol::Protocol;
+use crate::bench::common::section::Section;
 use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
-use crate::bench::report::proximity_clouds as report;
-use crate::bench::runner::config::{Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::report::proximity_clouds::{self as report, Plan};
+use crate::bench::runner::config::{Config, GridVariant, Sizing, Tracer};
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 /// The sparse scene (not in the paper): a small detailed object in a large empty room.
@@ -57,17 +60,7 @@ pub const PROXIMITY_CLOUDS_TABLE3: Protocol = Protocol {
     units: Units::Configs,
 };
 
-/// What a run of `proximity-clouds-table<n>` measures.
-pub struct Plan {
-    pub table: u32,
-    /// Image sides (square images), ascending.
-    pub sides: Vec<u32>,
-    pub frames: Sizing,
-    /// Table 1 adds the Stanford bunny at 512² (stream vs compute grid, issue 12 §5) unless the
-    /// command line chose the sizes.
-    pub bunny_512: bool,
-}
-
+/// How a run is planned and what it measures; the plan itself is what the report reads.
 impl Plan {
     pub fn of(bench: &Bench, table: u32) -> Plan {
         let square = |s: &[u32]| s.iter().map(|&n| (n, n)).collect::<Vec<_>>();
@@ -80,6 +73,8 @@ impl Plan {
             sides,
             frames: bench.sizing(QUICK, FULL),
             bunny_512: table == 1 && !bench.sizes_given(),
+            sparse: SPARSE,
+            bunny_side: BUNNY_SIDE,
         }
     }
 
@@ -98,24 +93,16 @@ impl Plan {
     /// The tracers of `scene`: stream g, stream pc (where the paper has pc), the compute exact
     /// grid g (cubic, the paper's largest axis), and its pc column (`--tracer grid
     /// --proximity-clouds`) where the paper has pc.
-    pub fn tracers(scene: &PaperScene) -> Vec<TracerSpec> {
-        let stream = |pc| TracerSpec::Stream {
-            axes: scene.grid,
-            proximity_clouds: pc,
-            naive_shadows: false,
-            no_mask: false,
-        };
+    pub fn tracers(scene: &PaperScene) -> Vec<Tracer> {
+        let stream = |pc| Tracer::stream(scene.grid, pc, false, false);
         let resolution = scene.grid.into_iter().max().unwrap_or(1);
         let mut v = vec![stream(false)];
         if scene.pc {
             v.push(stream(true));
         }
-        v.push(TracerSpec::Grid {
-            variant: GridVariant::Exact,
-            resolution,
-        });
+        v.push(Tracer::uniform_grid(GridVariant::Exact, resolution));
         if scene.pc {
-            v.push(TracerSpec::GridPc { resolution });
+            v.push(Tracer::grid_pc(resolution));
         }
         v
     }
@@ -124,17 +111,14 @@ impl Plan {
     /// to the naive implementation of shadow rays") on its dense scenes, each switched off
     /// beside stream g: the any-hit search (`--stream-naive-shadows`), the masking
     /// (`--stream-no-mask`), and both.
-    fn naive(&self, scene: &PaperScene) -> Vec<TracerSpec> {
+    fn naive(&self, scene: &PaperScene) -> Vec<Tracer> {
         let dense = pp::SCENES.iter().any(|s| s.file == scene.file);
         if self.table != 2 || !dense {
             return Vec::new();
         }
         [(true, false), (false, true), (true, true)]
-            .map(|(naive_shadows, no_mask)| TracerSpec::Stream {
-                axes: scene.grid,
-                proximity_clouds: false,
-                naive_shadows,
-                no_mask,
+            .map(|(naive_shadows, no_mask)| {
+                Tracer::stream(scene.grid, false, naive_shadows, no_mask)
             })
             .to_vec()
     }
@@ -147,7 +131,7 @@ impl Plan {
         for scene in scenes {
             for tracer in Plan::tracers(scene).into_iter().chain(self.naive(scene)) {
                 for &side in &self.sides {
-                    v.push(self.config(scene, tracer, side));
+                    v.push(self.config(scene, tracer.clone(), side));
                 }
             }
         }
@@ -159,7 +143,7 @@ impl Plan {
         v
     }
 
-    fn config(&self, scene: &PaperScene, tracer: TracerSpec, side: u32) -> Config {
+    fn config(&self, scene: &PaperScene, tracer: Tracer, side: u32) -> Config {
         Config {
             refl_depth: self.refl_depth(),
             shadows: self.shadows(),
@@ -174,7 +158,7 @@ fn run(p: &Protocol, bench: &mut Bench, table: u32) -> Result<Section> {
     let markdown = report::markdown(&plan, &outcomes);
     let figures = report::figures(p.name, &plan, &outcomes);
     let file = report::write_csv(&bench.out, p.name, &plan, &outcomes)?;
-    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    let mut s = p.sweep_section(&bench.out, markdown, &outcomes, &figures)?;
     s.files.push(file);
     Ok(s)
 }
@@ -215,6 +199,8 @@ mod tests {
             sides: vec![256, 512, 768],
             frames: FULL,
             bunny_512: false,
+            sparse: SPARSE,
+            bunny_side: BUNNY_SIDE,
         };
         let configs = plan.configs();
         // 3 scenes × 4 tracers + the Stanford bunny × 2 + the sparse room × 4, at 3 sides

@@ -1,9 +1,9 @@
 //! What the grid-resolution protocols (ch. 5.2, 5.3) share: configurations over resolutions
 //! and variants, the table per resolution, and the curves per variant.
 
-use crate::bench::report::format::{int, ratio, table};
+use crate::bench::common::format::{int, ratio, table};
 use crate::bench::report::plots::{Chart, Series, Style};
-use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::{Outcome, MEASURED_COLUMNS};
 
 /// The sizing of both resolution sweeps. Quick: 4 angles, 1 warm-up frame. Full: 36 angles
@@ -22,10 +22,7 @@ pub fn grid_configs(
     let mut v = Vec::new();
     for &variant in variants {
         for &resolution in resolutions {
-            let tracer = TracerSpec::Grid {
-                variant,
-                resolution,
-            };
+            let tracer = Tracer::uniform_grid(variant, resolution);
             v.push(Config::new(scene, tracer, refl_depth, s));
         }
     }
@@ -69,7 +66,7 @@ pub fn grid_outcomes<'a>(outcomes: &'a [Outcome], scene: &str) -> Vec<&'a Outcom
 pub fn base_outcome<'a>(outcomes: &'a [Outcome], scene: &str) -> Option<&'a Outcome> {
     outcomes
         .iter()
-        .find(|o| o.config.scene == scene && o.config.tracer == TracerSpec::Base)
+        .find(|o| o.config.scene == scene && o.config.tracer.is_base())
 }
 
 /// A markdown table with a row per grid configuration (and the base tracer first, if given).

@@ -5,12 +5,15 @@
 
 use anyhow::Result;
 
-use super::{thesis_bvh, Protocol, Section, Units};
+use super::protocol::Protocol;
+use super::thesis_bvh;
+use crate::bench::common::format::{int, percent, ratio, table};
+use crate::bench::common::section::Section;
 use crate::bench::published::thesis::{self, TEAPOT_TRIANGLES};
-use crate::bench::report::format::{int, percent, ratio, table};
 use crate::bench::report::plots::{self, Chart, Figure, Series, Style};
-use crate::bench::runner::config::{Config, Sizing, TracerSpec};
+use crate::bench::runner::config::{Config, Sizing, Tracer};
 use crate::bench::runner::outcome::{FrameRecord, Outcome, MEASURED_COLUMNS};
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
@@ -33,7 +36,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         .collect();
     let mut configs: Vec<Config> = scenes
         .iter()
-        .map(|scene| Config::new(scene, TracerSpec::Base, 1, s))
+        .map(|scene| Config::new(scene, Tracer::base(), 1, s))
         .collect();
     let names: Vec<&str> = scenes.iter().map(String::as_str).collect();
     configs.extend(thesis_bvh::configs(&names, 1, s));
@@ -45,7 +48,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         + &results_table(&base)
         + &findings(&base)
         + &thesis_bvh::table_text(&outcomes);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures(s, &base))
+    p.sweep_section(&bench.out, markdown, &outcomes, &figures(s, &base))
 }
 
 /// Fig. 19 and 20: one curve per scene over the rotation.

@@ -5,13 +5,16 @@
 
 use anyhow::Result;
 
+use super::protocol::Protocol;
 use super::sweep::{self, resolution_chart};
-use super::{thesis_bvh, Protocol, Section, Units};
+use super::thesis_bvh;
+use crate::bench::common::format::{int, num};
+use crate::bench::common::section::Section;
 use crate::bench::published::thesis;
-use crate::bench::report::format::{int, num};
 use crate::bench::report::plots::Figure;
-use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
@@ -30,7 +33,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let s = bench.sizing(sweep::QUICK, sweep::FULL);
     let resolutions = bench.grid_resolutions(QUICK_RESOLUTIONS, FULL_RESOLUTIONS);
     let variants = bench.variants();
-    let mut configs = vec![Config::new(SCENE, TracerSpec::Base, 1, s)];
+    let mut configs = vec![Config::new(SCENE, Tracer::base(), 1, s)];
     configs.extend(sweep::grid_configs(SCENE, 1, s, &variants, &resolutions));
     configs.extend(thesis_bvh::configs(&[SCENE], 1, s));
     // measure
@@ -43,7 +46,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         + &findings(&grid)
         + &thesis_bvh::table_text(&outcomes);
     let figures = figures(s, &grid, base);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
+    p.sweep_section(&bench.out, markdown, &outcomes, &figures)
 }
 
 /// Fig. 21 (FPS, with the base tracer as a line) and Fig. 22 (mean tests) by resolution.

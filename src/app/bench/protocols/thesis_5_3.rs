@@ -6,14 +6,17 @@
 
 use anyhow::Result;
 
+use super::protocol::Protocol;
 use super::sweep::{self, resolution_chart};
-use super::{thesis_bvh, Protocol, Section, Units};
+use super::thesis_bvh;
+use crate::bench::common::format::{int, num, ratio, table};
+use crate::bench::common::section::Section;
 use crate::bench::published::thesis::{self as p, Published};
-use crate::bench::report::format::{int, num, ratio, table};
 use crate::bench::report::plots::{Chart, Figure, Series, Style, BLACK_INDEX};
 use crate::bench::runner::args::Scale;
-use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, TracerSpec};
+use crate::bench::runner::config::{variant_name, Config, GridVariant, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 pub const PROTOCOL: Protocol = Protocol {
@@ -51,7 +54,7 @@ fn run(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         + &tables(&results)
         + &thesis_bvh::table_text(&outcomes);
     let figures = figures(plan.sizing, &results);
-    Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)
+    p.sweep_section(&bench.out, markdown, &outcomes, &figures)
 }
 
 impl Plan {
@@ -60,7 +63,7 @@ impl Plan {
     /// with the base tracer (202520 triangles per ray); the SAH BVH on both (ours).
     fn configs(&self) -> Vec<Config> {
         let (s, variants) = (self.sizing, &self.variants);
-        let mut configs = vec![Config::new(BUNNY, TracerSpec::Base, 0, s)];
+        let mut configs = vec![Config::new(BUNNY, Tracer::base(), 0, s)];
         configs.extend(sweep::grid_configs(
             BUNNY,
             0,
@@ -71,7 +74,7 @@ impl Plan {
         let dragon_res = [p::DRAGON_GRID_RESOLUTION];
         configs.extend(sweep::grid_configs(DRAGON, 1, s, variants, &dragon_res));
         if self.dragon_base {
-            configs.push(Config::new(DRAGON, TracerSpec::Base, 1, s));
+            configs.push(Config::new(DRAGON, Tracer::base(), 1, s));
         }
         // the SAH BVH on both, with the grid's reflection depths
         configs.extend(thesis_bvh::configs(&[BUNNY], 0, s));
@@ -123,13 +126,9 @@ impl<'a> Results<'a> {
 
     /// The successful grid configuration of `variant` at `resolution` among `grid`.
     fn grid_at(grid: &[&'a Outcome], variant: GridVariant, resolution: u32) -> Option<&'a Outcome> {
-        let spec = TracerSpec::Grid {
-            variant,
-            resolution,
-        };
         grid.iter()
             .copied()
-            .find(|o| o.ok() && o.config.tracer == spec)
+            .find(|o| o.ok() && o.config.tracer.grid() == Some((variant, resolution)))
     }
 
     /// The bunny with the grid at 24³ (the thesis' published resolution).

@@ -7,32 +7,24 @@
 //! "Two levels"). The protocols' own tables and figures stay the thesis' (base and grids); this
 //! module adds one table of the BVH beside them.
 
-use crate::bench::report::format::{int, num, ratio, table};
-use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
+use crate::bench::common::format::{int, num, ratio, table};
+use crate::bench::runner::config::{BvhVariant, Config, Sizing, Tracer};
 use crate::bench::runner::outcome::{FrameRecord, Outcome};
 
 /// The SAH BVH (the product's, not Wagner's) on each of `scenes`: one tree, then instances.
 pub fn configs(scenes: &[&str], refl_depth: u32, s: Sizing) -> Vec<Config> {
-    let tracers = [
-        TracerSpec::Bvh {
-            variant: BvhVariant::Sah,
-        },
-        TracerSpec::BvhInstances,
-    ];
-    let config = |(scene, tracer): (&&str, TracerSpec)| Config::new(scene, tracer, refl_depth, s);
+    let tracers = [Tracer::bvh(BvhVariant::Sah), Tracer::bvh_instances()];
+    let config = |(scene, tracer): (&&str, Tracer)| Config::new(scene, tracer, refl_depth, s);
     scenes
         .iter()
-        .flat_map(|scene| tracers.map(|t| (scene, t)))
+        .flat_map(|scene| tracers.clone().map(|t| (scene, t)))
         .map(config)
         .collect()
 }
 
 /// Whether `o` measured a BVH.
 pub fn is_bvh(o: &Outcome) -> bool {
-    matches!(
-        o.config.tracer,
-        TracerSpec::Bvh { .. } | TracerSpec::BvhInstances
-    )
+    o.config.tracer.row().name == "bvh"
 }
 
 /// The outcomes that are not the BVH's: those the thesis' tables and figures show.
@@ -71,17 +63,17 @@ pub fn table_text(outcomes: &[Outcome]) -> String {
         .map(|b| {
             let base = outcomes
                 .iter()
-                .find(|o| same(o, b) && o.config.tracer == TracerSpec::Base);
+                .find(|o| same(o, b) && o.config.tracer.is_base());
             let grid = outcomes
                 .iter()
-                .filter(|o| same(o, b) && matches!(o.config.tracer, TracerSpec::Grid { .. }))
+                .filter(|o| same(o, b) && o.config.tracer.grid().is_some())
                 .max_by(|x, y| fps(Some(x)).partial_cmp(&fps(Some(y))).expect("FPS"));
             let gpu = |o: Option<&Outcome>| o.and_then(|o| o.gpu_ms()).map(|s| s.mean);
             let tests = |o: Option<&Outcome>| o.and_then(|o| o.tests()).map(|s| s.mean);
             let cell = |v: Option<f64>, f: fn(f64) -> String| v.map_or("–".into(), f);
             // the update per frame: the refit's GPU time, or the instance table's CPU time
-            let (structure, refit, table) = match b.config.tracer {
-                TracerSpec::BvhInstances => (
+            let (structure, refit, table) = match b.config.tracer.variant_label() {
+                Some("sah-instances") => (
                     "instances",
                     "–".into(),
                     num(mean_fact(b, "bvh_instances_ms")),

@@ -9,17 +9,20 @@
 //!
 //! Every configuration names its BVH variant (`sah`, ours; `wagner`, the faithful megakernel):
 //! which variants run is `adapter::BVH_VARIANTS` (or `--bvh-variants`). Hardware-independent
-//! comparisons: FPS(n)/FPS(8) per size (A.1), FPS(size)/FPS(320×240) per object (A.2). The
-//! tables and figures are in [`crate::bench::report::wagner`].
+//! comparisons: FPS(n)/FPS(8) per size (A.1), FPS(size)/FPS(320×240) per object (A.2), each
+//! configuration beside its reference ([`ratios`]). The tables and figures are in
+//! [`crate::bench::report::wagner`].
 
 use anyhow::Result;
 
-use super::{Protocol, Section, Units};
+use super::protocol::Protocol;
+use crate::bench::common::section::Section;
 use crate::bench::published::wagner as pw;
-use crate::bench::report::wagner::{self as report, Ratios};
+use crate::bench::report::wagner::{self as report, size, Plan, RatioRow, Ratios};
 use crate::bench::runner::args::Scale;
-use crate::bench::runner::config::{BvhVariant, Config, Sizing, TracerSpec};
+use crate::bench::runner::config::{BvhVariant, Config, Sizing, Tracer};
 use crate::bench::runner::outcome::Outcome;
+use crate::bench::runner::units::Units;
 use crate::bench::runner::Bench;
 
 pub const SQUARE: &str = "square.toml";
@@ -56,18 +59,6 @@ pub const WAGNER_A2: Protocol = Protocol {
     units: Units::Configs,
 };
 
-/// What a run of a Wagner protocol measures.
-pub struct Plan {
-    /// Image sizes by pixel count, the reference 320×240 always among them.
-    pub sizes: Vec<(u32, u32)>,
-    /// The square's levels, ascending, level 1 always among them (A.1 only).
-    pub levels: Vec<u32>,
-    pub variants: Vec<BvhVariant>,
-    /// Measured frames (`angles`) and warm-up frames per configuration.
-    pub frames: Sizing,
-    pub scale: Scale,
-}
-
 impl Plan {
     fn of(bench: &Bench) -> Plan {
         let mut sizes = bench.sizes(QUICK_SIZES, FULL_SIZES);
@@ -95,7 +86,7 @@ impl Plan {
         let mut v = Vec::new();
         for &variant in &self.variants {
             for &size in &self.sizes {
-                let c = Config::fixed(scene, TracerSpec::Bvh { variant }, size, self.frames);
+                let c = Config::fixed(scene, Tracer::bvh(variant), size, self.frames);
                 v.push(match level {
                     Some(l) => c.with_level(l),
                     None => c,
@@ -125,7 +116,7 @@ impl Plan {
         };
         for &variant in &self.variants {
             if self.scale == Scale::Full || variant == BvhVariant::Sah {
-                let bvh = TracerSpec::Bvh { variant };
+                let bvh = Tracer::bvh(variant);
                 v.push(Config::fixed(DRAGON, bvh, pw::REFERENCE_SIZE, one));
             }
         }
@@ -138,7 +129,7 @@ impl Plan {
 fn a1_reference(o: &Outcome, r: &Outcome) -> bool {
     let (c, d) = (&o.config, &r.config);
     d.overrides.level == Some(REFERENCE_LEVEL)
-        && (c.tracer, c.width, c.height) == (d.tracer, d.width, d.height)
+        && (c.tracer.label(), c.width, c.height) == (d.tracer.label(), d.width, d.height)
 }
 
 /// Whether `r` is the reference of `o` in Table A.2: the same object and variant at 320×240.
@@ -147,22 +138,51 @@ fn a2_reference(o: &Outcome, r: &Outcome) -> bool {
     (d.width, d.height) == pw::REFERENCE_SIZE && c.scene == d.scene && c.tracer == d.tracer
 }
 
-/// The size of `o`'s configuration.
-pub fn size(o: &Outcome) -> (u32, u32) {
-    (o.config.width, o.config.height)
+/// The comparison of `outcomes`: the rows of `outcomes`: each one's FPS divided by that of the outcome `is_reference`
+/// picks, and `published` (the published FPS of the configuration and of its reference).
+fn ratios(
+    outcomes: &[Outcome],
+    reference: &'static str,
+    is_reference: fn(&Outcome, &Outcome) -> bool,
+    published: impl Fn(&Outcome) -> (Option<f64>, Option<f64>),
+) -> Ratios {
+    let fps = |o: &Outcome| o.ok().then(|| o.mean_fps()).flatten();
+    let rows = outcomes.iter().map(|o| {
+        let reference = outcomes.iter().find(|r| is_reference(o, r));
+        let (p, p_ref) = published(o);
+        let over = |a: Option<f64>, b: Option<f64>| Some(a? / b?);
+        RatioRow {
+            variant: o.config.tracer.variant_label().unwrap_or(""),
+            object: o.config.scene_name().to_string(),
+            level: o.config.overrides.level,
+            triangles: o.triangles,
+            size: size(o),
+            fps: fps(o),
+            ratio: over(fps(o), reference.and_then(fps)),
+            published: p,
+            published_ratio: over(p, p_ref),
+            gpu_ms: o.gpu_ms().map(|s| s.median),
+            build_ms: o.fact("bvh_build_ms"),
+            nodes: o.fact("bvh_nodes"),
+        }
+    });
+    Ratios {
+        reference,
+        rows: rows.collect(),
+    }
 }
 
 fn run_a1(p: &Protocol, bench: &mut Bench) -> Result<Section> {
     let plan = Plan::of(bench);
     let outcomes = bench.measure(p.name, &plan.a1_configs())?;
-    let ratios = Ratios::of(&outcomes, "FPS(8)", a1_reference, |o| {
+    let ratios = ratios(&outcomes, "FPS(8)", a1_reference, |o| {
         let published = |triangles| pw::a1_fps(triangles, size(o));
         (published(o.triangles), published(8))
     });
     let file = ratios.write(&bench.out, p.name)?;
     let markdown = report::a1_markdown(&plan, &ratios);
     let figures = report::a1_figures(&ratios);
-    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    let mut s = p.sweep_section(&bench.out, markdown, &outcomes, &figures)?;
     s.files.push(file);
     Ok(s)
 }
@@ -175,7 +195,7 @@ fn run_a2(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         .filter(|o| o.config.scene != DRAGON)
         .cloned()
         .collect();
-    let ratios = Ratios::of(&objects, "FPS(320×240)", a2_reference, |o| {
+    let ratios = ratios(&objects, "FPS(320×240)", a2_reference, |o| {
         let published = |size| pw::a2_fps(o.config.scene_name(), size);
         (published(size(o)), published(pw::REFERENCE_SIZE))
     });
@@ -186,7 +206,7 @@ fn run_a2(p: &Protocol, bench: &mut Bench) -> Result<Section> {
         .collect();
     let markdown = report::a2_markdown(&plan, &ratios, dragon_mesh(bench), &dragon);
     let figures = report::a2_figures(&ratios);
-    let mut s = Section::of_sweep(p, &bench.out, markdown, &outcomes, &figures)?;
+    let mut s = p.sweep_section(&bench.out, markdown, &outcomes, &figures)?;
     s.files.push(file);
     Ok(s)
 }

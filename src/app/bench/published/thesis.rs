@@ -2,7 +2,7 @@
 //! belongs to. Only numbers the text states are here: Figures 19–22 are plots whose values the
 //! text does not give, so for them only the stated setup and the qualitative findings are kept.
 
-use crate::bench::report::format::table;
+use crate::bench::common::format::table;
 
 /// The thesis' test system (ch. 5, first paragraph), and its parts.
 pub const GPU: &str = "NVIDIA GeForce GTX 780 (2304 shader units, 3 GB)";

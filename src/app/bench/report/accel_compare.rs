@@ -6,13 +6,111 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::csv_files::write_rows;
-use super::format::{int, num, ratio, table};
 use super::plots::{Chart, Figure, Series, Style};
-use crate::bench::protocols::accel_compare::{Row, Work, ACCELERATORS, QUICK_BASE_MAX_TRIANGLES};
-use crate::bench::protocols::accel_compare::{QUICK_WAGNER_MAX_TRIANGLES, STADIUM};
+use crate::bench::common::format::{int, num, ratio, table};
 use crate::bench::runner::args::Scale;
 use crate::bench::runner::config::Sizing;
+use crate::bench::runner::csv_files::write_rows;
+use gpgpu_rt::design::{self, Pipeline};
+
+/// What the comparison compares, as the protocol chose it: the accelerators (the tables'
+/// columns), the stadium (where the uniform grid is expected to break), the quick scale's
+/// limits, the frames and the scale.
+pub struct Plan {
+    pub accelerators: &'static [Accelerator],
+    pub stadium: &'static str,
+    pub quick_base_max_triangles: usize,
+    pub quick_wagner_max_triangles: usize,
+    pub sizing: Sizing,
+    pub scale: Scale,
+}
+
+/// An accelerator of the comparison: a point-light design of `design::REGISTRY`, with or
+/// without proximity clouds where it takes them, and its name in the tables and figures.
+#[derive(Debug, Clone, Copy)]
+pub struct Accelerator {
+    pub name: &'static str,
+    pub row: &'static design::Row,
+    pub proximity_clouds: bool,
+}
+
+impl Accelerator {
+    /// The pipeline it runs in, as the tables name it.
+    pub fn pipeline(&self) -> &'static str {
+        match self.row.pipeline {
+            Pipeline::Mueller2015 => "Müller 2015 (4 kernels)",
+            Pipeline::Wagner2018 => "own: Wagner 2018 megakernel",
+            Pipeline::Stream => "own: streaming tracer fragment passes",
+            Pipeline::Klee2016 => "own: Klee 2016 soft shadows",
+        }
+    }
+}
+
+/// The work of one kind of rays (or of the whole frame) per frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Work {
+    pub rays: f64,
+    /// Mean GPU milliseconds over the measured frames.
+    pub gpu_ms: f64,
+    pub tests: f64,
+    /// Voxels (grids) or BVH nodes visited.
+    pub visits: f64,
+}
+
+impl Work {
+    pub fn mrays_per_s(&self) -> Option<f64> {
+        (self.gpu_ms > 0.0 && self.rays > 0.0).then(|| self.rays / self.gpu_ms / 1e3)
+    }
+    pub fn tests_per_ray(&self) -> Option<f64> {
+        (self.rays > 0.0).then(|| self.tests / self.rays)
+    }
+    pub fn visits_per_ray(&self) -> Option<f64> {
+        (self.rays > 0.0 && self.visits > 0.0).then(|| self.visits / self.rays)
+    }
+    fn add(&mut self, o: &Work) {
+        self.rays += o.rays;
+        self.gpu_ms += o.gpu_ms;
+        self.tests += o.tests;
+        self.visits += o.visits;
+    }
+}
+
+/// One configuration's measurements.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub scene: String,
+    pub triangles: usize,
+    pub lights: usize,
+    pub accelerator: &'static Accelerator,
+    /// "grid exact 24³", "stream pc 58": the tracer with its resolution.
+    pub tracer: String,
+    pub build_ms: Option<f64>,
+    pub bytes: Option<f64>,
+    /// Per kind of ray, [`RAY_KINDS`] order (Müller's pipeline and the stream; zero work in
+    /// Wagner's megakernel).
+    pub kinds: [Work; 4],
+    /// Every ray of the frame over all of the frame's GPU time (builds included).
+    pub frame: Work,
+    /// Share of the pixels whose first hit agrees with the judge's, and the judge.
+    pub agreement: Option<(f64, String)>,
+    /// Triangle references and voxel ids the thesis grid's fixed lists could not hold.
+    pub lost: u64,
+    pub error: Option<String>,
+}
+
+impl Row {
+    /// Whether the pipeline counted the kinds of ray apart (all but Wagner's megakernel).
+    pub fn has_kinds(&self) -> bool {
+        self.kinds[0].rays > 0.0
+    }
+
+    /// The feelers towards every light: the first light's and the others'.
+    pub fn shadow_all(&self) -> Work {
+        let mut w = self.kinds[1];
+        w.add(&self.kinds[2]);
+        w
+    }
+}
 
 /// The row's work of one kind of ray.
 type KindOf = fn(&Row) -> Work;
@@ -105,26 +203,27 @@ fn opt_num(v: Option<f64>) -> String {
     v.map_or("–".into(), num)
 }
 
-pub fn markdown(rows: &[Row], s: Sizing, scale: Scale) -> String {
-    let mut md = intro(s, scale);
+pub fn markdown(plan: &Plan, rows: &[Row]) -> String {
+    let mut md = intro(plan);
     md += "\n### Frame throughput (Mrays/s: all rays of the frame over all of its GPU time)\n\n";
-    md += &throughput_matrix(rows);
+    md += &throughput_matrix(plan, rows);
     md += "\n### Each kind of ray apart (Müller 2015's pipeline and the stream)\n\n";
     md += &kinds_table(rows);
     md += "\n### Build, memory, work per ray, agreement\n\n";
     md += &configs_table(rows);
     md += "\n### Analysis\n\n";
-    md += &analysis(rows);
+    md += &analysis(plan, rows);
     md
 }
 
-fn intro(s: Sizing, scale: Scale) -> String {
+fn intro(plan: &Plan) -> String {
+    let (s, scale) = (plan.sizing, plan.scale);
     let skipped = match scale {
         Scale::Quick => format!(
             " At this scale the base tracer runs on scenes of at most {} triangles and Wagner's \
              faithful (recursive) build on at most {} (the CPU reference judges every scene).",
-            int(QUICK_BASE_MAX_TRIANGLES as f64),
-            int(QUICK_WAGNER_MAX_TRIANGLES as f64)
+            int(plan.quick_base_max_triangles as f64),
+            int(plan.quick_wagner_max_triangles as f64)
         ),
         Scale::Full => String::new(),
     };
@@ -147,13 +246,14 @@ fn intro(s: Sizing, scale: Scale) -> String {
 }
 
 /// Scenes × accelerators: the frame's Mrays/s, the fastest in bold.
-fn throughput_matrix(rows: &[Row]) -> String {
+fn throughput_matrix(plan: &Plan, rows: &[Row]) -> String {
     let mut header = vec!["scene", "triangles"];
-    header.extend(ACCELERATORS.iter().map(|a| a.name));
+    header.extend(plan.accelerators.iter().map(|a| a.name));
     let lines: Vec<Vec<String>> = scenes(rows)
         .iter()
         .map(|(scene, t)| {
-            let values: Vec<Option<f64>> = ACCELERATORS
+            let values: Vec<Option<f64>> = plan
+                .accelerators
                 .iter()
                 .map(|a| find(rows, scene, a.name).and_then(|r| r.frame.mrays_per_s()))
                 .collect();
@@ -275,9 +375,9 @@ fn median(values: &mut [f64]) -> Option<f64> {
 }
 
 /// (triangles, primary tests per ray) of an accelerator over the scenes but the stadium.
-fn tests_per_primary_ray(rows: &[Row], accelerator: &str) -> Vec<(f64, f64)> {
+fn tests_per_primary_ray(plan: &Plan, rows: &[Row], accelerator: &str) -> Vec<(f64, f64)> {
     let r = rows.iter().filter(|r| {
-        r.accelerator.name == accelerator && r.error.is_none() && r.scene != stem(STADIUM)
+        r.accelerator.name == accelerator && r.error.is_none() && r.scene != stem(plan.stadium)
     });
     let work = |r: &Row| match r.has_kinds() {
         true => r.kinds[0].tests_per_ray(),
@@ -293,8 +393,12 @@ fn stem(scene: &str) -> &str {
 
 /// The findings: who wins where, whether tests per ray stay constant, where the grid breaks,
 /// and each accelerator against the SAH BVH (the peer table's yardstick against Embree).
-fn analysis(rows: &[Row]) -> String {
-    wins(rows) + &constancy(rows) + &stadium(rows) + &agreement(rows) + &versus_bvh(rows)
+fn analysis(plan: &Plan, rows: &[Row]) -> String {
+    wins(rows)
+        + &constancy(plan, rows)
+        + &stadium(plan, rows)
+        + &agreement(rows)
+        + &versus_bvh(plan, rows)
 }
 
 /// The configurations whose first hits differ from the judge's, with what their lists lost.
@@ -361,17 +465,18 @@ fn wins(rows: &[Row]) -> String {
 }
 
 /// Szirmay-Kalos et al. 2002: with a grid of ~T cells the expected tests per ray are O(1).
-fn constancy(rows: &[Row]) -> String {
+fn constancy(plan: &Plan, rows: &[Row]) -> String {
     let mut s = String::from(
         "- **Do the tests per ray stay constant?** Szirmay-Kalos et al. (2002) expect O(1) \
          tests and steps per ray for a uniform grid with cells in proportion to the triangles. \
          The log–log slope of primary-ray triangle tests per ray over the triangle count \
          (0: constant, 1: in proportion; every scene but the stadium): ",
     );
-    let parts: Vec<String> = ACCELERATORS
+    let parts: Vec<String> = plan
+        .accelerators
         .iter()
         .filter_map(|a| {
-            let p = tests_per_primary_ray(rows, a.name);
+            let p = tests_per_primary_ray(plan, rows, a.name);
             let slope = log_log_slope(&p)?;
             let ys: Vec<f64> = p.iter().map(|q| q.1).collect();
             let lo = ys.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -389,15 +494,16 @@ fn constancy(rows: &[Row]) -> String {
 }
 
 /// The stadium against the other scenes, for the grids and the BVH.
-fn stadium(rows: &[Row]) -> String {
-    let scene = stem(STADIUM);
+fn stadium(plan: &Plan, rows: &[Row]) -> String {
+    let scene = stem(plan.stadium);
     let mut s = String::from(
         "- **The teapot in a stadium** (the whole teapot falls into a few of the grid's cells): \
          primary tests per ray there vs the median over the other scenes, and the frame \
          throughput relative to `bvh sah` there vs the median elsewhere: ",
     );
     let bvh = |scene: &str| find(rows, scene, "bvh sah").and_then(|r| r.frame.mrays_per_s());
-    let parts: Vec<String> = ACCELERATORS
+    let parts: Vec<String> = plan
+        .accelerators
         .iter()
         .filter(|a| a.name != "bvh sah")
         .filter_map(|a| {
@@ -406,7 +512,7 @@ fn stadium(rows: &[Row]) -> String {
                 true => here.kinds[0].tests_per_ray(),
                 false => here.frame.tests_per_ray(),
             }?;
-            let mut others: Vec<f64> = tests_per_primary_ray(rows, a.name)
+            let mut others: Vec<f64> = tests_per_primary_ray(plan, rows, a.name)
                 .iter()
                 .map(|p| p.1)
                 .collect();
@@ -432,12 +538,13 @@ fn stadium(rows: &[Row]) -> String {
 }
 
 /// Each accelerator's frame throughput relative to the SAH BVH, over the scenes both ran.
-fn versus_bvh(rows: &[Row]) -> String {
+fn versus_bvh(plan: &Plan, rows: &[Row]) -> String {
     let mut s = String::from(
         "- **Against the SAH BVH, and so against Embree**: the geometric mean over the scenes of \
          each accelerator's frame Mrays/s divided by `bvh sah`'s on the same scene: ",
     );
-    let parts: Vec<String> = ACCELERATORS
+    let parts: Vec<String> = plan
+        .accelerators
         .iter()
         .map(|a| {
             let ratios: Vec<f64> = rows
@@ -470,8 +577,15 @@ fn series_points(rows: &[Row], name: &str, y: impl Fn(&Row) -> Option<f64>) -> V
 }
 
 /// A log–log chart of `y` over the triangle count, a series per accelerator with data.
-fn chart(rows: &[Row], title: &str, y_label: &str, y: fn(&Row) -> Option<f64>) -> Chart {
-    let series = ACCELERATORS
+fn chart(
+    plan: &Plan,
+    rows: &[Row],
+    title: &str,
+    y_label: &str,
+    y: fn(&Row) -> Option<f64>,
+) -> Chart {
+    let series = plan
+        .accelerators
         .iter()
         .enumerate()
         .map(|(i, a)| Series::new(a.name, series_points(rows, a.name, y), Style::LinePoints, i))
@@ -482,14 +596,14 @@ fn chart(rows: &[Row], title: &str, y_label: &str, y: fn(&Row) -> Option<f64>) -
         .log_y()
 }
 
-pub fn figures(rows: &[Row]) -> Vec<Figure> {
-    let throughput = chart(rows, "Frame throughput", "Mrays/s", |r| {
+pub fn figures(plan: &Plan, rows: &[Row]) -> Vec<Figure> {
+    let throughput = chart(plan, rows, "Frame throughput", "Mrays/s", |r| {
         r.frame.mrays_per_s()
     });
-    let tests = chart(rows, "Triangle tests per ray", "tests per ray", |r| {
+    let tests = chart(plan, rows, "Triangle tests per ray", "tests per ray", |r| {
         r.frame.tests_per_ray()
     });
-    let build = chart(rows, "Build", "build ms", |r| r.build_ms);
+    let build = chart(plan, rows, "Build", "build ms", |r| r.build_ms);
     vec![Figure::new(
         "accel-compare.png",
         "Mrays/s, tests per ray and build time over the triangle count (log–log)",

@@ -7,8 +7,6 @@
 //! their protocol's file ([`accel_compare`], [`proximity_clouds`], [`wagner`]).
 
 pub mod accel_compare;
-pub mod csv_files;
-pub mod format;
 pub mod plots;
 pub mod proximity_clouds;
 pub mod wagner;
@@ -18,15 +16,15 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use crate::bench::protocols::Section;
+use crate::bench::common::format::table;
+use crate::bench::common::section::Section;
 use crate::bench::published::thesis;
 use crate::bench::runner::adapter::grid_list_defaults;
 use crate::bench::runner::args::{BenchArgs, Rotation, Scale};
 use crate::bench::runner::config::{FULL_SIZE, QUICK_SIZE};
 use crate::bench::runner::machine::Machine;
-use crate::bench::runner::shard::Shard;
+use crate::bench::runner::units::Shard;
 use crate::bench::runner::Bench;
-use format::table;
 
 /// A published work a report sets our numbers beside: the short name every page uses
 /// (docs/references.md), what the work is, and the part of it the protocols replicate.

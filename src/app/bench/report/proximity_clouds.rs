@@ -7,13 +7,28 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::csv_files::write_rows;
-use super::format::{int, num, ratio, table};
 use super::plots::{Chart, Figure, Series, Style};
-use crate::bench::protocols::proximity_clouds::{Plan, SPARSE};
+use crate::bench::common::format::{int, num, ratio, table};
 use crate::bench::published::proximity_clouds::{self as pp, PaperScene};
-use crate::bench::runner::config::TracerSpec;
+use crate::bench::runner::config::{Sizing, Tracer};
+use crate::bench::runner::csv_files::write_rows;
 use crate::bench::runner::outcome::Outcome;
+
+/// What a run of `proximity-clouds-table<n>` measures.
+pub struct Plan {
+    pub table: u32,
+    /// Image sides (square images), ascending.
+    pub sides: Vec<u32>,
+    pub frames: Sizing,
+    /// Table 1 adds the Stanford bunny at 512² (stream vs compute grid) unless the
+    /// command line chose the sizes.
+    pub bunny_512: bool,
+    /// The scene added to the paper's (not in the paper), where skipping empty cells should
+    /// pay.
+    pub sparse: PaperScene,
+    /// The side of the Stanford bunny's image that `bunny_512` adds.
+    pub bunny_side: u32,
+}
 
 /// The paper's columns and ours.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,26 +58,19 @@ impl Column {
             Column::GridPc => "grid-pc",
         }
     }
-    fn of(t: &TracerSpec) -> Option<Column> {
-        match *t {
-            TracerSpec::Stream {
-                naive_shadows,
-                no_mask,
-                ..
-            } if naive_shadows || no_mask => Some(match (naive_shadows, no_mask) {
-                (true, false) => Column::StreamNaive,
-                (false, true) => Column::StreamNoMask,
-                _ => Column::StreamNaiveNoMask,
-            }),
-            TracerSpec::Stream {
-                proximity_clouds, ..
-            } => Some(if proximity_clouds {
-                Column::StreamPc
-            } else {
-                Column::StreamG
-            }),
-            TracerSpec::Grid { .. } => Some(Column::GridG),
-            TracerSpec::GridPc { .. } => Some(Column::GridPc),
+    fn of(t: &Tracer) -> Option<Column> {
+        if let Some(o) = t.stream_options() {
+            return Some(match (o.naive_shadows, o.no_mask, o.proximity_clouds) {
+                (true, false, _) => Column::StreamNaive,
+                (false, true, _) => Column::StreamNoMask,
+                (true, true, _) => Column::StreamNaiveNoMask,
+                (false, false, true) => Column::StreamPc,
+                (false, false, false) => Column::StreamG,
+            });
+        }
+        match (t.grid(), t.proximity_clouds()) {
+            (Some(_), _) => Some(Column::GridG),
+            (None, true) => Some(Column::GridPc),
             _ => None,
         }
     }
@@ -114,8 +122,8 @@ fn side_cell(plan: &Plan, side: u32) -> String {
 }
 
 /// The scenes of the report, with the sides each was measured at.
-fn scenes_and_sides(outcomes: &[Outcome]) -> Vec<(PaperScene, Vec<u32>)> {
-    let all = pp::SCENES.iter().chain(std::iter::once(&SPARSE));
+fn scenes_and_sides(plan: &Plan, outcomes: &[Outcome]) -> Vec<(PaperScene, Vec<u32>)> {
+    let all = pp::SCENES.iter().chain(std::iter::once(&plan.sparse));
     all.filter_map(|s| {
         let mut sides: Vec<u32> = outcomes
             .iter()
@@ -230,7 +238,7 @@ fn times_table(plan: &Plan, outcomes: &[Outcome]) -> String {
         header.extend(["grid pc", "grid pc/g"]);
     }
     let mut rows = Vec::new();
-    for (scene, sides) in scenes_and_sides(outcomes) {
+    for (scene, sides) in scenes_and_sides(plan, outcomes) {
         for side in sides {
             let paper = |pc| pp::ms(plan.table, scene.file, paper_side(plan, side)?, pc);
             let o = |c| ours(outcomes, scene.file, side, c);
@@ -301,8 +309,8 @@ fn counts_table(outcomes: &[Outcome]) -> String {
 /// pc/g over the dense scenes: how many (scene, side) pairs pc was slower, of how many.
 pub fn pc_slower(plan: &Plan, outcomes: &[Outcome], paper: bool) -> (usize, usize) {
     let mut slower = (0, 0);
-    for (scene, sides) in scenes_and_sides(outcomes) {
-        if !scene.pc || scene.file == SPARSE.file {
+    for (scene, sides) in scenes_and_sides(plan, outcomes) {
+        if !scene.pc || scene.file == plan.sparse.file {
             continue;
         }
         for side in sides {
@@ -390,7 +398,7 @@ fn findings(plan: &Plan, outcomes: &[Outcome]) -> String {
     let _ = writeln!(
         s,
         "- Streaming tracer vs compute grid on the same frames: {}.",
-        bunny_line(outcomes)
+        bunny_line(plan, outcomes)
     );
     s
 }
@@ -469,7 +477,7 @@ fn sparse_line(plan: &Plan, outcomes: &[Outcome]) -> String {
         .sides
         .iter()
         .map(|&side| {
-            let at = |c| ours(outcomes, SPARSE.file, side, c);
+            let at = |c| ours(outcomes, plan.sparse.file, side, c);
             let (g, pc) = (at(Column::StreamG), at(Column::StreamPc));
             let (gg, gpc) = (at(Column::GridG), at(Column::GridPc));
             format!(
@@ -483,9 +491,9 @@ fn sparse_line(plan: &Plan, outcomes: &[Outcome]) -> String {
     parts.join("; ")
 }
 
-fn bunny_line(outcomes: &[Outcome]) -> String {
+fn bunny_line(plan: &Plan, outcomes: &[Outcome]) -> String {
     let file = pp::STANFORD_BUNNY.file;
-    let side = crate::bench::protocols::proximity_clouds::BUNNY_SIDE;
+    let side = plan.bunny_side;
     let at = |c| ours(outcomes, file, side, c);
     match (at(Column::StreamG), at(Column::GridG)) {
         (Some(g), Some(gg)) => format!(
@@ -502,7 +510,7 @@ fn bunny_line(outcomes: &[Outcome]) -> String {
 /// One panel per scene: ms relative to the scene's stream g at the smallest side, against
 /// the side relative to the smallest (1, 2, 3), ours and the paper's.
 pub fn figures(protocol: &str, plan: &Plan, outcomes: &[Outcome]) -> Vec<Figure> {
-    let scenes = [pp::KNIGHT, pp::TORUS_KNOT, pp::BUNNY, SPARSE];
+    let scenes = [pp::KNIGHT, pp::TORUS_KNOT, pp::BUNNY, plan.sparse];
     let charts: Vec<Chart> = scenes.iter().map(|s| chart(plan, outcomes, s)).collect();
     let caption = format!(
         "The streaming tracer, Table {}: milliseconds relative to stream g at the smallest side, by side \

@@ -1,4 +1,4 @@
-//! The report of the Wagner 2018 protocols ([`crate::bench::protocols::wagner`]): our FPS
+//! The report of the Wagner 2018 protocols: what a run measured (its [`Plan`]) and our FPS
 //! beside the published ones with the hardware-independent ratios (a CSV and markdown tables),
 //! the published tables as typed in, the dragon's BVH build beside the thesis' remark, and
 //! figures shaped like Fig. 5.1 and Fig. 5.4.
@@ -8,12 +8,30 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use super::csv_files::write_rows;
-use super::format::{int, num, ratio, table};
 use super::plots::{Chart, Figure, Series, Style};
-use crate::bench::protocols::wagner::{size, Plan};
+use crate::bench::common::format::{int, num, ratio, table};
 use crate::bench::published::wagner as pw;
+use crate::bench::runner::args::Scale;
+use crate::bench::runner::config::{BvhVariant, Sizing};
+use crate::bench::runner::csv_files::write_rows;
 use crate::bench::runner::outcome::Outcome;
+
+/// What a run of a Wagner protocol measures.
+pub struct Plan {
+    /// Image sizes by pixel count, the reference 320×240 always among them.
+    pub sizes: Vec<(u32, u32)>,
+    /// The square's levels, ascending, level 1 always among them (A.1 only).
+    pub levels: Vec<u32>,
+    pub variants: Vec<BvhVariant>,
+    /// Measured frames (`angles`) and warm-up frames per configuration.
+    pub frames: Sizing,
+    pub scale: Scale,
+}
+
+/// The size of `o`'s configuration.
+pub fn size(o: &Outcome) -> (u32, u32) {
+    (o.config.width, o.config.height)
+}
 
 /// One measured configuration beside the published numbers.
 #[derive(Debug, Clone)]
@@ -43,40 +61,6 @@ pub struct Ratios {
 }
 
 impl Ratios {
-    /// The rows of `outcomes`: each one's FPS divided by that of the outcome `is_reference`
-    /// picks, and `published` (the published FPS of the configuration and of its reference).
-    pub fn of(
-        outcomes: &[Outcome],
-        reference: &'static str,
-        is_reference: fn(&Outcome, &Outcome) -> bool,
-        published: impl Fn(&Outcome) -> (Option<f64>, Option<f64>),
-    ) -> Ratios {
-        let fps = |o: &Outcome| o.ok().then(|| o.mean_fps()).flatten();
-        let rows = outcomes.iter().map(|o| {
-            let reference = outcomes.iter().find(|r| is_reference(o, r));
-            let (p, p_ref) = published(o);
-            let over = |a: Option<f64>, b: Option<f64>| Some(a? / b?);
-            RatioRow {
-                variant: o.config.tracer.variant_label().unwrap_or(""),
-                object: o.config.scene_name().to_string(),
-                level: o.config.overrides.level,
-                triangles: o.triangles,
-                size: size(o),
-                fps: fps(o),
-                ratio: over(fps(o), reference.and_then(fps)),
-                published: p,
-                published_ratio: over(p, p_ref),
-                gpu_ms: o.gpu_ms().map(|s| s.median),
-                build_ms: o.fact("bvh_build_ms"),
-                nodes: o.fact("bvh_nodes"),
-            }
-        });
-        Ratios {
-            reference,
-            rows: rows.collect(),
-        }
-    }
-
     /// Write `<protocol>_ratios.csv` into `out`; the file name, relative to `out`.
     pub fn write(&self, out: &Path, protocol: &str) -> Result<PathBuf> {
         let file = PathBuf::from(format!("{protocol}_ratios.csv"));

@@ -12,10 +12,8 @@ use anyhow::{Context as _, Result};
 use glam::Mat4;
 
 use super::args::BenchArgs;
-use super::config::{BvhVariant, Config, Sizing, TracerSpec};
-use gpgpu_rt::accel::{
-    Accel, BvhLevels, BvhOptions, BvhPasses, ExactGridOptions, GridVariant, ThesisGridOptions,
-};
+use super::config::{BvhVariant, Config, Sizing};
+use gpgpu_rt::accel::{Accel, ThesisGridOptions};
 use gpgpu_rt::design::Design;
 use gpgpu_rt::gl::{GlContext, GlInfo, ShaderSource};
 use gpgpu_rt::pipeline::klee2016::{SoftShadowOptions, SoftShadowRenderer};
@@ -60,75 +58,45 @@ pub fn grid_list_defaults() -> (u32, Option<u32>) {
 /// `--bvh-variants` says otherwise): ours in Müller's pipeline and Wagner's megakernel.
 pub const BVH_VARIANTS: &[BvhVariant] = &[BvhVariant::Sah, BvhVariant::Wagner];
 
-/// The design of configuration `c`, with the command line's `--tile` and list lengths; the
-/// first hits kept where the configuration is judged against the CPU reference.
+/// The design of configuration `c` (its tracer's, each protocol's configuration pinned there)
+/// at the configuration's size and reflection depth, with the command line's `--tile` and
+/// list lengths, the thesis' RGBA shadow flags; the first hits kept where the configuration is
+/// judged against the CPU reference.
 fn design(c: &Config, args: &BenchArgs) -> Design {
     let (width, height, aovs) = (c.width, c.height, c.judge);
-    let mueller = |accel| {
-        Design::Mueller2015(RenderOptions {
+    match c.tracer.0.clone() {
+        Design::Mueller2015(o) => Design::Mueller2015(RenderOptions {
             tile: args.tile,
             shadow_flags: ShadowFlags::Rgba,
             aovs,
-            ..RenderOptions::new(accel, width, height, c.refl_depth)
-        })
-    };
-    // the protocols measure the SAH BVH in Müller 2015's four kernels, the thesis' pipeline
-    // that every accelerator of theirs runs in: pinned here, whatever the default of `render`
-    let bvh = |levels| {
-        Accel::Bvh(BvhOptions {
-            passes: BvhPasses::FourKernels,
-            levels,
-        })
-    };
-    match c.tracer {
-        TracerSpec::Base => mueller(Accel::Base),
-        TracerSpec::Grid {
-            variant: GridVariant::Thesis,
-            resolution,
-        } => {
-            let d = ThesisGridOptions::default();
-            mueller(Accel::ThesisGrid(ThesisGridOptions {
-                resolution: Some(resolution),
-                voxel_array_length: args.grid.voxel_array_length.unwrap_or(d.voxel_array_length),
-                ray_array_length: args.grid.ray_array_length.or(d.ray_array_length),
-            }))
-        }
-        TracerSpec::Grid {
-            variant: GridVariant::Exact,
-            resolution,
-        } => mueller(Accel::ExactGrid(ExactGridOptions {
-            resolution: Some(resolution),
-            proximity_clouds: false,
-        })),
-        TracerSpec::GridPc { resolution } => mueller(Accel::ExactGrid(ExactGridOptions {
-            resolution: Some(resolution),
-            proximity_clouds: true,
-        })),
-        TracerSpec::Bvh {
-            variant: BvhVariant::Sah,
-        } => mueller(bvh(BvhLevels::One)),
-        TracerSpec::BvhInstances => mueller(bvh(BvhLevels::Two)),
-        TracerSpec::Bvh {
-            variant: BvhVariant::Wagner,
-        } => Design::Wagner2018(WagnerOptions {
+            ..RenderOptions::new(with_lists(o.accel, args), width, height, c.refl_depth)
+        }),
+        Design::Wagner2018(_) => Design::Wagner2018(WagnerOptions {
             width,
             height,
             tile: args.tile,
             aovs,
         }),
-        TracerSpec::Stream {
-            axes,
-            proximity_clouds,
-            naive_shadows,
-            no_mask,
-        } => Design::Stream(StreamOptions {
-            dims: Some(axes),
-            proximity_clouds,
-            naive_shadows,
-            no_mask,
+        Design::Stream(o) => Design::Stream(StreamOptions {
+            width,
+            height,
+            refl_depth: c.refl_depth,
             aovs,
-            ..StreamOptions::new(width, height, c.refl_depth)
+            ..o
         }),
+        Design::Klee2016(_) => unreachable!("the soft shadows are measured by their own protocols"),
+    }
+}
+
+/// The thesis grid with the command line's list lengths, where it gives them.
+fn with_lists(accel: Accel, args: &BenchArgs) -> Accel {
+    match accel {
+        Accel::ThesisGrid(o) => Accel::ThesisGrid(ThesisGridOptions {
+            voxel_array_length: args.grid.voxel_array_length.unwrap_or(o.voxel_array_length),
+            ray_array_length: args.grid.ray_array_length.or(o.ray_array_length),
+            ..o
+        }),
+        other => other,
     }
 }
 

@@ -7,7 +7,7 @@ use anyhow::{bail, Result};
 use gpgpu_rt::limits;
 
 use super::config::{BvhVariant, GridVariant};
-use super::shard::{parse_shard, Shard};
+use super::units::{parse_shard, Shard};
 
 /// The protocols `gpgpu-rt bench` knows: the command line's values
 /// (`crate::bench::protocols::protocol_of` says which protocol each one runs).

@@ -1,7 +1,10 @@
 //! What a protocol configures: the sizes at each scale, and the configurations it measures
 //! (scene, tracer, image size, reflection depth, rotation angles, warm-up frames).
 
-use gpgpu_rt::design::Row;
+use gpgpu_rt::accel::{self, Accel, BvhLevels, BvhOptions, BvhPasses, ExactGridOptions};
+use gpgpu_rt::design::{Design, Row};
+use gpgpu_rt::pipeline::mueller2015::RenderOptions;
+use gpgpu_rt::pipeline::stream::StreamOptions;
 pub use gpgpu_rt::scene::Overrides;
 
 /// Default image size at `--scale quick`: small enough for Mesa llvmpipe.
@@ -51,86 +54,144 @@ pub use gpgpu_rt::accel::GridVariant;
 /// measures is [`super::adapter::BVH_VARIANTS`].
 pub use gpgpu_rt::accel::BvhVariant;
 
-/// Which tracer a configuration measures.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TracerSpec {
+/// Which tracer a configuration measures: the library's design, the same value `render`
+/// parses from its command line, with each protocol's configuration pinned in it (the SAH BVH
+/// in Müller 2015's four kernels, the thesis' pipeline the protocols compare in). Its size,
+/// reflection depth, tile and AOVs are the configuration's, set when it runs
+/// (`adapter::design`).
+#[derive(Debug, Clone)]
+pub struct Tracer(pub Design);
+
+/// Two tracers are one configuration where their labels are: the label names every option a
+/// protocol varies, and the reports and CSVs know a configuration by it.
+impl PartialEq for Tracer {
+    fn eq(&self, other: &Tracer) -> bool {
+        self.label() == other.label()
+    }
+}
+
+impl Tracer {
+    /// Müller 2015's pipeline with `accel` (a placeholder size until it runs).
+    fn mueller(accel: Accel) -> Tracer {
+        Tracer(Design::Mueller2015(RenderOptions::new(accel, 1, 1, 0)))
+    }
+
     /// The base tracer: every ray against every triangle.
-    Base,
-    /// The uniform-grid tracer with a fixed resolution (N³ voxels).
-    Grid {
-        variant: GridVariant,
-        resolution: u32,
-    },
-    /// A BVH tracer (`--tracer bvh`) of one variant.
-    Bvh { variant: BvhVariant },
-    /// The SAH BVH as a tree per object under instances (`--tracer bvh --bvh-instances`): a
-    /// moving object rewrites its instance, where the one tree is refitted.
-    BvhInstances,
-    /// The streaming tracer (`--tracer stream`) on a gx×gy×gz grid, with or without
-    /// proximity clouds: the paper's columns pc and g.
-    /// With `naive_shadows`, the naive shadow rays the paper's optimisation is measured
-    /// against (`--stream-naive-shadows`); with `no_mask`, without the masking kernel's
-    /// optimisation (`--stream-no-mask`).
-    Stream {
+    pub fn base() -> Tracer {
+        Tracer::mueller(Accel::Base)
+    }
+
+    /// The uniform grid `variant` with a fixed resolution (N³ voxels; the thesis grid with
+    /// Listing 17's list lengths unless the command line says otherwise).
+    pub fn uniform_grid(variant: GridVariant, resolution: u32) -> Tracer {
+        let accel = match variant {
+            GridVariant::Thesis => accel::thesis_grid::ENTRY.plain,
+            GridVariant::Exact => accel::exact_grid::ENTRY.plain,
+        };
+        Tracer::mueller(accel.with_grid_resolution(resolution))
+    }
+
+    /// The exact grid of N³ voxels with proximity clouds (`--tracer grid --proximity-clouds`).
+    pub fn grid_pc(resolution: u32) -> Tracer {
+        Tracer::mueller(Accel::ExactGrid(ExactGridOptions {
+            resolution: Some(resolution),
+            proximity_clouds: true,
+        }))
+    }
+
+    /// A BVH of one variant: ours in Müller 2015's four kernels, or Wagner 2018's kernel.
+    pub fn bvh(variant: BvhVariant) -> Tracer {
+        match variant {
+            BvhVariant::Sah => Tracer::sah(BvhLevels::One),
+            BvhVariant::Wagner => Tracer(Design::plain(Tracer::row_named("bvh-wagner"), 1, 1, 0)),
+        }
+    }
+
+    /// The SAH BVH as a tree per object under instances (`--bvh-instances`), in the four
+    /// kernels: a moving object rewrites its instance, where the one tree is refitted.
+    pub fn bvh_instances() -> Tracer {
+        Tracer::sah(BvhLevels::Two)
+    }
+
+    fn sah(levels: BvhLevels) -> Tracer {
+        Tracer::mueller(Accel::Bvh(BvhOptions {
+            passes: BvhPasses::FourKernels,
+            levels,
+        }))
+    }
+
+    /// The streaming tracer on a gx×gy×gz grid, with or without proximity clouds (the
+    /// paper's columns pc and g); with `naive_shadows`, the naive shadow rays the paper's
+    /// optimisation is measured against; with `no_mask`, without the masking kernel's.
+    pub fn stream(
         axes: [u32; 3],
         proximity_clouds: bool,
         naive_shadows: bool,
         no_mask: bool,
-    },
-    /// The compute exact grid (`--tracer grid`) of N³ voxels with proximity clouds
-    /// (`--tracer grid --proximity-clouds`, issue 12 §3).
-    GridPc { resolution: u32 },
-}
+    ) -> Tracer {
+        Tracer(Design::Stream(StreamOptions {
+            dims: Some(axes),
+            proximity_clouds,
+            naive_shadows,
+            no_mask,
+            ..StreamOptions::new(1, 1, 0)
+        }))
+    }
 
-impl TracerSpec {
+    fn row_named(name: &str) -> &'static Row {
+        gpgpu_rt::design::row(name).expect("the registry has every tracer of the bench")
+    }
+
     /// Its design in `design::REGISTRY`.
     pub fn row(&self) -> &'static Row {
-        let name = match self {
-            TracerSpec::Base => "base",
-            TracerSpec::Grid {
-                variant: GridVariant::Thesis,
-                ..
-            } => "grid-thesis",
-            TracerSpec::Grid { .. } | TracerSpec::GridPc { .. } => "grid-exact",
-            TracerSpec::Bvh {
-                variant: BvhVariant::Sah,
-            }
-            | TracerSpec::BvhInstances => "bvh",
-            TracerSpec::Bvh {
-                variant: BvhVariant::Wagner,
-            } => "bvh-wagner",
-            TracerSpec::Stream { .. } => "stream",
-        };
-        gpgpu_rt::design::row(name).expect("the registry has every tracer of the bench")
+        self.0.row()
+    }
+
+    /// The accelerator of Müller 2015's pipeline; `None` for the other pipelines.
+    fn accel(&self) -> Option<&Accel> {
+        match &self.0 {
+            Design::Mueller2015(o) => Some(&o.accel),
+            _ => None,
+        }
+    }
+
+    /// The streaming tracer's options; `None` for the other designs.
+    pub fn stream_options(&self) -> Option<&StreamOptions> {
+        match &self.0 {
+            Design::Stream(o) => Some(o),
+            _ => None,
+        }
+    }
+
+    /// Whether it is the base tracer.
+    pub fn is_base(&self) -> bool {
+        self.accel() == Some(&Accel::Base)
     }
 
     /// Whether it skips empty cells by proximity clouds.
     pub fn proximity_clouds(&self) -> bool {
-        match *self {
-            TracerSpec::GridPc { .. } => true,
-            TracerSpec::Stream {
-                proximity_clouds, ..
-            } => proximity_clouds,
+        match (self.accel(), self.stream_options()) {
+            (Some(a), _) => a.proximity_clouds(),
+            (_, Some(o)) => o.proximity_clouds,
             _ => false,
         }
     }
 
+    /// "base", "grid", "bvh", "stream": the `--tracer` value.
     pub fn name(&self) -> &'static str {
-        match self {
-            TracerSpec::Base => "base",
-            TracerSpec::Grid { .. } => "grid",
-            TracerSpec::Bvh { .. } | TracerSpec::BvhInstances => "bvh",
-            TracerSpec::Stream { .. } => "stream",
-            TracerSpec::GridPc { .. } => "grid",
+        match (&self.0, self.accel()) {
+            (_, Some(a)) => a.tracer(),
+            (Design::Stream(_), _) => "stream",
+            _ => "bvh",
         }
     }
-    /// The grid's variant and resolution; `None` for the other tracers.
+
+    /// The uniform grid's variant and resolution (without proximity clouds); `None` for the
+    /// other tracers.
     pub fn grid(&self) -> Option<(GridVariant, u32)> {
-        match *self {
-            TracerSpec::Grid {
-                variant,
-                resolution,
-            } => Some((variant, resolution)),
+        match *self.accel()? {
+            Accel::ThesisGrid(o) => Some((GridVariant::Thesis, o.resolution?)),
+            Accel::ExactGrid(o) if !o.proximity_clouds => Some((GridVariant::Exact, o.resolution?)),
             _ => None,
         }
     }
@@ -143,58 +204,38 @@ impl TracerSpec {
     }
     /// The grid's cells per axis, of any grid tracer: "24", "14x16x14"; `None` without a grid.
     pub fn grid_label(&self) -> Option<String> {
-        match *self {
-            TracerSpec::Grid { resolution, .. } | TracerSpec::GridPc { resolution } => {
-                Some(resolution.to_string())
-            }
-            TracerSpec::Stream {
-                axes: [x, y, z], ..
-            } if x == y && y == z => Some(x.to_string()),
-            TracerSpec::Stream {
-                axes: [x, y, z], ..
-            } => Some(format!("{x}x{y}x{z}")),
-            _ => None,
+        if let Some(n) = self.accel().and_then(|a| a.grid_resolution()) {
+            return Some(n.to_string());
+        }
+        match self.stream_options()?.dims? {
+            [x, y, z] if x == y && y == z => Some(x.to_string()),
+            [x, y, z] => Some(format!("{x}x{y}x{z}")),
         }
     }
     /// The variant's name, of the grid or the BVH: "thesis", "sah"; `None` for the base tracer.
     pub fn variant_label(&self) -> Option<&'static str> {
-        match *self {
-            TracerSpec::Base => None,
-            TracerSpec::Grid { variant, .. } => Some(variant_name(variant)),
-            TracerSpec::Bvh { variant } => Some(variant.name()),
-            TracerSpec::BvhInstances => Some("sah-instances"),
-            TracerSpec::Stream {
-                proximity_clouds,
-                naive_shadows,
-                no_mask,
-                ..
-            } => Some(match (proximity_clouds, naive_shadows, no_mask) {
-                (false, false, false) => "g",
-                (true, false, false) => "pc",
-                (false, true, false) => "g-naive",
-                (true, true, false) => "pc-naive",
-                (false, false, true) => "g-nomask",
-                (true, false, true) => "pc-nomask",
-                (false, true, true) => "g-naive-nomask",
-                (true, true, true) => "pc-naive-nomask",
-            }),
-            TracerSpec::GridPc { .. } => Some("exact-pc"),
+        if let Some(o) = self.stream_options() {
+            return Some(stream_label(o));
         }
+        Some(match self.accel() {
+            None => "wagner",
+            Some(Accel::Base) => return None,
+            Some(Accel::ThesisGrid(_)) => "thesis",
+            Some(Accel::ExactGrid(o)) if o.proximity_clouds => "exact-pc",
+            Some(Accel::ExactGrid(_)) => "exact",
+            Some(Accel::Bvh(o)) if o.levels == BvhLevels::Two => "sah-instances",
+            Some(Accel::Bvh(_)) => "sah",
+        })
     }
     /// "base", "grid thesis 24³", "bvh sah", "stream pc 14x16x14".
     pub fn label(&self) -> String {
-        match *self {
-            TracerSpec::Base => "base".into(),
-            TracerSpec::Grid {
-                variant,
-                resolution,
-            } => format!("grid {} {resolution}³", variant_name(variant)),
-            TracerSpec::Bvh { variant } => format!("bvh {}", variant.name()),
-            TracerSpec::BvhInstances => "bvh sah-instances".into(),
-            TracerSpec::Stream { .. } | TracerSpec::GridPc { .. } => format!(
-                "{} {} {}",
+        match (self.grid(), self.variant_label()) {
+            (_, None) => self.name().into(),
+            (Some((v, n)), _) => format!("grid {} {n}³", variant_name(v)),
+            (None, Some(v)) if self.name() == "bvh" => format!("bvh {v}"),
+            (None, Some(v)) => format!(
+                "{} {v} {}",
                 self.name(),
-                self.variant_label().unwrap_or_default(),
                 self.grid_label().unwrap_or_default()
             ),
         }
@@ -202,6 +243,20 @@ impl TracerSpec {
     /// A file-name friendly form: "base", "grid-thesis-24", "bvh-sah".
     pub fn slug(&self) -> String {
         self.label().replace('³', "").replace(' ', "-")
+    }
+}
+
+/// The streaming tracer's column: "g", "pc", "pc-naive", "g-naive-nomask".
+fn stream_label(o: &StreamOptions) -> &'static str {
+    match (o.proximity_clouds, o.naive_shadows, o.no_mask) {
+        (false, false, false) => "g",
+        (true, false, false) => "pc",
+        (false, true, false) => "g-naive",
+        (true, true, false) => "pc-naive",
+        (false, false, true) => "g-nomask",
+        (true, false, true) => "pc-nomask",
+        (false, true, true) => "g-naive-nomask",
+        (true, true, true) => "pc-naive-nomask",
     }
 }
 
@@ -219,7 +274,7 @@ pub struct Config {
     pub scene: String,
     /// Procedural sizes that replace the scene file's (the square's `level`).
     pub overrides: Overrides,
-    pub tracer: TracerSpec,
+    pub tracer: Tracer,
     /// REFL_DEPTH: reflection passes after the primary pass.
     pub refl_depth: u32,
     pub width: u32,
@@ -238,7 +293,7 @@ pub struct Config {
 
 impl Config {
     /// `tracer` on `scene` at the size of `s`, over `s.angles` angles of a full rotation.
-    pub fn new(scene: &str, tracer: TracerSpec, refl_depth: u32, s: Sizing) -> Config {
+    pub fn new(scene: &str, tracer: Tracer, refl_depth: u32, s: Sizing) -> Config {
         Config {
             scene: scene.into(),
             overrides: Overrides::default(),
@@ -254,12 +309,7 @@ impl Config {
     }
     /// `tracer` on `scene` at `width`×`height`, `frames` frames after `warmup`, camera and
     /// objects fixed (every frame at angle 0: nothing moves, nothing is rebuilt).
-    pub fn fixed(
-        scene: &str,
-        tracer: TracerSpec,
-        (width, height): (u32, u32),
-        s: Sizing,
-    ) -> Config {
+    pub fn fixed(scene: &str, tracer: Tracer, (width, height): (u32, u32), s: Sizing) -> Config {
         Config {
             width,
             height,
@@ -332,23 +382,18 @@ mod tests {
             GridVariant::from_str("exact", false),
             Ok(GridVariant::Exact)
         );
-        let spec = TracerSpec::Grid {
-            variant: GridVariant::Thesis,
-            resolution: 24,
-        };
+        let spec = Tracer::uniform_grid(GridVariant::Thesis, 24);
         assert_eq!(
             (spec.label(), spec.slug()),
             ("grid thesis 24³".into(), "grid-thesis-24".into())
         );
-        let bvh = TracerSpec::Bvh {
-            variant: BvhVariant::Sah,
-        };
+        let bvh = Tracer::bvh(BvhVariant::Sah);
         assert_eq!(
             (bvh.label(), bvh.slug()),
             ("bvh sah".into(), "bvh-sah".into())
         );
         assert_eq!((bvh.variant_label(), bvh.grid()), (Some("sah"), None));
-        let instances = TracerSpec::BvhInstances;
+        let instances = Tracer::bvh_instances();
         assert_eq!(
             (instances.label(), instances.slug(), instances.row().name),
             (
@@ -357,6 +402,17 @@ mod tests {
                 "bvh"
             )
         );
+        // each protocol pins the thesis' four kernels, whatever `render`'s default
+        let four = |t: &Tracer| matches!(&t.0, Design::Mueller2015(o) if !o.accel.fused());
+        assert!(four(&bvh) && four(&instances));
+        let pc = Tracer::grid_pc(16);
+        assert_eq!(pc.label(), "grid exact-pc 16");
+        assert_eq!(
+            Tracer::stream([14, 16, 14], true, false, false).label(),
+            "stream pc 14x16x14"
+        );
+        assert_eq!(Tracer::bvh(BvhVariant::Wagner).label(), "bvh wagner");
+        assert!(Tracer::base().is_base() && Tracer::base().label() == "base");
         let c = Config::fixed("square.toml", bvh, (320, 240), Sizing::quick(3, 1)).with_level(2);
         assert_eq!(
             (c.label(), c.slug()),

@@ -5,18 +5,19 @@
 //!
 //! Beside it, what a run needs: the command line ([`args`]), the configurations ([`config`]),
 //! the only door to the library's renderers ([`adapter`]), the CPU reference that judges first
-//! hits ([`judge`]), a configuration's frames and statistics ([`outcome`], [`stats`]), the
-//! machine it ran on ([`machine`]), and the units of work of `--list`, `--shard` and `bench
-//! merge` ([`shard`]).
+//! hits ([`judge`]), a configuration's frames ([`outcome`]), the CSVs of its frames and
+//! statistics ([`csv_files`]), the machine it ran on ([`machine`]), and the units of work of
+//! `--list`, `--shard` and `bench merge` ([`units`], [`shard`]).
 
 pub mod adapter;
 pub mod args;
 pub mod config;
+pub mod csv_files;
 pub mod judge;
 pub mod machine;
 pub mod outcome;
 pub mod shard;
-pub mod stats;
+pub mod units;
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
@@ -29,8 +30,7 @@ use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::bench::protocols::Section;
-use crate::bench::report::csv_files;
+use crate::bench::common::section::Section;
 use adapter::{Frame, FrameStats, Gpu, RayTracer, BVH_VARIANTS};
 use args::{BenchArgs, Rotation, Scale};
 use config::{BvhVariant, Config, GridVariant, Overrides, Sizing};
@@ -38,7 +38,8 @@ use gpgpu_rt::scene::{Camera, Scene};
 use judge::Judge;
 use machine::Machine;
 use outcome::{FrameRecord, Outcome};
-use shard::{Measured, Mode, Shard};
+use shard::{Measured, Mode};
+use units::Shard;
 
 /// A benchmark session: the GPU, the options, the output folder and the scenes; what it does
 /// with each unit of work (measure, list, replay: [`Mode`]) and what it measured.

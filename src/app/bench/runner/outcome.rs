@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use super::adapter::FrameStats;
 use super::config::Config;
-use super::stats::Stats;
-use crate::bench::report::format::{int, mmm, num};
+use crate::bench::common::format::{int, mmm, num};
+use crate::bench::common::stats::Stats;
 
 /// The report's columns of a measured configuration (see [`Outcome::measured_cells`]).
 pub const MEASURED_COLUMNS: [&str; 5] = [

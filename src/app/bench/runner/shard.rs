@@ -8,7 +8,7 @@
 //! A unit is one configuration of the protocols that measure rendered frames
 //! ([`super::Bench::measure`]: warm-up included, so a shard's timings are as good as
 //! an unsharded run's), or a whole protocol where its measurements depend on each other (the
-//! Klee 2016 protocols time the CPU on the GPU's G-buffer): [`Units::Whole`].
+//! Klee 2016 protocols time the CPU on the GPU's G-buffer): [`super::units::Units::Whole`].
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -19,52 +19,14 @@ use serde::{Deserialize, Serialize};
 
 use super::machine::Machine;
 use super::outcome::{FrameRecord, Outcome};
-use super::Bench;
-use crate::bench::protocols::Section;
+use super::units::Shard;
+use crate::bench::common::section::Section;
 use gpgpu_rt::frame::FrameStats;
 
 /// The version of `shard.json`'s layout.
 pub const FORMAT: u32 = 1;
 /// The file a shard writes into its `--out`.
 pub const MANIFEST: &str = "shard.json";
-
-/// How a protocol's work divides into units.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Units {
-    /// One unit per configuration it hands to [`Bench::measure`].
-    Configs,
-    /// The whole protocol is one unit.
-    Whole,
-}
-
-/// `--shard K/N`: the K-th of N shards, 1 ≤ K ≤ N.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    pub k: u32,
-    pub n: u32,
-}
-
-impl Shard {
-    /// Does this shard measure the unit at (0-based) `index`?
-    pub fn takes(&self, index: usize) -> bool {
-        index % self.n as usize == (self.k - 1) as usize
-    }
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.k, self.n)
-    }
-}
-
-/// "3/8" → the third of eight shards.
-pub fn parse_shard(s: &str) -> Result<Shard, String> {
-    let parsed = s.split_once('/').and_then(|(k, n)| {
-        let (k, n) = (k.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?);
-        (1..=n).contains(&k).then_some(Shard { k, n })
-    });
-    parsed.ok_or_else(|| format!("{s:?} is not a shard K/N with 1 ≤ K ≤ N, e.g. 3/8"))
-}
 
 /// What the bench does with each unit.
 pub enum Mode {
@@ -316,8 +278,8 @@ pub fn copy_file(from_dir: &Path, rel: &Path, out: &Path) -> Result<()> {
 }
 
 /// Write the shard's manifest into its output folder.
-pub fn write_manifest(bench: &Bench, m: &Manifest) -> Result<PathBuf> {
-    let path = bench.out.join(MANIFEST);
+pub fn write_manifest(out: &Path, m: &Manifest) -> Result<PathBuf> {
+    let path = out.join(MANIFEST);
     let text = serde_json::to_string_pretty(m)?;
     gpgpu_rt::output::write_file(&path, |w| Ok(w.write_all(text.as_bytes())?))?;
     Ok(path)
@@ -326,20 +288,6 @@ pub fn write_manifest(bench: &Bench, m: &Manifest) -> Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn shards_partition_the_units() {
-        assert_eq!(parse_shard("2/3"), Ok(Shard { k: 2, n: 3 }));
-        for bad in ["0/3", "4/3", "3", "a/b", "1/0"] {
-            assert!(parse_shard(bad).is_err(), "{bad}");
-        }
-        for n in 1..5 {
-            for i in 0..20 {
-                let takers = (1..=n).filter(|&k| Shard { k, n }.takes(i)).count();
-                assert_eq!(takers, 1, "unit {i} of {n} shards");
-            }
-        }
-    }
 
     #[test]
     fn the_recorded_command_line_drops_shard_and_out() {

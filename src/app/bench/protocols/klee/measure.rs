@@ -8,11 +8,12 @@ use std::time::Instant;
 use anyhow::Result;
 use glam::Vec3;
 
-use super::{Protocol, Section};
-use crate::bench::report::csv_files::write_rows;
+use crate::bench::common::section::Section;
+use crate::bench::protocols::protocol::Protocol;
 use crate::bench::report::plots::Figure;
 use crate::bench::runner::adapter::{ShadowFrame, SoftShadows};
 use crate::bench::runner::config::Sizing;
+use crate::bench::runner::csv_files::write_rows;
 use crate::bench::runner::Bench;
 use gpgpu_rt::reference::linespace::ShadowCounts;
 use gpgpu_rt::scene::{Scene, ShadowMode};
@@ -269,5 +270,5 @@ pub fn section(
         s.warmup,
         bench.machine.gl_renderer
     );
-    Section::new(p, opening + markdown, vec![csv]).with_figures(&bench.out, figures)
+    p.figure_section(&bench.out, opening + markdown, vec![csv], figures)
 }

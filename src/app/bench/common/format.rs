@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use crate::bench::runner::stats::Stats;
+use super::stats::Stats;
 
 /// An integer with thousands separators: 1,137,720,816.
 pub fn int(v: f64) -> String {

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
-use crate::bench::runner::args::Rotation;
-use crate::bench::runner::outcome::{FrameRecord, Outcome};
-use crate::bench::runner::stats::Stats;
+use super::args::Rotation;
+use super::outcome::{FrameRecord, Outcome};
+use crate::bench::common::stats::Stats;
 
 /// The two CSV files of `protocol`, relative to the output folder.
 pub fn names(protocol: &str) -> Vec<PathBuf> {
