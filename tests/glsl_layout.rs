@@ -6,7 +6,7 @@
 //!   first) or an include guard; a switch one accelerator sets lives in its own folder, or the
 //!   common file takes a hook its kernel defines (as `closestHit` and `occluded`);
 //! - the SAH BVH's fused pass (its entry files, `bvh/fused*.comp`, picked in
-//!   `src/accel/bvh/mod.rs`, and the includes that only they use) has at most
+//!   `src/accel/bvh/fused.rs`, and the includes that only they use) has at most
 //!   [`FUSED_CONDITIONALS`] conditional directives: its variants are entry files over one body.
 //!
 //! Planted violations in the checkers' own tests below show that each rule can fail.
@@ -248,7 +248,7 @@ fn fused_conditionals(
     (found.len(), found)
 }
 
-/// The fused pass' entry files, as `src/accel/bvh/mod.rs` picks them.
+/// The fused pass' entry files, as `src/accel/bvh/fused.rs` picks them.
 fn fused_entries(bvh_rs: &str) -> Vec<String> {
     let mut out: Vec<String> = bvh_rs
         .split('"')
@@ -295,7 +295,7 @@ fn no_accelerator_switch_in_common_glsl() {
 #[test]
 fn the_fused_pass_variants_are_entry_files() {
     let files = shader_files();
-    let entries = fused_entries(&read("src/accel/bvh/mod.rs"));
+    let entries = fused_entries(&read("src/accel/bvh/fused.rs"));
     assert!(
         entries.len() >= 2 && entries.iter().all(|e| files.contains_key(e)),
         "fused entry files {entries:?}"

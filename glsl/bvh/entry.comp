@@ -48,7 +48,7 @@ vec3 gridOrigin = vec3(0.0), gridStep = vec3(0.0);
 // for llvmpipe: per axis the smallest and largest divisor of safeInverse (a nonzero rd), whose
 // inverses are the bounds of the rays' 1/rd — 1/x falls on either side of 0, and rounding
 // keeps the order — so that a ray costs no division; inactive rays, and pixels out of the
-// image (inactive: common/pass_ray.glsl), count for nothing.
+// image (inactive: bvh/pass_ray.glsl), count for nothing.
 bool bound(ivec2 block)
 {
     const float inf = 1.0 / 0.0;

@@ -1,5 +1,5 @@
-// One pass of Müller 2015's Fig. 8 loop in one kernel, for the SAH BVH (ours; the documented
-// variant `--fused-passes`, docs/listings.md): the body its entry files share. Per pixel the
+// One pass of Müller 2015's Fig. 8 loop in one kernel, for the SAH BVH (ours; its default, the
+// four kernels with `--four-kernels`, docs/listings.md): the body its entry files share. Per pixel the
 // closest hit (intersect1, the SAH BVH's walk of bvh/intersect1.comp: the entry file's
 // closestHit), its evaluation (Listings 13 and 14: common/intersect1_hit.glsl's hitTexels, with
 // the t, u and v the walk's test of the closest triangle found — bvh/evaluate_hit.comp finds

@@ -1,5 +1,5 @@
 // One pass of Müller 2015's Fig. 8 loop in one kernel for the SAH BVH's two levels (ours, the
-// documented variants `--fused-passes` and `--bvh-instances`; the pass: bvh/fused.glsl): an
+// BVH's default pass with `--bvh-levels two`; the pass: bvh/fused.glsl): an
 // invocation per pixel (no block lists: an instance's empty entry leaves the block's other
 // instances to walk). The closest hit is the walk of bvh/intersect1.comp; its hit record then
 // gives the hit's instance, whose normal matrix the hit's evaluation turns the normals with

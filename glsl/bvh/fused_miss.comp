@@ -1,5 +1,5 @@
 // One pass of Müller 2015's Fig. 8 loop in one kernel for the SAH BVH with one tree (ours, the
-// documented variant `--fused-passes`; the pass: bvh/fused.glsl) over the entry pass' second
+// BVH's default pass; the pass: bvh/fused.glsl) over the entry pass' second
 // list: the blocks whose rays all miss the tree's root, or none of whose rays is active
 // (bvh/fused_lists.glsl). Their walk, which would visit nothing from the empty entry, is left
 // out — no hit — and with it the compiler folds away the hit's evaluation, its feelers and its

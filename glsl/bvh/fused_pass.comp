@@ -1,6 +1,6 @@
 // One pass of Müller 2015's Fig. 8 loop (intersect1, Listings 13 and 14, intersect2 with
 // Listing 15, shading with Listing 16) in one kernel, for the SAH BVH with one tree — ours, the
-// documented variant `--fused-passes` (docs/listings.md); the pass itself: bvh/fused.glsl. A
+// BVH's default pass (docs/listings.md); the pass itself: bvh/fused.glsl. A
 // work group per block of the entry pass' first list, the blocks whose rays may hit
 // (bvh/fused_lists.glsl); the closest hit is the walk of bvh/intersect1.comp, whose test gives
 // the hit's t, u and v.

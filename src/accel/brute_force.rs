@@ -12,7 +12,8 @@ use std::any::Any;
 
 use anyhow::{bail, Result};
 
-use super::{Accel, Accelerator, BuildContext, Entry, FrameContext, LightTarget};
+use super::interface::{Accelerator, BuildContext, Entry, FrameContext, LightTarget};
+use super::options::Accel;
 use crate::frame::FrameStats;
 use crate::gl::{GlInfo, Kernel};
 use crate::scene::Scene;

@@ -14,7 +14,8 @@ use serde_json::json;
 
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
-use super::{Accel, Accelerator, BuildContext, Entry, ExactGridOptions, FrameContext, LightTarget};
+use super::interface::{Accelerator, BuildContext, Entry, FrameContext, LightTarget};
+use super::options::{Accel, ExactGridOptions};
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;

@@ -47,7 +47,7 @@ impl GridFrame {
     }
 }
 
-/// The resolution `--grid` asks for (`requested`; `None`: [`super::auto_resolution`]),
+/// The resolution `--grid` asks for (`requested`; `None`: [`super::options::auto_resolution`]),
 /// checked against the largest of the grid `variant` ("thesis", "exact").
 pub fn resolution(
     scene: &Scene,
@@ -55,7 +55,7 @@ pub fn resolution(
     variant: &str,
     max: u32,
 ) -> anyhow::Result<u32> {
-    let n = requested.unwrap_or_else(|| super::auto_resolution(scene.triangle_count()));
+    let n = requested.unwrap_or_else(|| super::options::auto_resolution(scene.triangle_count()));
     if n == 0 || n > max {
         anyhow::bail!("--grid {n}: the {variant} grid supports 1..={max} voxels per axis");
     }

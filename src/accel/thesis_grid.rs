@@ -16,9 +16,8 @@ use serde_json::json;
 
 use super::grid_frame::GridMapping;
 use super::grid_frame::{lists_of, resolution, GridFrame};
-use super::{
-    Accel, Accelerator, BuildContext, Entry, FrameContext, LightTarget, ThesisGridOptions,
-};
+use super::interface::{Accelerator, BuildContext, Entry, FrameContext, LightTarget};
+use super::options::{Accel, ThesisGridOptions};
 use crate::frame::FrameStats;
 use crate::gl::resources::Ssbo;
 use crate::gl::slots::ssbo;

@@ -12,28 +12,28 @@ use std::any::Any;
 use std::cell::Cell;
 use std::sync::Arc;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
-use glow::HasContext;
 use serde_json::json;
 
-use super::{
-    max_pixel_events, set_camera, Accel, Accelerator, BuildContext, BvhLevels, BvhOptions,
-    BvhPasses, Entry, FrameContext, FusedPasses, FusedRun, LightTarget, PassHost,
-    PIXELS_PER_INVOCATION,
+use super::interface::{
+    max_pixel_events, Accelerator, BuildContext, Entry, FrameContext, FusedRun, LightTarget,
+    PassHost, PIXELS_PER_INVOCATION,
 };
+use super::options::{Accel, BvhLevels, BvhOptions, BvhPasses};
 use crate::frame::FrameStats;
 use crate::gl::kernel::PIXEL_GROUP;
-use crate::gl::resources::Owned;
-use crate::gl::resources::{GpuTimers, Ssbo, TexelData, TextureBuffers};
-use crate::gl::slots::{image, ssbo};
+use crate::gl::resources::{TexelData, TextureBuffers};
+use crate::gl::slots::image;
 use crate::gl::{Gl, GlInfo, Kernel};
 use crate::scene::{transform_triangles, CameraRays, Scene};
 
 mod build;
+mod fused;
 pub mod instances;
 pub mod layout;
+mod moving;
 mod planes;
 pub mod refit;
 pub mod tree;
@@ -46,6 +46,9 @@ pub use layout::{
 pub use planes::{Grid, Planes, RayGrid, GRID_STEPS};
 pub use refit::{Refit, RefitKernels, REBUILD_GROWTH, REFIT_GROUP, REFIT_TIMER};
 pub use tree::{octant_planes, BvhTree};
+
+use fused::{fused_kernels, BlockLists, EntryPass, Fused, ENTRY_GROUP};
+use moving::{refit_kernels, Moving};
 
 /// The fastest configuration (`docs/design/bvh.md`, "The default"): the fused pass over one
 /// tree.
@@ -149,148 +152,6 @@ fn kernel_defines(info: &GlInfo, blocks: (u32, u32)) -> [(&'static str, String);
     ]
 }
 
-/// The refit's kernels (`glsl/bvh/refit_*.comp`), with the BVH's defines, timed together
-/// ([`Refit::run`]).
-fn refit_kernels(b: &BuildContext, defs: &[(&'static str, String)]) -> Result<RefitKernels> {
-    let extra = [
-        ("REFIT_GROUP", REFIT_GROUP.to_string()),
-        ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
-        // the records' pass reads through image buffers where the units exist (Refit::run)
-        (
-            "REFIT_VIEWS",
-            ((b.info.profile.image_units as u32 > image::REFIT_BOXES) as i32).to_string(),
-        ),
-        ("BVH_GRID_STEPS", GRID_STEPS.to_string()),
-    ];
-    let defs = [defs, &extra[..]].concat();
-    let kernel = |file| b.kernel(file, &defs, REFIT_TIMER);
-    Ok(RefitKernels {
-        leaves: kernel("bvh/refit_leaves.comp")?,
-        records: kernel("bvh/refit_records.comp")?,
-    })
-}
-
-/// The fused pass (`glsl/bvh/fused.glsl`): each pixel's counts in record 0 (the first
-/// light's beside the closest hit's where it is a point light), else the first light's at
-/// record 1; the other lights' at record 2 where the scene has more than one light
-/// (`pipeline::mueller2015::records`). With block lists (`lists`: one tree) two kernels, a
-/// work group per block: the blocks whose rays may hit (`glsl/bvh/fused_pass.comp`) and those
-/// whose rays all miss (`glsl/bvh/fused_miss.comp`, timed as `fused_miss`;
-/// `glsl/bvh/block_lists.glsl`); without (two levels, [`Bvh::create`]) one, a pixel an
-/// invocation (`glsl/bvh/fused_instances.comp`). `eye`: the variant that computes the eye rays
-/// in place (`PASS_EYE_RAYS`).
-fn fused_kernels(
-    b: &BuildContext,
-    defs: &[(&'static str, String)],
-    f: FusedPasses,
-    lists: bool,
-    eye: bool,
-) -> Result<Vec<Kernel>> {
-    let variant = [
-        ("PASS_EYE_RAYS", (eye as i32).to_string()),
-        (
-            "EYE_PASS_STORES_RAYS",
-            (f.rays.eye_pass_stores_rays as i32).to_string(),
-        ),
-    ];
-    let kernel = |file, timer| fused_kernel(b, &[defs, &variant[..]].concat(), f, file, timer);
-    match lists {
-        true => Ok(vec![
-            kernel("bvh/fused_pass.comp", "fused_pass")?,
-            kernel("bvh/fused_miss.comp", "fused_miss")?,
-        ]),
-        false => Ok(vec![kernel("bvh/fused_instances.comp", "fused_pass")?]),
-    }
-}
-
-/// `--fused-passes` (`glsl/bvh/fused.glsl`): the pass in one kernel, or with one tree in
-/// two over the block lists (the blocks that may hit, those that cannot); no kernel without.
-struct Fused {
-    /// the kernels of the passes whose rays are in the ray-state images, compiled only where
-    /// some pass takes them ([`FusedPasses::rays`]; empty without `--fused-passes`)
-    loaded: Vec<Kernel>,
-    /// those of the first pass computing its eye rays in place (`PASS_EYE_RAYS`), likewise
-    eye: Vec<Kernel>,
-    /// the entry pass of the first pass computing its eye rays in place (where one does; the
-    /// other passes' is [`Bvh::entry`])
-    eye_entry: Option<Kernel>,
-    /// whether the pass [`Accelerator::fused_pass`] prepared last computes its eye rays in place
-    in_place: bool,
-    lists: Option<BlockLists>,
-    /// the most walks one per-pixel record counts: 1, or with the fused pass a hit's feelers
-    walks_per_record: u64,
-    /// the most events those walks may count (`max_pixel_events`: the counts over the block
-    /// lists sum a block's 64 pixels, the others 16)
-    max_events: u64,
-}
-
-impl Fused {
-    /// The kernels of the pass [`Accelerator::fused_pass`] prepared last.
-    fn pass_kernels(&self) -> &[Kernel] {
-        let kernels = if self.in_place {
-            &self.eye
-        } else {
-            &self.loaded
-        };
-        assert!(!kernels.is_empty(), "no fused kernels for this pass' rays");
-        kernels
-    }
-}
-
-/// The fused pass' block lists (`glsl/bvh/block_lists.glsl`): the image's blocks that may hit
-/// and those that cannot, each list a dispatch command, a count and a word per block.
-struct BlockLists {
-    buffer: Ssbo,
-    /// empties the lists before each entry pass and writes their dispatch commands after it
-    /// (`glsl/bvh/block_lists.comp`)
-    kernel: Kernel,
-}
-
-impl BlockLists {
-    fn new(b: &BuildContext, defs: &[(&'static str, String)], blocks: u32) -> Result<BlockLists> {
-        let words = 16 + 2 * blocks as usize;
-        let max_block = b.info.max_ssbo_block_size;
-        let buffer = Ssbo::new(b.gl, "bvh_block_lists", 4 * words, None, max_block)?;
-        // timed with the entry pass, a part of intersect1: the pass' set-up
-        let kernel = b.kernel("bvh/block_lists.comp", defs, "intersect1")?;
-        Ok(BlockLists { buffer, kernel })
-    }
-
-    /// Both lists emptied for the entry pass to fill (`finish` unset), or their dispatch
-    /// commands written from what it filled (set); the buffer bound for the entry pass, the
-    /// fused kernels and the pass' counts over the lists (`pixel_counts`' `BLOCK_LISTED`).
-    fn step(&self, gl: &Gl, timers: &mut GpuTimers, finish: bool) {
-        self.buffer.bind(gl, ssbo::BVH_BLOCK_LISTS);
-        self.kernel.use_program();
-        self.kernel.set_i32("finish", finish as i32);
-        self.kernel.dispatch_1d(timers, 1);
-    }
-}
-
-fn fused_kernel(
-    b: &BuildContext,
-    defs: &[(&'static str, String)],
-    f: FusedPasses,
-    file: &str,
-    timer: &'static str,
-) -> Result<Kernel> {
-    let extra = [
-        ("SCENE_IMAGES", (b.scene_images as i32).to_string()),
-        ("RECORD_FIRST_LIGHT", "1".to_string()),
-        (
-            "RECORD_OTHER_LIGHTS",
-            if f.lights > 1 { "2" } else { "0" }.to_string(),
-        ),
-        (
-            "FIRST_LIGHT_PACKED",
-            (f.first_light_point as i32).to_string(),
-        ),
-    ];
-    b.kernel(file, &[defs, &extra[..]].concat(), timer)
-}
-
-/// Invocations of a work group of `glsl/bvh/entry.comp` (`BVH_ENTRY_GROUP`), one block each.
-const ENTRY_GROUP: u32 = 64;
 const _: () = assert!(
     BLOCK == PIXEL_GROUP,
     "a block is one work group of intersect1"
@@ -320,27 +181,6 @@ enum Levels {
     Two(Option<Instances>),
 }
 
-/// The refit of the last build's tree ([`refit`]) and what the rebuild policy knows of it.
-struct Moving {
-    kernels: RefitKernels,
-    /// the last build's refit buffers
-    refit: Option<Refit>,
-    /// refits since the last build
-    refits: u64,
-    /// the SAH cost of the tree as the last refit whose cost was read left it (the last build's
-    /// after a build)
-    cost: Cell<f64>,
-    /// the fence after the last refit, while its cost is not read: the host reads it once the
-    /// GPU has passed the fence, without waiting ([`Bvh::read_cost`])
-    pending: Cell<Option<Owned<glow::Fence>>>,
-    /// `GL_MAX_SHADER_STORAGE_BLOCK_SIZE`, for the refit's buffers
-    max_block: i64,
-    /// the compute image units of the profile, for the refit's image-buffer views
-    max_units: i32,
-    /// the next refit is preceded by one abandoned halfway ([`Bvh::abandon_next_refit_halfway`])
-    abandon_next: Cell<bool>,
-}
-
 pub struct Bvh {
     gl: Arc<Gl>,
     /// the entry point of each block of intersect1's rays (`glsl/bvh/entry.comp`), into the
@@ -348,9 +188,10 @@ pub struct Bvh {
     entry: Kernel,
     /// the blocks of the image
     blocks: u32,
-    intersect1: Kernel,
-    intersect2: Kernel,
-    /// `--fused-passes`: the pass' kernels and block lists
+    /// the four kernels' intersect1 and intersect2 (`--four-kernels`; `None` for the fused pass,
+    /// which runs kernels of its own)
+    four: Option<[Kernel; 2]>,
+    /// the fused pass' kernels and block lists (empty with the four kernels)
     fused: Fused,
     /// object-space vertex positions of every object (triangle soup, scene order)
     objects: Vec<Vec<Vec3>>,
@@ -406,8 +247,13 @@ impl Bvh {
             gl: b.gl.clone(),
             entry: entry(false)?,
             blocks: blocks.0 * blocks.1,
-            intersect1: b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
-            intersect2: b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
+            four: match b.fused {
+                Some(_) => None,
+                None => Some([
+                    b.kernel("bvh/intersect1.comp", &defs, "intersect1")?,
+                    b.kernel("bvh/intersect2.comp", &defs, "intersect2")?,
+                ]),
+            },
             fused: Fused {
                 loaded: fused(false)?,
                 eye: fused(true)?,
@@ -468,7 +314,7 @@ impl Bvh {
             bail!(
                 "the BVH has {} nodes and {} leaf slots: {} walks of a pixel could count more than \
                  {} events, beyond the per-pixel counts' 32 bits; use a smaller scene (or, with \
-                 --fused-passes, fewer lights or light samples)",
+                 the fused pass, fewer lights or light samples)",
                 bvh.stats.nodes,
                 bvh.tris.len(),
                 self.fused.walks_per_record,
@@ -481,7 +327,7 @@ impl Bvh {
         // the old buffers (if any) drop after the new ones are made, as before
         self.buffers = Some(buffers);
         self.moving.refit = Some(refit);
-        self.drop_pending();
+        self.moving.drop_pending();
         self.moving.refits = 0;
         self.moving.cost.set(bvh.stats.sah_cost);
         self.stats = bvh.stats;
@@ -545,6 +391,9 @@ impl Bvh {
         b.map(|b| b.read_u32(&self.gl, 0)).unwrap_or_default()
     }
 
+    /// The blocks' entry pass `entry` (`glsl/bvh/entry.comp`; with `eye`'s camera where it
+    /// computes the eye rays in place), the word buffer bound for it to write its entries and
+    /// then for the walks to read them.
     /// For tests: the next refit is preceded by one whose boxes pass covers half the leaves and
     /// stops there, as a refit cut short would leave the buffers; the next must be whole.
     #[doc(hidden)]
@@ -559,128 +408,35 @@ impl Bvh {
 
     /// The SAH cost of the tree as the last refit left it over the last build's (1 after a
     /// build): past [`REBUILD_GROWTH`], the next frame that moves an object rebuilds. Waits for
-    /// the last refit (for tests; the frames read it without waiting: [`Bvh::read_cost`]).
+    /// the last refit (for tests; the frames read it without waiting).
     pub fn sah_growth(&self) -> Result<f64> {
-        self.read_cost(true)?;
+        self.moving.read_cost(&self.gl, true)?;
         Ok(self.moving.cost.get() / self.stats.sah_cost)
     }
 
-    /// Read the last refit's SAH cost (32 bytes) once the GPU has finished the refit: with
-    /// `wait`, now; without, only if it has (a fence), else the cost stays the one before and
-    /// is read at a later frame. So a frame never waits for its refit; the rebuild a refit's
-    /// growth calls for comes at the first moving frame after its cost was read — the next
-    /// frame, where the frame's statistics (timer queries) waited for the GPU anyway, else a
-    /// frame or more later (docs/design/bvh.md, "Moving objects").
-    fn read_cost(&self, wait: bool) -> Result<()> {
-        let Some(fence) = self.moving.pending.take() else {
-            return Ok(());
-        };
-        let timeout = if wait { i32::MAX } else { 0 };
-        loop {
-            // SAFETY: a fence of ours, alive while `fence` is (deleted as it drops).
-            let flush = glow::SYNC_FLUSH_COMMANDS_BIT;
-            let state = unsafe { self.gl.client_wait_sync(fence.raw(), flush, timeout) };
-            match state {
-                glow::TIMEOUT_EXPIRED if wait => continue,
-                glow::TIMEOUT_EXPIRED => {
-                    self.moving.pending.set(Some(fence));
-                    return Ok(());
-                }
-                _ => break,
-            }
-        }
-        drop(fence);
-        let refit = self
-            .moving
-            .refit
-            .as_ref()
-            .expect("a refit before its fence");
-        self.moving.cost.set(refit.sah_cost(&self.gl)?);
-        Ok(())
-    }
-
-    /// Forget the last refit's cost unread (a rebuild replaces it).
-    fn drop_pending(&self) {
-        drop(self.moving.pending.take());
-    }
-
-    /// Refit the tree on the GPU to this frame's world-space vertices (the scene's `vertex` SSBO,
-    /// bound); its SAH cost is read later ([`Bvh::read_cost`]).
+    /// Refit the tree on the GPU to this frame's world-space vertices ([`moving`]).
     fn refit(&mut self, f: &mut FrameContext) -> Result<()> {
-        let refit = self.moving.refit.as_ref().expect("a tree to refit");
         self.bind(f.gl, glow::READ_WRITE);
         let buffers = self.buffers.as_ref().expect("a built tree's buffers");
-        let storage = buffers.bind_storage(f.gl, 0, ssbo::BVH_WORDS, self.moving.max_block);
-        if self.moving.abandon_next.take() {
-            refit.run_abandoned(f.gl, f.timers, &self.moving.kernels, storage);
-        }
-        refit.run(f.gl, f.timers, &self.moving.kernels, storage);
-        self.drop_pending();
-        // SAFETY: a fence on a current context, owned (deleted as it drops).
-        let fence = unsafe { f.gl.fence_sync(glow::SYNC_GPU_COMMANDS_COMPLETE, 0) };
-        let fence = fence.map_err(|e| anyhow!("glFenceSync: {e}"))?;
-        self.moving.pending.set(Some(Owned::new(f.gl, fence)));
+        self.moving.run(f, buffers)?;
         self.built_for = Some(f.models.to_vec());
-        self.moving.refits += 1;
         Ok(())
     }
 
-    /// The blocks' entry pass `entry` (`glsl/bvh/entry.comp`; with `eye`'s camera where it
-    /// computes the eye rays in place), the word buffer bound for it to write its entries and
-    /// then for the walks to read them.
-    fn dispatch_entry(&self, f: &mut FrameContext, entry: &Kernel, eye: Option<&CameraRays>) {
-        self.bind(f.gl, glow::READ_WRITE);
-        entry.use_program();
-        if let Some(cam) = eye {
-            set_camera(entry, cam);
-        }
-        entry.dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
-        self.bind(f.gl, glow::READ_ONLY);
-    }
-
-    /// Bind the word buffer with `access`: the entry kernel writes its last texels
-    /// (`glow::READ_WRITE`), the others only read it (`glow::READ_ONLY`).
-    /// The fused pass' entry pass (and its block lists around it) for the pass' rays: the eye
-    /// rays of `eye` in place, or the loaded ray state.
-    fn fused_entry(&mut self, f: &mut FrameContext, eye: Option<&CameraRays>) {
-        self.fused.in_place = eye.is_some();
-        if let Some(lists) = &self.fused.lists {
-            lists.step(f.gl, f.timers, false);
-        }
-        let entry = match eye {
-            Some(_) => self.fused.eye_entry.as_ref(),
-            None => Some(&self.entry),
-        };
-        let entry = entry.expect("the entry pass of the rays the frame's passes take");
-        self.dispatch_entry(f, entry, eye);
-        if let Some(lists) = &self.fused.lists {
-            // the lists' dispatch commands from what the entry pass counted
-            lists.step(f.gl, f.timers, true);
+    /// The entry pass over this tree as uploaded.
+    fn entry_pass(&self) -> EntryPass<'_> {
+        EntryPass {
+            buffers: self.buffers.as_ref(),
+            blocks: self.blocks,
         }
     }
 
-    /// Dispatch the fused kernels of the pass, their uniforms set; without `misses` not the
-    /// one for the blocks whose rays all miss (their pixels were filled by clears).
-    fn dispatch_fused(&self, f: &mut FrameContext, misses: bool) {
-        let kernels = self.fused.pass_kernels();
-        match &self.fused.lists {
-            Some(lists) => {
-                // the blocks that may hit, then the others: each list in one dispatch, whatever
-                // the tiles (glsl/bvh/block_lists.glsl)
-                let dispatched = if misses { 2 } else { 1 };
-                for (list, k) in kernels.iter().enumerate().take(dispatched) {
-                    k.use_program();
-                    k.set_i32("listThreads", f.pixels.threads as i32);
-                    let command = 16 * list as i32;
-                    k.dispatch_indirect(f.timers, lists.buffer.buffer.raw(), command);
-                }
-            }
-            None => {
-                let k = &kernels[0];
-                k.use_program();
-                k.dispatch_pixels(f.timers, f.pixels);
-            }
-        }
+    /// intersect1 and intersect2 of the four kernels, which the pipeline asks for only where the
+    /// BVH was made without its fused pass.
+    fn four_kernels(&self) -> &[Kernel; 2] {
+        self.four
+            .as_ref()
+            .expect("the four kernels' intersection kernels: made with --four-kernels")
     }
 
     fn bind(&self, gl: &Gl, access: u32) {
@@ -700,7 +456,7 @@ impl Accelerator for Bvh {
         if let Levels::Two(_) = self.levels {
             return self.place_instances(f.models);
         }
-        self.read_cost(false)?;
+        self.moving.read_cost(&self.gl, false)?;
         let growth = self.moving.cost.get() / self.stats.sah_cost;
         if self.moving.refit.is_some() && growth <= REBUILD_GROWTH {
             return self.refit(f);
@@ -710,15 +466,17 @@ impl Accelerator for Bvh {
     }
 
     fn closest_hit(&mut self, f: &mut FrameContext, _pass: u32) -> &Kernel {
-        self.dispatch_entry(f, &self.entry, None);
-        self.intersect1.use_program();
-        &self.intersect1
+        self.entry_pass().dispatch(f, &self.entry, None);
+        let k = &self.four_kernels()[0];
+        k.use_program();
+        k
     }
 
     fn occluded(&mut self, f: &mut FrameContext, _target: &LightTarget) -> &Kernel {
         self.bind(f.gl, glow::READ_ONLY);
-        self.intersect2.use_program();
-        &self.intersect2
+        let k = &self.four_kernels()[1];
+        k.use_program();
+        k
     }
 
     fn stats(&self, stats: &mut FrameStats) {
@@ -736,7 +494,7 @@ impl Accelerator for Bvh {
         f.insert("bvh_depth".into(), json!(s.depth));
         f.insert("bvh_bytes".into(), json!(s.bytes));
         // the frame's timer queries were read: its refit is done, its cost read without a wait
-        let _ = self.read_cost(false);
+        let _ = self.moving.read_cost(&self.gl, false);
         f.insert("bvh_sah_cost".into(), json!(self.moving.cost.get()));
         f.insert("bvh_build_sah_cost".into(), json!(s.sah_cost));
         f.insert("bvh_refits".into(), json!(self.moving.refits));
@@ -751,32 +509,11 @@ impl Accelerator for Bvh {
         eye: Option<&CameraRays>,
         host: &dyn PassHost,
     ) -> Option<FusedRun> {
-        if self.fused.loaded.is_empty() && self.fused.eye.is_empty() {
-            return None;
-        }
-        self.fused_entry(f, eye);
-        for k in self.fused.pass_kernels() {
-            k.use_program();
-            if let Some(cam) = eye {
-                set_camera(k, cam);
-            }
-            host.set_uniforms(k);
-        }
-        host.frame_work(f.gl, f.timers);
-        // Ours: in the first pass every pixel's eye ray is active, so a block whose rays all
-        // miss the tree (the miss list) ends as a clear leaves it, its counts one ray traced
-        // that visited nothing a pixel — where no AOVs keep the first hits (eye rays in place)
-        // and no texel of the ray state needs storing: the frame's clear left them inactive
-        // (docs/design/frame.md, "The fused pass")
-        let run = FusedRun {
-            lists: self.fused.lists.is_some(),
-            clears: eye.is_some() && self.fused.lists.is_some(),
+        let entry = EntryPass {
+            buffers: self.buffers.as_ref(),
+            blocks: self.blocks,
         };
-        if run.clears {
-            host.fill_misses(f.gl, f.timers);
-        }
-        self.dispatch_fused(f, !run.clears);
-        Some(run)
+        self.fused.run(f, eye, host, (&entry, &self.entry))
     }
 
     fn as_any(&self) -> &dyn Any {

@@ -248,8 +248,8 @@ pub struct RayTracer {
     accel: Box<dyn Accelerator>,
     /// The hit records and per-pixel counts, for an accelerator that uses them.
     records: Option<Records>,
-    /// `--fused-passes`: what the fused kernel was compiled for, which decides where its
-    /// counts lie (`glsl/bvh/fused_pass.comp`)
+    /// with the fused pass: what its kernels were compiled for, which decides where its
+    /// counts lie (`glsl/bvh/fused.glsl`)
     fused: Option<FusedPasses>,
     last: Option<FrameStats>,
 }
@@ -459,7 +459,7 @@ impl RayTracer {
     }
 
     /// One pass of Fig. 8's loop: intersect1, intersect2 per light, shading — or with
-    /// `--fused-passes` the accelerator's fused pass kernel.
+    /// the accelerator's fused pass (the SAH BVH's default).
     fn pass(&mut self, cam: &CameraRays, pass: u32) {
         if self.options.fused() {
             return self.fused_pass(cam, pass);
@@ -522,13 +522,13 @@ impl RayTracer {
     }
 
     /// Whether pass `pass` computes its eye rays in place (the fused pass' first, where no
-    /// AOVs keep the rays: `glsl/common/pass_ray.glsl`), so no eye-ray kernel runs.
+    /// AOVs keep the rays: `glsl/bvh/pass_ray.glsl`), so no eye-ray kernel runs.
     fn eye_in_place(&self, pass: u32) -> bool {
         self.options.fused() && pass == 0 && self.aov_images.is_none()
     }
 
     /// One pass in the accelerator's fused kernel (ours, the SAH BVH's default:
-    /// `glsl/bvh/fused_pass.comp`), the pipeline's part through [`FusedHost`]; then the
+    /// `glsl/bvh/fused.glsl`), the pipeline's part through [`FusedHost`]; then the
     /// counts of its three records, each under the bank intersect1 and intersect2 count under.
     fn fused_pass(&mut self, cam: &CameraRays, pass: u32) {
         let eye = self.eye_in_place(pass);
@@ -658,7 +658,7 @@ impl PassHost for FusedHost<'_> {
 
 /// The fused pass' feeler records a pass sums, each under its bank: the first light's (packed
 /// in record 0 beside the closest hit's where it is a point light, else record 1) and the
-/// other lights' (record 2) — `glsl/bvh/fused_pass.comp`.
+/// other lights' (record 2) — `glsl/bvh/fused.glsl`.
 fn feeler_records(fused: FusedPasses) -> Vec<(Bank, Record)> {
     let first = match fused.first_light_point {
         true => Record::PackedHigh(0),

@@ -49,7 +49,7 @@ pub enum Record {
     Plain(u32),
 }
 
-/// Records per pixel with `--fused-passes` (`glsl/bvh/fused_pass.comp`): record 0 the closest
+/// Records per pixel of the fused pass (`glsl/bvh/fused.glsl`): record 0 the closest
 /// hit's counts (and a first point light's feelers' beside them), record 1 an area light's
 /// samples' as the first light, record 2 the other lights' feelers'.
 pub const FUSED_RECORDS: u32 = 3;
@@ -242,7 +242,7 @@ impl Records {
     }
 
     /// Add every pixel's `record` (the fused pass keeps three a pixel:
-    /// `glsl/bvh/fused_pass.comp`) to the bound bank, its triangle tests under `tests`.
+    /// `glsl/bvh/fused.glsl`) to the bound bank, its triangle tests under `tests`.
     pub fn add_record_counts(&self, timers: &mut GpuTimers, tests: &str, record: Record) {
         let k = self.counts_program(&self.pixel_counts, record, false);
         k.set_ivec4("countSlots", count_slots(tests));
