@@ -124,7 +124,7 @@ impl Kernel {
         defines: &Defines,
         timer: &'static str,
     ) -> Result<Kernel> {
-        let program = Owned::new(gl, compile_program(gl, shaders, stages, defines)?);
+        let program = compile_program(gl, shaders, stages, defines)?;
         let files: Vec<String> = stages
             .iter()
             .map(|(_, f)| shaders.display_name(f))

@@ -9,11 +9,13 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use glow::HasContext;
 
 use super::context::Gl;
+use super::resources::Owned;
 
 /// The kernel files compiled into the binary, keyed by their path below `glsl/` (every file
 /// of the folder: see `build.rs`).
@@ -256,33 +258,32 @@ pub fn compiler_messages() -> u64 {
 }
 
 /// One stage of a program: kind (glow::COMPUTE_SHADER, ...) and file name below `glsl/`.
-/// Compiler warnings are logged (file and line mapped like errors) and counted.
+/// Compiler warnings are logged (file and line mapped like errors) and counted. The program
+/// and its stages are owned: whatever fails, nothing is left behind.
 pub fn compile_program(
-    gl: &Gl,
+    gl: &Arc<Gl>,
     source: &ShaderSource,
     stages: &[(u32, &str)],
     defines: &Defines,
-) -> Result<glow::Program> {
-    // SAFETY: GL object creation and queries on a current context.
+) -> Result<Owned<glow::Program>> {
+    // SAFETY: GL object creation and queries on a current context, of objects we own.
     unsafe {
-        let program = gl.create_program().map_err(|e| anyhow!(e))?;
+        let program = Owned::new(gl, gl.create_program().map_err(|e| anyhow!(e))?);
         let mut shaders = Vec::new();
         for &(kind, name) in stages {
             let (text, lines) = source.assemble(name, defines)?;
             dump_source(name, &text);
-            let shader = gl.create_shader(kind).map_err(|e| anyhow!(e))?;
-            gl.shader_source(shader, &text);
-            gl.compile_shader(shader);
-            if !gl.get_shader_compile_status(shader) {
-                let log = map_log(&gl.get_shader_info_log(shader), &lines);
-                gl.delete_shader(shader);
-                gl.delete_program(program);
+            let shader = Owned::new(gl, gl.create_shader(kind).map_err(|e| anyhow!(e))?);
+            gl.shader_source(shader.raw(), &text);
+            gl.compile_shader(shader.raw());
+            if !gl.get_shader_compile_status(shader.raw()) {
+                let log = map_log(&gl.get_shader_info_log(shader.raw()), &lines);
                 bail!(
                     "GLSL compile error in {}:\n{log}",
                     source.display_name(name)
                 );
             }
-            let log = gl.get_shader_info_log(shader);
+            let log = gl.get_shader_info_log(shader.raw());
             if !log.trim().is_empty() {
                 COMPILER_MESSAGES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 log::warn!(
@@ -291,17 +292,16 @@ pub fn compile_program(
                     map_log(&log, &lines).trim_end()
                 );
             }
-            gl.attach_shader(program, shader);
+            gl.attach_shader(program.raw(), shader.raw());
             shaders.push(shader);
         }
-        gl.link_program(program);
-        for s in shaders {
-            gl.detach_shader(program, s);
-            gl.delete_shader(s);
+        gl.link_program(program.raw());
+        // the stages are deleted as they drop, detached: the program no longer needs them
+        for s in &shaders {
+            gl.detach_shader(program.raw(), s.raw());
         }
-        if !gl.get_program_link_status(program) {
-            let log = gl.get_program_info_log(program);
-            gl.delete_program(program);
+        if !gl.get_program_link_status(program.raw()) {
+            let log = gl.get_program_info_log(program.raw());
             let names: Vec<String> = stages.iter().map(|(_, n)| source.display_name(n)).collect();
             bail!("GLSL link error in {}:\n{log}", names.join(" + "));
         }

@@ -39,6 +39,7 @@ gl_object! {
     glow::NativeVertexArray => delete_vertex_array,
     glow::NativeQuery => delete_query,
     glow::NativeProgram => delete_program,
+    glow::NativeShader => delete_shader,
     glow::NativeFence => delete_sync,
 }
 

@@ -40,7 +40,6 @@ use winit::keyboard::ModifiersState;
 use winit::window::WindowId;
 
 use crate::args::DesignArgs;
-use gpgpu_rt::gl::resources::Owned;
 use gpgpu_rt::gl::ShaderSource;
 use gpgpu_rt::limits;
 use gpgpu_rt::output::console::ConsoleError;
@@ -381,7 +380,7 @@ impl App {
         let gl = running.window.gl.clone();
         // owned: a failed reload below deletes it as it drops
         let program = match quad {
-            true => Some(Owned::new(&gl, compile_quad_program(&gl, &self.shaders)?)),
+            true => Some(compile_quad_program(&gl, &self.shaders)?),
             false => None,
         };
         let shown = self.design.shown();

@@ -231,7 +231,7 @@ impl GlWindow {
 /// The screen-filling quad's program (`glsl/common/screen_quad.vert` + `.frag`), from `source` when it
 /// has them, else from the copies built into the binary (a `--glsl-dir` made before the viewer
 /// existed lacks them).
-pub fn compile_quad_program(gl: &Gl, source: &ShaderSource) -> Result<glow::Program> {
+pub fn compile_quad_program(gl: &Arc<Gl>, source: &ShaderSource) -> Result<Owned<glow::Program>> {
     let has_own = source
         .dir
         .as_ref()
@@ -289,12 +289,11 @@ pub struct ScreenQuad {
 }
 
 impl ScreenQuad {
-    pub fn new(gl: Arc<Gl>, program: glow::Program) -> Result<ScreenQuad> {
+    pub fn new(gl: Arc<Gl>, program: Owned<glow::Program>) -> Result<ScreenQuad> {
         // a triangle strip covering clip space
         let positions: [f32; 8] = [-1.0, -1.0, 1.0, -1.0, -1.0, 1.0, 1.0, 1.0];
         // SAFETY: object creation and vertex setup on the current context.
         unsafe {
-            let program = Owned::new(&gl, program);
             let vao = Owned::new(&gl, gl.create_vertex_array().map_err(|e| anyhow!(e))?);
             let vbo = Owned::new(&gl, gl.create_buffer().map_err(|e| anyhow!(e))?);
             gl.bind_vertex_array(Some(vao.raw()));
