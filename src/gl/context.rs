@@ -414,8 +414,8 @@ pub struct Gl {
     glow: glow::Context,
     /// The barrier bits not issued since the last pass that ran shaders ([`super::sync`]).
     pending_barriers: std::sync::atomic::AtomicU32,
-    clear_buffer_data: ClearBufferDataFn,
-    clear_tex_image: ClearTexImageFn,
+    pub(super) clear_buffer_data: ClearBufferDataFn,
+    pub(super) clear_tex_image: ClearTexImageFn,
     get_query_iv: GetQueryIvFn,
     get_query_object_u64: GetQueryObjectU64Fn,
     tex_buffer: TexBufferFn,
@@ -493,7 +493,7 @@ impl Gl {
         Ok(Gl {
             glow: glow::Context::from_loader_function(|n| load(n)),
             // SAFETY: the pointers are the named GL entry points with these signatures.
-            pending_barriers: std::sync::atomic::AtomicU32::new(super::sync::ALL),
+            pending_barriers: std::sync::atomic::AtomicU32::new(super::barrier_bits::ALL),
             clear_buffer_data: std::mem::transmute::<*const c_void, ClearBufferDataFn>(
                 clear_buffer_data,
             ),
@@ -523,23 +523,7 @@ impl Gl {
     pub(crate) fn set_all_barriers_pending(&self) {
         use std::sync::atomic::Ordering;
         self.pending_barriers
-            .store(super::sync::ALL, Ordering::Relaxed);
-    }
-
-    /// `glClearBufferData(target, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value)` on the
-    /// buffer bound to `target`: every 32-bit word of it becomes `value`.
-    pub fn clear_buffer_u32(&self, target: u32, value: u32) {
-        super::sync::before(self, glow::BUFFER_UPDATE_BARRIER_BIT);
-        // SAFETY: value outlives the call; the format describes one u32.
-        unsafe {
-            (self.clear_buffer_data)(
-                target,
-                glow::R32UI,
-                glow::RED_INTEGER,
-                glow::UNSIGNED_INT,
-                &value as *const u32 as *const c_void,
-            )
-        }
+            .store(super::barrier_bits::ALL, Ordering::Relaxed);
     }
 
     /// `glTexBuffer(GL_TEXTURE_BUFFER, format, buffer)` on the texture bound to
@@ -557,36 +541,6 @@ impl Gl {
         // SAFETY: v outlives the call.
         unsafe { (self.get_query_object_u64)(query.0.get(), glow::QUERY_RESULT, &mut v) };
         v
-    }
-
-    /// `glClearTexImage` of level 0 with four floats (RGBA32F textures).
-    pub fn clear_tex_f32(&self, texture: glow::Texture, value: [f32; 4]) {
-        super::sync::before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
-        // SAFETY: value outlives the call.
-        unsafe {
-            (self.clear_tex_image)(
-                texture.0.get(),
-                0,
-                glow::RGBA,
-                glow::FLOAT,
-                value.as_ptr() as *const c_void,
-            )
-        }
-    }
-
-    /// `glClearTexImage` of level 0 with four unsigned integers (RGBA32UI / R32UI textures).
-    pub fn clear_tex_u32(&self, texture: glow::Texture, format: u32, value: [u32; 4]) {
-        super::sync::before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
-        // SAFETY: value outlives the call.
-        unsafe {
-            (self.clear_tex_image)(
-                texture.0.get(),
-                0,
-                format,
-                glow::UNSIGNED_INT,
-                value.as_ptr() as *const c_void,
-            )
-        }
     }
 }
 

@@ -7,7 +7,6 @@
 //! to `glsl/common/intersect.glsl:3`. (A line map rather than `#line L FILE`: Mesa drops the
 //! file number in its semantic errors.)
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -15,6 +14,7 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use glow::HasContext;
 
 use super::context::Gl;
+pub use super::defines::Defines;
 use super::resources::Owned;
 
 /// The kernel files compiled into the binary, keyed by their path below `glsl/` (every file
@@ -155,20 +155,6 @@ fn normalize(path: &str) -> String {
         }
     }
     parts.join("/")
-}
-
-/// `#define NAME VALUE` lines injected after `#version`, in name order.
-#[derive(Debug, Clone, Default)]
-pub struct Defines(pub BTreeMap<String, String>);
-
-impl Defines {
-    pub fn new() -> Self {
-        Self::default()
-    }
-    pub fn set(mut self, name: &str, value: impl ToString) -> Self {
-        self.0.insert(name.to_string(), value.to_string());
-        self
-    }
 }
 
 /// For every line of an assembled source: the file and line it came from.

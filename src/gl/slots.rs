@@ -6,7 +6,7 @@
 //! Slots of different designs may share a number (a program binds one design's resources);
 //! the names say whose they are.
 
-use super::program::Defines;
+use super::defines::Defines;
 
 macro_rules! slot_table {
     ($(#[$doc:meta])* $module:ident, $prefix:literal { $($(#[$d:meta])* $name:ident = $value:expr,)* }) => {

@@ -30,36 +30,13 @@
 //! access after a pass instead, whatever its kind: a GPU run compares the two (`scripts/gpu-check.sh`), since no run on llvmpipe or
 //! lavapipe — whose barriers finish all work whatever the bits — can show a missing bit.
 
+use std::ffi::c_void;
+
 use glow::HasContext;
 
 use super::context::Gl;
 
-/// Every kind of later access this program makes to memory that shaders wrote:
-///
-/// | bit | the later access |
-/// |---|---|
-/// | `SHADER_STORAGE_BARRIER_BIT` | SSBO loads, stores and atomics of the next kernels |
-/// | `SHADER_IMAGE_ACCESS_BARRIER_BIT` | image loads and stores (the ray-state images, the BVH's image buffer) |
-/// | `TEXTURE_FETCH_BARRIER_BIT` | sampler and `texelFetch` reads, texture buffers included (the quads, Wagner's and the streaming tracer's textures) |
-/// | `BUFFER_UPDATE_BARRIER_BIT` | `glGetBufferSubData` (counters, grid totals), `glClearBufferData` |
-/// | `TEXTURE_UPDATE_BARRIER_BIT` | `glGetTexImage` (frames, AOVs), `glClearTexImage` (the ray-state images each frame, the shadow flags each pass), `glCopyImageSubData` (the AOV copies) |
-/// | `FRAMEBUFFER_BARRIER_BIT` | rendering or clearing into a texture a shader stored into (Klee 2016's G-buffer diffuse texture, which the shadow pass shades in place) |
-/// | `COMMAND_BARRIER_BIT` | indirect dispatch commands (the SAH BVH's fused pass over the block lists its entry pass counts) |
-///
-/// Not needed: no vertex or index data written by shaders, no atomic counter buffers, pixel
-/// buffers, uniform buffers or transform feedback.
-pub const ALL: u32 = glow::SHADER_STORAGE_BARRIER_BIT
-    | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
-    | glow::TEXTURE_FETCH_BARRIER_BIT
-    | glow::BUFFER_UPDATE_BARRIER_BIT
-    | glow::TEXTURE_UPDATE_BARRIER_BIT
-    | glow::FRAMEBUFFER_BARRIER_BIT
-    | glow::COMMAND_BARRIER_BIT;
-
-/// What a compute kernel may access: storage buffers, images, textures (and texture buffers).
-pub const SHADER: u32 = glow::SHADER_STORAGE_BARRIER_BIT
-    | glow::SHADER_IMAGE_ACCESS_BARRIER_BIT
-    | glow::TEXTURE_FETCH_BARRIER_BIT;
+pub use super::barrier_bits::{ALL, SHADER};
 
 /// The environment variable that makes every access issue every bit (`all`).
 pub const BARRIERS_ENV: &str = "GPGPU_RT_BARRIERS";
@@ -94,4 +71,53 @@ pub fn after_pass(gl: &Gl) {
 /// Before a pass whose shaders access every kind (the streaming tracer's fragment passes).
 pub fn barrier(gl: &Gl) {
     before(gl, ALL);
+}
+/// The clears of buffers and textures that shaders may have written: each issues its barrier
+/// first (its fields are the context's, the barrier this module's).
+impl Gl {
+    /// `glClearBufferData(target, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value)` on the
+    /// buffer bound to `target`: every 32-bit word of it becomes `value`.
+    pub fn clear_buffer_u32(&self, target: u32, value: u32) {
+        before(self, glow::BUFFER_UPDATE_BARRIER_BIT);
+        // SAFETY: value outlives the call; the format describes one u32.
+        unsafe {
+            (self.clear_buffer_data)(
+                target,
+                glow::R32UI,
+                glow::RED_INTEGER,
+                glow::UNSIGNED_INT,
+                &value as *const u32 as *const c_void,
+            )
+        }
+    }
+
+    /// `glClearTexImage` of level 0 with four floats (RGBA32F textures).
+    pub fn clear_tex_f32(&self, texture: glow::Texture, value: [f32; 4]) {
+        before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
+        // SAFETY: value outlives the call.
+        unsafe {
+            (self.clear_tex_image)(
+                texture.0.get(),
+                0,
+                glow::RGBA,
+                glow::FLOAT,
+                value.as_ptr() as *const c_void,
+            )
+        }
+    }
+
+    /// `glClearTexImage` of level 0 with four unsigned integers (RGBA32UI / R32UI textures).
+    pub fn clear_tex_u32(&self, texture: glow::Texture, format: u32, value: [u32; 4]) {
+        before(self, glow::TEXTURE_UPDATE_BARRIER_BIT);
+        // SAFETY: value outlives the call.
+        unsafe {
+            (self.clear_tex_image)(
+                texture.0.get(),
+                0,
+                format,
+                glow::UNSIGNED_INT,
+                value.as_ptr() as *const c_void,
+            )
+        }
+    }
 }

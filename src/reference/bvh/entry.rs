@@ -17,7 +17,7 @@
 
 use glam::Vec3;
 
-use super::{octant, safe_divisor};
+use super::ray::{octant, safe_divisor};
 use crate::accel::bvh::{octant_planes, BvhTree, BLOCK, END, GRID_STEPS, OCTANTS};
 
 /// The rays of a block (all of one octant), bounded per axis.

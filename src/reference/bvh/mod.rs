@@ -22,7 +22,9 @@ use crate::reference::search::{closest_among, CpuAccelerator, Feeler, Hit};
 use crate::scene::Scene;
 
 mod entry;
+mod ray;
 pub use entry::{BlockEntry, RayBounds};
+use ray::{octant, safe_inverse};
 
 impl BvhTree {
     /// The shadow feeler's walk, as intersect2's: whether it is blocked, its triangle tests and
@@ -112,23 +114,6 @@ impl BvhTree {
         let t_far = far.iter().fold(limit.to_bits() as i32, |m, &t| m.min(t));
         t_near <= t_far
     }
-}
-
-/// The ray's octant: bit a set when it points down axis a (by the sign of 1/rd, as the kernels).
-fn octant(inv: Vec3) -> usize {
-    (0..3).map(|a| ((inv[a] < 0.0) as usize) << a).sum()
-}
-
-/// 1/rd with zero (and tiny) components replaced by 1e-20, so the slab test never computes
-/// 0·∞ (the kernels do the same).
-fn safe_inverse(rd: Vec3) -> Vec3 {
-    safe_divisor(rd).recip()
-}
-
-/// The divisors of [`safe_inverse`]: rd with zero (and tiny) components replaced by 1e-20.
-fn safe_divisor(rd: Vec3) -> Vec3 {
-    let s = |d: f32| if d.abs() < 1e-20 { 1e-20 } else { d };
-    Vec3::new(s(rd.x), s(rd.y), s(rd.z))
 }
 
 impl CpuAccelerator for BvhTree {
