@@ -531,14 +531,6 @@ const KNOWN_CIRCLES: &[(&[&str], &str)] = &[
     ),
     (
         &[
-            "src/pipeline/mueller2015/images.rs",
-            "src/pipeline/mueller2015/mod.rs",
-            "src/pipeline/mueller2015/records.rs",
-        ],
-        "the pipeline's images and records read the renderer's types in mod.rs",
-    ),
-    (
-        &[
             "src/scene/bpt.rs",
             "src/scene/gltf.rs",
             "src/scene/magnitudes.rs",
@@ -556,11 +548,7 @@ const KNOWN_CIRCLES: &[(&[&str], &str)] = &[
 const KNOWN_UP: &[&str] = &[
     "src/app/view/mod.rs",
     "src/lib.rs",
-    "src/pipeline/klee2016/mod.rs",
     "src/pipeline/mod.rs",
-    "src/pipeline/mueller2015/mod.rs",
-    "src/reference/bvh/mod.rs",
-    "src/reference/mod.rs",
     "src/scene/mod.rs",
 ];
 

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use super::ShadowFlags;
+use super::options::ShadowFlags;
 use crate::frame::{flip_rows, flip_xyz, Aovs};
 use crate::gl::resources::Image2d;
 use crate::gl::slots::image;

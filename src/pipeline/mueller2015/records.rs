@@ -11,7 +11,7 @@
 use anyhow::Result;
 use bytemuck::{Pod, Zeroable};
 
-use super::COUNTERS;
+use super::options::COUNTERS;
 use crate::accel::PIXELS_PER_INVOCATION;
 use crate::gl::resources::{bind_image_unit, GpuTimers, Owned, Ssbo};
 use crate::gl::slots::{image, ssbo};
