@@ -10,7 +10,7 @@ kernels over one tree.
 Each render draws FRAMES frames and reports its last (`--stats`: `wall_ms`, the frame from the start of
 its draw to `glFinish`, the scene's transform and the accelerator's update included, and
 `gpu_ms_total`); the configurations alternate within a
-round, ROUNDS rounds, and the report gives the median and range of each, and each one's ratio to
+round, every other round in reverse order, ROUNDS rounds, and the report gives the median and range of each, and each one's ratio to
 the default in the same round.
 
     python3 tools/default_config.py [--rounds N] [--drivers llvmpipe,zink]
@@ -71,7 +71,8 @@ def main():
         f"`python3 tools/default_config.py --rounds {a.rounds} --drivers {a.drivers}`, "
         f"{datetime.date.today()}, on this machine's CPU (Mesa's software drivers share it: "
         "ratios, not absolute times, carry over). 512², each scene's reflection depth, "
-        f"the last of {FRAMES} frames of each render; wall: the frame from the start of its draw "
+        f"the last of {FRAMES} frames of each render, the configurations in turn (every other round "
+        "in reverse); wall: the frame from the start of its draw "
         "to `glFinish` (the transform and the BVH's update included). Ratio: to the default "
         "in the same round.",
     ]
@@ -79,8 +80,9 @@ def main():
         for scene, configs in CASES:
             rows = {name: [] for name, _ in configs}
             renderer, ran = "", {}
-            for _ in range(a.rounds):
-                for name, options in configs:
+            for r in range(a.rounds):
+                # every other round in reverse, so that no configuration always runs first
+                for name, options in (configs if r % 2 == 0 else configs[::-1]):
                     wall, gpu, config, renderer = frame(driver, scene, options)
                     rows[name].append((wall, gpu))
                     ran[name] = config

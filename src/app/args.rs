@@ -230,8 +230,7 @@ impl BvhArgs {
 
     /// These options where the objects move from frame to frame: `--bvh-levels auto` takes
     /// the two levels, which update a moving object's instance where one tree is refitted
-    /// every frame (a turning dragon's frame 0.77× the refitted tree's on llvmpipe, 0.75× on
-    /// zink: docs/design/bvh.md, "The default").
+    /// every frame — the faster frame on both drivers (docs/design/bvh.md, "The default").
     pub fn objects_move(self) -> BvhArgs {
         let levels = match self.bvh_levels {
             BvhLevelsArg::Auto => BvhLevelsArg::Two,
