@@ -277,7 +277,12 @@ fn no_accelerator_switch_in_common_glsl() {
         "glsl/common/ has {} files",
         common.len()
     );
-    let pipeline = pipeline_defines(&read("src/pipeline/mueller2015/mod.rs"));
+    // kernel_defines in the pipeline's module, its counters in options.rs
+    let pipeline = [
+        "src/pipeline/mueller2015/mod.rs",
+        "src/pipeline/mueller2015/options.rs",
+    ];
+    let pipeline = pipeline_defines(&pipeline.map(read).concat());
     assert!(pipeline.contains("SHADOW_BITS") && pipeline.contains("COUNTER_RAYS"));
     let mut sources = Vec::new();
     rust_files(&root().join("src/accel"), &mut sources);

@@ -9,7 +9,9 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::{budget, Mesh, SceneError, MAX_PROCEDURAL_TRIANGLES};
+use super::budget;
+use super::mesh::Mesh;
+use super::model::{SceneError, MAX_PROCEDURAL_TRIANGLES};
 
 /// Non-empty lines of one patch: `3 3` and 16 control points.
 const LINES_PER_PATCH: usize = 17;

@@ -22,8 +22,10 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
+use super::camera::Camera;
 use super::mesh::Mesh;
-use super::{budget, file, Camera, Light, SceneError};
+use super::model::{Light, SceneError};
+use super::{budget, file};
 
 /// A glTF file's default scene, flattened.
 pub struct LoadedGltf {
@@ -322,15 +324,15 @@ fn check_accessor(path: &Path, a: &gltf::Accessor, buffers: &[Vec<u8>]) -> Resul
 }
 
 /// Load the glTF file's scene: its triangles are counted from the JSON and checked against
-/// [`super::MAX_SCENE_TRIANGLES`] and the host's memory before any buffer is read.
+/// [`super::model::MAX_SCENE_TRIANGLES`] and the host's memory before any buffer is read.
 pub fn load(path: &Path) -> Result<LoadedGltf, SceneError> {
     let g = parse(path)?;
     let doc = &g.document;
     let scene = main_scene(path, doc)?;
     let nodes = world_nodes(&scene);
     let triangles = nodes_triangles(path, &nodes)?;
-    if triangles > super::MAX_SCENE_TRIANGLES {
-        let most = super::MAX_SCENE_TRIANGLES;
+    if triangles > super::model::MAX_SCENE_TRIANGLES {
+        let most = super::model::MAX_SCENE_TRIANGLES;
         let m = format!("{triangles} triangles, more than the {most} a scene may have");
         return Err(err(path, m));
     }

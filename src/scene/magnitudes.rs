@@ -24,7 +24,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::{Scene, SceneError};
+use super::model::{Scene, SceneError};
 
 /// Largest ratio of a coordinate (vertex or camera) to the viewing distance.
 pub const MAX_RANGE: f32 = 1048576.0; // 2^20

@@ -11,8 +11,10 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 use super::bpt::read_model_text;
+use super::budget;
+use super::mesh::Mesh;
 use super::mesh::{corner_normals, smooth_normals};
-use super::{budget, Mesh, SceneError};
+use super::model::SceneError;
 
 /// A material found in an MTL file.
 #[derive(Debug, Clone)]

@@ -10,8 +10,10 @@ use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Ply, Property};
 
+use super::budget;
+use super::mesh::Mesh;
 use super::mesh::{corner_normals, smooth_normals};
-use super::{budget, Mesh, SceneError};
+use super::model::SceneError;
 
 /// Host bytes of one parsed element (ply-rs keeps a map of named properties per element):
 /// this much per element plus [`ELEMENT_PROPERTY_BYTES`] per property.

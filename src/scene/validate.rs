@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Object, Scene};
+use super::model::{Object, Scene};
 
 /// The first index of a non-finite vector, if any.
 fn first_bad3(v: impl IntoIterator<Item = Vec3>) -> Option<usize> {
