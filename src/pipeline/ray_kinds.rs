@@ -116,7 +116,7 @@ impl CounterBanks {
             .map(|b| {
                 let bank = &raw[b * words..];
                 (0..self.slots)
-                    .map(|i| super::counter_value(bank, i))
+                    .map(|i| super::renderer::counter_value(bank, i))
                     .collect()
             })
             .collect()

@@ -7,10 +7,11 @@ use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::Key::{self, Character as Ch, Named};
 use winit::keyboard::NamedKey;
 
+use super::app::App;
 use super::design::value_name;
+use super::orbit;
 use super::renderer::{BvhVariant, GridResolution, GridVariant, ShadowMode, TracerArg};
 use super::window::Viewport;
-use super::{orbit, App};
 
 /// Largest reflection depth the keys go to.
 const MAX_REFL_DEPTH: u32 = 16;

@@ -20,6 +20,7 @@
 //! (the GL window and the screen-filling quad), `orbit` (camera moves), `watch` (the
 //! `--glsl-dir` watcher).
 
+mod app;
 mod design;
 mod frames;
 mod keys;
@@ -32,73 +33,30 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
-use glow::HasContext;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::ModifiersState;
 use winit::window::WindowId;
 
-use crate::args::DesignArgs;
 use gpgpu_rt::gl::ShaderSource;
-use gpgpu_rt::limits;
 use gpgpu_rt::output::console::ConsoleError;
 use gpgpu_rt::output::{self, Format, Target};
 use gpgpu_rt::scene::{Camera, Scene};
 use gpgpu_rt::{errln, outln};
 
+pub use app::ViewArgs;
+use app::{App, Input, Running};
 use design::Design;
 use frames::{Clock, FrameCount, Picture};
 use renderer::{soft_shadow_support, Renderers, ShadowMode, Show, Stats, TracerArg, TracerOptions};
 use watch::GlslWatcher;
 use window::{
-    compile_quad_program, fit_viewport, read_back_buffer, save_image, GlWindow, ScreenQuad,
+    compile_quad_program, fit_viewport, plain, read_back_buffer, save_image, GlWindow, ScreenQuad,
     Viewport,
 };
 
 /// How often `--glsl-dir` is polled for changes.
 const WATCH_INTERVAL: Duration = Duration::from_millis(200);
-
-/// Options of `gpgpu-rt view`.
-#[derive(clap::Args, Debug, Clone)]
-pub struct ViewArgs {
-    /// Scene file: TOML (e.g. scenes/teapot1.toml) or glTF 2.0 (.gltf, .glb).
-    pub scene: PathBuf,
-    /// No progress line while the scene loads and the first tracer is built (one appears on a
-    /// terminal when that takes more than 2 s).
-    #[arg(long)]
-    pub quiet: bool,
-    /// Render width in pixels, 1 to 16384 (default: the scene's render.width); the window
-    /// opens at this size.
-    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
-    pub width: Option<u32>,
-    /// Render height in pixels, 1 to 16384 (default: the scene's render.height).
-    #[arg(long, value_parser = limits::parser(limits::IMAGE_SIDE))]
-    pub height: Option<u32>,
-    /// The design to start with and the options of every design, as for `render` (T switches
-    /// the tracer, B the BVH variant; G / shift+G / A change the grid's resolution, V its
-    /// variant; S cycles the soft shadows' mode, L / shift+L their samples).
-    #[command(flatten)]
-    pub design: DesignArgs,
-    /// Load the kernels from this directory and reload them whenever a file in it changes.
-    #[arg(long, value_name = "DIR")]
-    pub glsl_dir: Option<PathBuf>,
-    /// Save the window's last frame (see --frames) to this image and exit: PNG, or JPEG for a
-    /// name ending in .jpg or .jpeg (as `render -o`).
-    #[arg(long, value_name = "FILE.png")]
-    pub screenshot: Option<PathBuf>,
-    /// Render N frames (1 to 100000), then exit (after saving --screenshot); default with
-    /// --screenshot: 1.
-    #[arg(long, value_name = "N", value_parser = limits::parser(limits::FRAMES))]
-    pub frames: Option<u32>,
-    /// With --glsl-dir: count --frames only from the first successful reload of an edited
-    /// kernel (capture the effect of an edit from a script).
-    #[arg(long)]
-    pub wait_reload: bool,
-    /// Print one line per frame (GPU ms per kernel, triangle tests) to stdout.
-    #[arg(long)]
-    pub log_frames: bool,
-}
 
 /// Open the viewer and run it until the window closes (or --frames are done).
 pub fn run(mut args: ViewArgs) -> Result<()> {
@@ -153,56 +111,6 @@ pub fn run(mut args: ViewArgs) -> Result<()> {
     app.result
 }
 
-/// What runs while the window is open. Field order is drop order: GL objects before the window.
-struct Running {
-    renderers: Renderers,
-    quad: ScreenQuad,
-    watcher: Option<GlslWatcher>,
-    window: GlWindow,
-}
-
-impl Running {
-    /// Show `texture` (the last frame, if any) in the window, letterboxed to the `image` size:
-    /// the viewport it fills.
-    fn present(&self, texture: Option<glow::Texture>, image: (u32, u32)) -> Viewport {
-        let size = self.window.size();
-        let viewport = fit_viewport(size, image);
-        if let Some(texture) = texture {
-            // SAFETY: drawing to the window's default framebuffer.
-            unsafe { self.window.gl.bind_framebuffer(glow::FRAMEBUFFER, None) };
-            self.quad.draw(texture, size, viewport);
-        }
-        viewport
-    }
-}
-
-#[derive(Default)]
-struct Input {
-    modifiers: ModifiersState,
-    cursor: Option<(f64, f64)>,
-    orbiting: bool,
-    panning: bool,
-}
-
-struct App {
-    args: ViewArgs,
-    scene: Scene,
-    shaders: ShaderSource,
-    /// The design shown and its options.
-    design: Design,
-    camera: Camera,
-    running: Option<Running>,
-    result: Result<()>,
-    input: Input,
-    picture: Picture,
-    frames: FrameCount,
-    clock: Clock,
-    /// An error or notice shown in the title until the next success.
-    notice: Option<String>,
-    /// Screenshots saved with P.
-    screenshots: u32,
-}
-
 /// The first line of an error that names a file and line (the compile log's first error), else
 /// its first line: what fits into a title bar.
 fn headline(error: &str) -> String {
@@ -217,19 +125,6 @@ fn headline(error: &str) -> String {
         .or(lines.first())
         .map(|l| l.to_string())
         .unwrap_or_default()
-}
-
-/// 1234567 -> "1 234 567".
-fn group_digits(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push('\u{202f}');
-        }
-        out.push(c);
-    }
-    out
 }
 
 impl App {
@@ -750,35 +645,6 @@ mod tests {
             "cannot read GLSL file x"
         );
     }
-
-    #[test]
-    fn digits_are_grouped() {
-        assert_eq!(group_digits(0), "0");
-        assert_eq!(group_digits(1234567), "1\u{202f}234\u{202f}567");
-    }
-}
-
-/// A window-system library's error without the source location it may carry (winit's
-/// `OsError` prints `os error at /…/winit-0.30.13/src/platform_impl/linux/mod.rs:765: …`): a
-/// user's message names what failed, not a dependency's source file.
-pub fn plain(e: &dyn std::fmt::Display) -> String {
-    let msg = e.to_string();
-    let mut out = String::new();
-    let mut rest = msg.as_str();
-    while let Some(i) = rest.find(".rs:") {
-        let digits = rest[i + 4..].bytes().take_while(u8::is_ascii_digit).count();
-        if digits == 0 {
-            out.push_str(&rest[..i + 4]);
-            rest = &rest[i + 4..];
-            continue;
-        }
-        let start = rest[..i].rfind(char::is_whitespace).map_or(0, |k| k + 1);
-        let before = rest[..start].trim_end();
-        out.push_str(before.strip_suffix(" at").unwrap_or(before));
-        rest = &rest[i + 4 + digits..];
-    }
-    out.push_str(rest);
-    out
 }
 
 #[cfg(test)]

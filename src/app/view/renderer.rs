@@ -9,7 +9,6 @@ use std::sync::Arc;
 
 use anyhow::{bail, Result};
 
-use super::group_digits;
 use crate::args::SoftShadowArgs;
 use gpgpu_rt::frame::FrameStats;
 use gpgpu_rt::gl::{Gl, GlInfo, ShaderSource};
@@ -302,5 +301,29 @@ impl Stats {
     pub fn grid_resolution(&self) -> Option<u32> {
         let r = self.0.facts.get("grid_resolution")?.as_u64()?;
         Some(r as u32)
+    }
+}
+
+/// 1234567 -> "1 234 567".
+pub(super) fn group_digits(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push('\u{202f}');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::group_digits;
+
+    #[test]
+    fn digits_are_grouped() {
+        assert_eq!(group_digits(0), "0");
+        assert_eq!(group_digits(1234567), "1\u{202f}234\u{202f}567");
     }
 }

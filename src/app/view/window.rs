@@ -75,12 +75,7 @@ fn open_window(
                 .min_by_key(config_rank)
                 .expect("glutin offers at least one config")
         })
-        .map_err(|e| {
-            anyhow!(
-                "cannot open a window with an OpenGL config: {}",
-                super::plain(&e)
-            )
-        })?;
+        .map_err(|e| anyhow!("cannot open a window with an OpenGL config: {}", plain(&e)))?;
     let window = window.ok_or_else(|| anyhow!("the window system gave no window"))?;
     Ok((window, config))
 }
@@ -109,12 +104,7 @@ fn window_surface(
             .display()
             .create_window_surface(config, &surface_attributes)
     }
-    .map_err(|e| {
-        anyhow!(
-            "cannot create a GL surface for the window: {}",
-            super::plain(&e)
-        )
-    })
+    .map_err(|e| anyhow!("cannot create a GL surface for the window: {}", plain(&e)))
 }
 
 impl GlWindow {
@@ -128,7 +118,7 @@ impl GlWindow {
         let (window, config) = open_window(event_loop, title, width, height)?;
         let handle = window
             .window_handle()
-            .map_err(|e| anyhow!("no native window handle: {}", super::plain(&e)))?
+            .map_err(|e| anyhow!("no native window handle: {}", plain(&e)))?
             .as_raw();
         let display = config.display();
         let attributes = ContextAttributesBuilder::new()
@@ -140,19 +130,16 @@ impl GlWindow {
         let context = unsafe { display.create_context(&config, &attributes) }.map_err(|e| {
             anyhow!(
                 "cannot create an OpenGL 4.5 core context for the window: {}",
-                super::plain(&e)
+                plain(&e)
             )
         })?;
         let surface = window_surface(&window, handle, &config, (width, height))?;
-        let context = context.make_current(&surface).map_err(|e| {
-            anyhow!(
-                "cannot make the window's GL context current: {}",
-                super::plain(&e)
-            )
-        })?;
+        let context = context
+            .make_current(&surface)
+            .map_err(|e| anyhow!("cannot make the window's GL context current: {}", plain(&e)))?;
         // No vsync: the viewer measures frames per second of the tracer, not of the display.
         if let Err(e) = surface.set_swap_interval(&context, SwapInterval::DontWait) {
-            log::info!("cannot turn vsync off: {}", super::plain(&e));
+            log::info!("cannot turn vsync off: {}", plain(&e));
         }
         // SAFETY: the context is current; symbols come from its display.
         let gl = unsafe {
@@ -205,7 +192,7 @@ impl GlWindow {
             if let Err(e) = c.make_current_surfaceless() {
                 log::info!(
                     "cannot make the context current without a surface: {}",
-                    super::plain(&e)
+                    plain(&e)
                 );
             }
         }
@@ -213,18 +200,15 @@ impl GlWindow {
 
     /// Before drawing to the window: its surface current again.
     pub fn begin_present(&self) -> Result<()> {
-        self.context.make_current(&self.surface).map_err(|e| {
-            anyhow!(
-                "cannot make the window's GL context current: {}",
-                super::plain(&e)
-            )
-        })
+        self.context
+            .make_current(&self.surface)
+            .map_err(|e| anyhow!("cannot make the window's GL context current: {}", plain(&e)))
     }
 
     pub fn swap(&self) -> Result<()> {
         self.surface
             .swap_buffers(&self.context)
-            .map_err(|e| anyhow!("swapping the window's buffers failed: {}", super::plain(&e)))
+            .map_err(|e| anyhow!("swapping the window's buffers failed: {}", plain(&e)))
     }
 }
 
@@ -431,6 +415,29 @@ pub fn save_image(path: &std::path::Path, width: u32, height: u32, pixels: &[u8]
         image::Rgb([pixels[i], pixels[i + 1], pixels[i + 2]])
     });
     output::write_file(path, |w| output::encode_image(&img, path, w))
+}
+
+/// A window-system library's error without the source location it may carry (winit's
+/// `OsError` prints `os error at /…/winit-0.30.13/src/platform_impl/linux/mod.rs:765: …`): a
+/// user's message names what failed, not a dependency's source file.
+pub fn plain(e: &dyn std::fmt::Display) -> String {
+    let msg = e.to_string();
+    let mut out = String::new();
+    let mut rest = msg.as_str();
+    while let Some(i) = rest.find(".rs:") {
+        let digits = rest[i + 4..].bytes().take_while(u8::is_ascii_digit).count();
+        if digits == 0 {
+            out.push_str(&rest[..i + 4]);
+            rest = &rest[i + 4..];
+            continue;
+        }
+        let start = rest[..i].rfind(char::is_whitespace).map_or(0, |k| k + 1);
+        let before = rest[..start].trim_end();
+        out.push_str(before.strip_suffix(" at").unwrap_or(before));
+        rest = &rest[i + 4 + digits..];
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]

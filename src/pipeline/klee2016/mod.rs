@@ -35,7 +35,7 @@ use self::gbuffer::GBuffer;
 use self::ntree::{NTree, PackedLinespaces};
 use self::present::Present;
 use self::shadow_pass::{shadow_kernel, ShadowPass, ShadowUniforms};
-use super::Renderer;
+use super::renderer::Renderer;
 use crate::frame::{flip_rows, Aovs, Frame, FrameStats};
 use crate::gl::context::LoopLimit;
 use crate::gl::resources::{GpuTimers, Owned};
@@ -518,7 +518,7 @@ impl Renderer for SoftShadowRenderer {
     fn draw(&mut self, camera: &Camera) -> Result<FrameStats> {
         let t0 = Instant::now();
         let mut stats = self.draw_passes(camera)?;
-        super::finish(&self.gl);
+        super::renderer::finish(&self.gl);
         stats.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)
@@ -526,7 +526,7 @@ impl Renderer for SoftShadowRenderer {
 
     fn read_back(&mut self) -> Result<Frame> {
         let t0 = Instant::now();
-        let (camera, mut stats) = super::last_drawn(&self.last)?;
+        let (camera, mut stats) = super::renderer::last_drawn(&self.last)?;
         let (w, h) = self.size();
         let color =
             crate::gl::resources::read_texture_rgba32f(&self.gl, self.present.output(), w, h);

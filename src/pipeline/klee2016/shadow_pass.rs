@@ -337,7 +337,7 @@ impl ShadowPass {
     fn counts(&self) -> ShadowCounts {
         let raw = self.buffers[2].read_u32(&self.gl);
         ShadowCounts(std::array::from_fn(|i| {
-            crate::pipeline::counter_value(&raw, i)
+            crate::pipeline::renderer::counter_value(&raw, i)
         }))
     }
 

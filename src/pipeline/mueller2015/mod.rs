@@ -22,7 +22,7 @@ use self::gpu_scene::GpuScene;
 use self::images::{AovImages, RayImages};
 use self::records::{Record, Records, FUSED_RECORDS};
 use super::ray_kinds::{self, Bank, CounterBanks};
-use super::Renderer;
+use super::renderer::Renderer;
 use crate::accel::{
     Accel, Accelerator, BuildContext, Entry, FrameContext, FusedPasses, LightTarget, PassHost,
     PassRays,
@@ -644,13 +644,13 @@ impl Renderer for RayTracer {
                 loop_limit_advice(&self.options)
             );
         }
-        super::end_of_frame(&gl, &mut stats, start)?;
+        super::renderer::end_of_frame(&gl, &mut stats, start)?;
         self.last = Some(stats.clone());
         Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {
-        let stats = super::last_drawn(&self.last)?;
+        let stats = super::renderer::last_drawn(&self.last)?;
         let (w, h) = self.size();
         Ok(Frame {
             width: w,

@@ -35,7 +35,7 @@ use self::grid::{auto_dims, StreamGrid};
 use self::grid_textures::GridTextures;
 use self::targets::{AovTargets, Targets};
 use super::ray_kinds::{self, Bank, CounterBanks};
-use super::Renderer;
+use super::renderer::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Owned};
 use crate::gl::{check_error, Defines, Gl, GlInfo, Kernel, ShaderSource};
@@ -625,13 +625,13 @@ impl Renderer for StreamRenderer {
                 self.options.max_calls
             );
         }
-        super::end_of_frame(&self.gl, &mut stats, start)?;
+        super::renderer::end_of_frame(&self.gl, &mut stats, start)?;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {
-        let (_, stats) = super::last_drawn(&self.last)?;
+        let (_, stats) = super::renderer::last_drawn(&self.last)?;
         let (w, h) = self.size();
         Ok(Frame {
             width: w,

@@ -28,7 +28,7 @@ use serde_json::json;
 
 use self::gpu::{Images, SceneTextures};
 use self::uniforms::{Lighting, Surface, WagnerCamera, EPSILON, LOOP_BUDGET, STACK};
-use super::Renderer;
+use super::renderer::Renderer;
 use crate::frame::{flip_rows, flip_xyz, Aovs, Frame, FrameStats};
 use crate::gl::resources::{GpuTimers, Ssbo};
 use crate::gl::slots::ssbo;
@@ -290,7 +290,7 @@ impl WagnerRenderer {
     /// The counters, timers and facts of the frame.
     fn frame_stats(&mut self) -> FrameStats {
         let raw = self.counters.read_u32(&self.gl);
-        let count = |i: usize| super::counter_value(&raw, i);
+        let count = |i: usize| super::renderer::counter_value(&raw, i);
         let mut stats = FrameStats {
             gpu_ms: self.timers.resolve(&self.gl),
             truncated_rays: count(3),
@@ -361,13 +361,13 @@ impl Renderer for WagnerRenderer {
                 stats.truncated_rays
             );
         }
-        super::end_of_frame(&self.gl, &mut stats, start)?;
+        super::renderer::end_of_frame(&self.gl, &mut stats, start)?;
         self.last = Some((*camera, stats.clone()));
         Ok(stats)
     }
 
     fn read_back(&mut self) -> Result<Frame> {
-        let (camera, stats) = super::last_drawn(&self.last)?;
+        let (camera, stats) = super::renderer::last_drawn(&self.last)?;
         let (w, h) = self.size();
         Ok(Frame {
             width: w,
