@@ -645,14 +645,11 @@ mod tests {
             "cannot read GLSL file x"
         );
     }
-}
 
-#[cfg(test)]
-mod plain_tests {
     #[test]
-    fn source_locations_are_dropped() {
-        let m = "os error at /root/.cargo/registry/src/x/winit-0.30.13/src/platform_impl/linux/mod.rs:765: no DISPLAY";
-        assert_eq!(super::plain(&m), "os error: no DISPLAY");
-        assert_eq!(super::plain(&"a file.rs: fine"), "a file.rs: fine");
+    fn digits_are_grouped() {
+        use super::renderer::group_digits;
+        assert_eq!(group_digits(0), "0");
+        assert_eq!(group_digits(1234567), "1\u{202f}234\u{202f}567");
     }
 }

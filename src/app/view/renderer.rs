@@ -316,14 +316,3 @@ pub(super) fn group_digits(n: u64) -> String {
     }
     out
 }
-
-#[cfg(test)]
-mod tests {
-    use super::group_digits;
-
-    #[test]
-    fn digits_are_grouped() {
-        assert_eq!(group_digits(0), "0");
-        assert_eq!(group_digits(1234567), "1\u{202f}234\u{202f}567");
-    }
-}

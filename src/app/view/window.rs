@@ -445,6 +445,13 @@ mod tests {
     use super::*;
 
     #[test]
+    fn source_locations_are_dropped() {
+        let m = "os error at /root/.cargo/registry/src/x/winit-0.30.13/src/platform_impl/linux/mod.rs:765: no DISPLAY";
+        assert_eq!(plain(&m), "os error: no DISPLAY");
+        assert_eq!(plain(&"a file.rs: fine"), "a file.rs: fine");
+    }
+
+    #[test]
     fn viewport_fills_a_window_of_the_image_size_and_letterboxes_otherwise() {
         let full = fit_viewport((96, 96), (96, 96));
         assert_eq!(
