@@ -23,7 +23,7 @@ pub(super) const ENTRY_GROUP: u32 = 64;
 /// (`pipeline::mueller2015::records`). With block lists (`lists`: one tree) two kernels, a
 /// work group per block: the blocks whose rays may hit (`glsl/bvh/fused_pass.comp`) and those
 /// whose rays all miss (`glsl/bvh/fused_miss.comp`, timed as `fused_miss`;
-/// `glsl/bvh/block_lists.glsl`); without (two levels, [`Bvh::create`]) one, a pixel an
+/// `glsl/bvh/block_lists.glsl`); without (two levels, `Bvh::create`) one, a pixel an
 /// invocation (`glsl/bvh/fused_instances.comp`). `eye`: the variant that computes the eye rays
 /// in place (`PASS_EYE_RAYS`).
 pub(super) fn fused_kernels(
