@@ -132,8 +132,8 @@ uvec4 feelers(ivec2 storePos, vec3 p, vec3 n, int id, inout uvec4 first, inout u
         if (l == 0) first += takeCounts(); else others += takeCounts();
     }
     // (no loop of no pass: Mesa 22.3 kept a loop over AREA_LIGHTS = 0 with its walk, and
-    // llvmpipe ran its first pass under an empty lane mask — with shade.glsl's such loop
-    // 1.11–1.16× the JIT instructions of a bunny frame, docs/design/frame.md)
+    // llvmpipe ran its first pass under an empty lane mask — measured in
+    // docs/design/frame.md, the fused pass' table)
 #if AREA_LIGHTS > 0
     for (int a = 0; a < AREA_LIGHTS; a++) {
         for (int r = 0; r < areaSamples; r++) {

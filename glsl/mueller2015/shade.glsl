@@ -8,8 +8,8 @@ uniform vec4 camPosition;
 uniform vec4 ambientColor;
 // the point lights (POINT_LIGHTS: a #define of the pipeline; ours: Listing 16 loops over a
 // uniform count, which llvmpipe kept as a loop with its lane masks — as a constant it unrolls,
-// also the fused pass' loop of feelers around its walk: 0.93–0.94 of the JIT instructions of a
-// frame with one light, docs/design/frame.md)
+// also the fused pass' loop of feelers around its walk: docs/design/frame.md, the fused pass'
+// table)
 const int lightCount = POINT_LIGHTS;
 #if AREA_LIGHTS > 0 && !SHADOW_BITS
 #error "area lights need the bitwise shadow flags (a bit per light sample)"

@@ -148,17 +148,23 @@ pub(super) struct EntryPass<'a> {
 }
 
 impl EntryPass<'_> {
+    /// The word buffer's images bound with `access` (nothing before the first build).
+    pub(super) fn bind(&self, gl: &Gl, access: u32) {
+        if let Some(b) = self.buffers {
+            b.bind_images(gl, access);
+        }
+    }
+
     /// Dispatch `kernel`, the entry pass of the loaded rays or of eye rays computed in place
     /// (`eye`), over every block: it writes the blocks' entries into the word buffer.
     pub(super) fn dispatch(&self, f: &mut FrameContext, kernel: &Kernel, eye: Option<&CameraRays>) {
-        let bind = |access| self.buffers.inspect(|b| b.bind_images(f.gl, access));
-        bind(glow::READ_WRITE);
+        self.bind(f.gl, glow::READ_WRITE);
         kernel.use_program();
         if let Some(cam) = eye {
             set_camera(kernel, cam);
         }
         kernel.dispatch_1d(f.timers, self.blocks.div_ceil(ENTRY_GROUP));
-        bind(glow::READ_ONLY);
+        self.bind(f.gl, glow::READ_ONLY);
     }
 }
 

@@ -440,9 +440,7 @@ impl Bvh {
     }
 
     fn bind(&self, gl: &Gl, access: u32) {
-        if let Some(b) = &self.buffers {
-            b.bind_images(gl, access);
-        }
+        self.entry_pass().bind(gl, access);
     }
 }
 
@@ -509,6 +507,7 @@ impl Accelerator for Bvh {
         eye: Option<&CameraRays>,
         host: &dyn PassHost,
     ) -> Option<FusedRun> {
+        // the fields, not entry_pass(): the pass borrows self.fused mutably beside them
         let entry = EntryPass {
             buffers: self.buffers.as_ref(),
             blocks: self.blocks,
